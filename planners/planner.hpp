@@ -1,0 +1,63 @@
+// The common planner interface and the registry that maps scenario names to planners.
+// A planner turns a Toolpath into a timed Trajectory within the Cartesian limits; it
+// knows nothing of MuJoCo or of the machine's geometry (kinematics hands it limits).
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/limits.hpp"
+#include "core/toolpath.hpp"
+#include "core/trajectory.hpp"
+
+namespace depotwin {
+
+// A planner named in a scenario with its parameters (each a number or a list of numbers).
+struct PlannerSpec {
+  std::string name;
+  std::map<std::string, std::vector<double>> params;
+  int line = 0;  // where it was declared, for messages
+
+  // the parameter's first value, or `fallback` when absent
+  double get(const std::string& key, double fallback) const;
+};
+
+// A parameter a planner declares by name with its range (OMPL's declareParam), so a
+// scenario can set any planner's settings generically and get range errors for free.
+struct PlannerParameter {
+  std::string name;
+  double default_value = 0.0;
+  double min_value = 0.0;
+  double max_value = 0.0;
+  std::string description;
+  bool list_allowed = false;  // may be given as a list (e.g. one weight per corner)
+};
+
+class Planner {
+ public:
+  virtual ~Planner() = default;
+  // Plan the whole job: from the toolpath's start at rest, through every print path in
+  // order, to its end at rest. Throws InputError when the toolpath cannot be planned
+  // within the limits.
+  virtual Trajectory plan(const Toolpath& toolpath, const MachineLimits& limits) const = 0;
+};
+
+struct PlannerInfo {
+  std::string name;
+  std::string description;
+  std::vector<PlannerParameter> parameters;
+  std::function<std::unique_ptr<Planner>(const PlannerSpec&)> make;
+};
+
+// every registered planner, in a stable order
+const std::vector<PlannerInfo>& planner_registry();
+const PlannerInfo* find_planner(const std::string& name);
+// "" when the spec names a registered planner with known, in-range parameters; else the problem
+std::string check_planner_spec(const PlannerSpec& spec);
+// throws InputError when check_planner_spec fails
+std::unique_ptr<Planner> make_planner(const PlannerSpec& spec);
+
+}  // namespace depotwin

@@ -1,0 +1,77 @@
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "planners/bezier.hpp"
+#include "planners/lspb_mtt.hpp"
+#include "planners/planner.hpp"
+#include "planners/stop_and_go.hpp"
+
+namespace depotwin {
+
+double PlannerSpec::get(const std::string& key, double fallback) const {
+  auto it = params.find(key);
+  return it == params.end() || it->second.empty() ? fallback : it->second.front();
+}
+
+const std::vector<PlannerInfo>& planner_registry() {
+  static const std::vector<PlannerInfo> registry = {
+      {"lspb_mtt",
+       "Thompson & Yoon 2014: LSPB on print segments, minimum-time transitions",
+       {},
+       [](const PlannerSpec&) { return std::make_unique<LspbMttPlanner>(); }},
+      {"stop_and_go",
+       "naive baseline: rest-to-rest trapezoid per print segment, material on throughout",
+       {},
+       [](const PlannerSpec&) { return std::make_unique<StopAndGoPlanner>(); }},
+      {"bezier", "Giberti et al. 2017: lines with Bezier corner blends at constant speed",
+       bezier_parameters(), [](const PlannerSpec& spec) { return make_bezier_planner(spec); }},
+  };
+  return registry;
+}
+
+const PlannerInfo* find_planner(const std::string& name) {
+  for (const PlannerInfo& info : planner_registry())
+    if (info.name == name) return &info;
+  return nullptr;
+}
+
+std::string check_planner_spec(const PlannerSpec& spec) {
+  const PlannerInfo* info = find_planner(spec.name);
+  if (!info) {
+    std::string known;
+    for (const PlannerInfo& p : planner_registry()) known += (known.empty() ? "" : ", ") + p.name;
+    return "unknown planner '" + spec.name + "' (known: " + known + ")";
+  }
+  for (const auto& [key, values] : spec.params) {
+    auto it = std::find_if(info->parameters.begin(), info->parameters.end(),
+                           [&](const PlannerParameter& p) { return p.name == key; });
+    if (it == info->parameters.end()) {
+      std::string known;
+      for (const PlannerParameter& p : info->parameters) known += (known.empty() ? "" : ", ") + p.name;
+      return "planner '" + spec.name + "' has no parameter '" + key + "'" +
+             (known.empty() ? std::string(" (it takes none)") : " (known: " + known + ")");
+    }
+    if (values.empty()) return "parameter '" + key + "' has no value";
+    if (values.size() > 1 && !it->list_allowed)
+      return "parameter '" + key + "' takes a single number, not a list";
+    for (double v : values) {
+      if (!std::isfinite(v) || v < it->min_value || v > it->max_value) {
+        std::ostringstream msg;
+        msg << "parameter '" << key << "' = " << v << " is outside [" << it->min_value << ", "
+            << it->max_value << "]";
+        return msg.str();
+      }
+    }
+  }
+  return "";
+}
+
+std::unique_ptr<Planner> make_planner(const PlannerSpec& spec) {
+  const std::string problem = check_planner_spec(spec);
+  if (!problem.empty()) throw InputError("planners", problem);
+  return find_planner(spec.name)->make(spec);
+}
+
+}  // namespace depotwin

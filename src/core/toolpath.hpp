@@ -1,0 +1,39 @@
+// The toolpath: what is to be printed, before any timing.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace depotwin {
+
+// One print path: a polyline (mm) printed at one desired speed with material on.
+struct PrintPath {
+  std::vector<Vec3> points;   // at least two, consecutive points distinct
+  std::vector<Vec3> normals;  // optional unit surface normals per point (conformal work)
+  double speed_mm_s = 0.0;    // desired TCP speed while printing
+  int source_index = 0;       // index in the scenario's list, for messages and reports
+
+  double length_mm() const;
+  const Vec3& front() const { return points.front(); }
+  const Vec3& back() const { return points.back(); }
+  // the same path printed the other way round
+  PrintPath reversed() const;
+};
+
+// Start and end of the job (at rest) and the print paths in print order.
+struct Toolpath {
+  Vec3 start_mm = Vec3::Zero();
+  Vec3 end_mm = Vec3::Zero();
+  std::vector<PrintPath> paths;
+
+  double print_length_mm() const;
+  // axis-aligned bounds over start, end and every path point
+  void bounds(Vec3& lo, Vec3& hi) const;
+};
+
+// Two path ends closer than this (mm) are one point: printing continues through them.
+constexpr double kJoinTolerance_mm = 1e-6;
+
+}  // namespace depotwin

@@ -1,0 +1,108 @@
+#include "core/trajectory.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace depotwin {
+
+Trajectory::Trajectory(std::string planner, std::vector<TrajectoryPiece> pieces,
+                       std::vector<std::string> warnings)
+    : planner_(std::move(planner)), pieces_(std::move(pieces)), warnings_(std::move(warnings)) {
+  // the pieces must tile [0, duration] without gaps
+  double t = 0.0;
+  for (const TrajectoryPiece& piece : pieces_) {
+    if (std::abs(piece.t_begin_s - t) > 1e-9 || piece.t_end_s < piece.t_begin_s)
+      throw InternalError("trajectory pieces are not contiguous in time");
+    t = piece.t_end_s;
+  }
+}
+
+int Trajectory::piece_at(double t) const {
+  if (pieces_.empty()) return -1;
+  auto it = std::upper_bound(pieces_.begin(), pieces_.end(), t,
+                             [](double time, const TrajectoryPiece& p) { return time < p.t_begin_s; });
+  if (it == pieces_.begin()) return 0;
+  return static_cast<int>(it - pieces_.begin()) - 1;
+}
+
+namespace {
+
+// cubic Hermite interpolation between two samples of period h at fraction s in [0, 1]
+void hermite(const Vec3& p0, const Vec3& v0, const Vec3& p1, const Vec3& v1, double h, double s,
+             Vec3& p, Vec3& v, Vec3& a) {
+  const double s2 = s * s, s3 = s2 * s;
+  const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s;
+  const double h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+  p = h00 * p0 + h10 * h * v0 + h01 * p1 + h11 * h * v1;
+  // derivatives with respect to time (ds/dt = 1/h)
+  const double d00 = 6 * s2 - 6 * s, d10 = 3 * s2 - 4 * s + 1;
+  const double d01 = -6 * s2 + 6 * s, d11 = 3 * s2 - 2 * s;
+  v = (d00 * p0 + d01 * p1) / h + d10 * v0 + d11 * v1;
+  const double e00 = 12 * s - 6, e10 = 6 * s - 4, e01 = -12 * s + 6, e11 = 6 * s - 2;
+  a = (e00 * p0 + e01 * p1) / (h * h) + (e10 * v0 + e11 * v1) / h;
+}
+
+}  // namespace
+
+void evaluate_motion(const TrajectoryPiece& piece, double tau, Vec3& position_mm,
+                     Vec3& velocity_mm_s, Vec3& acceleration_mm_s2) {
+  if (const auto* phases = std::get_if<PhaseMotion>(&piece.motion)) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const AxisState s = phases->axes[axis].at(tau);
+      position_mm[axis] = s.q;
+      velocity_mm_s[axis] = s.v;
+      acceleration_mm_s2[axis] = s.a;
+    }
+    return;
+  }
+  const auto& sampled = std::get<SampledMotion>(piece.motion);
+  const size_t n = sampled.position_mm.size();
+  if (n == 0) throw InternalError("sampled trajectory piece without samples");
+  if (n == 1 || tau <= 0.0) {
+    position_mm = sampled.position_mm.front();
+    velocity_mm_s = sampled.velocity_mm_s.front();
+    acceleration_mm_s2.setZero();
+    return;
+  }
+  const double h = sampled.period_s;
+  const double k_real = tau / h;
+  size_t k = static_cast<size_t>(std::floor(k_real));
+  if (k >= n - 1) {
+    position_mm = sampled.position_mm.back();
+    velocity_mm_s = sampled.velocity_mm_s.back();
+    acceleration_mm_s2.setZero();
+    return;
+  }
+  hermite(sampled.position_mm[k], sampled.velocity_mm_s[k], sampled.position_mm[k + 1],
+          sampled.velocity_mm_s[k + 1], h, k_real - static_cast<double>(k), position_mm,
+          velocity_mm_s, acceleration_mm_s2);
+}
+
+TrajectorySample Trajectory::at(double t) const {
+  TrajectorySample sample;
+  if (pieces_.empty()) return sample;
+  t = std::clamp(t, 0.0, duration_s());
+  const int index = piece_at(t);
+  const TrajectoryPiece& piece = pieces_[index];
+  sample.t_s = t;
+  sample.piece_index = index;
+  sample.path_index = piece.path_index;
+  sample.depositing = piece.depositing;
+  sample.desired_speed_mm_s = piece.desired_speed_mm_s;
+  evaluate_motion(piece, t - piece.t_begin_s, sample.position_mm, sample.velocity_mm_s,
+                  sample.acceleration_mm_s2);
+  return sample;
+}
+
+double Trajectory::depositing_time_s() const {
+  double total = 0.0;
+  for (const TrajectoryPiece& piece : pieces_)
+    if (piece.depositing) total += piece.t_end_s - piece.t_begin_s;
+  return total;
+}
+
+double Trajectory::transition_time_s() const { return duration_s() - depositing_time_s(); }
+
+}  // namespace depotwin

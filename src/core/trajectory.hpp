@@ -1,0 +1,83 @@
+// The planned trajectory: immutable plain data, sampled by time (Ruckig's
+// at_time, Drake's value(t)). Every planner produces one; planned metrics,
+// the controller and the plots read only this.
+#pragma once
+
+#include <array>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/profile.hpp"
+#include "core/types.hpp"
+
+namespace depotwin {
+
+// Motion given per Cartesian axis as constant-acceleration phases (LSPB, MTT, trapezoids).
+struct PhaseMotion {
+  std::array<AxisProfile, 3> axes;  // x, y, z; time relative to the piece's start
+};
+
+// Motion given as TCP samples at a fixed period (Bezier with the Taylor update of u),
+// interpolated by cubic Hermite segments between samples.
+struct SampledMotion {
+  double period_s = 0.001;
+  std::vector<Vec3> position_mm;    // sample k at time k * period_s
+  std::vector<Vec3> velocity_mm_s;  // same size as position_mm
+};
+
+// One time interval of the trajectory with one meaning: printing path `path_index`,
+// or a transition between paths (path_index = -1, nothing deposited).
+struct TrajectoryPiece {
+  double t_begin_s = 0.0;
+  double t_end_s = 0.0;
+  int path_index = -1;               // index into Toolpath::paths, -1 for a transition
+  bool depositing = false;           // shutter open / flow on
+  double desired_speed_mm_s = 0.0;   // 0 in transitions
+  std::variant<PhaseMotion, SampledMotion> motion;
+};
+
+// What the trajectory says at one instant.
+struct TrajectorySample {
+  double t_s = 0.0;
+  Vec3 position_mm = Vec3::Zero();
+  Vec3 velocity_mm_s = Vec3::Zero();
+  Vec3 acceleration_mm_s2 = Vec3::Zero();
+  bool depositing = false;
+  int path_index = -1;
+  int piece_index = -1;
+  double desired_speed_mm_s = 0.0;
+};
+
+class Trajectory {
+ public:
+  Trajectory() = default;
+  // pieces must be contiguous in time starting at 0; warnings are carried to metrics.json
+  Trajectory(std::string planner, std::vector<TrajectoryPiece> pieces,
+             std::vector<std::string> warnings = {});
+
+  const std::string& planner() const { return planner_; }
+  double duration_s() const { return pieces_.empty() ? 0.0 : pieces_.back().t_end_s; }
+  const std::vector<TrajectoryPiece>& pieces() const { return pieces_; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+  // state at time t, clamped to [0, duration]; at a piece boundary the later piece wins
+  TrajectorySample at(double t) const;
+  // index of the piece containing t (clamped)
+  int piece_at(double t) const;
+
+  // total time with depositing on / off
+  double depositing_time_s() const;
+  double transition_time_s() const;
+
+ private:
+  std::string planner_;
+  std::vector<TrajectoryPiece> pieces_;
+  std::vector<std::string> warnings_;
+};
+
+// Evaluate one piece's motion at local time tau (seconds since the piece started).
+void evaluate_motion(const TrajectoryPiece& piece, double tau, Vec3& position_mm,
+                     Vec3& velocity_mm_s, Vec3& acceleration_mm_s2);
+
+}  // namespace depotwin

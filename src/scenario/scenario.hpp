@@ -1,0 +1,68 @@
+// A scenario file loaded into plain structs. Only scenario/ includes yaml-cpp.
+// Schema and defaults: README.md ("Scenario files") and docs/ARCHITECTURE.md.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/limits.hpp"
+#include "core/toolpath.hpp"
+#include "planners/planner.hpp"
+#include "planners/sequencer.hpp"
+
+namespace depotwin {
+
+// `process:` — how material leaves the nozzle.
+struct ProcessSpec {
+  std::string type = "aerosol";  // aerosol | extrusion
+  // aerosol: continuous stream from job start to job end, Gaussian footprint
+  double flow_mm3_s = 0.0;       // 0: derived from the target thickness (see README)
+  double sigma_mm = 0.1;         // footprint standard deviation
+  double line_width_mm = 0.0;    // 0: 4 sigma (aerosol) or bead width (extrusion)
+  double shutter_time_s = 0.02;  // flap open/close time
+  // extrusion: commanded flow with first-order lag
+  double bead_width_mm = 0.4;
+  double layer_height_mm = 0.2;
+  double tau_s = 0.05;
+};
+
+// `sim:` — simulation and deposition-grid settings.
+struct SimSpec {
+  double timestep_s = 0.001;
+  double cell_mm = 0.0;  // 0: sigma / 4 (aerosol) or bead width / 8 (extrusion)
+  double kp_scale = 1.0;  // multiply the model's default servo gains
+  double settle_s = 0.0;  // extra simulated time after the trajectory ends
+};
+
+// `outputs:` — what a run writes besides metrics.
+struct OutputSpec {
+  bool render = true;
+  int image_width = 640;
+  int image_height = 480;
+};
+
+struct Scenario {
+  std::string file;           // the scenario file as given
+  std::string directory;      // its directory: relative paths resolve against it
+  std::string name;
+  std::string machine = "xy_stage";  // xy_stage | linear_delta | arm6 | path to an MJCF file
+  std::string model_path;             // resolved MJCF path ("" until resolved by the pipeline)
+  MachineLimits limits;               // Cartesian TCP limits for the planners
+  bool has_joint_limits = false;      // `limits: {joint: {...}}` given (linear delta carriages)
+  AxisLimits joint_limits;
+  ProcessSpec process;
+  Toolpath toolpath;
+  OrderSpec order;
+  std::vector<PlannerSpec> planners;
+  SimSpec sim;
+  OutputSpec outputs;
+};
+
+// Load and validate a scenario file. Throws InputError listing every problem
+// found ("file:line: key: what is wrong"), not only the first.
+Scenario load_scenario(const std::string& path);
+
+}  // namespace depotwin
