@@ -1,0 +1,133 @@
+#include "metrics/motion_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace depotwin {
+
+void MotionSamples::reserve(size_t n) {
+  t_s.reserve(n);
+  position_mm.reserve(n);
+  velocity_mm_s.reserve(n);
+  depositing.reserve(n);
+  path_index.reserve(n);
+  desired_speed_mm_s.reserve(n);
+}
+
+void MotionSamples::push_back(double t, const Vec3& p, const Vec3& v, bool deposit, int path,
+                              double desired) {
+  t_s.push_back(t);
+  position_mm.push_back(p);
+  velocity_mm_s.push_back(v);
+  depositing.push_back(deposit ? 1 : 0);
+  path_index.push_back(path);
+  desired_speed_mm_s.push_back(desired);
+}
+
+MotionSamples sample_trajectory(const Trajectory& trajectory, double period_s) {
+  MotionSamples samples;
+  const double duration = trajectory.duration_s();
+  const long count = static_cast<long>(std::floor(duration / period_s + 1e-9)) + 1;
+  samples.reserve(count + 1);
+  for (long k = 0; k < count; ++k) {
+    const TrajectorySample s = trajectory.at(k * period_s);
+    samples.push_back(s.t_s, s.position_mm, s.velocity_mm_s, s.depositing, s.path_index,
+                      s.desired_speed_mm_s);
+  }
+  // the exact end, so that the final rest state is always included
+  if ((count - 1) * period_s < duration - 1e-12) {
+    const TrajectorySample s = trajectory.at(duration);
+    samples.push_back(s.t_s, s.position_mm, s.velocity_mm_s, s.depositing, s.path_index,
+                      s.desired_speed_mm_s);
+  }
+  return samples;
+}
+
+namespace {
+
+// time weight of sample k: half the interval to each neighbour
+double time_weight(const MotionSamples& s, size_t k) {
+  const double before = k > 0 ? s.t_s[k] - s.t_s[k - 1] : 0.0;
+  const double after = k + 1 < s.size() ? s.t_s[k + 1] - s.t_s[k] : 0.0;
+  return 0.5 * (before + after);
+}
+
+bool depositing_with_target(const MotionSamples& s, size_t k) {
+  return s.depositing[k] && s.desired_speed_mm_s[k] > 0.0;
+}
+
+}  // namespace
+
+std::vector<double> relative_speed_error(const MotionSamples& samples) {
+  std::vector<double> error(samples.size(), 0.0);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    if (!depositing_with_target(samples, k)) continue;
+    const double desired = samples.desired_speed_mm_s[k];
+    error[k] = std::abs(samples.velocity_mm_s[k].norm() - desired) / desired;
+  }
+  return error;
+}
+
+VelocityErrorStats velocity_error(const MotionSamples& samples) {
+  VelocityErrorStats stats;
+  const std::vector<double> error = relative_speed_error(samples);
+  std::vector<std::pair<double, double>> weighted;  // (error, time weight)
+  double total_time = 0.0, sum_sq = 0.0, length = 0.0, length_over = 0.0;
+  for (size_t k = 0; k < samples.size(); ++k) {
+    if (!depositing_with_target(samples, k)) continue;
+    const double w = time_weight(samples, k);
+    const double ds = samples.velocity_mm_s[k].norm() * w;  // path length of this sample
+    stats.max_rel = std::max(stats.max_rel, error[k]);
+    sum_sq += error[k] * error[k] * w;
+    total_time += w;
+    length += ds;
+    if (error[k] > 0.01) length_over += ds;
+    weighted.push_back({error[k], w});
+  }
+  if (total_time <= 0.0) return stats;
+  stats.rms_rel = std::sqrt(sum_sq / total_time);
+  stats.frac_len_over_1pct = length > 0.0 ? length_over / length : 0.0;
+  // time-weighted 95th percentile: the smallest error with >= 95 % of the time at or below it
+  std::sort(weighted.begin(), weighted.end());
+  double cumulative = 0.0;
+  for (const auto& [e, w] : weighted) {
+    cumulative += w;
+    if (cumulative >= 0.95 * total_time) {
+      stats.p95_rel = e;
+      break;
+    }
+  }
+  return stats;
+}
+
+double distance_to_polyline(const Vec3& point, const std::vector<Vec3>& polyline) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i + 1 < polyline.size(); ++i) {
+    const Vec3 a = polyline[i], ab = polyline[i + 1] - a;
+    const double len2 = ab.squaredNorm();
+    const double u = len2 > 0.0 ? std::clamp((point - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (a + u * ab - point).norm());
+  }
+  if (polyline.size() == 1) best = (polyline[0] - point).norm();
+  return best;
+}
+
+PathErrorStats path_error(const MotionSamples& samples, const Toolpath& toolpath) {
+  PathErrorStats stats;
+  double sum_sq = 0.0, total_time = 0.0;
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const int path = samples.path_index[k];
+    if (!samples.depositing[k] || path < 0 || path >= static_cast<int>(toolpath.paths.size()))
+      continue;
+    const double e = distance_to_polyline(samples.position_mm[k], toolpath.paths[path].points);
+    const double w = time_weight(samples, k);
+    stats.max_mm = std::max(stats.max_mm, e);
+    sum_sq += e * e * w;
+    total_time += w;
+  }
+  if (total_time > 0.0) stats.rms_mm = std::sqrt(sum_sq / total_time);
+  return stats;
+}
+
+}  // namespace depotwin

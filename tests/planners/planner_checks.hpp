@@ -1,0 +1,131 @@
+// Shared checks for the planner contract (tests/planners and other planner tests).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "core/limits.hpp"
+#include "core/toolpath.hpp"
+#include "core/trajectory.hpp"
+#include "metrics/motion_metrics.hpp"
+
+namespace depotwin::testing_support {
+
+// A seeded random toolpath: isolated segments and connected chains inside a 40 mm box.
+inline Toolpath random_toolpath(std::uint64_t seed, double speed_mm_s) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> coordinate(-20.0, 20.0), length(0.5, 12.0),
+      heading(0.0, 2 * kPi);
+  std::uniform_int_distribution<int> chain_length(1, 4), path_count(1, 5);
+  Toolpath toolpath;
+  toolpath.start_mm = Vec3(coordinate(rng), coordinate(rng), 0);
+  toolpath.end_mm = Vec3(coordinate(rng), coordinate(rng), 0);
+  const int paths = path_count(rng);
+  for (int i = 0; i < paths; ++i) {
+    PrintPath path;
+    path.speed_mm_s = speed_mm_s;
+    path.source_index = i;
+    Vec3 p(coordinate(rng), coordinate(rng), 0);
+    path.points.push_back(p);
+    const int edges = chain_length(rng);
+    for (int k = 0; k < edges; ++k) {
+      const double h = heading(rng), l = length(rng);
+      p += Vec3(l * std::cos(h), l * std::sin(h), 0);
+      path.points.push_back(p);
+    }
+    toolpath.paths.push_back(path);
+  }
+  return toolpath;
+}
+
+// The planner contract: starts and ends at rest at the start and end points, continuous
+// position, per-axis limits held, every print path covered with material on, nothing
+// deposited in transitions.
+inline void expect_contract(const Trajectory& trajectory, const Toolpath& toolpath,
+                            const MachineLimits& limits, double path_tolerance_mm = 1e-6) {
+  ASSERT_GT(trajectory.duration_s(), 0.0);
+  const TrajectorySample first = trajectory.at(0.0), last = trajectory.at(trajectory.duration_s());
+  EXPECT_LT((first.position_mm - toolpath.start_mm).norm(), 1e-9);
+  EXPECT_LT(first.velocity_mm_s.norm(), 1e-9);
+  EXPECT_LT((last.position_mm - toolpath.end_mm).norm(), 1e-9);
+  EXPECT_LT(last.velocity_mm_s.norm(), 1e-9);
+
+  // pieces: contiguous, continuous across boundaries, material only on print paths
+  const auto& pieces = trajectory.pieces();
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    const TrajectoryPiece& piece = pieces[i];
+    EXPECT_EQ(piece.depositing, piece.path_index >= 0) << "piece " << i;
+    if (i == 0) continue;
+    Vec3 p_end, v_end, a_end, p_begin, v_begin, a_begin;
+    const TrajectoryPiece& previous = pieces[i - 1];
+    evaluate_motion(previous, previous.t_end_s - previous.t_begin_s, p_end, v_end, a_end);
+    evaluate_motion(piece, 0.0, p_begin, v_begin, a_begin);
+    EXPECT_LT((p_end - p_begin).norm(), 1e-9) << "position jump at piece " << i;
+    EXPECT_LT((v_end - v_begin).norm(), 1e-6) << "velocity jump at piece " << i;
+  }
+
+  // limits at 1 ms samples and at every piece boundary
+  const MotionSamples samples = sample_trajectory(trajectory, 0.001);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const TrajectorySample s = trajectory.at(samples.t_s[k]);
+    for (int axis = 0; axis < 3; ++axis) {
+      ASSERT_LE(std::abs(s.velocity_mm_s[axis]), limits.axes[axis].v_max_mm_s * (1 + 1e-9))
+          << "axis " << axis << " t " << s.t_s;
+      ASSERT_LE(std::abs(s.acceleration_mm_s2[axis]), limits.axes[axis].a_max_mm_s2 * (1 + 1e-6))
+          << "axis " << axis << " t " << s.t_s;
+    }
+  }
+
+  // every path: its ends are reached with material on, and its edges' midpoints are traced
+  for (size_t i = 0; i < toolpath.paths.size(); ++i) {
+    const PrintPath& path = toolpath.paths[i];
+    std::vector<Vec3> deposited;
+    for (size_t k = 0; k < samples.size(); ++k)
+      if (samples.depositing[k] && samples.path_index[k] == static_cast<int>(i))
+        deposited.push_back(samples.position_mm[k]);
+    for (const TrajectoryPiece& piece : pieces) {
+      if (piece.path_index != static_cast<int>(i)) continue;
+      Vec3 p, v, a;
+      evaluate_motion(piece, 0.0, p, v, a);
+      deposited.push_back(p);
+      evaluate_motion(piece, piece.t_end_s - piece.t_begin_s, p, v, a);
+      deposited.push_back(p);
+    }
+    ASSERT_FALSE(deposited.empty()) << "path " << i << " never printed";
+    auto nearest = [&](const Vec3& q) {
+      double best = 1e300;
+      for (const Vec3& d : deposited) best = std::min(best, (d - q).norm());
+      return best;
+    };
+    EXPECT_LT(nearest(path.front()), path_tolerance_mm) << "path " << i << " start";
+    EXPECT_LT(nearest(path.back()), path_tolerance_mm) << "path " << i << " end";
+    // edge midpoints are traced closely. LSPB with averaged joint velocities (eqs. 52-53)
+    // leaves the straight line while an axis changes its velocity by up to v at a_max; the
+    // offset that builds up is below v^2 / (4 a_max), so allow that, 5 % of the edge and one
+    // sample's travel
+    double a_min = limits.axes[0].a_max_mm_s2;
+    for (const AxisLimits& axis : limits.axes) a_min = std::min(a_min, axis.a_max_mm_s2);
+    const double blend_offset = path.speed_mm_s * path.speed_mm_s / (4 * a_min);
+    for (size_t k = 0; k + 1 < path.points.size(); ++k) {
+      const double length = (path.points[k + 1] - path.points[k]).norm();
+      const Vec3 mid = 0.5 * (path.points[k] + path.points[k + 1]);
+      EXPECT_LT(nearest(mid), blend_offset + 0.05 * length + 0.001 * path.speed_mm_s +
+                                  path_tolerance_mm)
+          << "path " << i << " edge " << k;
+    }
+    // the path is printed in one go: its pieces are consecutive in time
+    int first_piece = -1, last_piece = -1, count = 0;
+    for (size_t p = 0; p < pieces.size(); ++p) {
+      if (pieces[p].path_index != static_cast<int>(i)) continue;
+      if (first_piece < 0) first_piece = static_cast<int>(p);
+      last_piece = static_cast<int>(p);
+      ++count;
+    }
+    EXPECT_EQ(last_piece - first_piece + 1, count) << "path " << i << " printed in parts";
+  }
+}
+
+}  // namespace depotwin::testing_support
