@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Install DepoTwin's dependencies from Debian 12 packages. Idempotent: installs only what
+# is missing (running `apt-get update` first in that case). Nothing is downloaded from
+# elsewhere and nothing is vendored.
+set -euo pipefail
+
+packages=(
+  cmake g++ make pkg-config
+  libmujoco-dev libqhull-dev libgl-dev   # MuJoCo 2.2.2 (+ what its CMake config needs)
+  libeigen3-dev libassimp-dev libosmesa6-dev
+  libgtest-dev libbenchmark-dev
+  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libstb-dev liblemon-dev zlib1g-dev
+  gnuplot-nox                            # plots (pngcairo terminal, headless)
+  fonts-dejavu-core                      # fonts for plot and image text
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends \
+  "${missing[@]}"
+echo "setup: done"

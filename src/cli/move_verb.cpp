@@ -1,0 +1,108 @@
+#include "cli/move_verb.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "motion/mtt.hpp"
+#include "motion/sync.hpp"
+
+namespace depotwin {
+
+std::vector<double> parse_number_list(const std::string& text, const std::string& option) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(value))
+      throw InputError(option, "'" + item + "' is not a finite number (expected e.g. 0,5.5)");
+    values.push_back(value);
+  }
+  if (values.empty()) throw InputError(option, "no value given");
+  return values;
+}
+
+namespace {
+
+// broadcast a one-value list to every axis; otherwise the sizes must match
+double value_for_axis(const std::vector<double>& list, size_t axis) {
+  return list.size() == 1 ? list[0] : list[axis];
+}
+
+}  // namespace
+
+nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
+  using Json = nlohmann::ordered_json;
+  const std::vector<std::pair<std::string, const std::vector<double>*>> lists{
+      {"--q0", &request.q0}, {"--q1", &request.q1},     {"--v0", &request.v0},
+      {"--v1", &request.v1}, {"--vmax", &request.v_max}, {"--amax", &request.a_max}};
+  size_t axes = 1;
+  for (const auto& [name, list] : lists) axes = std::max(axes, list->size());
+  if (axes > 6) throw InputError("--q0", "at most six axes");
+  std::vector<Problem> problems;
+  for (const auto& [name, list] : lists) {
+    if (list->size() != 1 && list->size() != axes)
+      problems.push_back({"", 0, name,
+                          "has " + std::to_string(list->size()) + " values for " +
+                              std::to_string(axes) + " axes (give one per axis, or one for all)"});
+  }
+  if (!request.j_max.empty()) {
+    for (double j : request.j_max)
+      if (j != 0.0)
+        problems.push_back({"", 0, "--jmax",
+                            "jerk-limited moves are not supported: the minimum-time move here "
+                            "is acceleration-limited (give 0 or leave --jmax out)"});
+  }
+  if (!problems.empty()) throw InputError(problems);
+
+  // per axis: limits and boundary velocities, then the synchronised move
+  std::vector<AxisMove> moves(axes);
+  for (size_t i = 0; i < axes; ++i) {
+    AxisMove& m = moves[i];
+    m.boundary = AxisBoundary{value_for_axis(request.q0, i), value_for_axis(request.q1, i),
+                              value_for_axis(request.v0, i), value_for_axis(request.v1, i)};
+    m.v_max = value_for_axis(request.v_max, i);
+    m.a_max = value_for_axis(request.a_max, i);
+    const std::string axis = " of axis " + std::to_string(i);
+    if (!(m.v_max > 0.0)) problems.push_back({"", 0, "--vmax", "must be > 0" + axis});
+    if (!(m.a_max > 0.0)) problems.push_back({"", 0, "--amax", "must be > 0" + axis});
+    if (m.v_max > 0.0 && std::abs(m.boundary.v0) > m.v_max)
+      problems.push_back({"", 0, "--v0", "|v0| exceeds v_max" + axis});
+    if (m.v_max > 0.0 && std::abs(m.boundary.v1) > m.v_max)
+      problems.push_back({"", 0, "--v1", "|v1| exceeds v_max" + axis});
+  }
+  if (!problems.empty()) throw InputError(problems);
+  const SynchronizedMove move = synchronized_move(moves);
+
+  Json out;
+  out["duration_s"] = move.duration_s;
+  Json axes_json = Json::array();
+  for (size_t i = 0; i < axes; ++i) {
+    const AxisMove& m = moves[i];
+    Json phases = Json::array();
+    for (const Phase& phase : move.axes[i].phases())
+      phases.push_back(Json{{"t_start_s", phase.t_begin_s},
+                            {"duration_s", phase.duration_s},
+                            {"acceleration", phase.a},
+                            {"v_start", phase.v0},
+                            {"v_end", phase.v_end()},
+                            {"q_start", phase.q0},
+                            {"q_end", phase.q_end()}});
+    axes_json.push_back(Json{
+        {"q0", m.boundary.q0},
+        {"q1", m.boundary.q1},
+        {"v0", m.boundary.v0},
+        {"v1", m.boundary.v1},
+        {"v_max", m.v_max},
+        {"a_max", m.a_max},
+        {"min_duration_s", feasible_durations(m.boundary, m.v_max, m.a_max).t_min()},
+        {"phases", phases}});
+  }
+  out["axes"] = axes_json;
+  return out;
+}
+
+}  // namespace depotwin

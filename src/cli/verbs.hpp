@@ -1,0 +1,26 @@
+// The scenario verbs of the CLI; each returns the process exit status.
+#pragma once
+
+#include <string>
+
+namespace depotwin {
+
+struct RunOptions {
+  std::string scenario;
+  std::string planners;  // comma list; empty: the scenario's
+  std::string out;
+  bool no_render = false;
+  bool quiet = false;
+};
+
+struct CompareOptions {
+  RunOptions run;
+  std::string orders;  // comma list of sequencers to compare instead of planners
+};
+
+int run_verb(const RunOptions& options);
+int compare_verb(const CompareOptions& options);
+int plan_verb(const RunOptions& options);
+int validate_verb(const std::string& scenario);
+
+}  // namespace depotwin

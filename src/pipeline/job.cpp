@@ -1,0 +1,210 @@
+#include "pipeline/job.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "report/metrics_json.hpp"
+#include "report/output_dir.hpp"
+#include "report/trajectory_csv.hpp"
+
+namespace depotwin {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kSamplePeriod_s = 0.001;  // trajectory.csv and planned metrics
+
+// a machine named in the scenario: a built-in name, or an MJCF path driven with the
+// Cartesian-stage kinematics (the model must use the xy_stage joint and site names)
+std::unique_ptr<Machine> machine_for(const Scenario& scenario, std::string& model_path) {
+  if (auto machine = make_machine(scenario.machine)) {
+    model_path = (fs::path(DEPOTWIN_MODELS_DIR) / machine->model_file()).string();
+    return machine;
+  }
+  if (fs::path(scenario.machine).extension() == ".xml") {
+    model_path = scenario.machine;
+    return make_machine("xy_stage");
+  }
+  std::string known;
+  for (const std::string& name : machine_names()) known += (known.empty() ? "" : ", ") + name;
+  throw InputError(scenario.file, 0, "machine",
+                   "'" + scenario.machine + "' is not supported (known: " + known +
+                       ", or a path to an MJCF file of a Cartesian stage)");
+}
+
+}  // namespace
+
+PreparedJob prepare_job(const Scenario& scenario) {
+  PreparedJob job;
+  job.scenario = scenario;
+  job.machine = machine_for(scenario, job.model_path);
+
+  // every point of the toolpath must be reachable by the machine
+  std::vector<Problem> problems;
+  JointVector joints;
+  auto check_reachable = [&](const Vec3& p, const std::string& key) {
+    std::string why;
+    if (!job.machine->inverse(p, joints, &why)) {
+      std::ostringstream msg;
+      msg << "point (" << p.x() << ", " << p.y() << ", " << p.z() << ") mm is not reachable by "
+          << job.machine->name() << ": " << why;
+      problems.push_back(Problem{scenario.file, 0, key, msg.str()});
+    }
+  };
+  const Toolpath& toolpath = scenario.toolpath;
+  check_reachable(toolpath.start_mm, "toolpath.start");
+  check_reachable(toolpath.end_mm, "toolpath.end");
+  for (const PrintPath& path : toolpath.paths)
+    for (const Vec3& p : path.points)
+      check_reachable(p, "toolpath path " + std::to_string(path.source_index));
+  if (!problems.empty()) throw InputError(problems);
+
+  // the Cartesian limits no joint exceeds anywhere in the toolpath's box
+  Vec3 lo, hi;
+  toolpath.bounds(lo, hi);
+  job.limits = job.machine->cartesian_limits(scenario.limits, lo, hi);
+
+  // print order (Ganganath et al.), before every planner
+  job.order = sequence(toolpath, job.limits, scenario.order);
+  job.toolpath = apply_order(toolpath, job.order);
+  return job;
+}
+
+std::vector<PlannerSpec> select_planners(const Scenario& scenario, const std::string& names) {
+  if (names.empty()) return scenario.planners;
+  std::vector<PlannerSpec> selected;
+  std::stringstream list(names);
+  std::string name;
+  while (std::getline(list, name, ',')) {
+    if (name.empty()) continue;
+    bool found = false;
+    for (const PlannerSpec& spec : scenario.planners) {
+      if (spec.name != name) continue;
+      selected.push_back(spec);
+      found = true;
+    }
+    if (found) continue;
+    // a registered planner the scenario does not list runs with its defaults
+    PlannerSpec spec{name, {}, 0};
+    const std::string problem = check_planner_spec(spec);
+    if (!problem.empty()) throw InputError("--planner", problem);
+    selected.push_back(spec);
+  }
+  if (selected.empty()) throw InputError("--planner", "no planner named");
+  return selected;
+}
+
+std::string output_directory(const Scenario& scenario, const std::string& requested) {
+  return requested.empty() ? (fs::path("results") / scenario.name).string() : requested;
+}
+
+PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
+  PlannedRun run;
+  run.spec = spec;
+  run.trajectory = make_planner(spec)->plan(job.toolpath, job.limits);
+  run.planned = sample_trajectory(run.trajectory, kSamplePeriod_s);
+
+  MetricsReport& r = run.report;
+  r.scenario = job.scenario.name;
+  r.machine = job.machine->name();
+  r.planner = spec.name;
+  r.sequencer = job.scenario.order.label();
+  r.time.total_s = run.trajectory.duration_s();
+  r.time.print_s = run.trajectory.depositing_time_s();
+  r.time.transition_s = run.trajectory.transition_time_s();
+  r.planned_velocity_error = velocity_error(run.planned);
+  r.path_error = path_error(run.planned, job.toolpath);
+  OrderStats order;
+  order.method = job.scenario.order.method;
+  order.refine = job.scenario.order.refine;
+  order.cost_model = job.scenario.order.cost_model;
+  order.cost_s = job.order.cost_s;
+  if (job.order.lower_bound_s > 0.0) order.lower_bound_s = job.order.lower_bound_s;
+  r.order = order;
+  r.warnings = run.trajectory.warnings();
+  return run;
+}
+
+std::vector<MetricsReport> write_plans(const PreparedJob& job, const std::vector<PlannerSpec>& planners,
+                                       const std::string& directory) {
+  std::vector<MetricsReport> reports;
+  for (const PlannerSpec& spec : planners) {
+    const PlannedRun run = plan_job(job, spec);
+    StagedDirectory out((fs::path(directory) / spec.name).string());
+    write_file_atomically(out.file("metrics.json"), metrics_json_text(run.report));
+    write_file_atomically(out.file("trajectory.csv"), planned_trajectory_csv(run.planned));
+    out.commit();
+    reports.push_back(run.report);
+  }
+  return reports;
+}
+
+namespace {
+
+std::string percent(double fraction) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f %%", 100.0 * fraction);
+  return text;
+}
+
+std::string fixed(double value, int digits) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.*f", digits, value);
+  return text;
+}
+
+}  // namespace
+
+std::string summary_table(const std::vector<MetricsReport>& reports) {
+  // one row per planner; simulated columns only when a simulation ran
+  const bool simulated = !reports.empty() && reports.front().velocity_error.has_value();
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> header{"planner", "time s", "print s", "transit s", "plan vel err max",
+                                  "plan vel err rms", "path err mm"};
+  if (simulated) {
+    header.insert(header.end(), {"sim vel err max", "thickness cv", "line cv", "waste"});
+  }
+  header.push_back("warnings");
+  rows.push_back(header);
+  for (const MetricsReport& r : reports) {
+    std::vector<std::string> row{r.planner,
+                                 fixed(r.time.total_s, 3),
+                                 fixed(r.time.print_s, 3),
+                                 fixed(r.time.transition_s, 3),
+                                 percent(r.planned_velocity_error.max_rel),
+                                 percent(r.planned_velocity_error.rms_rel),
+                                 fixed(r.path_error.max_mm, 4)};
+    if (simulated) {
+      row.push_back(r.velocity_error ? percent(r.velocity_error->max_rel) : "-");
+      row.push_back(r.thickness ? fixed(r.thickness->cv, 4) : "-");
+      row.push_back(r.thickness ? fixed(r.thickness->line_cv, 4) : "-");
+      row.push_back(r.waste ? percent(r.waste->fraction) : "-");
+    }
+    row.push_back(std::to_string(r.warnings.size()));
+    rows.push_back(row);
+  }
+  // column widths, then the rows
+  std::vector<size_t> width(header.size(), 0);
+  for (const auto& row : rows)
+    for (size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], row[c].size());
+  std::string out;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    for (size_t c = 0; c < rows[i].size(); ++c) {
+      const std::string& cell = rows[i][c];
+      const std::string pad(width[c] - cell.size(), ' ');
+      out += c == 0 ? cell + pad : "  " + pad + cell;
+    }
+    out += '\n';
+    if (i == 0) {
+      for (size_t c = 0; c < width.size(); ++c) out += std::string(width[c] + (c ? 2 : 0), '-');
+      out += '\n';
+    }
+  }
+  return out;
+}
+
+}  // namespace depotwin

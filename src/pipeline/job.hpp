@@ -1,0 +1,55 @@
+// The run pipeline: scenario -> machine + limits -> print order -> plan -> (simulate ->
+// deposit ->) score -> write. The CLI verbs are thin wrappers around these functions.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "kinematics/machine.hpp"
+#include "metrics/metrics_report.hpp"
+#include "planners/planner.hpp"
+#include "planners/sequencer.hpp"
+#include "scenario/scenario.hpp"
+
+namespace depotwin {
+
+// A scenario made ready for planning: its machine, the Cartesian limits the planners get
+// (the machine's joint limits mapped over the toolpath's box), and the print order.
+struct PreparedJob {
+  Scenario scenario;
+  std::unique_ptr<Machine> machine;
+  std::string model_path;  // the MJCF to simulate
+  MachineLimits limits;    // what every planner must respect
+  OrderResult order;
+  Toolpath toolpath;       // in print order
+};
+
+// Throws InputError for an unknown machine, an unreachable toolpath, ...
+PreparedJob prepare_job(const Scenario& scenario);
+
+// the planners to run: all of the scenario's, or those named (comma list); InputError
+// for a name the scenario does not list
+std::vector<PlannerSpec> select_planners(const Scenario& scenario, const std::string& names);
+
+// results/<scenario name> unless --out is given
+std::string output_directory(const Scenario& scenario, const std::string& requested);
+
+// the plan and its metrics
+struct PlannedRun {
+  PlannerSpec spec;
+  Trajectory trajectory;
+  MotionSamples planned;  // the plan every 1 ms
+  MetricsReport report;   // planned metrics only
+};
+PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec);
+
+// `depotwin plan`: DIR/<planner>/metrics.json and trajectory.csv per planner; returns the
+// reports in planner order
+std::vector<MetricsReport> write_plans(const PreparedJob& job, const std::vector<PlannerSpec>& planners,
+                                       const std::string& directory);
+
+// a fixed-width summary table of the reports
+std::string summary_table(const std::vector<MetricsReport>& reports);
+
+}  // namespace depotwin
