@@ -1,5 +1,5 @@
 // A scenario file loaded into plain structs. Only scenario/ includes yaml-cpp.
-// Schema and defaults: README.md ("Scenario files") and docs/ARCHITECTURE.md.
+// Schema and defaults: src/scenario/SCHEMA.md (summarised in README.md, "Scenario files").
 #pragma once
 
 #include <cstdint>
@@ -32,7 +32,7 @@ struct ProcessSpec {
 // `sim:` — simulation and deposition-grid settings.
 struct SimSpec {
   double timestep_s = 0.001;
-  double cell_mm = 0.0;  // 0: sigma / 4 (aerosol) or bead width / 8 (extrusion)
+  double cell_mm = 0.0;   // 0: sigma / 4 (aerosol) or bead width / 8 (extrusion)
   double kp_scale = 1.0;  // multiply the model's default servo gains
   double settle_s = 0.0;  // extra simulated time after the trajectory ends
 };
@@ -45,13 +45,14 @@ struct OutputSpec {
 };
 
 struct Scenario {
-  std::string file;           // the scenario file as given
-  std::string directory;      // its directory: relative paths resolve against it
+  std::string file;       // the scenario file as given
+  std::string directory;  // its directory: relative paths resolve against it
   std::string name;
   std::string machine = "xy_stage";  // xy_stage | linear_delta | arm6 | path to an MJCF file
-  std::string model_path;             // resolved MJCF path ("" until resolved by the pipeline)
-  MachineLimits limits;               // Cartesian TCP limits for the planners
-  bool has_joint_limits = false;      // `limits: {joint: {...}}` given (linear delta carriages)
+  std::string model_path;  // resolved MJCF path: set by the loader for an MJCF machine file, else
+                           // "" until the pipeline resolves the built-in name
+  MachineLimits limits;    // Cartesian TCP limits for the planners
+  bool has_joint_limits = false;  // `limits: {joint: {...}}` given (linear delta carriages)
   AxisLimits joint_limits;
   ProcessSpec process;
   Toolpath toolpath;
@@ -62,7 +63,15 @@ struct Scenario {
 };
 
 // Load and validate a scenario file. Throws InputError listing every problem
-// found ("file:line: key: what is wrong"), not only the first.
+// found ("file:line: key: what is wrong"), not only the first: problems of the scenario
+// file in line order (file = `path` as given, line 1-based, key a dotted path such as
+// `toolpath.segments[2]` or `limits.x.v_max`), then those of an imported G-code file.
+// Relative paths in the file (machine MJCF, gcode) resolve against its directory.
+// Full schema and defaults: src/scenario/SCHEMA.md.
 Scenario load_scenario(const std::string& path);
+
+// For `depotwin validate`: every problem load_scenario would report, or an empty list
+// when the file loads. Never throws InputError.
+std::vector<Problem> validate_scenario_file(const std::string& path);
 
 }  // namespace depotwin

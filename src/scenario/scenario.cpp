@@ -1,0 +1,817 @@
+// The scenario loader: YAML -> Scenario structs, collecting every problem it finds.
+// Schema: src/scenario/SCHEMA.md.
+#include "scenario/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "planners/random_instances.hpp"
+#include "scenario/gcode.hpp"
+#include "scenario/yaml_reader.hpp"
+
+namespace depotwin {
+
+namespace {
+
+using namespace scenario_detail;
+namespace fs = std::filesystem;
+
+const std::vector<std::string> kBuiltinMachines{"xy_stage", "linear_delta", "arm6"};
+const std::vector<std::string> kToolpathKinds{"segments", "polylines", "gcode", "random_segments",
+                                              "surface"};
+// the paper's stage (Thompson & Yoon) when `limits:` is absent
+constexpr double kDefaultVMax_mm_s = 4.0;
+constexpr double kDefaultAMax_mm_s2 = 30.0;
+// a print speed may exceed an axis limit by this relative amount (rounding)
+constexpr double kSpeedTolerance = 1e-9;
+constexpr int kMinImageSize = 16;
+constexpr int kMaxImageSize = 2048;
+constexpr long long kMaxRandomSegments = 100000;
+
+std::string join(const std::vector<std::string>& names, const std::string& separator = ", ") {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : separator) + name;
+  return text;
+}
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::string format_point(const Vec3& p) {
+  return "(" + format_number(p.x()) + ", " + format_number(p.y()) + ", " + format_number(p.z()) +
+         ")";
+}
+
+// a number with at most 4 significant digits, for speeds in messages
+std::string format_speed(double value) {
+  std::ostringstream out;
+  out.precision(4);
+  out << value;
+  return out.str();
+}
+
+// where a print path came from, so its problems name the right file, line and key
+struct PathOrigin {
+  std::string file;
+  std::string key;               // e.g. toolpath.segments[2]
+  std::vector<int> point_lines;  // per point
+  bool name_segments = true;     // false for a 2-point `segments` entry (the key says it all)
+};
+
+class Loader {
+ public:
+  explicit Loader(const std::string& path) : problems_(path) {
+    scenario_.file = path;
+    const fs::path file_path(path);
+    relative_dir_ = file_path.parent_path();
+    std::error_code error;
+    const fs::path absolute = fs::absolute(file_path, error);
+    scenario_.directory =
+        (error ? relative_dir_ : absolute.parent_path()).lexically_normal().string();
+    scenario_.name = file_path.stem().string();
+    scenario_.limits = MachineLimits::uniform(kDefaultVMax_mm_s, kDefaultAMax_mm_s2);
+    scenario_.planners = {PlannerSpec{"lspb_mtt", {}, 0}, PlannerSpec{"stop_and_go", {}, 0}};
+  }
+
+  Scenario load();
+
+ private:
+  bool read_document(YAML::Node& root);
+  void read_name(const Field& field);
+  void read_machine(const Field& field);
+  void read_limits(const Field& field);
+  void read_axis_limits(const MapView& view, AxisLimits& axis);
+  void read_process(const Field& field);
+  void read_toolpath(const Field* field);
+  void read_segments(const Field& field, const std::optional<double>& default_speed);
+  void read_polylines(const Field& field, const std::optional<double>& default_speed);
+  void read_gcode_file(const Field& field, const std::optional<double>& default_speed);
+  void read_random_segments(const Field& field, const std::optional<double>& default_speed,
+                            bool start_given, bool end_given);
+  std::optional<std::vector<Vec3>> read_points(const Field& field, std::vector<int>& lines);
+  void check_path(const PrintPath& path, const PathOrigin& origin);
+  void read_order(const Field& field);
+  bool read_order_name(const Field& field, OrderSpec& order);
+  void read_planners(const Field& field);
+  void read_sim(const Field& field);
+  void read_outputs(const Field& field);
+  // a path as written, resolved against the scenario file's directory
+  fs::path resolve(const std::string& given) const {
+    return (relative_dir_ / given).lexically_normal();
+  }
+
+  ProblemList problems_;
+  Scenario scenario_;
+  fs::path relative_dir_;
+  bool limits_ok_ = true;       // speed feasibility is checked only against valid limits
+  bool speed_missing_ = false;  // reported once, not per path
+};
+
+Scenario Loader::load() {
+  YAML::Node root;
+  if (!read_document(root)) throw InputError(problems_.problems());
+
+  // the top level: every key optional except the toolpath
+  const MapView top(
+      Field{root, "", 1, 1},
+      {"name", "machine", "limits", "process", "toolpath", "order", "planners", "sim", "outputs"},
+      problems_);
+  if (top.is_map()) {
+    if (const Field* f = top.find("name")) read_name(*f);
+    if (const Field* f = top.find("machine")) read_machine(*f);
+    if (const Field* f = top.find("limits")) read_limits(*f);
+    if (const Field* f = top.find("process")) read_process(*f);
+    read_toolpath(top.find("toolpath"));
+    if (const Field* f = top.find("order")) read_order(*f);
+    if (const Field* f = top.find("planners")) read_planners(*f);
+    if (const Field* f = top.find("sim")) read_sim(*f);
+    if (const Field* f = top.find("outputs")) read_outputs(*f);
+  }
+  if (problems_.empty()) return scenario_;
+
+  // scenario-file problems in line order, then those of imported files
+  std::vector<Problem>& list = problems_.problems();
+  const std::string& file = problems_.file();
+  std::stable_sort(list.begin(), list.end(), [&](const Problem& a, const Problem& b) {
+    const bool a_other = a.file != file, b_other = b.file != file;
+    if (a_other != b_other) return !a_other;
+    return !a_other && a.line < b.line;
+  });
+  throw InputError(list);
+}
+
+bool Loader::read_document(YAML::Node& root) {
+  // the file itself
+  const fs::path file_path(problems_.file());
+  std::error_code error;
+  if (!fs::exists(file_path, error)) {
+    problems_.add(0, "", "scenario file not found");
+    return false;
+  }
+  if (fs::is_directory(file_path, error)) {
+    problems_.add(0, "", "is a directory, expected a scenario .yaml file");
+    return false;
+  }
+  std::ifstream in(file_path);
+  std::stringstream text;
+  text << in.rdbuf();
+  if (!in) {
+    problems_.add(0, "", "cannot read the scenario file");
+    return false;
+  }
+  // exactly one YAML document
+  std::vector<YAML::Node> documents;
+  try {
+    documents = YAML::LoadAll(text.str());
+  } catch (const YAML::ParserException& e) {
+    problems_.add(e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
+    return false;
+  } catch (const YAML::Exception& e) {
+    problems_.add(0, "", std::string("malformed YAML: ") + e.what());
+    return false;
+  }
+  if (documents.empty() || documents.front().IsNull()) {
+    problems_.add(1, "", "the file holds no settings: expected a map with at least `toolpath:`");
+    return false;
+  }
+  if (documents.size() > 1) {
+    problems_.add(line_of(documents[1]), "",
+                  "more than one YAML document (---): a scenario file holds one");
+    return false;
+  }
+  root = documents.front();
+  return true;
+}
+
+void Loader::read_name(const Field& field) {
+  const std::optional<std::string> name = read_string(field, problems_);
+  if (!name) return;
+  // it names the results folder
+  if (name->find_first_of("/\\") != std::string::npos || *name == "." || *name == "..") {
+    problems_.add(field.line, field.key,
+                  "'" + *name + "' cannot name a results folder (no '/', '\\', '.' or '..')");
+    return;
+  }
+  scenario_.name = *name;
+}
+
+void Loader::read_machine(const Field& field) {
+  const std::optional<std::string> machine = read_string(field, problems_);
+  if (!machine) return;
+  if (contains(kBuiltinMachines, *machine)) {
+    scenario_.machine = *machine;
+    return;
+  }
+  // otherwise an MJCF file, relative to the scenario file
+  const fs::path given(*machine);
+  std::string extension = given.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension != ".xml") {
+    problems_.add(field.line, field.key,
+                  "unknown machine '" + *machine + "' (expected " + join(kBuiltinMachines) +
+                      " or a path to an MJCF .xml file)");
+    return;
+  }
+  const fs::path resolved = resolve(*machine);
+  std::error_code error;
+  if (!fs::is_regular_file(resolved, error)) {
+    problems_.add(field.line, field.key,
+                  "MJCF file '" + *machine + "' not found (looked for " + resolved.string() + ")");
+    return;
+  }
+  scenario_.machine = fs::absolute(resolved, error).lexically_normal().string();
+  scenario_.model_path = scenario_.machine;
+}
+
+void Loader::read_axis_limits(const MapView& view, AxisLimits& axis) {
+  if (const Field* f = view.find("v_max"))
+    axis.v_max_mm_s = read_number(*f, problems_, Range::positive()).value_or(axis.v_max_mm_s);
+  if (const Field* f = view.find("a_max"))
+    axis.a_max_mm_s2 = read_number(*f, problems_, Range::positive()).value_or(axis.a_max_mm_s2);
+  if (const Field* f = view.find("j_max"))
+    axis.j_max_mm_s3 = read_number(*f, problems_, Range::non_negative()).value_or(axis.j_max_mm_s3);
+}
+
+void Loader::read_limits(const Field& field) {
+  const std::size_t problems_before = problems_.size();
+  const std::vector<std::string> axis_keys{"v_max", "a_max", "j_max"};
+  const MapView view(field, {"v_max", "a_max", "j_max", "x", "y", "z", "joint"}, problems_);
+  if (!view.is_map()) {
+    limits_ok_ = false;
+    return;
+  }
+  // common values, then per-axis overrides
+  AxisLimits common{kDefaultVMax_mm_s, kDefaultAMax_mm_s2, 0.0};
+  read_axis_limits(view, common);
+  static const char* kAxisNames[3] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    AxisLimits axis = common;
+    if (const Field* f = view.find(kAxisNames[i])) {
+      const MapView axis_view(*f, axis_keys, problems_);
+      if (axis_view.is_map()) read_axis_limits(axis_view, axis);
+    }
+    scenario_.limits.axes[i] = axis;
+  }
+  // joint (carriage) limits: no defaults, v_max and a_max are required
+  if (const Field* f = view.find("joint")) {
+    const MapView joint_view(*f, axis_keys, problems_);
+    if (joint_view.is_map()) {
+      AxisLimits joint{0.0, 0.0, 0.0};
+      for (const char* required : {"v_max", "a_max"})
+        if (!joint_view.has(required))
+          problems_.add(
+              f->key_line, f->key,
+              std::string("missing ") + required + " (joint limits need v_max and a_max)");
+      read_axis_limits(joint_view, joint);
+      scenario_.has_joint_limits = true;
+      scenario_.joint_limits = joint;
+    }
+  }
+  limits_ok_ = problems_.size() == problems_before;
+  // the same rules the planners apply (MachineLimits::validate)
+  if (limits_ok_) {
+    const std::string problem = scenario_.limits.validate();
+    if (!problem.empty()) {
+      problems_.add(field.key_line, field.key, problem);
+      limits_ok_ = false;
+    }
+  }
+}
+
+void Loader::read_process(const Field& field) {
+  const std::vector<std::string> aerosol_only{"flow_mm3_s", "sigma_mm", "shutter_time_s"};
+  const std::vector<std::string> extrusion_only{"bead_width_mm", "layer_height_mm", "tau_s"};
+  const MapView view(field,
+                     {"type", "flow_mm3_s", "sigma_mm", "line_width_mm", "shutter_time_s",
+                      "bead_width_mm", "layer_height_mm", "tau_s"},
+                     problems_);
+  if (!view.is_map()) return;
+  ProcessSpec& process = scenario_.process;
+  bool type_known = true;
+  if (const Field* f = view.find("type")) {
+    const std::optional<std::string> type = read_string(*f, problems_);
+    if (type && *type != "aerosol" && *type != "extrusion")
+      problems_.add(f->line, f->key,
+                    "unknown process type '" + *type + "' (expected aerosol or extrusion)");
+    type_known = type && (*type == "aerosol" || *type == "extrusion");
+    if (type_known) process.type = *type;
+  }
+  // a parameter of the other process type is a mistake, not something to ignore
+  const auto read = [&](const std::string& key, const Range& range, double& target) {
+    const Field* f = view.find(key);
+    if (!f) return;
+    const bool wrong_type =
+        type_known && ((process.type == "aerosol" && contains(extrusion_only, key)) ||
+                       (process.type == "extrusion" && contains(aerosol_only, key)));
+    if (wrong_type) {
+      const std::string other = process.type == "aerosol" ? "extrusion" : "aerosol";
+      problems_.add(f->line, f->key,
+                    "applies to " + other + ", not to process type " + process.type);
+      return;
+    }
+    target = read_number(*f, problems_, range).value_or(target);
+  };
+  read("flow_mm3_s", Range::non_negative(), process.flow_mm3_s);
+  read("sigma_mm", Range::positive(), process.sigma_mm);
+  read("line_width_mm", Range::non_negative(), process.line_width_mm);
+  read("shutter_time_s", Range::positive(), process.shutter_time_s);
+  read("bead_width_mm", Range::positive(), process.bead_width_mm);
+  read("layer_height_mm", Range::positive(), process.layer_height_mm);
+  read("tau_s", Range::positive(), process.tau_s);
+}
+
+void Loader::read_toolpath(const Field* field) {
+  if (!field) {
+    problems_.add(1, "toolpath",
+                  "missing: give the print paths, e.g. toolpath: {speed: 3, segments: [...]}");
+    return;
+  }
+  const MapView view(
+      *field,
+      {"speed", "start", "end", "segments", "polylines", "gcode", "random_segments", "surface"},
+      problems_);
+  if (!view.is_map()) return;
+  Toolpath& toolpath = scenario_.toolpath;
+
+  // default print speed, start and end (end defaults to start)
+  std::optional<double> default_speed;
+  if (const Field* f = view.find("speed")) {
+    default_speed = read_number(*f, problems_, Range::positive());
+    speed_missing_ = !default_speed;  // already reported: do not repeat per path
+  }
+  if (const Field* f = view.find("start"))
+    toolpath.start_mm = read_point(*f, problems_).value_or(Vec3::Zero());
+  toolpath.end_mm = toolpath.start_mm;
+  if (const Field* f = view.find("end"))
+    toolpath.end_mm = read_point(*f, problems_).value_or(toolpath.start_mm);
+
+  // exactly one kind of print paths
+  std::vector<const Field*> kinds;
+  for (const std::string& kind : kToolpathKinds)
+    if (const Field* f = view.find(kind)) kinds.push_back(f);
+  std::stable_sort(kinds.begin(), kinds.end(),
+                   [](const Field* a, const Field* b) { return a->key_line < b->key_line; });
+  if (kinds.empty()) {
+    problems_.add(
+        field->key_line, field->key,
+        "no print paths: give exactly one of segments, polylines, gcode, random_segments");
+    return;
+  }
+  for (std::size_t i = 1; i < kinds.size(); ++i)
+    problems_.add(kinds[i]->line, kinds[i]->key,
+                  "a toolpath takes exactly one of segments, polylines, gcode, random_segments; "
+                  "remove this or " +
+                      kinds.front()->key);
+  const Field& kind = *kinds.front();
+  const std::string name = kind.key.substr(kind.key.rfind('.') + 1);
+  if (name == "segments") {
+    read_segments(kind, default_speed);
+  } else if (name == "polylines") {
+    read_polylines(kind, default_speed);
+  } else if (name == "gcode") {
+    read_gcode_file(kind, default_speed);
+  } else if (name == "random_segments") {
+    read_random_segments(kind, default_speed, view.has("start"), view.has("end"));
+  } else {
+    problems_.add(kind.line, kind.key,
+                  "surface toolpaths are not supported yet (use segments, polylines or gcode)");
+  }
+}
+
+std::optional<std::vector<Vec3>> Loader::read_points(const Field& field, std::vector<int>& lines) {
+  if (!expect_list(field, problems_, "a list of points [[x, y], ...]")) return std::nullopt;
+  if (field.node.size() < 2) {
+    problems_.add(field.line, field.key,
+                  "a print path needs at least 2 points, got " + std::to_string(field.node.size()));
+    return std::nullopt;
+  }
+  std::vector<Vec3> points;
+  bool ok = true;
+  for (std::size_t j = 0; j < field.node.size(); ++j) {
+    const Field point_field = field.item(j);
+    const std::optional<Vec3> point = read_point(point_field, problems_);
+    ok = ok && point.has_value();
+    points.push_back(point.value_or(Vec3::Zero()));
+    lines.push_back(point_field.line);
+  }
+  if (!ok) return std::nullopt;
+  return points;
+}
+
+void Loader::read_segments(const Field& field, const std::optional<double>& default_speed) {
+  if (!expect_list(field, problems_, "a list of segments [[x, y], [x, y]]")) return;
+  if (field.node.size() == 0) {
+    problems_.add(field.line, field.key, "is empty: give at least one segment");
+    return;
+  }
+  if (!default_speed && !speed_missing_) {
+    problems_.add(field.key_line, "toolpath.speed",
+                  "missing: the print speed of the segments (mm/s)");
+    speed_missing_ = true;
+  }
+  for (std::size_t i = 0; i < field.node.size(); ++i) {
+    const Field item = field.item(i);
+    if (!item.node.IsSequence() || item.node.size() != 2) {
+      const std::string got = item.node.IsSequence()
+                                  ? "a list of " + std::to_string(item.node.size()) + " points"
+                                  : describe(item.node);
+      problems_.add(item.line, item.key,
+                    "expected a segment [[x, y], [x, y]] (two points), got " + got +
+                        (item.node.IsSequence() ? " (use polylines for more)" : ""));
+      continue;
+    }
+    std::vector<int> lines;
+    const std::optional<std::vector<Vec3>> points = read_points(item, lines);
+    if (!points) continue;
+    PrintPath path;
+    path.points = *points;
+    path.speed_mm_s = default_speed.value_or(0.0);
+    path.source_index = static_cast<int>(i);
+    check_path(path, PathOrigin{problems_.file(), item.key, {item.line, item.line}, false});
+    scenario_.toolpath.paths.push_back(std::move(path));
+  }
+}
+
+void Loader::read_polylines(const Field& field, const std::optional<double>& default_speed) {
+  if (!expect_list(field, problems_, "a list of polylines")) return;
+  if (field.node.size() == 0) {
+    problems_.add(field.line, field.key, "is empty: give at least one polyline");
+    return;
+  }
+  for (std::size_t i = 0; i < field.node.size(); ++i) {
+    const Field item = field.item(i);
+    // either a bare point list or {points: [...], speed: s}
+    Field points_field = item;
+    std::optional<double> speed = default_speed;
+    bool speed_bad = false;
+    if (item.node.IsMap()) {
+      const MapView view(item, {"points", "speed"}, problems_);
+      const Field* points = view.find("points");
+      if (const Field* f = view.find("speed")) {
+        speed = read_number(*f, problems_, Range::positive());
+        speed_bad = !speed;
+      }
+      if (!points) {
+        problems_.add(item.line, item.key, "missing points: [[x, y], ...]");
+        continue;
+      }
+      points_field = *points;
+    } else if (!item.node.IsSequence()) {
+      problems_.add(
+          item.line, item.key,
+          "expected a list of points or {points: [...], speed: s}, got " + describe(item.node));
+      continue;
+    }
+    if (!speed && !speed_bad && !speed_missing_)
+      problems_.add(item.line, item.key,
+                    "no print speed: give toolpath.speed or speed: for this polyline");
+    std::vector<int> lines;
+    const std::optional<std::vector<Vec3>> points = read_points(points_field, lines);
+    if (!points) continue;
+    PrintPath path;
+    path.points = *points;
+    path.speed_mm_s = speed.value_or(0.0);
+    path.source_index = static_cast<int>(i);
+    check_path(path, PathOrigin{problems_.file(), item.key, lines, true});
+    scenario_.toolpath.paths.push_back(std::move(path));
+  }
+}
+
+void Loader::read_gcode_file(const Field& field, const std::optional<double>& default_speed) {
+  const std::optional<std::string> given = read_string(field, problems_);
+  if (!given) return;
+  const fs::path resolved = resolve(*given);
+  std::error_code error;
+  if (!fs::is_regular_file(resolved, error)) {
+    problems_.add(field.line, field.key,
+                  "G-code file '" + *given + "' not found (looked for " + resolved.string() + ")");
+    return;
+  }
+  GcodeImport imported;
+  try {
+    imported = read_gcode(resolved.string(), default_speed.value_or(0.0));
+  } catch (const InputError& e) {
+    for (const Problem& p : e.problems()) problems_.add_problem(p);
+    return;
+  }
+  if (imported.toolpath.paths.empty()) {
+    problems_.add(field.line, field.key,
+                  "G-code file '" + *given + "' has no print moves (G1 with increasing E)");
+    return;
+  }
+  for (std::size_t i = 0; i < imported.toolpath.paths.size(); ++i) {
+    PrintPath& path = imported.toolpath.paths[i];
+    check_path(path, PathOrigin{resolved.string(), field.key, imported.point_lines[i], true});
+    scenario_.toolpath.paths.push_back(std::move(path));
+  }
+}
+
+void Loader::read_random_segments(const Field& field, const std::optional<double>& default_speed,
+                                  bool start_given, bool end_given) {
+  const std::size_t problems_before = problems_.size();
+  const MapView view(field, {"n", "bed", "length", "seed", "speed"}, problems_);
+  if (!view.is_map()) return;
+  RandomSegmentsSpec spec;
+  if (const Field* f = view.find("n"))
+    spec.count =
+        static_cast<int>(read_integer(*f, problems_, 1, kMaxRandomSegments).value_or(spec.count));
+  if (const Field* f = view.find("bed")) {
+    if (const auto bed = read_numbers(*f, problems_, 2, Range::positive())) {
+      spec.bed_x_mm = (*bed)[0];
+      spec.bed_y_mm = (*bed)[1];
+    }
+  }
+  if (const Field* f = view.find("length")) {
+    if (const auto length = read_numbers(*f, problems_, 2, Range::positive())) {
+      if ((*length)[0] > (*length)[1])
+        problems_.add(f->line, f->key,
+                      "expected [min, max] with min <= max, got [" + format_number((*length)[0]) +
+                          ", " + format_number((*length)[1]) + "]");
+      spec.length_min_mm = (*length)[0];
+      spec.length_max_mm = (*length)[1];
+    }
+  }
+  if (const Field* f = view.find("seed")) spec.seed = read_seed(*f, problems_).value_or(spec.seed);
+  std::optional<double> speed = default_speed;
+  bool speed_bad = false;
+  if (const Field* f = view.find("speed")) {
+    speed = read_number(*f, problems_, Range::positive());
+    speed_bad = !speed;
+  }
+  if (!speed && !speed_bad && !speed_missing_)
+    problems_.add(field.key_line, field.key, "no print speed: give toolpath.speed or speed: here");
+  if (problems_.size() != problems_before || !speed) return;
+  spec.speed_mm_s = *speed;
+
+  // generate; the generator's own problems get this file and line
+  Toolpath generated;
+  try {
+    generated = make_random_segments(spec);
+  } catch (const InputError& e) {
+    for (Problem p : e.problems()) {
+      if (p.file.empty()) {
+        p.file = problems_.file();
+        p.line = field.key_line;
+      }
+      if (p.key.empty()) p.key = field.key;
+      problems_.add_problem(p);
+    }
+    return;
+  }
+  // the instance's start and end apply where the file gives none (end defaults to start)
+  Toolpath& toolpath = scenario_.toolpath;
+  if (!start_given) toolpath.start_mm = generated.start_mm;
+  if (!end_given) toolpath.end_mm = start_given ? toolpath.start_mm : generated.end_mm;
+  for (PrintPath& path : generated.paths) {
+    check_path(path, PathOrigin{problems_.file(), field.key,
+                                std::vector<int>(path.points.size(), field.key_line), true});
+    scenario_.toolpath.paths.push_back(std::move(path));
+  }
+}
+
+void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
+  for (std::size_t k = 0; k + 1 < path.points.size(); ++k) {
+    const std::string segment = origin.name_segments
+                                    ? "segment " + std::to_string(k) + " (points " +
+                                          std::to_string(k) + " and " + std::to_string(k + 1) + ")"
+                                    : "segment";
+    const Vec3 step = path.points[k + 1] - path.points[k];
+    const double length_mm = step.norm();
+    const int line = origin.point_lines.at(k + 1);
+    // consecutive points must differ
+    if (length_mm <= kJoinTolerance_mm) {
+      problems_.add_problem(Problem{origin.file, line, origin.key,
+                                    segment + " has zero length: both points are " +
+                                        format_point(path.points[k]) +
+                                        " (consecutive points must differ)"});
+      return;
+    }
+    if (!limits_ok_ || path.speed_mm_s <= 0.0) continue;
+    // every axis must reach its share of the print speed
+    static const char* kAxisNames[3] = {"x", "y", "z"};
+    int worst_axis = -1;
+    double worst_ratio = 1.0 + kSpeedTolerance;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double needed_mm_s = path.speed_mm_s * std::abs(step[axis]) / length_mm;
+      const double ratio = needed_mm_s / scenario_.limits.axes[axis].v_max_mm_s;
+      if (ratio > worst_ratio) {
+        worst_ratio = ratio;
+        worst_axis = axis;
+      }
+    }
+    if (worst_axis >= 0) {
+      const double needed_mm_s = path.speed_mm_s * std::abs(step[worst_axis]) / length_mm;
+      problems_.add_problem(Problem{origin.file, line, origin.key,
+                                    (origin.name_segments ? segment + ": " : std::string()) +
+                                        "print speed " + format_speed(path.speed_mm_s) +
+                                        " mm/s needs " + format_speed(needed_mm_s) + " mm/s on " +
+                                        kAxisNames[worst_axis] + ", above limits v_max " +
+                                        format_speed(scenario_.limits.axes[worst_axis].v_max_mm_s) +
+                                        " (lower the speed or raise the limit)"});
+      return;  // one problem per path is enough
+    }
+  }
+}
+
+bool Loader::read_order_name(const Field& field, OrderSpec& order) {
+  const std::optional<std::string> text = read_string(field, problems_);
+  if (!text) return false;
+  const std::size_t plus = text->find('+');
+  const std::string first = text->substr(0, plus);
+  const std::string second = plus == std::string::npos ? "" : text->substr(plus + 1);
+  const bool ok = plus == std::string::npos
+                      ? contains(sequencer_methods(), first) || contains(refine_methods(), first)
+                      : contains(sequencer_methods(), first) && contains(refine_methods(), second);
+  if (!ok) {
+    problems_.add(field.line, field.key,
+                  "unknown sequencer '" + *text + "' (expected " + join(sequencer_methods()) +
+                      ", optionally +" + join(refine_methods(), "|") + ", or " +
+                      join(refine_methods()) + " alone for nearest_neighbor+it)");
+    return false;
+  }
+  // a refinement alone is shorthand for nearest_neighbor plus that refinement
+  if (contains(refine_methods(), first)) {
+    order.method = "nearest_neighbor";
+    order.refine = first;
+  } else {
+    order.method = first;
+    order.refine = second;
+  }
+  return true;
+}
+
+void Loader::read_order(const Field& field) {
+  OrderSpec& order = scenario_.order;
+  if (field.node.IsScalar()) {
+    read_order_name(field, order);
+    return;
+  }
+  if (!field.node.IsMap()) {
+    problems_.add(field.line, field.key,
+                  "expected a sequencer name or {method, refine, cost_model, seed}, got " +
+                      describe(field.node));
+    return;
+  }
+  const MapView view(field, {"method", "refine", "cost_model", "seed"}, problems_);
+  bool method_refines = false;
+  if (const Field* f = view.find("method")) {
+    if (read_order_name(*f, order)) method_refines = !order.refine.empty();
+  }
+  if (const Field* f = view.find("refine")) {
+    const std::optional<std::string> refine = read_string(*f, problems_);
+    if (refine && !contains(refine_methods(), *refine) && *refine != "none") {
+      problems_.add(
+          f->line, f->key,
+          "unknown refinement '" + *refine + "' (expected " + join(refine_methods()) + " or none)");
+    } else if (refine && method_refines && *refine != order.refine) {
+      problems_.add(f->line, f->key,
+                    "method already implies refine " + order.refine + "; give one refinement");
+    } else if (refine) {
+      order.refine = *refine == "none" ? "" : *refine;
+    }
+  }
+  if (const Field* f = view.find("cost_model")) {
+    const std::optional<std::string> model = read_string(*f, problems_);
+    if (model && !contains(cost_models(), *model))
+      problems_.add(f->line, f->key,
+                    "unknown cost model '" + *model + "' (expected " + join(cost_models()) + ")");
+    else if (model)
+      order.cost_model = *model;
+  }
+  if (const Field* f = view.find("seed"))
+    order.seed = read_seed(*f, problems_).value_or(order.seed);
+}
+
+void Loader::read_planners(const Field& field) {
+  if (!expect_list(field, problems_,
+                   "a list of planners, e.g. [lspb_mtt, {name: bezier, delta: 0.3}]"))
+    return;
+  if (field.node.size() == 0) {
+    problems_.add(field.line, field.key, "is empty: name at least one planner");
+    return;
+  }
+  std::vector<PlannerSpec> planners;
+  for (std::size_t i = 0; i < field.node.size(); ++i) {
+    const Field item = field.item(i);
+    PlannerSpec spec;
+    spec.line = item.line;
+    std::vector<const Field*> parameter_fields;
+    std::optional<MapView> view;
+    if (item.node.IsScalar()) {
+      spec.name = item.node.Scalar();
+    } else if (item.node.IsMap()) {
+      // {name: X, <parameter>: number | [numbers]}: every key but name is a parameter
+      std::vector<std::string> keys;
+      for (const auto& key_value : item.node)
+        if (key_value.first.IsScalar()) keys.push_back(key_value.first.Scalar());
+      view.emplace(item, keys, problems_);
+      const Field* name = view->find("name");
+      if (!name) {
+        problems_.add(item.line, item.key, "missing name: (which planner)");
+        continue;
+      }
+      const std::optional<std::string> text = read_string(*name, problems_);
+      if (!text) continue;
+      spec.name = *text;
+      for (const std::string& key : keys)
+        if (key != "name" && view->find(key)) parameter_fields.push_back(view->find(key));
+    } else {
+      problems_.add(
+          item.line, item.key,
+          "expected a planner name or {name: X, parameter: value}, got " + describe(item.node));
+      continue;
+    }
+    // the name first, then each parameter on its own line
+    const std::string name_problem = check_planner_spec(PlannerSpec{spec.name, {}, spec.line});
+    if (!name_problem.empty()) {
+      problems_.add(item.line, item.key, name_problem);
+      continue;
+    }
+    for (const Field* parameter : parameter_fields) {
+      const std::string key = parameter->key.substr(parameter->key.rfind('.') + 1);
+      std::vector<double> values;
+      bool ok = true;
+      if (parameter->node.IsSequence()) {
+        if (parameter->node.size() == 0) {
+          problems_.add(parameter->line, parameter->key, "is an empty list: give a number");
+          continue;
+        }
+        for (std::size_t j = 0; j < parameter->node.size(); ++j) {
+          const std::optional<double> value = read_number(parameter->item(j), problems_);
+          ok = ok && value.has_value();
+          values.push_back(value.value_or(0.0));
+        }
+      } else {
+        const std::optional<double> value = read_number(*parameter, problems_);
+        ok = value.has_value();
+        values.push_back(value.value_or(0.0));
+      }
+      if (!ok) continue;
+      PlannerSpec single{spec.name, {{key, values}}, spec.line};
+      const std::string problem = check_planner_spec(single);
+      if (!problem.empty()) {
+        problems_.add(parameter->line, parameter->key, problem);
+        continue;
+      }
+      spec.params[key] = values;
+    }
+    // each planner once: results are written per planner name
+    const bool repeated = std::any_of(planners.begin(), planners.end(),
+                                      [&](const PlannerSpec& p) { return p.name == spec.name; });
+    if (repeated) {
+      problems_.add(item.line, item.key, "planner '" + spec.name + "' is listed twice");
+      continue;
+    }
+    planners.push_back(std::move(spec));
+  }
+  scenario_.planners = std::move(planners);
+}
+
+void Loader::read_sim(const Field& field) {
+  const MapView view(field, {"timestep_s", "cell_mm", "kp_scale", "settle_s"}, problems_);
+  SimSpec& sim = scenario_.sim;
+  if (const Field* f = view.find("timestep_s"))
+    sim.timestep_s =
+        read_number(*f, problems_, Range{0.0, false, 0.01, true}).value_or(sim.timestep_s);
+  if (const Field* f = view.find("cell_mm"))
+    sim.cell_mm = read_number(*f, problems_, Range::non_negative()).value_or(sim.cell_mm);
+  if (const Field* f = view.find("kp_scale"))
+    sim.kp_scale = read_number(*f, problems_, Range::positive()).value_or(sim.kp_scale);
+  if (const Field* f = view.find("settle_s"))
+    sim.settle_s = read_number(*f, problems_, Range::non_negative()).value_or(sim.settle_s);
+}
+
+void Loader::read_outputs(const Field& field) {
+  const MapView view(field, {"render", "image_width", "image_height"}, problems_);
+  OutputSpec& outputs = scenario_.outputs;
+  if (const Field* f = view.find("render"))
+    outputs.render = read_bool(*f, problems_).value_or(outputs.render);
+  if (const Field* f = view.find("image_width"))
+    outputs.image_width = static_cast<int>(
+        read_integer(*f, problems_, kMinImageSize, kMaxImageSize).value_or(outputs.image_width));
+  if (const Field* f = view.find("image_height"))
+    outputs.image_height = static_cast<int>(
+        read_integer(*f, problems_, kMinImageSize, kMaxImageSize).value_or(outputs.image_height));
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::string& path) {
+  return Loader(path).load();
+}
+
+std::vector<Problem> validate_scenario_file(const std::string& path) {
+  try {
+    load_scenario(path);
+  } catch (const InputError& e) {
+    return e.problems();
+  }
+  return {};
+}
+
+}  // namespace depotwin

@@ -1,0 +1,274 @@
+#include "scenario/yaml_reader.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace depotwin::scenario_detail {
+
+namespace {
+
+// yaml-cpp tags quoted scalars "!" and plain ones "?"
+bool is_quoted(const YAML::Node& node) {
+  return node.Tag() == "!";
+}
+
+bool is_empty(const YAML::Node& node) {
+  return !node.IsDefined() || node.IsNull();
+}
+
+std::string lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
+// YAML's spellings of infinity and not-a-number (.inf, -.Inf, .NaN, ...)
+bool is_yaml_special_float(const std::string& text) {
+  const std::string lower = lowercase(text);
+  return lower == ".nan" || lower == ".inf" || lower == "+.inf" || lower == "-.inf";
+}
+
+// the whole text as a double (locale-independent), or nothing
+std::optional<double> parse_double(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  const char* first = text.data();
+  const char* last = text.data() + text.size();
+  if (*first == '+') ++first;
+  double value = 0.0;
+  const auto [end, error] = std::from_chars(first, last, value);
+  if (error != std::errc() || end != last) return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+int line_of(const YAML::Node& node) {
+  if (!node.IsDefined()) return 0;
+  const YAML::Mark mark = node.Mark();
+  return mark.is_null() ? 0 : mark.line + 1;
+}
+
+std::string describe(const YAML::Node& node) {
+  if (is_empty(node)) return "nothing";
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a map";
+  if (is_quoted(node)) return "the text \"" + node.Scalar() + "\"";
+  return "'" + node.Scalar() + "'";
+}
+
+void ProblemList::add(int line, const std::string& key, const std::string& message) {
+  problems_.push_back(Problem{file_, line, key, message});
+}
+
+Field Field::child(const YAML::Node& value, const std::string& suffix) const {
+  Field out;
+  out.node = value;
+  out.key = key.empty() ? suffix : key + "." + suffix;
+  const int value_line = is_empty(value) ? 0 : line_of(value);
+  out.line = value_line > 0 ? value_line : line;
+  out.key_line = out.line;
+  return out;
+}
+
+Field Field::item(std::size_t index) const {
+  Field out;
+  out.node = node[index];
+  out.key = key + "[" + std::to_string(index) + "]";
+  const int value_line = is_empty(out.node) ? 0 : line_of(out.node);
+  out.line = value_line > 0 ? value_line : line;
+  out.key_line = out.line;
+  return out;
+}
+
+MapView::MapView(const Field& field, const std::vector<std::string>& allowed, ProblemList& problems)
+    : field_(field) {
+  if (!field.node.IsMap()) {
+    problems.add(field.line, field.key, "expected a map, got " + describe(field.node));
+    return;
+  }
+  is_map_ = true;
+  for (const auto& key_value : field.node) {
+    const YAML::Node key_node = key_value.first;
+    const YAML::Node value_node = key_value.second;
+    const int key_line = line_of(key_node) > 0 ? line_of(key_node) : field.line;
+    if (!key_node.IsScalar()) {
+      problems.add(key_line, field.key, "a key must be a name, got " + describe(key_node));
+      continue;
+    }
+    const std::string name = key_node.Scalar();
+    Field entry;
+    entry.node = value_node;
+    entry.key = field.key.empty() ? name : field.key + "." + name;
+    // an empty value (`key:`) is marked at the next token; point at the key instead
+    entry.line = is_empty(value_node) || line_of(value_node) == 0 ? key_line : line_of(value_node);
+    entry.key_line = key_line;
+    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
+      std::string known;
+      for (const std::string& a : allowed) known += (known.empty() ? "" : ", ") + a;
+      problems.add(key_line, entry.key, "unknown key (expected one of: " + known + ")");
+      continue;
+    }
+    if (find(name)) {
+      problems.add(key_line, entry.key, "given twice (keep one)");
+      continue;
+    }
+    entries_.emplace_back(name, std::move(entry));
+  }
+}
+
+const Field* MapView::find(const std::string& key) const {
+  for (const auto& [name, entry] : entries_)
+    if (name == key) return &entry;
+  return nullptr;
+}
+
+bool Range::contains(double value) const {
+  const bool above = min_inclusive ? value >= min : value > min;
+  const bool below = max_inclusive ? value <= max : value < max;
+  return above && below;
+}
+
+std::string Range::text() const {
+  const bool has_min = std::isfinite(min);
+  const bool has_max = std::isfinite(max);
+  if (has_min && has_max)
+    return std::string("in ") + (min_inclusive ? "[" : "(") + format_number(min) + ", " +
+           format_number(max) + (max_inclusive ? "]" : ")");
+  if (has_min) return std::string(min_inclusive ? ">= " : "> ") + format_number(min);
+  if (has_max) return std::string(max_inclusive ? "<= " : "< ") + format_number(max);
+  return "finite";
+}
+
+std::optional<double> read_number(const Field& field, ProblemList& problems, const Range& range) {
+  const YAML::Node& node = field.node;
+  if (!node.IsScalar()) {
+    problems.add(field.line, field.key, "expected a number, got " + describe(node));
+    return std::nullopt;
+  }
+  const std::string& text = node.Scalar();
+  if (is_quoted(node)) {
+    problems.add(field.line, field.key,
+                 "expected a number, got " + describe(node) + " (write it without quotes)");
+    return std::nullopt;
+  }
+  if (is_yaml_special_float(text)) {
+    problems.add(field.line, field.key, "must be a finite number, got " + text);
+    return std::nullopt;
+  }
+  const std::optional<double> value = parse_double(text);
+  if (!value) {
+    problems.add(field.line, field.key, "expected a number, got " + describe(node));
+    return std::nullopt;
+  }
+  if (!std::isfinite(*value)) {
+    problems.add(field.line, field.key, "must be a finite number, got " + text);
+    return std::nullopt;
+  }
+  if (!range.contains(*value)) {
+    problems.add(field.line, field.key, "must be " + range.text() + ", got " + text);
+    return std::nullopt;
+  }
+  return value;
+}
+
+std::optional<long long> read_integer(const Field& field, ProblemList& problems,
+                                      long long min_value, long long max_value) {
+  const std::optional<double> value = read_number(field, problems);
+  if (!value) return std::nullopt;
+  const Range range{static_cast<double>(min_value), true, static_cast<double>(max_value), true};
+  if (std::floor(*value) != *value || !range.contains(*value)) {
+    problems.add(field.line, field.key,
+                 "must be a whole number " + range.text() + ", got " + field.node.Scalar());
+    return std::nullopt;
+  }
+  return static_cast<long long>(*value);
+}
+
+std::optional<std::uint64_t> read_seed(const Field& field, ProblemList& problems) {
+  const YAML::Node& node = field.node;
+  const std::string text = node.IsScalar() ? node.Scalar() : "";
+  std::uint64_t value = 0;
+  const char* last = text.data() + text.size();
+  const auto [end, error] = std::from_chars(text.data(), last, value);
+  if (!node.IsScalar() || is_quoted(node) || text.empty() || error != std::errc() || end != last) {
+    problems.add(field.line, field.key,
+                 "expected a whole number >= 0 (a random seed), got " + describe(node));
+    return std::nullopt;
+  }
+  return value;
+}
+
+std::optional<bool> read_bool(const Field& field, ProblemList& problems) {
+  bool value = false;
+  if (!field.node.IsScalar() || is_quoted(field.node) ||
+      !YAML::convert<bool>::decode(field.node, value)) {
+    problems.add(field.line, field.key, "expected true or false, got " + describe(field.node));
+    return std::nullopt;
+  }
+  return value;
+}
+
+std::optional<std::string> read_string(const Field& field, ProblemList& problems) {
+  if (!field.node.IsScalar() || field.node.Scalar().empty()) {
+    problems.add(field.line, field.key, "expected a name, got " + describe(field.node));
+    return std::nullopt;
+  }
+  return field.node.Scalar();
+}
+
+bool expect_list(const Field& field, ProblemList& problems, const std::string& what) {
+  if (field.node.IsSequence()) return true;
+  problems.add(field.line, field.key, "expected " + what + ", got " + describe(field.node));
+  return false;
+}
+
+std::optional<std::vector<double>> read_numbers(const Field& field, ProblemList& problems,
+                                                std::size_t count, const Range& range) {
+  if (!field.node.IsSequence() || field.node.size() != count) {
+    const std::string got = field.node.IsSequence()
+                                ? "a list of " + std::to_string(field.node.size())
+                                : describe(field.node);
+    problems.add(field.line, field.key,
+                 "expected a list of " + std::to_string(count) + " numbers, got " + got);
+    return std::nullopt;
+  }
+  std::vector<double> values;
+  bool ok = true;
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::optional<double> value = read_number(field.item(i), problems, range);
+    ok = ok && value.has_value();
+    values.push_back(value.value_or(0.0));
+  }
+  if (!ok) return std::nullopt;
+  return values;
+}
+
+std::optional<Vec3> read_point(const Field& field, ProblemList& problems) {
+  const YAML::Node& node = field.node;
+  if (!node.IsSequence() || node.size() < 2 || node.size() > 3) {
+    const std::string got = node.IsSequence() ? "a list of " + std::to_string(node.size()) +
+                                                    " number" + (node.size() == 1 ? "" : "s")
+                                              : describe(node);
+    problems.add(field.line, field.key, "expected a point [x, y] or [x, y, z] in mm, got " + got);
+    return std::nullopt;
+  }
+  Vec3 point = Vec3::Zero();
+  bool ok = true;
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const std::optional<double> value = read_number(field.item(i), problems);
+    ok = ok && value.has_value();
+    if (value) point[static_cast<int>(i)] = *value;
+  }
+  if (!ok) return std::nullopt;
+  return point;
+}
+
+std::string format_number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+}  // namespace depotwin::scenario_detail

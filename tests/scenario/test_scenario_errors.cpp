@@ -1,0 +1,545 @@
+// Bad scenario files: each problem names the file, the 1-based line and the dotted key,
+// and says what is wrong; every problem of a file is reported, not only the first.
+#include <gtest/gtest.h>
+
+#include "scenario/scenario.hpp"
+#include "scenario_test_util.hpp"
+
+namespace depotwin {
+namespace {
+
+using testing_scenario::dump;
+using testing_scenario::expect_problem;
+using ScenarioErrors = testing_scenario::ScenarioFiles;
+
+TEST_F(ScenarioErrors, UnknownTopLevelKey) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+colour: red
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "colour", 2,
+                 "unknown key (expected one of: name, machine");
+}
+
+TEST_F(ScenarioErrors, UnknownNestedKey) {
+  const auto problems = problems_of(R"(
+limits:
+  v_max: 4
+  x: {v_max: 3, a_maxx: 30}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "limits.x.a_maxx", 3,
+                 "unknown key (expected one of: v_max, a_max, j_max)");
+}
+
+TEST_F(ScenarioErrors, TextWhereANumberIsExpected) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: fast
+  segments: [[[0, 0], [1, 0]]]
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.speed", 2, "expected a number, got 'fast'");
+}
+
+TEST_F(ScenarioErrors, QuotedNumberIsText) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: "3"
+  segments: [[[0, 0], [1, 0]]]
+)");
+  expect_problem(problems, scenario_path(), "toolpath.speed", 2, "without quotes");
+}
+
+TEST_F(ScenarioErrors, MapWhereAListIsExpected) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+planners: {name: lspb_mtt}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "planners", 2, "expected a list of planners");
+}
+
+TEST_F(ScenarioErrors, NegativeLimit) {
+  const auto problems = problems_of(R"(
+limits: {v_max: -4, a_max: 30}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "limits.v_max", 1, "must be > 0, got -4");
+}
+
+TEST_F(ScenarioErrors, ZeroLimit) {
+  const auto problems = problems_of(R"(
+limits:
+  v_max: 4
+  a_max: 0
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "limits.a_max", 3, "must be > 0, got 0");
+}
+
+TEST_F(ScenarioErrors, NanAndInfiniteLimits) {
+  const auto problems = problems_of(R"(
+limits:
+  v_max: .nan
+  a_max: 30
+  j_max: -.inf
+  z: {a_max: nan}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  expect_problem(problems, scenario_path(), "limits.v_max", 2, "must be a finite number, got .nan");
+  expect_problem(problems, scenario_path(), "limits.j_max", 4,
+                 "must be a finite number, got -.inf");
+  expect_problem(problems, scenario_path(), "limits.z.a_max", 5, "must be a finite number");
+}
+
+TEST_F(ScenarioErrors, JointLimitsNeedVelocityAndAcceleration) {
+  const auto problems = problems_of(R"(
+limits: {joint: {v_max: 200}}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "limits.joint", 1, "missing a_max");
+}
+
+TEST_F(ScenarioErrors, ZeroLengthSegment) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  segments:
+    - [[2, 2], [8, 2]]
+    - [[8, 2], [8, 2]]
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.segments[1]", 5,
+                 "zero length: both points are (8, 2, 0)");
+}
+
+TEST_F(ScenarioErrors, ZeroLengthSegmentInAPolyline) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  polylines:
+    - [[0, 0], [1, 0], [1, 0], [2, 0]]
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.polylines[0]", 4,
+                 "segment 1 (points 1 and 2) has zero length");
+}
+
+// 5 mm/s along (3, 4) needs 5 * 4/5 = 4 mm/s on y, above a y limit of 3.9
+TEST_F(ScenarioErrors, PrintSpeedAboveWhatTheLimitsAllow) {
+  const auto problems = problems_of(R"(
+limits: {v_max: 3.9, a_max: 30, x: {v_max: 10}}
+toolpath:
+  speed: 5
+  segments:
+    - [[0, 0], [1, 0]]
+    - [[0, 0], [3, 4]]
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.segments[1]", 6,
+                 "print speed 5 mm/s needs 4 mm/s on y, above limits v_max 3.9");
+}
+
+TEST_F(ScenarioErrors, MissingFile) {
+  const std::string path = (dir_ / "no_such.yaml").string();
+  const auto problems = validate_scenario_file(path);
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].file, path);
+  EXPECT_EQ(problems[0].str(), path + ": scenario file not found");
+  EXPECT_THROW(load_scenario(path), InputError);
+}
+
+TEST_F(ScenarioErrors, MalformedYaml) {
+  const auto problems = problems_of(R"(
+name: broken
+toolpath:
+  speed: 3
+  segments: [[[0, 0], [1, 0]]
+order: as_given
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].file, scenario_path());
+  EXPECT_EQ(problems[0].line, 5) << problems[0].str();
+  EXPECT_NE(problems[0].message.find("malformed YAML"), std::string::npos);
+}
+
+TEST_F(ScenarioErrors, UnknownPlanner) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+planners:
+  - lspb_mtt
+  - warp_drive
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "planners[1]", 4,
+                 "unknown planner 'warp_drive' (known: lspb_mtt, stop_and_go");
+}
+
+TEST_F(ScenarioErrors, UnknownPlannerParameter) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+planners:
+  - name: lspb_mtt
+    smoothness: 0.3
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "planners[0].smoothness", 4,
+                 "planner 'lspb_mtt' has no parameter 'smoothness'");
+}
+
+TEST_F(ScenarioErrors, PlannerParameterMustBeNumbers) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+planners:
+  - {name: lspb_mtt, delta: [0.1, big]}
+  - {delta: 0.3}
+  - stop_and_go
+  - stop_and_go
+)");
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  expect_problem(problems, scenario_path(), "planners[0].delta[1]", 3,
+                 "expected a number, got 'big'");
+  expect_problem(problems, scenario_path(), "planners[1]", 4, "missing name");
+  expect_problem(problems, scenario_path(), "planners[3]", 6, "listed twice");
+}
+
+TEST_F(ScenarioErrors, UnknownOrderMethod) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+order: shortest_first
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "order", 2,
+                 "unknown sequencer 'shortest_first' (expected as_given, random, nearest_neighbor, "
+                 "christofides");
+}
+
+TEST_F(ScenarioErrors, BadOrderMapFields) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+order:
+  method: christofides+five_opt
+  refine: two_opt
+  cost_model: euclid
+  seed: -1
+)");
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  expect_problem(problems, scenario_path(), "order.method", 3, "unknown sequencer");
+  expect_problem(problems, scenario_path(), "order.cost_model", 5,
+                 "unknown cost model 'euclid' (expected machine, along_line)");
+  expect_problem(problems, scenario_path(), "order.seed", 6, "whole number >= 0");
+}
+
+TEST_F(ScenarioErrors, RefinementTwice) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+order: {method: two_opt, refine: three_opt}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "order.refine", 2, "already implies refine two_opt");
+}
+
+TEST_F(ScenarioErrors, TwoToolpathKindsAtOnce) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  segments: [[[0, 0], [1, 0]]]
+  polylines: [[[0, 0], [1, 0], [1, 1]]]
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.polylines", 4,
+                 "exactly one of segments, polylines, gcode, random_segments");
+}
+
+TEST_F(ScenarioErrors, NoToolpathKind) {
+  const auto problems = problems_of(R"(
+name: empty
+toolpath:
+  speed: 3
+  start: [0, 0]
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath", 2, "no print paths");
+}
+
+TEST_F(ScenarioErrors, NoToolpathAtAll) {
+  const auto problems = problems_of("name: nothing_to_print\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath", 1, "missing");
+}
+
+TEST_F(ScenarioErrors, PointWithOneCoordinate) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  start: [0, 0, 0, 1]
+  segments:
+    - [[0, 0], [5]]
+)");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.start", 3,
+                 "expected a point [x, y] or [x, y, z] in mm, got a list of 4 numbers");
+  expect_problem(problems, scenario_path(), "toolpath.segments[0][1]", 5, "got a list of 1 number");
+}
+
+TEST_F(ScenarioErrors, SegmentWithThreePoints) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  segments: [[[0, 0], [1, 0], [2, 0]]]
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.segments[0]", 3,
+                 "got a list of 3 points (use polylines for more)");
+}
+
+TEST_F(ScenarioErrors, PolylineWithOnePointAndMissingSpeed) {
+  const auto problems = problems_of(R"(
+toolpath:
+  polylines:
+    - {points: [[0, 0]], speed: 2}
+    - [[0, 0], [1, 0]]
+)");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.polylines[0].points", 3,
+                 "needs at least 2 points, got 1");
+  expect_problem(problems, scenario_path(), "toolpath.polylines[1]", 4, "no print speed");
+}
+
+TEST_F(ScenarioErrors, SegmentsWithoutSpeed) {
+  const auto problems = problems_of(R"(
+toolpath:
+  segments: [[[0, 0], [1, 0]], [[1, 1], [2, 2]]]
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.speed", 2, "missing");
+}
+
+TEST_F(ScenarioErrors, BadGcodeLine) {
+  write("job.gcode", R"(
+G90
+G1 X1 Y0 E1 F120
+G1 Xabc Y2 E2
+G1 X3 Y3 E3
+)");
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  gcode: job.gcode
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, (dir_ / "job.gcode").string(), "toolpath.gcode", 3,
+                 "malformed word 'Xabc'");
+}
+
+TEST_F(ScenarioErrors, GcodePrintSpeedAboveLimits) {
+  // F600 = 10 mm/s along x on line 2, above v_max 4
+  write("fast.gcode", "G1 X1 Y0 E1 F120\nG1 X11 Y0 E2 F600\n");
+  const auto problems = problems_of(R"(
+limits: {v_max: 4, a_max: 30}
+toolpath: {gcode: fast.gcode}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, (dir_ / "fast.gcode").string(), "toolpath.gcode", 2,
+                 "print speed 10 mm/s needs 10 mm/s on x, above limits v_max 4");
+}
+
+TEST_F(ScenarioErrors, MissingGcodeFile) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  gcode: parts/missing.gcode
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.gcode", 3,
+                 "G-code file 'parts/missing.gcode' not found");
+}
+
+TEST_F(ScenarioErrors, GcodeWithoutPrintMoves) {
+  write("travel.gcode", "G0 X10 Y10\nG1 X20 Y10 F600\n");
+  const auto problems = problems_of("toolpath: {speed: 3, gcode: travel.gcode}\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.gcode", 1, "has no print moves");
+}
+
+TEST_F(ScenarioErrors, BadOutputs) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+outputs:
+  render: maybe
+  image_width: 8
+  image_height: 480.5
+)");
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  expect_problem(problems, scenario_path(), "outputs.render", 3,
+                 "expected true or false, got 'maybe'");
+  expect_problem(problems, scenario_path(), "outputs.image_width", 4,
+                 "must be a whole number in [16, 2048], got 8");
+  expect_problem(problems, scenario_path(), "outputs.image_height", 5, "whole number");
+}
+
+TEST_F(ScenarioErrors, BadSim) {
+  const auto problems = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+sim: {timestep_s: 0.02, cell_mm: -1, kp_scale: 0, settle_s: 0}
+)");
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  expect_problem(problems, scenario_path(), "sim.timestep_s", 2, "must be in (0, 0.01], got 0.02");
+  expect_problem(problems, scenario_path(), "sim.cell_mm", 2, "must be >= 0, got -1");
+  expect_problem(problems, scenario_path(), "sim.kp_scale", 2, "must be > 0, got 0");
+}
+
+TEST_F(ScenarioErrors, ProcessKeyOfTheOtherType) {
+  const auto problems = problems_of(R"(
+process:
+  type: aerosol
+  sigma_mm: 0
+  tau_s: 0.05
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  expect_problem(problems, scenario_path(), "process.sigma_mm", 3, "must be > 0, got 0");
+  expect_problem(problems, scenario_path(), "process.tau_s", 4,
+                 "applies to extrusion, not to process type aerosol");
+}
+
+TEST_F(ScenarioErrors, UnknownProcessType) {
+  const auto problems = problems_of(R"(
+process: {type: inkjet}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "process.type", 1, "unknown process type 'inkjet'");
+}
+
+TEST_F(ScenarioErrors, UnknownMachineAndMissingModel) {
+  const auto unknown = problems_of(R"(
+machine: scara
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(unknown.size(), 1u) << dump(unknown);
+  expect_problem(unknown, scenario_path(), "machine", 1,
+                 "unknown machine 'scara' (expected xy_stage, linear_delta, arm6 or a path");
+  const auto missing = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+machine: models/none.xml
+)");
+  ASSERT_EQ(missing.size(), 1u) << dump(missing);
+  expect_problem(missing, scenario_path(), "machine", 2, "MJCF file 'models/none.xml' not found");
+}
+
+TEST_F(ScenarioErrors, DuplicateKey) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  segments: [[[0, 0], [1, 0]]]
+  speed: 4
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.speed", 4, "given twice");
+}
+
+TEST_F(ScenarioErrors, EmptyValueIsReportedAtItsKey) {
+  const auto problems = problems_of(R"(
+limits:
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "limits", 1, "expected a map, got nothing");
+}
+
+TEST_F(ScenarioErrors, SurfaceIsNotSupportedYet) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  surface: {mesh: part.stl}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.surface", 3,
+                 "surface toolpaths are not supported yet");
+}
+
+TEST_F(ScenarioErrors, BadRandomSegments) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  random_segments:
+    n: 0
+    bed: [100]
+    length: [40, 10]
+    seed: 1.5
+)");
+  ASSERT_EQ(problems.size(), 4u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.random_segments.n", 4,
+                 "must be a whole number in [1, 100000], got 0");
+  expect_problem(problems, scenario_path(), "toolpath.random_segments.bed", 5,
+                 "expected a list of 2 numbers, got a list of 1");
+  expect_problem(problems, scenario_path(), "toolpath.random_segments.length", 6, "min <= max");
+  expect_problem(problems, scenario_path(), "toolpath.random_segments.seed", 7,
+                 "whole number >= 0");
+}
+
+TEST_F(ScenarioErrors, BadName) {
+  const auto problems = problems_of(R"(
+name: ../escape
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "name", 1, "cannot name a results folder");
+}
+
+TEST_F(ScenarioErrors, EmptyFileAndSeveralDocuments) {
+  const auto empty = problems_of("# only a comment\n");
+  ASSERT_EQ(empty.size(), 1u) << dump(empty);
+  EXPECT_NE(empty[0].message.find("holds no settings"), std::string::npos) << empty[0].str();
+  const auto two = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+---
+name: second
+)");
+  ASSERT_EQ(two.size(), 1u) << dump(two);
+  EXPECT_EQ(two[0].line, 3) << two[0].str();
+  EXPECT_NE(two[0].message.find("more than one YAML document"), std::string::npos);
+  const auto list = problems_of("- just\n- a list\n");
+  ASSERT_EQ(list.size(), 1u) << dump(list);
+  EXPECT_EQ(list[0].line, 1);
+  EXPECT_NE(list[0].message.find("expected a map, got a list"), std::string::npos);
+}
+
+// three independent mistakes: all three reported, in line order, by one InputError
+TEST_F(ScenarioErrors, ReportsEveryProblemNotOnlyTheFirst) {
+  const std::string path = write("three.yaml", R"(
+name: three_problems
+limits: {v_max: 0, a_max: 30}
+toolpath:
+  speed: 3
+  segments:
+    - [[0, 0], [0, 0]]
+planners: [lspb_mtt, teleport]
+)");
+  try {
+    load_scenario(path);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::vector<Problem>& problems = e.problems();
+    ASSERT_EQ(problems.size(), 3u) << dump(problems);
+    EXPECT_EQ(problems[0].str(), path + ":2: limits.v_max: must be > 0, got 0");
+    EXPECT_EQ(problems[1].key, "toolpath.segments[0]");
+    EXPECT_EQ(problems[1].line, 6);
+    EXPECT_EQ(problems[2].key, "planners[1]");
+    EXPECT_EQ(problems[2].line, 7);
+    // what() carries every problem, one per line
+    const std::string text = e.what();
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2);
+  }
+}
+
+}  // namespace
+}  // namespace depotwin

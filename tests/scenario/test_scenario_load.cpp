@@ -1,0 +1,325 @@
+// Scenario files that must load, and the values they load into.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "planners/planner.hpp"
+#include "scenario/scenario.hpp"
+#include "scenario_test_util.hpp"
+
+namespace depotwin {
+namespace {
+
+using testing_scenario::dump;
+using testing_scenario::expect_problem;
+using ScenarioLoad = testing_scenario::ScenarioFiles;
+
+// the minimal form of docs/ARCHITECTURE.md, exactly as written there
+const char* kMinimal = R"(
+name: two_segments
+machine: xy_stage
+limits: {v_max: 4, a_max: 30}        # per axis, mm/s and mm/s^2
+process: {type: aerosol}              # defaults for everything else
+toolpath:
+  speed: 3                            # mm/s on every print segment
+  start: [0, 0]
+  end: [20, 0]
+  segments:                           # print segments, in this order
+    - [[2, 2], [8, 2]]
+    - [[8, 2], [5, 7]]
+order: as_given                       # or a sequencer name, or {method: two_opt, seed: 1}
+planners: [lspb_mtt]                  # names, or maps {name: bezier, delta: 0.3}
+)";
+
+void expect_point(const Vec3& actual, double x, double y, double z) {
+  EXPECT_DOUBLE_EQ(actual.x(), x);
+  EXPECT_DOUBLE_EQ(actual.y(), y);
+  EXPECT_DOUBLE_EQ(actual.z(), z);
+}
+
+TEST_F(ScenarioLoad, MinimalFormLoadsWithExpectedValues) {
+  const std::string path = write("two.yaml", kMinimal);
+  const Scenario s = load_scenario(path);
+  EXPECT_EQ(s.file, path);
+  EXPECT_EQ(s.directory, dir_.lexically_normal().string());
+  EXPECT_EQ(s.name, "two_segments");
+  EXPECT_EQ(s.machine, "xy_stage");
+  EXPECT_EQ(s.model_path, "");
+  // limits: the same on every axis, no jerk limit, no joint limits
+  for (const AxisLimits& axis : s.limits.axes) {
+    EXPECT_EQ(axis.v_max_mm_s, 4.0);
+    EXPECT_EQ(axis.a_max_mm_s2, 30.0);
+    EXPECT_EQ(axis.j_max_mm_s3, 0.0);
+  }
+  EXPECT_FALSE(s.has_joint_limits);
+  // process: aerosol with the struct's defaults
+  const ProcessSpec defaults;
+  EXPECT_EQ(s.process.type, "aerosol");
+  EXPECT_EQ(s.process.sigma_mm, defaults.sigma_mm);
+  EXPECT_EQ(s.process.flow_mm3_s, defaults.flow_mm3_s);
+  // toolpath: 2-D points get z = 0
+  expect_point(s.toolpath.start_mm, 0, 0, 0);
+  expect_point(s.toolpath.end_mm, 20, 0, 0);
+  ASSERT_EQ(s.toolpath.paths.size(), 2u);
+  ASSERT_EQ(s.toolpath.paths[0].points.size(), 2u);
+  expect_point(s.toolpath.paths[0].points[0], 2, 2, 0);
+  expect_point(s.toolpath.paths[0].points[1], 8, 2, 0);
+  ASSERT_EQ(s.toolpath.paths[1].points.size(), 2u);
+  expect_point(s.toolpath.paths[1].points[0], 8, 2, 0);
+  expect_point(s.toolpath.paths[1].points[1], 5, 7, 0);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(s.toolpath.paths[i].speed_mm_s, 3.0);
+    EXPECT_EQ(s.toolpath.paths[i].source_index, i);
+    EXPECT_TRUE(s.toolpath.paths[i].normals.empty());
+  }
+  EXPECT_DOUBLE_EQ(s.toolpath.print_length_mm(), 6.0 + std::sqrt(34.0));
+  // order and planners
+  EXPECT_EQ(s.order.method, "as_given");
+  EXPECT_EQ(s.order.refine, "");
+  EXPECT_EQ(s.order.cost_model, "machine");
+  EXPECT_EQ(s.order.seed, 1u);
+  ASSERT_EQ(s.planners.size(), 1u);
+  EXPECT_EQ(s.planners[0].name, "lspb_mtt");
+  EXPECT_TRUE(s.planners[0].params.empty());
+  EXPECT_EQ(s.planners[0].line, 13);
+  // untouched sections keep their defaults
+  EXPECT_EQ(s.sim.timestep_s, SimSpec{}.timestep_s);
+  EXPECT_EQ(s.outputs.render, OutputSpec{}.render);
+  EXPECT_EQ(s.outputs.image_width, OutputSpec{}.image_width);
+  EXPECT_TRUE(validate_scenario_file(path).empty());
+}
+
+TEST_F(ScenarioLoad, DefaultsWhenOnlyAToolpathIsGiven) {
+  const std::string path = write("my_job.yaml", R"(
+toolpath:
+  speed: 2
+  segments: [[[0, 0], [1, 0]]]
+)");
+  const Scenario s = load_scenario(path);
+  EXPECT_EQ(s.name, "my_job");  // the file stem
+  EXPECT_EQ(s.machine, "xy_stage");
+  for (const AxisLimits& axis : s.limits.axes) {
+    EXPECT_EQ(axis.v_max_mm_s, 4.0);
+    EXPECT_EQ(axis.a_max_mm_s2, 30.0);
+    EXPECT_EQ(axis.j_max_mm_s3, 0.0);
+  }
+  expect_point(s.toolpath.start_mm, 0, 0, 0);
+  expect_point(s.toolpath.end_mm, 0, 0, 0);  // end defaults to start
+  ASSERT_EQ(s.planners.size(), 2u);
+  EXPECT_EQ(s.planners[0].name, "lspb_mtt");
+  EXPECT_EQ(s.planners[1].name, "stop_and_go");
+  EXPECT_EQ(s.order.label(), "as_given");
+}
+
+TEST_F(ScenarioLoad, EveryOtherKey) {
+  std::filesystem::create_directories(dir_ / "models");
+  write("models/my_stage.xml", "<mujoco/>\n");
+  const std::string path = write("full.yaml", R"(
+name: full_job
+machine: models/my_stage.xml
+limits:
+  v_max: 50
+  a_max: 400
+  j_max: 8000
+  x: {v_max: 60}
+  z: {v_max: 10, a_max: 100, j_max: 0}
+  joint: {v_max: 200, a_max: 3000}
+process:
+  type: extrusion
+  line_width_mm: 0.5
+  bead_width_mm: 0.45
+  layer_height_mm: 0.25
+  tau_s: 0.08
+toolpath:
+  speed: 20
+  start: [0, 0, 5]
+  end: [100, 100, 5.5]
+  polylines:
+    - [[0, 0], [10, 0], [10, 10, 0.2]]
+    - {points: [[20, 0], [30, 0]], speed: 40}
+order: {method: christofides, refine: or_opt, cost_model: along_line, seed: 42}
+planners:
+  - stop_and_go
+  - {name: lspb_mtt}
+sim: {timestep_s: 0.0005, cell_mm: 0.05, kp_scale: 2.5, settle_s: 0.3}
+outputs: {render: false, image_width: 320, image_height: 2048}
+)");
+  const Scenario s = load_scenario(path);
+  EXPECT_EQ(s.name, "full_job");
+  const std::string model = (dir_ / "models" / "my_stage.xml").lexically_normal().string();
+  EXPECT_EQ(s.machine, model);
+  EXPECT_EQ(s.model_path, model);
+  // limits: common values with per-axis overrides
+  EXPECT_EQ(s.limits.axes[0].v_max_mm_s, 60.0);
+  EXPECT_EQ(s.limits.axes[0].a_max_mm_s2, 400.0);
+  EXPECT_EQ(s.limits.axes[0].j_max_mm_s3, 8000.0);
+  EXPECT_EQ(s.limits.axes[1].v_max_mm_s, 50.0);
+  EXPECT_EQ(s.limits.axes[1].a_max_mm_s2, 400.0);
+  EXPECT_EQ(s.limits.axes[2].v_max_mm_s, 10.0);
+  EXPECT_EQ(s.limits.axes[2].a_max_mm_s2, 100.0);
+  EXPECT_EQ(s.limits.axes[2].j_max_mm_s3, 0.0);
+  EXPECT_TRUE(s.has_joint_limits);
+  EXPECT_EQ(s.joint_limits.v_max_mm_s, 200.0);
+  EXPECT_EQ(s.joint_limits.a_max_mm_s2, 3000.0);
+  EXPECT_EQ(s.joint_limits.j_max_mm_s3, 0.0);
+  // process
+  EXPECT_EQ(s.process.type, "extrusion");
+  EXPECT_EQ(s.process.line_width_mm, 0.5);
+  EXPECT_EQ(s.process.bead_width_mm, 0.45);
+  EXPECT_EQ(s.process.layer_height_mm, 0.25);
+  EXPECT_EQ(s.process.tau_s, 0.08);
+  // toolpath: 3-D start/end, bare and map polylines, per-path speed
+  expect_point(s.toolpath.start_mm, 0, 0, 5);
+  expect_point(s.toolpath.end_mm, 100, 100, 5.5);
+  ASSERT_EQ(s.toolpath.paths.size(), 2u);
+  ASSERT_EQ(s.toolpath.paths[0].points.size(), 3u);
+  expect_point(s.toolpath.paths[0].points[2], 10, 10, 0.2);
+  EXPECT_EQ(s.toolpath.paths[0].speed_mm_s, 20.0);
+  EXPECT_EQ(s.toolpath.paths[1].speed_mm_s, 40.0);
+  EXPECT_EQ(s.toolpath.paths[1].source_index, 1);
+  expect_point(s.toolpath.paths[1].points[0], 20, 0, 0);
+  // order
+  EXPECT_EQ(s.order.method, "christofides");
+  EXPECT_EQ(s.order.refine, "or_opt");
+  EXPECT_EQ(s.order.cost_model, "along_line");
+  EXPECT_EQ(s.order.seed, 42u);
+  // planners keep the file's order and lines
+  ASSERT_EQ(s.planners.size(), 2u);
+  EXPECT_EQ(s.planners[0].name, "stop_and_go");
+  EXPECT_EQ(s.planners[0].line, 25);
+  EXPECT_EQ(s.planners[1].name, "lspb_mtt");
+  EXPECT_EQ(s.planners[1].line, 26);
+  // sim and outputs
+  EXPECT_EQ(s.sim.timestep_s, 0.0005);
+  EXPECT_EQ(s.sim.cell_mm, 0.05);
+  EXPECT_EQ(s.sim.kp_scale, 2.5);
+  EXPECT_EQ(s.sim.settle_s, 0.3);
+  EXPECT_FALSE(s.outputs.render);
+  EXPECT_EQ(s.outputs.image_width, 320);
+  EXPECT_EQ(s.outputs.image_height, 2048);
+}
+
+TEST_F(ScenarioLoad, AerosolParameters) {
+  const Scenario s = load_scenario(write("a.yaml", R"(
+process: {type: aerosol, flow_mm3_s: 0, sigma_mm: 0.05, line_width_mm: 0, shutter_time_s: 0.01}
+toolpath: {speed: 1, segments: [[[0, 0], [1, 1]]]}
+)"));
+  EXPECT_EQ(s.process.flow_mm3_s, 0.0);  // 0: derived
+  EXPECT_EQ(s.process.sigma_mm, 0.05);
+  EXPECT_EQ(s.process.line_width_mm, 0.0);  // 0: default width
+  EXPECT_EQ(s.process.shutter_time_s, 0.01);
+}
+
+// the string and map forms of `order:`
+TEST_F(ScenarioLoad, OrderForms) {
+  struct Case {
+    std::string text, method, refine;
+    std::uint64_t seed;
+  };
+  const std::vector<Case> cases{
+      {"nearest_neighbor", "nearest_neighbor", "", 1},
+      {"two_opt", "nearest_neighbor", "two_opt", 1},
+      {"christofides+three_opt", "christofides", "three_opt", 1},
+      {"{method: two_opt, seed: 1}", "nearest_neighbor", "two_opt", 1},
+      {"{method: or_opt, seed: 18446744073709551615}", "nearest_neighbor", "or_opt",
+       18446744073709551615ull},
+      {"{method: random, seed: 7}", "random", "", 7},
+      {"{method: christofides+two_opt, refine: two_opt}", "christofides", "two_opt", 1},
+      {"{method: nearest_neighbor, refine: none}", "nearest_neighbor", "", 1},
+  };
+  for (const Case& c : cases) {
+    const Scenario s = load_scenario(write("o.yaml", "order: " + c.text +
+                                                         "\ntoolpath: {speed: 1, segments: "
+                                                         "[[[0, 0], [1, 0]]]}\n"));
+    EXPECT_EQ(s.order.method, c.method) << c.text;
+    EXPECT_EQ(s.order.refine, c.refine) << c.text;
+    EXPECT_EQ(s.order.seed, c.seed) << c.text;
+    EXPECT_EQ(s.order.cost_model, "machine") << c.text;
+  }
+}
+
+// speeds exactly at an axis limit are feasible: 5 mm/s along (3, 4) needs 3 on x and 4 on y
+TEST_F(ScenarioLoad, PrintSpeedExactlyAtTheLimitIsAccepted) {
+  const std::vector<Problem> problems = problems_of(R"(
+limits: {v_max: 4, a_max: 30, x: {v_max: 3}}
+toolpath: {speed: 5, segments: [[[0, 0], [3, 4]]]}
+)");
+  EXPECT_TRUE(problems.empty()) << dump(problems);
+}
+
+TEST_F(ScenarioLoad, GcodeToolpathRelativeToTheScenarioFile) {
+  const std::string path =
+      std::string(DEPOTWIN_SOURCE_DIR) + "/tests/scenario/data/gcode_square.yaml";
+  const Scenario s = load_scenario(path);
+  EXPECT_EQ(s.name, "gcode_square");
+  EXPECT_EQ(s.process.type, "extrusion");
+  EXPECT_EQ(s.process.bead_width_mm, 0.45);
+  expect_point(s.toolpath.start_mm, 0, 0, 5);
+  expect_point(s.toolpath.end_mm, 0, 0, 5);
+  ASSERT_EQ(s.toolpath.paths.size(), 3u);
+  EXPECT_EQ(s.toolpath.paths[0].points.size(), 3u);
+  EXPECT_EQ(s.toolpath.paths[0].speed_mm_s, 10.0);
+  EXPECT_EQ(s.toolpath.paths[1].speed_mm_s, 20.0);
+  EXPECT_EQ(s.toolpath.paths[2].speed_mm_s, 5.0);
+  expect_point(s.toolpath.paths[2].points.back(), 40, 15, 0.2);
+  EXPECT_DOUBLE_EQ(s.toolpath.print_length_mm(), 20.0 + 10.0 + 15.0);
+}
+
+// A planner parameter from the registry: its default loads, a value past its range does
+// not. Skipped while no registered planner declares parameters.
+TEST_F(ScenarioLoad, PlannerParametersFromTheRegistry) {
+  const PlannerInfo* planner = nullptr;
+  for (const PlannerInfo& info : planner_registry())
+    if (!info.parameters.empty() && !planner) planner = &info;
+  if (!planner) GTEST_SKIP() << "no registered planner declares parameters yet";
+  const PlannerParameter& parameter = planner->parameters.front();
+  const std::string head = "toolpath: {speed: 1, segments: [[[0, 0], [1, 0]]]}\nplanners:\n";
+  std::ostringstream good;
+  good.precision(17);
+  good << head << "  - {name: " << planner->name << ", " << parameter.name << ": "
+       << parameter.default_value << "}\n";
+  const Scenario s = load_scenario(write("p.yaml", good.str()));
+  ASSERT_EQ(s.planners.size(), 1u);
+  ASSERT_EQ(s.planners[0].params.count(parameter.name), 1u);
+  EXPECT_EQ(s.planners[0].params.at(parameter.name), std::vector<double>{parameter.default_value});
+
+  // out of range: above the maximum (or below the minimum when the maximum is unbounded)
+  const double outside = std::isfinite(parameter.max_value)
+                             ? parameter.max_value + 1.0 + std::abs(parameter.max_value)
+                             : parameter.min_value - 1.0 - std::abs(parameter.min_value);
+  std::ostringstream bad;
+  bad.precision(17);
+  bad << head << "  - {name: " << planner->name << ", " << parameter.name << ": " << outside
+      << "}\n";
+  expect_problem(problems_of(bad.str()), scenario_path(), "planners[0]." + parameter.name, 3,
+                 "is outside");
+}
+
+TEST_F(ScenarioLoad, RandomSegmentsKeysAreParsed) {
+  // the generator may not exist yet; when it does, the instance has n paths at the speed
+  const std::string path = write("r.yaml", R"(
+toolpath:
+  random_segments: {n: 6, bed: [100, 80], length: [10, 40], seed: 3, speed: 2}
+limits: {v_max: 4, a_max: 30}
+)");
+  try {
+    const Scenario s = load_scenario(path);
+    ASSERT_EQ(s.toolpath.paths.size(), 6u);
+    for (const PrintPath& p : s.toolpath.paths) {
+      EXPECT_EQ(p.speed_mm_s, 2.0);
+      EXPECT_GE(p.length_mm(), 10.0 - 1e-9);
+      EXPECT_LE(p.length_mm(), 40.0 + 1e-9);
+    }
+  } catch (const InputError& e) {
+    // only the generator's own complaint, with this file and the random_segments line
+    for (const Problem& p : e.problems()) {
+      EXPECT_EQ(p.file, path);
+      EXPECT_EQ(p.line, 2) << p.str();
+      EXPECT_EQ(p.key, "toolpath.random_segments") << p.str();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace depotwin
