@@ -1,0 +1,94 @@
+// Deposition metrics: pure functions of the thickness field, the toolpath and the
+// material account (ARCHITECTURE.md "Definitions"). Paths are taken in the substrate
+// plane (x, y); r = half the line width.
+//
+//  target region  cells (centres on the field's lattice) within r of any print path's
+//                 centreline (capsules: round caps at the path ends).
+//  end zones      cells of a path's band whose nearest centreline point lies within r
+//                 (arc length) of the path's start or end, caps included.
+//  stats region   target region minus every path's end zones.
+//  thickness      over the stats region, cell values: mean_um, cv = std / mean (population
+//                 std), min_rel = min / mean, max_rel = max / mean. line_cv = CV of the
+//                 field sampled bilinearly on each centreline every cell length, from
+//                 arc length r to length - r. Empty region or zero mean: all zeros.
+//  material       on_target = landed inside the target region, overspray = landed
+//                 outside, captured = blocked by the shutter; fraction = (overspray +
+//                 captured) / emitted.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/toolpath.hpp"
+#include "deposition/process.hpp"
+#include "deposition/sparse_tiles.hpp"
+#include "deposition/thickness_field.hpp"
+
+namespace depotwin {
+
+struct ThicknessStats {
+  double mean_um = 0.0;
+  double cv = 0.0;
+  double min_rel = 0.0;
+  double max_rel = 0.0;
+  double line_cv = 0.0;
+  size_t cells = 0;         // cells in the stats region
+  size_t line_samples = 0;  // centreline samples behind line_cv
+};
+
+struct MaterialSplit {
+  double emitted_mm3 = 0.0;
+  double on_target_mm3 = 0.0;
+  double overspray_mm3 = 0.0;
+  double captured_mm3 = 0.0;
+  double fraction = 0.0;  // (overspray + captured) / emitted; 0 when nothing was emitted
+  double closed_time_s = 0.0;
+};
+
+struct DepositionMetrics {
+  ThicknessStats thickness;
+  MaterialSplit material;
+};
+
+// The target region and end zones on a field's cell lattice (sparse, like the field).
+class TargetRegion {
+ public:
+  struct Cell {
+    double best_arc_mm = 0.0;         // arc length of the nearest point along `path`
+    float best_distance2_mm2 = 0.0f;  // squared distance to that point
+    int32_t path = -1;                // path being resolved (construction scratch)
+    uint8_t flags = 0;
+  };
+  static constexpr uint8_t kTarget = 1;
+  static constexpr uint8_t kEndZone = 2;
+  using Tiles = SparseTiles<Cell>;
+
+  TargetRegion(const Toolpath& toolpath, double line_width_mm, double cell_mm);
+
+  double cell_mm() const { return cell_mm_; }
+  double half_width_mm() const { return half_width_mm_; }
+  bool in_target(int ix, int iy) const { return flags(ix, iy) & kTarget; }
+  bool in_stats(int ix, int iy) const { return flags(ix, iy) == kTarget; }
+  uint8_t flags(int ix, int iy) const;
+  size_t target_cells() const;
+  const Tiles& tiles() const { return tiles_; }
+
+ private:
+  void finish_cell(Cell& cell) const;
+
+  double cell_mm_;
+  double half_width_mm_;
+  std::vector<double> path_length_mm_;
+  Tiles tiles_;
+};
+
+ThicknessStats thickness_stats(const ThicknessField& field, const TargetRegion& region,
+                               const Toolpath& toolpath);
+MaterialSplit split_material(const ThicknessField& field, const TargetRegion& region,
+                             const MaterialAccount& account);
+// both, building the region once (line_width_mm: Process::line_width_mm())
+DepositionMetrics evaluate_deposition(const ThicknessField& field, const Toolpath& toolpath,
+                                      double line_width_mm, const MaterialAccount& account);
+
+}  // namespace depotwin

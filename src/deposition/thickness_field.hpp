@@ -1,0 +1,74 @@
+// The thickness field: deposited material on the substrate, one value per square cell.
+//
+// Units: thickness in mm (double) internally; heightmaps hand out micrometres.
+// Lattice: cell (ix, iy) is centred at (ix * cell_mm, iy * cell_mm) in the substrate
+// frame, so every field with the same cell size shares one lattice. A cell's
+// thickness times cell_mm^2 is the volume that landed in it; total_volume_mm3() is
+// therefore exactly what the deposition kernel put down.
+// Storage: sparse 64 x 64 tiles (SparseTiles), allocated when material first lands
+// near them; a 100 x 100 mm bed at 10 um cells only pays for the printed band.
+#pragma once
+
+#include <cstddef>
+
+#include "core/heightmap.hpp"
+#include "deposition/sparse_tiles.hpp"
+
+namespace depotwin {
+
+// Extent of the cells holding material (cell centres, mm); empty when nothing landed.
+struct FieldBounds {
+  bool empty = true;
+  double x_lo_mm = 0.0;
+  double y_lo_mm = 0.0;
+  double x_hi_mm = 0.0;
+  double y_hi_mm = 0.0;
+};
+
+class ThicknessField {
+ public:
+  using Tiles = SparseTiles<double>;
+
+  // cell_mm must be > 0 (InputError "sim.cell_mm" otherwise)
+  explicit ThicknessField(double cell_mm);
+
+  double cell_mm() const { return cell_mm_; }
+
+  // thickness (mm) of one cell; 0 where nothing landed
+  double cell_thickness_mm(int ix, int iy) const;
+  // bilinear interpolation between cell centres (mm)
+  double thickness_mm_at(double x_mm, double y_mm) const;
+  // sum of thickness x cell area over every cell (tiles in sorted order: deterministic)
+  double total_volume_mm3() const;
+  // cells with thickness > 0
+  FieldBounds bounds() const;
+
+  // dense copy (thickness in um) of the cells whose centres lie in [lo, hi]; with
+  // stride > 1 each output cell is the mean of stride x stride field cells (volume
+  // preserving), origin at the block centre. Throws InternalError above 2^28 cells.
+  HeightMap to_heightmap(double x_lo_mm, double y_lo_mm, double x_hi_mm, double y_hi_mm,
+                         int stride = 1) const;
+  // the same over bounds() (an empty 0 x 0 map when nothing landed)
+  HeightMap to_heightmap(int stride = 1) const;
+  // smallest stride whose export of [lo, hi] has at most max_cells cells (>= 1)
+  int stride_for_max_cells(double x_lo_mm, double y_lo_mm, double x_hi_mm, double y_hi_mm,
+                           size_t max_cells) const;
+
+  // memory statistics, for the sparsity contract
+  size_t allocated_tiles() const { return tiles_.tile_count(); }
+  size_t allocated_cells() const { return tiles_.allocated_cells(); }
+
+  // add material to one cell (thickness in mm); used by tests and importers
+  void add_to_cell(int ix, int iy, double thickness_mm);
+  void clear() { tiles_.clear(); }
+
+  // raw tile access for the deposition kernel and the metrics
+  Tiles& tiles() { return tiles_; }
+  const Tiles& tiles() const { return tiles_; }
+
+ private:
+  double cell_mm_;
+  Tiles tiles_;
+};
+
+}  // namespace depotwin

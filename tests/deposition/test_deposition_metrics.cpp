@@ -1,0 +1,144 @@
+// Deposition metrics: target region geometry, end zones, thickness statistics and the
+// material split, on hand-built fields with known answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "deposition/deposition_metrics.hpp"
+#include "deposition_test_util.hpp"
+
+namespace depotwin {
+namespace {
+
+constexpr double kCell = 0.025;
+
+// brute-force distance from a point to a polyline (xy)
+double distance_to_polyline(const PrintPath& path, double x, double y) {
+  double best = 1e300;
+  for (size_t k = 0; k + 1 < path.points.size(); ++k) {
+    const Eigen::Vector2d a = path.points[k].head<2>(), b = path.points[k + 1].head<2>();
+    const Eigen::Vector2d p(x, y);
+    const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (p - (a + t * (b - a))).norm());
+  }
+  return best;
+}
+
+// the row-interval rasteriser finds exactly the lattice points within r of the path
+TEST(TargetRegion, MatchesBruteForceOnAPolylineWithCorners) {
+  Toolpath toolpath;
+  PrintPath path;
+  path.points = {Vec3(0.013, 0.021, 0), Vec3(1.511, 0.402, 0), Vec3(0.9, 1.7, 0),
+                 Vec3(0.9, 2.3, 0)};
+  toolpath.paths.push_back(path);
+  const double width = 0.4, r = 0.2;
+  const TargetRegion region(toolpath, width, kCell);
+  size_t expected = 0;
+  size_t mismatches = 0;
+  for (int iy = -20; iy <= 110; ++iy) {
+    for (int ix = -20; ix <= 80; ++ix) {
+      const double d = distance_to_polyline(path, ix * kCell, iy * kCell);
+      if (std::abs(d - r) < 1e-9) continue;  // on the boundary: either answer is fine
+      const bool inside = d < r;
+      expected += inside ? 1 : 0;
+      mismatches += inside != region.in_target(ix, iy) ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_GT(expected, 1000u);
+}
+
+// straight on-lattice line: target = 17 rows x (401 columns + caps), stats = 17 x 385
+TEST(TargetRegion, EndZonesRemoveOneHalfWidthAtEachEnd) {
+  const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, 10.0, 0.0, 3.0);
+  const TargetRegion region(toolpath, 0.4, kCell);
+  size_t stats_cells = 0, band_cells = 0;
+  for (int iy = -10; iy <= 10; ++iy) {
+    for (int ix = -10; ix <= 410; ++ix) {
+      stats_cells += region.in_stats(ix, iy) ? 1 : 0;
+      band_cells += (region.in_target(ix, iy) && ix >= 0 && ix <= 400) ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(band_cells, 17u * 401u);
+  EXPECT_EQ(stats_cells, 17u * 385u);
+  // the caps: lattice points with i >= 1 and i^2 + j^2 <= 64, twice
+  size_t cap = 0;
+  for (int i = 1; i <= 8; ++i)
+    for (int j = -8; j <= 8; ++j) cap += (i * i + j * j <= 64) ? 1 : 0;
+  EXPECT_EQ(region.target_cells(), 17u * 401u + 2 * cap);
+}
+
+// known field: 1 um below the centreline, 2 um on and above it, a gap of zero cells
+TEST(ThicknessStats, MeanCvMinMaxOfAKnownField) {
+  const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, 10.0, 0.0, 3.0);
+  ThicknessField field(kCell);
+  for (int iy = -8; iy <= 8; ++iy)
+    for (int ix = -8; ix <= 408; ++ix)
+      if (!(ix >= 100 && ix < 105)) field.add_to_cell(ix, iy, iy < 0 ? 1e-3 : 2e-3);
+  const TargetRegion region(toolpath, 0.4, kCell);
+  const ThicknessStats stats = thickness_stats(field, region, toolpath);
+  ASSERT_EQ(stats.cells, 17u * 385u);
+  // per stats column: 8 cells of 1 um, 9 of 2 um; 5 columns are empty
+  const double n = 17.0 * 385.0;
+  const double sum = 380.0 * (8.0 * 1.0 + 9.0 * 2.0);
+  const double squares = 380.0 * (8.0 * 1.0 + 9.0 * 4.0);
+  const double mean = sum / n;
+  EXPECT_NEAR(stats.mean_um, mean, 1e-9);
+  EXPECT_NEAR(stats.cv, std::sqrt(squares / n - mean * mean) / mean, 1e-9);
+  EXPECT_NEAR(stats.min_rel, 0.0, 1e-12);
+  EXPECT_NEAR(stats.max_rel, 2.0 / mean, 1e-9);
+  // centreline (row 0 = 2 um) sampled on cell centres: 380 of 385 samples at 2 um
+  ASSERT_EQ(stats.line_samples, 385u);
+  const double line_mean = 2.0 * 380.0 / 385.0;
+  const double line_sq = 4.0 * 380.0 / 385.0;
+  EXPECT_NEAR(stats.line_cv, std::sqrt(line_sq - line_mean * line_mean) / line_mean, 1e-9);
+}
+
+TEST(ThicknessStats, UniformFieldHasZeroSpread) {
+  const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, 5.0, 0.0, 3.0);
+  ThicknessField field(kCell);
+  for (int iy = -20; iy <= 20; ++iy)
+    for (int ix = -20; ix <= 220; ++ix) field.add_to_cell(ix, iy, 1.5e-3);
+  const DepositionMetrics metrics = evaluate_deposition(field, toolpath, 0.4, MaterialAccount{});
+  EXPECT_NEAR(metrics.thickness.mean_um, 1.5, 1e-12);
+  EXPECT_NEAR(metrics.thickness.cv, 0.0, 1e-12);
+  EXPECT_NEAR(metrics.thickness.line_cv, 0.0, 1e-12);
+  EXPECT_NEAR(metrics.thickness.min_rel, 1.0, 1e-12);
+  EXPECT_NEAR(metrics.thickness.max_rel, 1.0, 1e-12);
+}
+
+// on_target / overspray by cell, captured and emitted from the account
+TEST(MaterialSplit, SplitsLandedMaterialByTargetRegion) {
+  const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, 5.0, 0.0, 3.0);
+  ThicknessField field(kCell);
+  field.add_to_cell(40, 0, 2.0);    // on the centreline
+  field.add_to_cell(40, 8, 3.0);    // exactly half a width away: inside
+  field.add_to_cell(40, 9, 5.0);    // just outside
+  field.add_to_cell(-300, 0, 7.0);  // far away
+  const double area = kCell * kCell;
+  MaterialAccount account;
+  account.landed_mm3 = 17.0 * area;
+  account.captured_mm3 = 3.0 * area;
+  account.emitted_mm3 = 20.0 * area;
+  account.closed_time_s = 0.25;
+  const MaterialSplit split = evaluate_deposition(field, toolpath, 0.4, account).material;
+  EXPECT_DOUBLE_EQ(split.on_target_mm3, 5.0 * area);
+  EXPECT_DOUBLE_EQ(split.overspray_mm3, 12.0 * area);
+  EXPECT_DOUBLE_EQ(split.captured_mm3, 3.0 * area);
+  EXPECT_DOUBLE_EQ(split.emitted_mm3, 20.0 * area);
+  EXPECT_DOUBLE_EQ(split.fraction, 15.0 / 20.0);
+  EXPECT_DOUBLE_EQ(split.closed_time_s, 0.25);
+}
+
+TEST(ThicknessStats, EmptyToolpathGivesZeros) {
+  ThicknessField field(kCell);
+  field.add_to_cell(0, 0, 1.0);
+  const DepositionMetrics metrics = evaluate_deposition(field, Toolpath{}, 0.4, MaterialAccount{});
+  EXPECT_EQ(metrics.thickness.cells, 0u);
+  EXPECT_EQ(metrics.thickness.mean_um, 0.0);
+  EXPECT_EQ(metrics.thickness.line_cv, 0.0);
+  EXPECT_EQ(metrics.material.fraction, 0.0);
+}
+
+}  // namespace
+}  // namespace depotwin

@@ -1,0 +1,140 @@
+// Extrusion process: bead cross-section Q/v, first-order flow lag (thin start, ooze blob),
+// and material conservation with nothing captured.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "deposition/deposition_metrics.hpp"
+#include "deposition/process.hpp"
+#include "deposition_test_util.hpp"
+
+namespace depotwin {
+namespace {
+
+using test::drive;
+
+constexpr double kBeadWidth = 0.4;
+constexpr double kLayerHeight = 0.2;
+constexpr double kTau = 0.05;
+constexpr double kSpeed = 20.0;
+constexpr double kLength = 20.0;  // mm, printed in 1 s
+const double kSqrt2Pi = std::sqrt(2.0 * kPi);
+
+DepositionSettings extrusion_settings() {
+  DepositionSettings settings;
+  settings.type = ProcessType::extrusion;
+  settings.bead_width_mm = kBeadWidth;
+  settings.layer_height_mm = kLayerHeight;
+  settings.tau_s = kTau;
+  return settings;
+}
+
+// print one line along x at constant speed with the command on, then dwell at its end
+// with the command off so the lagged flow oozes out
+void print_line_then_dwell(Process& process, double dwell_s) {
+  const double t_print = kLength / kSpeed;
+  drive(
+      process, 0.0, t_print + dwell_s, 1e-3,
+      [&](double t) { return Vec3(kSpeed * std::min(t, t_print), 0.0, 0.0); },
+      [](double) { return 0.0; }, [&](double t) { return t < t_print ? 1.0 : 0.0; },
+      [&](double t) { return t < t_print ? kSpeed : 0.0; });
+}
+
+// cross-section area at column x: sum of the column's cells times the cell width (mm^2)
+double cross_section_mm2(const ThicknessField& field, double x_mm) {
+  const int ix = static_cast<int>(std::lround(x_mm / field.cell_mm()));
+  double sum = 0.0;
+  for (int iy = -40; iy <= 40; ++iy) sum += field.cell_thickness_mm(ix, iy);
+  return sum * field.cell_mm();
+}
+
+TEST(Extrusion, DefaultsFollowTheBead) {
+  const DepositionSettings settings = extrusion_settings();
+  EXPECT_DOUBLE_EQ(settings.footprint_sigma_mm(), 0.1);      // w / 4
+  EXPECT_DOUBLE_EQ(settings.resolved_line_width_mm(), 0.4);  // w
+  EXPECT_DOUBLE_EQ(settings.default_cell_mm(), 0.05);        // w / 8
+}
+
+// steady bead: cross-section Q / v = w h, centreline peak w h / (sigma sqrt(2 pi))
+TEST(Extrusion, SteadyBeadCrossSectionIsFlowOverSpeed) {
+  ExtrusionProcess process(extrusion_settings(), 0.0);
+  print_line_then_dwell(process, 0.0);
+  const double area = kBeadWidth * kLayerHeight;
+  EXPECT_NEAR(cross_section_mm2(process.field(), 12.0) / area, 1.0, 1e-4);
+  EXPECT_NEAR(process.field().thickness_mm_at(12.0, 0.0) / (area / (0.1 * kSqrt2Pi)), 1.0, 1e-4);
+}
+
+// the lag: the start is thin (cross-section w h (1 - exp(-x / (v tau)))), the end blobs
+TEST(Extrusion, LagGivesThinStartAndOozeBlob) {
+  ExtrusionProcess process(extrusion_settings(), 0.0);
+  const double t_print = kLength / kSpeed;
+  print_line_then_dwell(process, 0.0);
+  const double emitted_at_stop = process.account().emitted_mm3;
+  const double flow_at_stop = process.nozzle_flow_mm3_s();
+  drive(
+      process, t_print, t_print + 2.0, 1e-3, [&](double) { return Vec3(kLength, 0.0, 0.0); },
+      [](double) { return 0.0; }, [](double) { return 0.0; }, [](double) { return 0.0; });
+
+  // ooze after the stop: the remaining flow integrates to Q tau, all of it at the end point
+  const double nominal = kSpeed * kBeadWidth * kLayerHeight;
+  EXPECT_NEAR(flow_at_stop, nominal * (1.0 - std::exp(-t_print / kTau)), 1e-9 * nominal);
+  EXPECT_NEAR(process.account().emitted_mm3 - emitted_at_stop, flow_at_stop * kTau,
+              1e-9 * nominal * kTau);
+  EXPECT_EQ(process.nozzle_flow_mm3_s(), 0.0);
+
+  // thin start: cross-section follows the lagged flow (smoothed by sigma << v tau)
+  const double area = kBeadWidth * kLayerHeight;
+  const double x_start = 1.0;  // = v tau
+  EXPECT_NEAR(cross_section_mm2(process.field(), x_start) / (area * (1.0 - std::exp(-1.0))), 1.0,
+              0.02);
+
+  // the metric view: thickness near the start below the mean, at the end above it
+  const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, kLength, 0.0, kSpeed);
+  const DepositionMetrics metrics =
+      evaluate_deposition(process.field(), toolpath, process.line_width_mm(), process.account());
+  const double line_mean_mm = process.field().thickness_mm_at(10.0, 0.0);
+  EXPECT_LT(process.field().thickness_mm_at(0.3, 0.0), 0.5 * line_mean_mm);
+  EXPECT_GT(process.field().thickness_mm_at(kLength - 0.1, 0.0), 2.0 * line_mean_mm);
+  EXPECT_LT(metrics.thickness.min_rel, 0.5);
+  EXPECT_GT(metrics.thickness.max_rel, 1.5);
+}
+
+// emitted = on_target + overspray (nothing captured); emitted = commanded volume once the
+// ooze has run out, and ooze on a travel move is overspray
+TEST(Extrusion, MaterialIsConservedAndOozeOnTravelIsOverspray) {
+  ExtrusionProcess process(extrusion_settings(), 0.0);
+  const double t_print = kLength / kSpeed;
+  // print, then travel away sideways at 50 mm/s for 2 s with the command off
+  drive(
+      process, 0.0, t_print + 2.0, 1e-3,
+      [&](double t) {
+        return t < t_print ? Vec3(kSpeed * t, 0.0, 0.0) : Vec3(kLength, 50.0 * (t - t_print), 0.0);
+      },
+      [](double) { return 0.0; }, [&](double t) { return t < t_print ? 1.0 : 0.0; },
+      [&](double t) { return t < t_print ? kSpeed : 0.0; });
+
+  const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, kLength, 0.0, kSpeed);
+  const DepositionMetrics metrics =
+      evaluate_deposition(process.field(), toolpath, process.line_width_mm(), process.account());
+  const MaterialSplit& m = metrics.material;
+  const double commanded = kSpeed * kBeadWidth * kLayerHeight * t_print;
+  EXPECT_NEAR(m.emitted_mm3, commanded, 1e-9 * commanded);
+  EXPECT_EQ(m.captured_mm3, 0.0);
+  EXPECT_NEAR(m.on_target_mm3 + m.overspray_mm3, m.emitted_mm3, 1e-6 * m.emitted_mm3);
+  // most of the ooze (~Q tau, 5% of the line) is strung along the travel: overspray
+  EXPECT_GT(m.overspray_mm3, 0.5 * kSpeed * kBeadWidth * kLayerHeight * kTau);
+}
+
+TEST(Extrusion, ZeroTauFollowsTheCommandInstantly) {
+  DepositionSettings settings = extrusion_settings();
+  settings.tau_s = 0.0;
+  ExtrusionProcess process(settings, 0.0);
+  print_line_then_dwell(process, 0.5);
+  const double commanded = kSpeed * kBeadWidth * kLayerHeight * (kLength / kSpeed);
+  EXPECT_NEAR(process.account().emitted_mm3, commanded, 1e-12 * commanded);
+  // no lag: the start cross-section is already the full bead half a sigma in
+  EXPECT_NEAR(cross_section_mm2(process.field(), 0.5) / (kBeadWidth * kLayerHeight), 1.0, 1e-4);
+}
+
+}  // namespace
+}  // namespace depotwin
