@@ -1,0 +1,88 @@
+// The data behind the plots, computed before any drawing so tests can check it: transition
+// bands, min/max-preserving decimation, error series, display-sized thickness maps and the
+// fixed-format text that gnuplot reads. Pure functions; no gnuplot here.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/heightmap.hpp"
+#include "core/toolpath.hpp"
+#include "core/trajectory.hpp"
+#include "metrics/motion_metrics.hpp"
+
+namespace depotwin::plots {
+
+// One time interval [begin_s, end_s] (s).
+struct TimeInterval {
+  double begin_s = 0.0;
+  double end_s = 0.0;
+};
+bool operator==(const TimeInterval& a, const TimeInterval& b);
+
+// the transitions of a plan: maximal runs of consecutive pieces that deposit nothing, with
+// the pieces' exact boundary times; empty when material is on for the whole job
+std::vector<TimeInterval> transition_intervals(const Trajectory& trajectory);
+// the same from samples (when no Trajectory is at hand): each maximal run of non-depositing
+// samples, from its first sample's time to the time of the next depositing sample (or the
+// last sample); exact to the sampling period
+std::vector<TimeInterval> transition_intervals(const MotionSamples& samples);
+
+// A curve as gnuplot draws it: points in order, a NaN in x marks a break in the line.
+struct Curve {
+  std::vector<double> x, y;
+
+  size_t size() const { return x.size(); }
+  void add(double px, double py);
+  void add_break();
+  // points that are not breaks
+  size_t point_count() const;
+};
+
+// Min/max-preserving decimation of values[begin, end): the range is cut into buckets of
+// equal sample count and each bucket keeps its smallest and its largest sample (in index
+// order); the first and the last sample are always kept. At most max_points indices
+// (max_points >= 4), sorted; the global extrema of the range are always among them.
+std::vector<size_t> decimate_min_max(const std::vector<double>& values, size_t begin, size_t end,
+                                     size_t max_points);
+
+// y(t) as a curve of at most about max_points points: NaN values in y are gaps (the line
+// breaks there); each finite run is decimated with decimate_min_max, the point budget shared
+// in proportion to the runs' sample counts (every run keeps at least its ends)
+Curve time_curve(const std::vector<double>& t_s, const std::vector<double>& y, size_t max_points);
+
+// which samples an XY path curve shows
+enum class PathPart { printing, transition, all };
+// XY path of the samples in `part` (one line per maximal run; a transition run reaches the
+// print samples on both sides), thinned to points a minimum spacing apart (run ends always
+// kept); the spacing starts below a pixel (extent / 1500) and grows until the curve has at
+// most max_points points
+Curve xy_path_curve(const MotionSamples& samples, PathPart part, size_t max_points);
+
+// the size the relative path error is divided by: the largest extent of the print paths'
+// bounding box (Thompson & Yoon's 10-mm feature); falls back to Toolpath::bounds when no
+// print path is given and to 1 mm for a degenerate toolpath
+double feature_size_mm(const Toolpath& toolpath);
+
+// e = | |v| - v_des | / v_des (relative_speed_error) where material is deposited, NaN elsewhere
+std::vector<double> speed_error_with_gaps(const MotionSamples& samples);
+// distance to the print path being printed / feature size where material is deposited on a
+// valid path, NaN elsewhere
+std::vector<double> relative_position_error(const MotionSamples& samples, const Toolpath& toolpath,
+                                            double feature_mm);
+
+// A thickness map reduced for display: each output cell is the mean of a block of
+// `factor` x `factor` input cells (cells beyond the edge ignored), centred on the block,
+// so that neither side has more than max_cells_per_side cells. factor 1 copies the map.
+HeightMap downsample_for_display(const HeightMap& map, int max_cells_per_side);
+
+// the text gnuplot reads: "x y" per line in fixed %.9g format, a blank line per break
+std::string format_curve(const Curve& curve);
+// float32 cells in row-major order (x fastest), host byte order, for `binary array=(nx,ny)`
+std::string format_binary_map(const HeightMap& map);
+
+// printf into a std::string (C locale number formatting)
+std::string format(const char* pattern, ...) __attribute__((format(printf, 1, 2)));
+
+}  // namespace depotwin::plots

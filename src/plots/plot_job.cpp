@@ -1,0 +1,41 @@
+#include "plots/plot_job.hpp"
+
+#include "plots/style.hpp"
+
+namespace depotwin::plots {
+
+PlotJob::PlotJob(const std::string& output_directory, const PlotOptions& options)
+    : gnuplot_(find_gnuplot(options.gnuplot)), temporary_(output_directory) {}
+
+std::string PlotJob::data_file(const std::string& name, const std::string& content) {
+  const std::string path = temporary_.file(name);
+  write_text_file(path, content);
+  return style::quoted(path);
+}
+
+void PlotJob::begin_png(const std::string& final_path, int width_px, int height_px) {
+  const std::string temporary = temporary_.file("png-" + std::to_string(pngs_.size()) + ".png");
+  pngs_.push_back({temporary, final_path});
+  script_ += "\n# " + final_path + "\n";
+  script_ += style::terminal(width_px, height_px);
+  script_ += "set output " + style::quoted(temporary) + "\n";
+  script_ += style::common_settings();
+}
+
+void PlotJob::end_png() {
+  script_ += "unset multiplot\nunset output\n";
+}
+
+PlotResult PlotJob::finish() {
+  const std::string script_path = temporary_.file("plots.gp");
+  write_text_file(script_path, script_);
+  PlotResult result;
+  result.warnings = run_gnuplot(gnuplot_, script_path, temporary_.file("gnuplot.stderr"));
+  for (const auto& [temporary, final_path] : pngs_) {
+    move_into_place(temporary, final_path);
+    result.files.push_back(final_path);
+  }
+  return result;
+}
+
+}  // namespace depotwin::plots

@@ -1,0 +1,501 @@
+// The five plots of one run: path.png (Fig. 8), axes.png (Fig. 9), errors.png (Figs. 10, 12),
+// thickness_profile.png and thickness.png.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "plots/plot_job.hpp"
+#include "plots/plots.hpp"
+#include "plots/style.hpp"
+
+namespace depotwin::plots {
+
+namespace {
+
+constexpr const char* kAxisNames[3] = {"x", "y", "z"};
+
+// running [lo, hi] of the finite values of curves
+struct Range {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+
+  void add(double v) {
+    if (!std::isfinite(v)) return;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  void add_y(const Curve& c) {
+    for (double v : c.y) add(v);
+  }
+  void add_x(const Curve& c) {
+    for (double v : c.x) add(v);
+  }
+  bool empty() const { return !(hi >= lo); }
+  // [lo, hi] padded by a fraction of its width (at least min_half_width either side of a single
+  // value)
+  std::string gnuplot(double pad_fraction, double min_half_width) const {
+    double a = empty() ? 0.0 : lo, b = empty() ? 1.0 : hi;
+    if (b - a < 2 * min_half_width) {
+      const double mid = 0.5 * (a + b);
+      a = mid - min_half_width;
+      b = mid + min_half_width;
+    }
+    const double pad = pad_fraction * (b - a);
+    return format("[%.9g:%.9g]", a - pad, b + pad);
+  }
+};
+
+// [0, 1.08 * max] for quantities that start at zero (errors, thickness)
+std::string zero_based_range(double max_value) {
+  return format("[0:%.9g]", max_value > 0.0 ? 1.08 * max_value : 1.0);
+}
+
+// an axis moves when its position range exceeds 1 um
+bool moves(const Curve& position) {
+  Range r;
+  r.add_y(position);
+  return !r.empty() && r.hi - r.lo > 1e-3;
+}
+
+// "plot a, b, c" from the non-empty elements
+std::string plot_command(const std::vector<std::string>& elements) {
+  std::string command;
+  for (const std::string& e : elements) {
+    if (e.empty()) continue;
+    command += command.empty() ? "plot " : ", \\\n     ";
+    command += e;
+  }
+  return command.empty() ? "" : command + "\n";
+}
+
+std::string line_style(const char* colour, double width, int dash = 1) {
+  return format("with lines lw %.2f dt %d lc rgb \"%s\"", width, dash, colour);
+}
+
+void require(bool condition, const char* what) {
+  if (!condition) throw InternalError(std::string("plots: ") + what);
+}
+
+}  // namespace
+
+const char* file_name(RunPlot plot) {
+  switch (plot) {
+    case RunPlot::path:
+      return "path.png";
+    case RunPlot::axes:
+      return "axes.png";
+    case RunPlot::errors:
+      return "errors.png";
+    case RunPlot::thickness_profile:
+      return "thickness_profile.png";
+    case RunPlot::thickness:
+      return "thickness.png";
+  }
+  return "plot.png";
+}
+
+std::vector<RunPlot> available_plots(const RunPlotInput& input) {
+  std::vector<RunPlot> plots = {RunPlot::path, RunPlot::axes, RunPlot::errors};
+  if (!input.profiles.empty()) plots.push_back(RunPlot::thickness_profile);
+  if (input.thickness != nullptr && input.thickness->nx > 0 && input.thickness->ny > 0)
+    plots.push_back(RunPlot::thickness);
+  return plots;
+}
+
+RunPlotData prepare_run_plot_data(const RunPlotInput& input, const PlotOptions& options) {
+  require(input.toolpath != nullptr, "run plots need the toolpath");
+  require(input.planned != nullptr && input.planned->size() > 0, "run plots need planned samples");
+  const MotionSamples& planned = *input.planned;
+  const bool simulated = input.simulated != nullptr && input.simulated->size() > 0;
+  const size_t budget = options.max_points_per_curve;
+
+  RunPlotData data;
+  data.simulated = simulated;
+  data.transitions = input.transitions ? *input.transitions : transition_intervals(planned);
+  data.duration_s = planned.t_s.back();
+  data.feature_size_mm =
+      input.feature_size_mm > 0.0 ? input.feature_size_mm : feature_size_mm(*input.toolpath);
+
+  // path.png
+  data.planned_print_xy = xy_path_curve(planned, PathPart::printing, budget);
+  data.planned_transition_xy = xy_path_curve(planned, PathPart::transition, budget);
+  if (simulated) data.simulated_xy = xy_path_curve(*input.simulated, PathPart::all, budget);
+
+  // axes.png: each axis's position and velocity, min/max decimated
+  std::vector<double> values;
+  auto axis_curves = [&](const MotionSamples& s, int axis, Curve& position, Curve& velocity) {
+    values.resize(s.size());
+    for (size_t k = 0; k < s.size(); ++k) values[k] = s.position_mm[k][axis];
+    position = time_curve(s.t_s, values, budget);
+    for (size_t k = 0; k < s.size(); ++k) values[k] = s.velocity_mm_s[k][axis];
+    velocity = time_curve(s.t_s, values, budget);
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    axis_curves(planned, axis, data.planned_position[axis], data.planned_velocity[axis]);
+    if (simulated)
+      axis_curves(*input.simulated, axis, data.simulated_position[axis],
+                  data.simulated_velocity[axis]);
+    data.axis_moves[axis] =
+        moves(data.planned_position[axis]) || moves(data.simulated_position[axis]);
+  }
+
+  // errors.png: percent, gaps where nothing is deposited
+  auto percent = [](std::vector<double> v) {
+    for (double& e : v) e *= 100.0;
+    return v;
+  };
+  data.planned_speed_error_pct =
+      time_curve(planned.t_s, percent(speed_error_with_gaps(planned)), budget);
+  data.planned_position_error_pct = time_curve(
+      planned.t_s, percent(relative_position_error(planned, *input.toolpath, data.feature_size_mm)),
+      budget);
+  if (simulated) {
+    const MotionSamples& s = *input.simulated;
+    data.simulated_speed_error_pct = time_curve(s.t_s, percent(speed_error_with_gaps(s)), budget);
+    data.simulated_position_error_pct = time_curve(
+        s.t_s, percent(relative_position_error(s, *input.toolpath, data.feature_size_mm)), budget);
+  }
+
+  // thickness_profile.png
+  for (const LineProfile& profile : input.profiles) {
+    require(profile.arc_length_mm.size() == profile.thickness_um.size(),
+            "a line profile's arc lengths and thicknesses differ in count");
+    data.profiles.push_back(time_curve(profile.arc_length_mm, profile.thickness_um, budget));
+  }
+
+  // thickness.png
+  if (input.thickness != nullptr && input.thickness->nx > 0 && input.thickness->ny > 0) {
+    require(input.thickness->thickness_um.size() ==
+                static_cast<size_t>(input.thickness->nx) * input.thickness->ny,
+            "the height map's size does not match nx * ny");
+    data.display_map = downsample_for_display(*input.thickness, options.max_map_cells_per_side);
+  }
+  return data;
+}
+
+namespace {
+
+// path.png: the planned XY path, print and transition styles, simulated path, start and end
+// (Thompson & Yoon Fig. 8)
+void path_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
+               const std::string& png) {
+  job.begin_png(png, style::kRunPlotWidth_px, style::kRunPlotHeight_px);
+  std::string& s = job.script();
+  const Toolpath& toolpath = *input.toolpath;
+  s += "set title " + style::quoted(input.title + ": XY path") + " font \"" + style::title_font() +
+       "\"\n";
+  s += "set xlabel " + style::quoted(style::axis_label("x", "mm")) + "\n";
+  s += "set ylabel " + style::quoted(style::axis_label("y", "mm")) + "\n";
+  s += "set size ratio -1\nset key outside right top vertical\n";
+  s += "set style textbox opaque noborder margins 1,1\n";
+
+  // ranges over everything drawn, with a margin
+  Range x, y;
+  x.add_x(data.planned_print_xy), y.add_y(data.planned_print_xy);
+  x.add_x(data.planned_transition_xy), y.add_y(data.planned_transition_xy);
+  x.add_x(data.simulated_xy), y.add_y(data.simulated_xy);
+  x.add(toolpath.start_mm.x()), y.add(toolpath.start_mm.y());
+  x.add(toolpath.end_mm.x()), y.add(toolpath.end_mm.y());
+  s += "set xrange " + x.gnuplot(0.05, 0.5) + "\nset yrange " + y.gnuplot(0.05, 0.5) + "\n";
+
+  // print paths numbered in print order at their middle (as in the paper's Fig. 7)
+  if (toolpath.paths.size() <= 40) {
+    for (size_t i = 0; i < toolpath.paths.size(); ++i) {
+      const auto& points = toolpath.paths[i].points;
+      const double half_mm = 0.5 * toolpath.paths[i].length_mm();
+      double walked_mm = 0.0;
+      Vec3 middle = points.front();
+      for (size_t j = 1; j < points.size(); ++j) {
+        const double step = (points[j] - points[j - 1]).norm();
+        if (walked_mm + step >= half_mm && step > 0.0) {
+          middle = points[j - 1] + (half_mm - walked_mm) / step * (points[j] - points[j - 1]);
+          break;
+        }
+        walked_mm += step;
+      }
+      s += format(
+          "set label %zu \"%zu\" at %.9g,%.9g offset 0.7,0.7 tc rgb \"#404040\" boxed front\n",
+          i + 1, i + 1, middle.x(), middle.y());
+    }
+  }
+
+  s += format("$start << EOD\n%.9g %.9g\nEOD\n$end << EOD\n%.9g %.9g\nEOD\n", toolpath.start_mm.x(),
+              toolpath.start_mm.y(), toolpath.end_mm.x(), toolpath.end_mm.y());
+  std::vector<std::string> elements;
+  if (data.planned_print_xy.point_count() > 0)
+    elements.push_back(job.data_file("path_print.dat", format_curve(data.planned_print_xy)) + " " +
+                       line_style(style::kPlannedColour, style::kPathLineWidth) +
+                       " title 'planned: printing'");
+  if (data.planned_transition_xy.point_count() > 0)
+    elements.push_back(
+        job.data_file("path_transition.dat", format_curve(data.planned_transition_xy)) + " " +
+        line_style(style::kTransitionPathColour, style::kPlannedLineWidth, 2) +
+        " title 'planned: transition'");
+  if (data.simulated_xy.point_count() > 0)
+    elements.push_back(job.data_file("path_simulated.dat", format_curve(data.simulated_xy)) + " " +
+                       line_style(style::kSimulatedPathColour, style::kThinLineWidth) +
+                       " title 'simulated'");
+  elements.push_back(
+      format("$start with points pt 7 ps 1.8 lc rgb \"%s\" title 'start'", style::kStartColour));
+  elements.push_back(
+      format("$end with points pt 5 ps 1.6 lc rgb \"%s\" title 'end'", style::kEndColour));
+  s += plot_command(elements);
+  job.end_png();
+}
+
+// the screen margins shared by stacked time panels, so their time axes line up
+struct Panel {
+  double bottom, top;
+};
+constexpr double kPanelLeft = 0.095, kPanelRight = 0.79;
+
+void begin_panel(std::string& s, const Panel& panel) {
+  s += format(
+      "set lmargin at screen %.4f\nset rmargin at screen %.4f\n"
+      "set bmargin at screen %.4f\nset tmargin at screen %.4f\n",
+      kPanelLeft, kPanelRight, panel.bottom, panel.top);
+}
+
+// axes.png: per-axis position and velocity against time, transitions shaded (Fig. 9)
+void axes_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
+               const std::string& png) {
+  job.begin_png(png, style::kRunPlotWidth_px, style::kRunPlotHeight_px);
+  std::string& s = job.script();
+  s += "set multiplot title " + style::quoted(input.title + ": axis position and velocity") +
+       " font \"" + style::title_font() + "\"\n";
+  s += "set key outside right top vertical\n";
+  s += format("set xrange [0:%.9g]\n", std::max(data.duration_s, 1e-6));
+  s += style::transition_shading(data.transitions);
+
+  // axes that stay put are left out; with none moving, x and y are shown
+  std::vector<int> axes;
+  for (int axis = 0; axis < 3; ++axis)
+    if (data.axis_moves[axis]) axes.push_back(axis);
+  if (axes.empty()) axes = {0, 1};
+
+  auto panel = [&](const Curve* planned, const Curve* simulated, const char* quantity,
+                   const char* unit, const std::string& file_stem, bool with_shading_key) {
+    Range y;
+    for (int axis : axes) y.add_y(planned[axis]), y.add_y(simulated[axis]);
+    s += "set ylabel " + style::quoted(style::axis_label(quantity, unit)) + "\n";
+    s += "set yrange " + y.gnuplot(0.06, 0.5) + "\n";
+    std::vector<std::string> elements;
+    for (int axis : axes) {
+      const std::string name = kAxisNames[axis];
+      if (planned[axis].point_count() > 0)
+        elements.push_back(
+            job.data_file(file_stem + "_planned_" + name + ".dat", format_curve(planned[axis])) +
+            " " + line_style(style::kAxisColours[axis], style::kPlannedLineWidth) + " title '" +
+            name + " planned'");
+      if (simulated[axis].point_count() > 0)
+        elements.push_back(job.data_file(file_stem + "_simulated_" + name + ".dat",
+                                         format_curve(simulated[axis])) +
+                           " " +
+                           line_style(style::kAxisColours[axis], style::kSimulatedLineWidth, 2) +
+                           " title '" + name + " simulated'");
+    }
+    if (with_shading_key) elements.push_back(style::transition_key_entry(data.transitions));
+    s += plot_command(elements);
+  };
+
+  begin_panel(s, {0.55, 0.90});
+  s += "set format x ''\nunset xlabel\n";
+  panel(data.planned_position, data.simulated_position, "position", "mm", "position", true);
+  begin_panel(s, {0.11, 0.51});
+  s += "set format x '%g'\nset xlabel " + style::quoted(style::axis_label("time", "s")) + "\n";
+  panel(data.planned_velocity, data.simulated_velocity, "velocity", "mm/s", "velocity", false);
+  job.end_png();
+}
+
+// errors.png: relative speed error and relative position error against time, transitions
+// shaded (Figs. 10 and 12)
+void errors_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
+                 const std::string& png) {
+  job.begin_png(png, style::kRunPlotWidth_px, style::kRunPlotHeight_px);
+  std::string& s = job.script();
+  s += "set multiplot title " + style::quoted(input.title + ": speed and position error") +
+       " font \"" + style::title_font() + "\"\n";
+  s += "set key outside right top vertical\n";
+  s += format("set xrange [0:%.9g]\n", std::max(data.duration_s, 1e-6));
+  s += style::transition_shading(data.transitions);
+
+  auto panel = [&](const Curve& planned, const Curve& simulated, const std::string& label,
+                   const std::string& stem, bool with_shading_key) {
+    Range y;
+    y.add_y(planned), y.add_y(simulated);
+    s += "set ylabel " + style::quoted(label) + "\n";
+    s += "set yrange " + zero_based_range(y.empty() ? 0.0 : y.hi) + "\n";
+    std::vector<std::string> elements;
+    if (planned.point_count() > 0)
+      elements.push_back(job.data_file(stem + "_planned.dat", format_curve(planned)) + " " +
+                         line_style(style::kPlannedColour, style::kPlannedLineWidth) +
+                         " title 'planned'");
+    if (simulated.point_count() > 0)
+      elements.push_back(job.data_file(stem + "_simulated.dat", format_curve(simulated)) + " " +
+                         line_style(style::kSimulatedColour, style::kSimulatedLineWidth) +
+                         " title 'simulated'");
+    // nothing deposited at all: an empty frame (a key entry alone is not a plot), no key box
+    // unless the shading needs one
+    const bool no_curves = elements.empty();
+    if (no_curves) elements.push_back(style::kEmptyFrame);
+    if (with_shading_key) elements.push_back(style::transition_key_entry(data.transitions));
+    const bool keyed = !no_curves || (with_shading_key && !data.transitions.empty());
+    s += keyed ? "set key outside right top vertical\n" : "unset key\n";
+    s += plot_command(elements);
+  };
+
+  begin_panel(s, {0.55, 0.90});
+  s += "set format x ''\nunset xlabel\n";
+  panel(data.planned_speed_error_pct, data.simulated_speed_error_pct, "(a) speed error (%)",
+        "speed_error", true);
+  begin_panel(s, {0.11, 0.51});
+  s += "set format x '%g'\nset xlabel " + style::quoted(style::axis_label("time", "s")) + "\n";
+  panel(data.planned_position_error_pct, data.simulated_position_error_pct,
+        format("(b) position error (%% of %.3g mm)", data.feature_size_mm), "position_error",
+        false);
+  job.end_png();
+}
+
+// thickness_profile.png: thickness along each print line's centreline, target and mean
+void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
+                  const std::string& png) {
+  job.begin_png(png, style::kRunPlotWidth_px, style::kRunPlotHeight_px);
+  std::string& s = job.script();
+  s += "set title " + style::quoted(input.title + ": thickness along the print lines") +
+       " font \"" + style::title_font() + "\"\n";
+  s += "set xlabel " + style::quoted(style::axis_label("arc length along the line", "mm")) + "\n";
+  s += "set ylabel " + style::quoted(style::axis_label("thickness", "µm")) + "\n";
+  s += "set key outside right top vertical\n";
+  s += "set lmargin at screen 0.095\nset rmargin at screen 0.79\n";
+  Range x, y;
+  for (const Curve& c : data.profiles) x.add_x(c), y.add_y(c);
+  y.add(input.target_thickness_um), y.add(input.mean_thickness_um);
+  s += format("set xrange [0:%.9g]\n", x.empty() || x.hi <= 0.0 ? 1.0 : x.hi);
+  s += "set yrange " + zero_based_range(y.empty() ? 0.0 : y.hi) + "\n";
+
+  // one colour and key entry per line when few; one shared colour and entry when many
+  const bool few = data.profiles.size() <= 8;
+  std::vector<std::string> elements;
+  // the reference lines first, so the profiles are drawn over them
+  if (input.target_thickness_um > 0.0)
+    elements.push_back(format("%.9g with lines lw 2 dt 2 lc rgb \"%s\" title 'target %.3g µm'",
+                              input.target_thickness_um, style::kTargetColour,
+                              input.target_thickness_um));
+  if (input.mean_thickness_um > 0.0)
+    elements.push_back(format("%.9g with lines lw 2 dt 3 lc rgb \"%s\" title 'mean %.3g µm'",
+                              input.mean_thickness_um, style::kMeanColour,
+                              input.mean_thickness_um));
+  for (size_t i = 0; i < data.profiles.size(); ++i) {
+    if (data.profiles[i].point_count() == 0) continue;
+    const int path = input.profiles[i].path_index;
+    std::string title = few ? format("title 'path %d'", path + 1)
+                            : (i == 0 ? format("title 'paths 1-%zu'", data.profiles.size())
+                                      : std::string("notitle"));
+    elements.push_back(
+        job.data_file(format("profile_%zu.dat", i), format_curve(data.profiles[i])) + " " +
+        line_style(few ? style::series_colour(i) : style::kPlannedColour, 1.5) + " " + title);
+  }
+  if (elements.empty()) elements.push_back(style::kEmptyFrame);
+  s += plot_command(elements);
+  job.end_png();
+}
+
+}  // namespace
+
+std::string thickness_map_elements(PlotJob& job, const HeightMap& map, const Toolpath* toolpath,
+                                   const std::string& stem, bool path_key) {
+  std::vector<std::string> elements;
+  elements.push_back(job.data_file(stem + ".bin", format_binary_map(map)) +
+                     format(" binary array=(%d,%d) dx=%.9g dy=%.9g origin=(%.9g,%.9g) "
+                            "format='%%float32' endian=default with image notitle",
+                            map.nx, map.ny, map.cell_mm, map.cell_mm, map.origin_x_mm,
+                            map.origin_y_mm));
+  if (toolpath != nullptr && !toolpath->paths.empty()) {
+    Curve paths;
+    for (const PrintPath& path : toolpath->paths) {
+      for (const Vec3& p : path.points) paths.add(p.x(), p.y());
+      paths.add_break();
+    }
+    elements.push_back(job.data_file(stem + "_paths.dat", format_curve(paths)) + " " +
+                       line_style(style::kPathOverlayColour, 1.2, 2) +
+                       (path_key ? " title 'print path'" : " notitle"));
+  }
+  return plot_command(elements);
+}
+
+std::string map_ranges(const std::vector<const HeightMap*>& maps, const Toolpath* toolpath) {
+  Range x, y;
+  for (const HeightMap* map : maps) {
+    if (map == nullptr || map->nx <= 0 || map->ny <= 0) continue;
+    x.add(map->origin_x_mm - 0.5 * map->cell_mm);
+    x.add(map->origin_x_mm + (map->nx - 0.5) * map->cell_mm);
+    y.add(map->origin_y_mm - 0.5 * map->cell_mm);
+    y.add(map->origin_y_mm + (map->ny - 0.5) * map->cell_mm);
+  }
+  if (toolpath != nullptr)
+    for (const PrintPath& path : toolpath->paths)
+      for (const Vec3& p : path.points) x.add(p.x()), y.add(p.y());
+  return "set xrange " + x.gnuplot(0.0, 0.05) + "\nset yrange " + y.gnuplot(0.0, 0.05) + "\n";
+}
+
+namespace {
+
+// thickness.png: top-down heat map with colour bar, mm axes, print paths overlaid
+void thickness_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
+                    const std::string& png) {
+  job.begin_png(png, style::kRunPlotWidth_px, style::kRunPlotHeight_px);
+  std::string& s = job.script();
+  const HeightMap& map = data.display_map;
+  s += "set title " + style::quoted(input.title + ": deposited thickness") + " font \"" +
+       style::title_font() + "\"\n";
+  s += "set xlabel " + style::quoted(style::axis_label("x", "mm")) + "\n";
+  s += "set ylabel " + style::quoted(style::axis_label("y", "mm")) + "\n";
+  s += "set size ratio -1\nunset grid\nset tics front\n";
+  // the key under the x label, right-aligned with the map, dark so the white sample shows
+  s += format(
+      "set bmargin 5\nset key at graph 1, screen 0.012 right bottom horizontal opaque "
+      "fc rgb \"%s\" textcolor rgb \"white\"\n",
+      style::kMapKeyColour);
+  s += style::thickness_palette();
+  s += format("set cbrange [0:%.9g]\n", std::max(static_cast<double>(map.max_value()), 1e-3));
+  s += "set cblabel " + style::quoted(style::axis_label("thickness", "µm")) + " offset 1.5,0\n";
+  s += "set colorbox\n";
+  s += map_ranges({&map}, input.toolpath);
+  s += thickness_map_elements(job, map, input.toolpath, "thickness_map", true);
+  job.end_png();
+}
+
+}  // namespace
+
+PlotResult render_run_plots(const RunPlotInput& input, const std::string& directory,
+                            const std::vector<RunPlot>& plots, const PlotOptions& options) {
+  const std::vector<RunPlot> wanted = plots.empty() ? available_plots(input) : plots;
+  PlotJob job(directory, options);  // GnuplotNotFound before any work
+  const RunPlotData data = prepare_run_plot_data(input, options);
+  for (RunPlot plot : wanted) {
+    const std::string png = directory + "/" + file_name(plot);
+    switch (plot) {
+      case RunPlot::path:
+        path_plot(job, input, data, png);
+        break;
+      case RunPlot::axes:
+        axes_plot(job, input, data, png);
+        break;
+      case RunPlot::errors:
+        errors_plot(job, input, data, png);
+        break;
+      case RunPlot::thickness_profile:
+        require(!data.profiles.empty(), "thickness_profile.png needs line profiles");
+        profile_plot(job, input, data, png);
+        break;
+      case RunPlot::thickness:
+        require(data.display_map.nx > 0 && data.display_map.ny > 0,
+                "thickness.png needs a thickness map");
+        thickness_plot(job, input, data, png);
+        break;
+    }
+  }
+  return job.finish();
+}
+
+}  // namespace depotwin::plots

@@ -1,0 +1,78 @@
+// The one look of every DepoTwin plot: fonts, sizes, colours, line styles and the grey
+// transition shading of Thompson & Yoon's Figs. 9, 10 and 12. Each function returns gnuplot
+// commands; the plot builders compose them and never spell a colour or font themselves.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "plots/plot_data.hpp"
+
+namespace depotwin::plots::style {
+
+// image sizes (px): legible at README width
+constexpr int kRunPlotWidth_px = 900;
+constexpr int kRunPlotHeight_px = 560;
+constexpr int kComparisonColumnWidth_px = 460;
+constexpr int kComparisonHeight_px = 1000;
+
+// fonts (DejaVu: fonts-dejavu-core, installed with gnuplot-nox by scripts/setup.sh)
+constexpr const char* kFont = "DejaVu Sans";
+constexpr int kFontSize_pt = 11;
+constexpr int kTitleFontSize_pt = 13;
+constexpr const char* kMonoFont = "DejaVu Sans Mono";
+
+// colours
+constexpr const char* kPlannedColour = "#1f77b4";          // planned motion
+constexpr const char* kSimulatedColour = "#d62728";        // simulated nozzle
+constexpr const char* kSimulatedPathColour = "#40d62728";  // the same, 25 % transparent (ARGB)
+constexpr const char* kTransitionPathColour = "#8c8c8c";
+constexpr const char* kShadingColour = "#d9d9d9";  // transition bands
+constexpr const char* kStartColour = "#2ca02c";
+constexpr const char* kEndColour = "#d62728";
+constexpr const char* kTargetColour = "#000000";
+constexpr const char* kMeanColour = "#d62728";
+constexpr const char* kPathOverlayColour = "#ffffff";
+constexpr const char* kMapKeyColour = "#440154";  // key box behind the white overlay sample
+constexpr const char* kAxisColours[3] = {"#1f77b4", "#ff7f0e", "#2ca02c"};  // x, y, z
+// colours cycled over print lines and planners
+constexpr const char* kSeriesColours[8] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728",
+                                           "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+
+// line widths (gnuplot units, 1 = 1 px at this terminal scale)
+constexpr double kPlannedLineWidth = 2.0;
+constexpr double kPathLineWidth = 3.0;  // planned print path under the simulated one
+constexpr double kSimulatedLineWidth = 1.2;
+constexpr double kThinLineWidth = 1.0;
+
+const char* series_colour(size_t index);
+
+// `set terminal pngcairo ...` for an image of the given size
+std::string terminal(int width_px, int height_px);
+// every plot starts from this: reset, grid, border, key box, number formats
+std::string common_settings();
+// a title line in the title font
+std::string title_font();
+std::string mono_font();
+// axis label with unit, e.g. axis_label("x", "mm") -> "x (mm)"
+std::string axis_label(const std::string& name, const std::string& unit);
+
+// grey rectangles spanning the full plot height over each interval (drawn behind the data),
+// one `set object rect` per band, and the key entry naming them; empty for no bands
+std::string transition_shading(const std::vector<TimeInterval>& bands);
+// the key entry for the shading ("transition"), only when there are bands
+std::string transition_key_entry(const std::vector<TimeInterval>& bands);
+// remove the rectangles again before the next plot
+std::string clear_shading();
+
+// a plot element that draws nothing (a line below every zero-based y range): the frame,
+// axes and shading of a panel without data
+constexpr const char* kEmptyFrame = "-1e30 with lines lc rgb \"white\" notitle";
+
+// the perceptually uniform colour map of thickness maps (viridis stops)
+std::string thickness_palette();
+
+// a string literal for gnuplot: single quotes, embedded quotes doubled (no escapes)
+std::string quoted(const std::string& text);
+
+}  // namespace depotwin::plots::style

@@ -1,0 +1,201 @@
+// Every plot function writes its PNG: right pixel size, not blank, no gnuplot warnings,
+// byte-identical on a second run; a missing gnuplot is the named error.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "plot_fixture.hpp"
+#include "plots/plots.hpp"
+#include "plots/style.hpp"
+#include "png_check.hpp"
+
+namespace depotwin {
+namespace {
+
+namespace fs = std::filesystem;
+using plots::RunPlot;
+using testing_support::make_plot_fixture;
+
+// a fresh directory per test under the build tree (kept afterwards, to look at the images)
+std::string output_directory(const std::string& name) {
+  const fs::path directory = fs::path(DEPOTWIN_BINARY_DIR) / "test_plots_output" / name;
+  fs::remove_all(directory);
+  fs::create_directories(directory);
+  return directory.string();
+}
+
+std::vector<std::string> entries(const std::string& directory) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(directory))
+    names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+void expect_png(const std::string& path, std::uint32_t width, std::uint32_t height) {
+  SCOPED_TRACE(path);
+  ASSERT_TRUE(fs::exists(path));
+  const std::string bytes = testing_support::read_bytes(path);
+  const auto header = testing_support::png_header(bytes);
+  ASSERT_TRUE(header.valid);
+  EXPECT_EQ(header.width, width);
+  EXPECT_EQ(header.height, height);
+  // a white page with a few lines already has a variance of several hundred grey levels^2
+  EXPECT_GT(testing_support::pixel_variance(bytes), 100.0);
+}
+
+const std::vector<RunPlot> kAllRunPlots = {RunPlot::path, RunPlot::axes, RunPlot::errors,
+                                           RunPlot::thickness_profile, RunPlot::thickness};
+
+class EachRunPlot : public ::testing::TestWithParam<RunPlot> {};
+
+TEST_P(EachRunPlot, WritesItsFileAlone) {
+  const auto f = make_plot_fixture(testing_support::thompson_like_toolpath(), 1.5);
+  const std::string name = plots::file_name(GetParam());
+  const std::string directory = output_directory("single_" + name.substr(0, name.size() - 4));
+  const plots::PlotResult result = plots::render_run_plots(f.input(), directory, {GetParam()});
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  ASSERT_EQ(result.files, std::vector<std::string>{directory + "/" + name});
+  expect_png(result.files[0], plots::style::kRunPlotWidth_px, plots::style::kRunPlotHeight_px);
+  // nothing else left behind: no temporary directory, no data files
+  EXPECT_EQ(entries(directory), std::vector<std::string>{name});
+}
+
+INSTANTIATE_TEST_SUITE_P(Plots, EachRunPlot, ::testing::ValuesIn(kAllRunPlots),
+                         [](const auto& info) {
+                           const std::string name = plots::file_name(info.param);
+                           return name.substr(0, name.size() - 4);
+                         });
+
+TEST(RunPlots, AllFiveInOneCallAndByteIdenticalTwice) {
+  const auto f = make_plot_fixture(testing_support::raster_toolpath(7), 0.5);
+  const auto input = f.input("raster / synthetic");
+  EXPECT_EQ(plots::available_plots(input), kAllRunPlots);
+  const std::string first = output_directory("all_first"), second = output_directory("all_second");
+  const auto a = plots::render_run_plots(input, first);
+  const auto b = plots::render_run_plots(input, second);
+  ASSERT_EQ(a.files.size(), 5u);
+  EXPECT_TRUE(a.warnings.empty()) << a.warnings.front();
+  for (size_t i = 0; i < a.files.size(); ++i) {
+    expect_png(a.files[i], plots::style::kRunPlotWidth_px, plots::style::kRunPlotHeight_px);
+    EXPECT_EQ(testing_support::read_bytes(a.files[i]), testing_support::read_bytes(b.files[i]))
+        << a.files[i];
+  }
+}
+
+TEST(RunPlots, PlanOnlyRunWithoutThickness) {
+  auto f = make_plot_fixture(testing_support::thompson_like_toolpath(), 1.5, false);
+  auto input = f.input("plan only");
+  input.thickness = nullptr;
+  input.profiles.clear();
+  const std::vector<RunPlot> expected = {RunPlot::path, RunPlot::axes, RunPlot::errors};
+  EXPECT_EQ(plots::available_plots(input), expected);
+  const std::string directory = output_directory("plan_only");
+  const auto result = plots::render_run_plots(input, directory);
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  ASSERT_EQ(result.files.size(), 3u);
+  for (const auto& file : result.files) expect_png(file, 900, 560);
+  // asking for a thickness plot without a map is the caller's bug
+  EXPECT_THROW(plots::render_run_plots(input, directory, {RunPlot::thickness}), InternalError);
+}
+
+TEST(RunPlots, NoTransitionRunRendersCleanly) {
+  const auto f = make_plot_fixture(testing_support::single_line_toolpath(), 1.0, true, true);
+  const std::string directory = output_directory("no_transitions");
+  const auto result = plots::render_run_plots(f.input("single line"), directory);
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  ASSERT_EQ(result.files.size(), 5u);
+  for (const auto& file : result.files) expect_png(file, 900, 560);
+}
+
+TEST(RunPlots, NothingDepositedStillRendersEveryFrame) {
+  Toolpath toolpath;  // a move from start to end, no print path
+  toolpath.end_mm = Vec3(5, 3, 0);
+  const auto f = make_plot_fixture(toolpath, 2.0);
+  ASSERT_EQ(f.expected_transitions.size(), 1u);
+  auto input = f.input("no print paths");
+  input.thickness = nullptr;
+  input.profiles.clear();
+  const plots::RunPlotData data = plots::prepare_run_plot_data(input);
+  EXPECT_EQ(data.planned_speed_error_pct.point_count(), 0u);
+  EXPECT_EQ(data.planned_print_xy.point_count(), 0u);
+  const std::string directory = output_directory("nothing_deposited");
+  const auto result = plots::render_run_plots(input, directory);
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  ASSERT_EQ(result.files.size(), 3u);
+  for (const auto& file : result.files) expect_png(file, 900, 560);
+}
+
+TEST(RunPlots, ManyLinesShareOneProfileKeyEntry) {
+  const auto f = make_plot_fixture(testing_support::raster_toolpath(12), 0.3, false);
+  const std::string directory = output_directory("many_lines");
+  const auto result =
+      plots::render_run_plots(f.input("12 lines"), directory, {RunPlot::thickness_profile});
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  ASSERT_EQ(result.files.size(), 1u);
+  expect_png(result.files[0], 900, 560);
+}
+
+TEST(Comparison, OneColumnPerPlannerOnASharedScale) {
+  const auto a = make_plot_fixture(testing_support::thompson_like_toolpath(), 1.5);
+  const auto b = make_plot_fixture(testing_support::thompson_like_toolpath(), 3.0);
+  // a thinner second map: the shared colour range is the thicker one's peak
+  HeightMap thinner = b.thickness;
+  for (float& v : thinner.thickness_um) v *= 0.5f;
+  plots::ComparisonInput input;
+  input.title = "fixture";
+  input.toolpath = &a.toolpath;
+  for (int c = 0; c < 3; ++c) {
+    const auto& f = c == 0 ? a : b;
+    plots::ComparisonColumn column;
+    column.planner = c == 0 ? "lspb_mtt" : c == 1 ? "slow_transitions" : "plan_only";
+    column.thickness = c == 0 ? &a.thickness : c == 1 ? &thinner : nullptr;
+    plots::set_speed_error(column, c == 2 ? f.planned : f.simulated);
+    column.transitions = plots::transition_intervals(f.trajectory);
+    const VelocityErrorStats stats = velocity_error(c == 2 ? f.planned : f.simulated);
+    column.max_speed_error_rel = stats.max_rel;
+    column.rms_speed_error_rel = stats.rms_rel;
+    if (c < 2) column.thickness_cv = 0.1 * (c + 1), column.waste_fraction = 0.2;
+    column.total_time_s = f.trajectory.duration_s();
+    input.columns.push_back(column);
+  }
+  EXPECT_FLOAT_EQ(static_cast<float>(plots::shared_thickness_max_um(input)),
+                  a.thickness.max_value());
+  const std::string directory = output_directory("comparison");
+  const auto result = plots::render_comparison(input, directory + "/comparison.png");
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  ASSERT_EQ(result.files.size(), 1u);
+  expect_png(result.files[0], 3 * plots::style::kComparisonColumnWidth_px,
+             plots::style::kComparisonHeight_px);
+  EXPECT_EQ(entries(directory), std::vector<std::string>{"comparison.png"});
+}
+
+TEST(Gnuplot, MissingToolIsANamedInternalError) {
+  const auto f = make_plot_fixture(testing_support::single_line_toolpath(), 1.0, false, true);
+  const std::string directory = output_directory("missing_gnuplot");
+  plots::PlotOptions options;
+  options.gnuplot = "depotwin-no-such-gnuplot";
+  try {
+    plots::render_run_plots(f.input(), directory, {}, options);
+    FAIL() << "expected GnuplotNotFound";
+  } catch (const InternalError& error) {  // exit status 1
+    EXPECT_STREQ(
+        error.what(),
+        "gnuplot not found: install the Debian package gnuplot-nox (scripts/setup.sh does)");
+  }
+  options.gnuplot = "/nonexistent/bin/gnuplot";
+  EXPECT_THROW(plots::render_run_plots(f.input(), directory, {}, options), plots::GnuplotNotFound);
+  EXPECT_TRUE(entries(directory).empty());
+}
+
+TEST(Gnuplot, FailingToolLeavesNoPartialOutput) {
+  const auto f = make_plot_fixture(testing_support::single_line_toolpath(), 1.0, false, true);
+  const std::string directory = output_directory("failing_gnuplot");
+  plots::PlotOptions options;
+  options.gnuplot = "false";  // found on PATH, exits 1
+  EXPECT_THROW(plots::render_run_plots(f.input(), directory, {}, options), InternalError);
+  EXPECT_TRUE(entries(directory).empty());
+}
+
+}  // namespace
+}  // namespace depotwin
