@@ -1,0 +1,407 @@
+#include "motion/jerk.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace depotwin {
+
+// --- profile ----------------------------------------------------------------------------
+
+double JerkPhase::q_end() const {
+  const double t = duration_s;
+  return q0 + t * (v0 + t * (0.5 * a0 + t * jerk / 6.0));
+}
+
+double JerkPhase::v_end() const {
+  return v0 + duration_s * (a0 + 0.5 * jerk * duration_s);
+}
+
+void JerkProfile::append(double duration_s, double jerk) {
+  if (!(duration_s > 0.0)) return;
+  JerkPhase phase;
+  phase.t_begin_s = this->duration_s();
+  phase.duration_s = duration_s;
+  phase.q0 = q_end();
+  phase.v0 = v_end();
+  phase.a0 = a_end();
+  phase.jerk = jerk;
+  phases_.push_back(phase);
+}
+
+double JerkProfile::duration_s() const {
+  return phases_.empty() ? 0.0 : phases_.back().t_begin_s + phases_.back().duration_s;
+}
+
+double JerkProfile::q_end() const {
+  return phases_.empty() ? q_start_ : phases_.back().q_end();
+}
+double JerkProfile::v_end() const {
+  return phases_.empty() ? v_start_ : phases_.back().v_end();
+}
+double JerkProfile::a_end() const {
+  return phases_.empty() ? a_start_ : phases_.back().a_end();
+}
+
+const JerkPhase* JerkProfile::phase_at(double t) const {
+  if (phases_.empty()) return nullptr;
+  if (t <= 0.0) return &phases_.front();
+  // last phase starting at or before t (phases are sorted by start time)
+  auto it = std::upper_bound(phases_.begin(), phases_.end(), t,
+                             [](double time, const JerkPhase& p) { return time < p.t_begin_s; });
+  return &*(it - 1);
+}
+
+AxisState JerkProfile::at(double t) const {
+  const JerkPhase* phase = phase_at(t);
+  if (phase == nullptr) return AxisState{q_start_, v_start_, a_start_};
+  const double tau = std::clamp(t - phase->t_begin_s, 0.0, phase->duration_s);
+  return AxisState{
+      phase->q0 + tau * (phase->v0 + tau * (0.5 * phase->a0 + tau * phase->jerk / 6.0)),
+      phase->v0 + tau * (phase->a0 + 0.5 * phase->jerk * tau), phase->a0 + phase->jerk * tau};
+}
+
+double JerkProfile::jerk_at(double t) const {
+  const JerkPhase* phase = phase_at(t);
+  return phase == nullptr ? 0.0 : phase->jerk;
+}
+
+double JerkProfile::peak_speed() const {
+  double peak = std::abs(v_start_);
+  for (const JerkPhase& p : phases_) {
+    peak = std::max({peak, std::abs(p.v0), std::abs(p.v_end())});
+    // inside a phase the velocity peaks where the acceleration crosses zero
+    if (p.jerk != 0.0) {
+      const double t = -p.a0 / p.jerk;
+      if (t > 0.0 && t < p.duration_s) peak = std::max(peak, std::abs(p.v0 + 0.5 * p.a0 * t));
+    }
+  }
+  return peak;
+}
+
+double JerkProfile::peak_acceleration() const {
+  double peak = std::abs(a_start_);
+  for (const JerkPhase& p : phases_) peak = std::max({peak, std::abs(p.a0), std::abs(p.a_end())});
+  return peak;
+}
+
+double JerkProfile::peak_jerk() const {
+  double peak = 0.0;
+  for (const JerkPhase& p : phases_) peak = std::max(peak, std::abs(p.jerk));
+  return peak;
+}
+
+// --- planning ---------------------------------------------------------------------------
+
+double s_curve_duration(double dv, double a_max, double j_max) {
+  dv = std::abs(dv);
+  // triangular acceleration up to the knee a^2 / j, trapezoidal beyond
+  return dv <= a_max * a_max / j_max ? 2.0 * std::sqrt(dv / j_max) : dv / a_max + a_max / j_max;
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// The point where a predicate that holds left of it and fails right of it flips, to full
+// double precision; returns the side where it holds (so a profile built from it never needs
+// a negative cruise).
+template <class Predicate>
+double bisect(double lo, double hi, Predicate holds) {
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid <= lo || mid >= hi) break;
+    (holds(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+// A peak (or trough) velocity v_p of the family, held as the two velocity changes into and
+// out of it, dv0 = v_p - v0 and dv1 = v_p - v1: a tiny S-curve next to v0 or v1 keeps its full
+// relative precision (its duration 2 sqrt(dv / j) is steep in dv), and the profile is built
+// from exactly the numbers that gave its time and displacement.
+struct Peak {
+  double dv0 = 0.0, dv1 = 0.0;
+};
+
+// one planning problem: boundary velocities and limits
+struct AxisProblem {
+  double v0 = 0.0, v1 = 0.0;
+  double v_max = 0.0, a_max = 0.0, j_max = 0.0;
+
+  double knee() const { return a_max * a_max / j_max; }
+  double tau(double dv) const { return s_curve_duration(dv, a_max, j_max); }
+  // d tau / d|dv|
+  double tau_slope(double dv) const {
+    dv = std::abs(dv);
+    return dv <= knee() ? 1.0 / std::sqrt(dv * j_max) : 1.0 / a_max;
+  }
+
+  // v_p = max(v0, v1) + x
+  Peak above(double x) const { return v0 >= v1 ? Peak{x, x + (v0 - v1)} : Peak{x + (v1 - v0), x}; }
+  // v_p = min(v0, v1) + x and v_p = max(v0, v1) - x, for 0 <= x <= |v1 - v0|
+  Peak up_from_low(double x) const {
+    const double gap = std::abs(v1 - v0);
+    return v0 <= v1 ? Peak{x, x - gap} : Peak{x - gap, x};
+  }
+  Peak down_from_high(double x) const {
+    const double gap = std::abs(v1 - v0);
+    return v0 >= v1 ? Peak{-x, gap - x} : Peak{gap - x, -x};
+  }
+  Peak at(double v_p) const { return Peak{v_p - v0, v_p - v1}; }
+
+  // g: time of both S-curves
+  double time(const Peak& p) const { return tau(p.dv0) + tau(p.dv1); }
+  // F: displacement of both S-curves, (va + vb) / 2 tau each
+  double travel(const Peak& p) const {
+    return 0.5 * (2.0 * v0 + p.dv0) * tau(p.dv0) + 0.5 * (2.0 * v1 + p.dv1) * tau(p.dv1);
+  }
+  // D(v_p, T) = F + v_p (T - g): the member with this peak filling T by a cruise
+  double displacement(const Peak& p, double T) const {
+    return travel(p) + (v0 + p.dv0) * std::max(0.0, T - time(p));
+  }
+  // dF/dv_p where v_p >= max(v0, v1): sum of tau_i / 2 + (v_i + v_p) / 2 tau'(dv_i)
+  double travel_slope(const Peak& p) const {
+    return 0.5 * (tau(p.dv0) + (2.0 * v0 + p.dv0) * tau_slope(p.dv0)) +
+           0.5 * (tau(p.dv1) + (2.0 * v1 + p.dv1) * tau_slope(p.dv1));
+  }
+
+  // the same problem mirrored, q, v -> -q, -v
+  AxisProblem mirrored() const { return AxisProblem{-v0, -v1, v_max, a_max, j_max}; }
+};
+
+Peak negated(const Peak& p) {
+  return Peak{-p.dv0, -p.dv1};
+}
+
+// the highest admissible peak for T >= tau(|v1 - v0|): g <= T, v_p <= v_max (g rises on
+// v_p >= max(v0, v1))
+Peak highest_peak(const AxisProblem& pr, double T) {
+  const Peak top = pr.at(pr.v_max);
+  if (pr.time(top) <= T) return top;
+  if (pr.time(pr.above(0.0)) >= T) return pr.above(0.0);
+  const double x_top = pr.v_max - std::max(pr.v0, pr.v1);
+  return pr.above(bisect(0.0, x_top, [&](double x) { return pr.time(pr.above(x)) <= T; }));
+}
+Peak lowest_peak(const AxisProblem& pr, double T) {
+  return negated(highest_peak(pr.mirrored(), T));
+}
+
+// The durations T >= tau(|v1 - v0|) in which even the farthest-reaching profile falls short
+// of d, D_max(T) < d, as an interval (lo, hi) ([lo, hi) when it starts at the first
+// duration; empty when lo >= hi). On T <= g(v_max) the highest peak climbs from max(v0, v1)
+// to v_max with D_max = F(peak); beyond, D_max = F(v_max) + v_max (T - g(v_max)). F is
+// convex on [max(v0, v1), 0] and increasing on [0, v_max], so D_max falls, then rises.
+std::pair<double, double> falls_short(const AxisProblem& pr, double d) {
+  const double m = std::max(pr.v0, pr.v1), x_top = pr.v_max - m;
+  auto F = [&](double x) { return pr.travel(pr.above(x)); };
+  auto g = [&](double x) { return pr.time(pr.above(x)); };
+  // lowest point of F: where its slope crosses zero on v_p in [m, 0], else at m
+  const double x_low =
+      m < 0.0 ? bisect(0.0, -m, [&](double x) { return pr.travel_slope(pr.above(x)) < 0.0; }) : 0.0;
+  if (F(x_low) >= d) return {kInf, -kInf};
+  // falling side: from the first duration, or from where F comes down to d
+  const double lo =
+      F(0.0) < d ? g(0.0) : g(bisect(0.0, x_low, [&](double x) { return F(x) >= d; }));
+  // rising side: where F climbs back to d, or on the cruise at v_max
+  const Peak top = pr.at(pr.v_max);
+  const double F_top = pr.travel(top);
+  const double hi = F_top >= d ? g(bisect(x_low, x_top, [&](double x) { return F(x) < d; }))
+                               : pr.time(top) + (d - F_top) / pr.v_max;
+  return {lo, hi};
+}
+
+AxisProblem checked_problem(const AxisBoundary& b, double v_max, double a_max, double j_max) {
+  for (const double limit : {v_max, a_max, j_max})
+    if (!(limit > 0.0) || !std::isfinite(limit))
+      throw InternalError("jerk-limited move: v_max, a_max and j_max must be positive and finite");
+  if (!std::isfinite(b.q0) || !std::isfinite(b.q1) || !std::isfinite(b.v0) || !std::isfinite(b.v1))
+    throw InternalError("jerk-limited move: boundary values must be finite");
+  if (std::abs(b.v0) > v_max * (1 + 1e-12) || std::abs(b.v1) > v_max * (1 + 1e-12))
+    throw InternalError("jerk-limited move: |v0| and |v1| must not exceed v_max");
+  // a boundary velocity a rounding error above v_max becomes the limit
+  return AxisProblem{b.v0, b.v1, std::max({v_max, std::abs(b.v0), std::abs(b.v1)}), a_max, j_max};
+}
+
+double tolerance(const AxisBoundary& b, double T, const AxisProblem& pr) {
+  return 1e-9 * (1.0 + std::abs(b.q1 - b.q0) + pr.v_max * T);
+}
+
+bool reachable(const AxisBoundary& b, double T, const AxisProblem& pr) {
+  if (T < pr.tau(b.v1 - b.v0) - 1e-12) return false;
+  const double d = b.q1 - b.q0, tol = tolerance(b, T, pr);
+  return pr.displacement(lowest_peak(pr, T), T) <= d + tol &&
+         d <= pr.displacement(highest_peak(pr, T), T) + tol;
+}
+
+// the S-curve changing the velocity by dv, appended to p
+void append_s_curve(JerkProfile& p, double dv, const AxisProblem& pr) {
+  const double x = std::abs(dv), sign = dv >= 0.0 ? 1.0 : -1.0;
+  if (x <= pr.knee()) {
+    // triangular acceleration, peak sqrt(x j) <= a_max
+    const double t_ramp = std::sqrt(x / pr.j_max);
+    p.append(t_ramp, sign * pr.j_max);
+    p.append(t_ramp, -sign * pr.j_max);
+  } else {
+    // trapezoidal acceleration: ramp to a_max, hold, ramp down
+    const double t_ramp = pr.a_max / pr.j_max;
+    p.append(t_ramp, sign * pr.j_max);
+    p.append(x / pr.a_max - t_ramp, 0.0);
+    p.append(t_ramp, -sign * pr.j_max);
+  }
+}
+
+// the family member: S-curve v0 -> v_p, cruise for the rest of T, S-curve v_p -> v1
+JerkProfile double_s(const AxisBoundary& b, const Peak& peak, double T, const AxisProblem& pr) {
+  JerkProfile p(b.q0, b.v0);
+  append_s_curve(p, peak.dv0, pr);
+  // a cruise of a rounding error (the time-optimal member has none) is left out
+  const double cruise_s = T - pr.time(peak);
+  if (cruise_s > 1e-13 * (1.0 + T)) p.append(cruise_s, 0.0);
+  append_s_curve(p, -peak.dv1, pr);
+  return p;
+}
+
+// (1 - w) first + w second, phase by phase over [0, T]: the jerk of each piece between the
+// union of both profiles' switching times is the same blend, so every state is too
+JerkProfile blend(const JerkProfile& first, const JerkProfile& second, double w, double T) {
+  JerkProfile out(first.q_start(), first.v_start(), first.a_start());
+  const auto& p1 = first.phases();
+  const auto& p2 = second.phases();
+  size_t i = 0, k = 0;
+  double t = 0.0;
+  auto end_of = [](const JerkPhase& p) { return p.t_begin_s + p.duration_s; };
+  while (t < T) {
+    while (i < p1.size() && end_of(p1[i]) <= t) ++i;
+    while (k < p2.size() && end_of(p2[k]) <= t) ++k;
+    const double end1 = i < p1.size() ? end_of(p1[i]) : kInf;
+    const double end2 = k < p2.size() ? end_of(p2[k]) : kInf;
+    const double next = std::min({end1, end2, T});
+    const double j1 = i < p1.size() ? p1[i].jerk : 0.0;
+    const double j2 = k < p2.size() ? p2[k].jerk : 0.0;
+    out.append(next - t, (1.0 - w) * j1 + w * j2);
+    t = next;
+  }
+  return out;
+}
+
+}  // namespace
+
+FeasibleDurations jerk_feasible_durations(const AxisBoundary& b, double v_max, double a_max,
+                                          double j_max) {
+  const AxisProblem pr = checked_problem(b, v_max, a_max, j_max);
+  const double d = b.q1 - b.q0;
+  const double t_velocity = pr.tau(b.v1 - b.v0);
+  // durations where the farthest profile falls short, and (mirrored: q, v -> -q, -v) where
+  // the nearest one overshoots
+  const auto short_of = falls_short(pr, d);
+  const auto over = falls_short(pr.mirrored(), -d);
+
+  // [t_velocity, inf) minus both blocked intervals (their ends stay: D reaches d there)
+  std::vector<std::pair<double, double>> feasible{{t_velocity, kInf}};
+  for (const auto& [lo, hi] : {short_of, over}) {
+    if (!(lo < hi)) continue;
+    std::vector<std::pair<double, double>> kept;
+    for (const auto& [first, last] : feasible) {
+      if (hi <= first || lo >= last) {
+        kept.push_back({first, last});
+        continue;
+      }
+      if (lo >= first) kept.push_back({first, lo});
+      if (hi < last) kept.push_back({hi, last});
+    }
+    feasible.swap(kept);
+  }
+  // a single point survives only where the move really is possible (e.g. T = 0 for a null move)
+  FeasibleDurations out;
+  for (const auto& interval : feasible) {
+    if (interval.second - interval.first > 1e-12 || reachable(b, interval.first, pr))
+      out.intervals.push_back(interval);
+  }
+  if (out.intervals.empty() || std::isfinite(out.intervals.back().second))
+    throw InternalError("jerk-limited move: no feasible duration found (bug)");
+  return out;
+}
+
+JerkProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, double v_max,
+                                 double a_max, double j_max) {
+  const AxisProblem pr = checked_problem(b, v_max, a_max, j_max);
+  const double T = duration_s, d = b.q1 - b.q0;
+  if (T <= 0.0) {
+    if (std::abs(d) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12) return JerkProfile(b.q0, b.v0);
+    throw InternalError("jerk-limited move: zero duration for a non-null move");
+  }
+  if (!reachable(b, T, pr))
+    throw InternalError("jerk-limited move: duration " + std::to_string(T) + " s is not feasible");
+
+  // the extreme family members; roundoff beyond them takes the extreme itself
+  Peak lo = lowest_peak(pr, T), hi = highest_peak(pr, T);
+  if (d >= pr.displacement(hi, T)) return double_s(b, hi, T, pr);
+  if (d <= pr.displacement(lo, T)) return double_s(b, lo, T, pr);
+
+  // peaks between v0 and v1 are admissible only near them when g there exceeds T; g is
+  // symmetric about the middle and rises towards it, so the blocked peaks are (c1, c2) with
+  // c1 = min(v0, v1) + x and c2 = max(v0, v1) - x
+  const double gap = std::abs(b.v1 - b.v0);
+  if (gap > 0.0 && pr.time(pr.up_from_low(0.5 * gap)) > T) {
+    const double x =
+        bisect(0.0, 0.5 * gap, [&](double y) { return pr.time(pr.up_from_low(y)) <= T; });
+    const Peak c1 = pr.up_from_low(x), c2 = pr.down_from_high(x);
+    const double d1 = pr.displacement(c1, T), d2 = pr.displacement(c2, T);
+    // d in the gap: blend the two members bounding it (both fill T exactly)
+    if (d > d1 && d < d2)
+      return blend(double_s(b, c1, T, pr), double_s(b, c2, T, pr), (d - d1) / (d2 - d1), T);
+    if (d <= d1)
+      hi = c1;
+    else
+      lo = c2;
+  }
+  // D(v_p, T) rises with v_p: bisect over dv0 = v_p - v0 for the peak that lands on q1
+  // (an end of the bracket is used as it is, so that its exact velocity changes are kept)
+  const double x_lo = lo.dv0, x_hi = hi.dv0;
+  auto member = [&](double dv0) { return Peak{dv0, dv0 + (b.v0 - b.v1)}; };
+  const double x = bisect(x_lo, x_hi, [&](double y) { return pr.displacement(member(y), T) < d; });
+  return double_s(b, x == x_lo ? lo : member(x), T, pr);
+}
+
+JerkProfile jerk_min_time_move(const AxisBoundary& b, double v_max, double a_max, double j_max) {
+  return jerk_fixed_time_move(b, jerk_feasible_durations(b, v_max, a_max, j_max).t_min(), v_max,
+                              a_max, j_max);
+}
+
+double common_feasible_duration(const std::vector<FeasibleDurations>& sets, double min_duration_s) {
+  // raise the candidate until every set accepts it; each set has at most one gap, so this
+  // settles after a few rounds
+  double t = std::max(0.0, min_duration_s);
+  for (int round = 0; round < 64; ++round) {
+    double next = t;
+    for (const FeasibleDurations& set : sets) next = std::max(next, set.earliest_at_least(next));
+    if (next == t) return t;
+    t = next;
+  }
+  throw InternalError("synchronised move: no common duration found");
+}
+
+double jerk_synchronized_duration(const std::vector<JerkAxisMove>& axes, double min_duration_s) {
+  std::vector<FeasibleDurations> sets;
+  sets.reserve(axes.size());
+  for (const JerkAxisMove& axis : axes)
+    sets.push_back(jerk_feasible_durations(axis.boundary, axis.v_max, axis.a_max, axis.j_max));
+  return common_feasible_duration(sets, min_duration_s);
+}
+
+JerkSynchronizedMove jerk_synchronized_move(const std::vector<JerkAxisMove>& axes,
+                                            double min_duration_s) {
+  JerkSynchronizedMove move;
+  move.duration_s = jerk_synchronized_duration(axes, min_duration_s);
+  move.axes.reserve(axes.size());
+  for (const JerkAxisMove& axis : axes)
+    move.axes.push_back(
+        jerk_fixed_time_move(axis.boundary, move.duration_s, axis.v_max, axis.a_max, axis.j_max));
+  return move;
+}
+
+}  // namespace depotwin
