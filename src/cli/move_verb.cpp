@@ -1,10 +1,12 @@
 #include "cli/move_verb.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
 
 #include "core/error.hpp"
+#include "motion/jerk.hpp"
 #include "motion/mtt.hpp"
 #include "motion/sync.hpp"
 
@@ -32,12 +34,78 @@ double value_for_axis(const std::vector<double>& list, size_t axis) {
   return list.size() == 1 ? list[0] : list[axis];
 }
 
+// the phases of an acceleration-limited profile
+nlohmann::ordered_json phases_json(const AxisProfile& profile) {
+  nlohmann::ordered_json phases = nlohmann::ordered_json::array();
+  for (const Phase& phase : profile.phases())
+    phases.push_back({{"t_start_s", phase.t_begin_s},
+                      {"duration_s", phase.duration_s},
+                      {"acceleration", phase.a},
+                      {"v_start", phase.v0},
+                      {"v_end", phase.v_end()},
+                      {"q_start", phase.q0},
+                      {"q_end", phase.q_end()}});
+  return phases;
+}
+
+// the phases of a jerk-limited profile: the same keys ("acceleration" at the phase start)
+// plus the constant jerk and the acceleration at the phase end
+nlohmann::ordered_json phases_json(const JerkProfile& profile) {
+  nlohmann::ordered_json phases = nlohmann::ordered_json::array();
+  for (const JerkPhase& phase : profile.phases())
+    phases.push_back({{"t_start_s", phase.t_begin_s},
+                      {"duration_s", phase.duration_s},
+                      {"acceleration", phase.a0},
+                      {"v_start", phase.v0},
+                      {"v_end", phase.v_end()},
+                      {"q_start", phase.q0},
+                      {"q_end", phase.q_end()},
+                      {"jerk", phase.jerk},
+                      {"acceleration_end", phase.a_end()}});
+  return phases;
+}
+
+// Some axes jerk-limited (j_max > 0), the others acceleration-limited: the earliest duration
+// feasible for every axis, each axis re-planned over it with its own kind of profile.
+nlohmann::ordered_json jerk_limited_move_json(const std::vector<AxisMove>& moves,
+                                              const std::vector<double>& j_max) {
+  using Json = nlohmann::ordered_json;
+  std::vector<FeasibleDurations> sets;
+  for (size_t i = 0; i < moves.size(); ++i) {
+    const AxisMove& m = moves[i];
+    sets.push_back(j_max[i] > 0.0 ? jerk_feasible_durations(m.boundary, m.v_max, m.a_max, j_max[i])
+                                  : feasible_durations(m.boundary, m.v_max, m.a_max));
+  }
+  const double duration_s = common_feasible_duration(sets);
+  Json out;
+  out["duration_s"] = duration_s;
+  Json axes_json = Json::array();
+  for (size_t i = 0; i < moves.size(); ++i) {
+    const AxisMove& m = moves[i];
+    const Json phases =
+        j_max[i] > 0.0
+            ? phases_json(jerk_fixed_time_move(m.boundary, duration_s, m.v_max, m.a_max, j_max[i]))
+            : phases_json(fixed_time_move(m.boundary, duration_s, m.v_max, m.a_max));
+    axes_json.push_back(Json{{"q0", m.boundary.q0},
+                             {"q1", m.boundary.q1},
+                             {"v0", m.boundary.v0},
+                             {"v1", m.boundary.v1},
+                             {"v_max", m.v_max},
+                             {"a_max", m.a_max},
+                             {"j_max", j_max[i]},
+                             {"min_duration_s", sets[i].t_min()},
+                             {"phases", phases}});
+  }
+  out["axes"] = axes_json;
+  return out;
+}
+
 }  // namespace
 
 nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
   using Json = nlohmann::ordered_json;
   const std::vector<std::pair<std::string, const std::vector<double>*>> lists{
-      {"--q0", &request.q0}, {"--q1", &request.q1},     {"--v0", &request.v0},
+      {"--q0", &request.q0}, {"--q1", &request.q1},      {"--v0", &request.v0},
       {"--v1", &request.v1}, {"--vmax", &request.v_max}, {"--amax", &request.a_max}};
   size_t axes = 1;
   for (const auto& [name, list] : lists) axes = std::max(axes, list->size());
@@ -49,13 +117,11 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
                           "has " + std::to_string(list->size()) + " values for " +
                               std::to_string(axes) + " axes (give one per axis, or one for all)"});
   }
-  if (!request.j_max.empty()) {
-    for (double j : request.j_max)
-      if (j != 0.0)
-        problems.push_back({"", 0, "--jmax",
-                            "jerk-limited moves are not supported: the minimum-time move here "
-                            "is acceleration-limited (give 0 or leave --jmax out)"});
-  }
+  // --jmax is optional: one value for all axes or one per axis, 0 = no jerk limit
+  if (request.j_max.size() > 1 && request.j_max.size() != axes)
+    problems.push_back({"", 0, "--jmax",
+                        "has " + std::to_string(request.j_max.size()) + " values for " +
+                            std::to_string(axes) + " axes (give one per axis, or one for all)"});
   if (!problems.empty()) throw InputError(problems);
 
   // per axis: limits and boundary velocities, then the synchronised move
@@ -73,8 +139,15 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
       problems.push_back({"", 0, "--v0", "|v0| exceeds v_max" + axis});
     if (m.v_max > 0.0 && std::abs(m.boundary.v1) > m.v_max)
       problems.push_back({"", 0, "--v1", "|v1| exceeds v_max" + axis});
+    if (!request.j_max.empty() && !(value_for_axis(request.j_max, i) >= 0.0))
+      problems.push_back({"", 0, "--jmax", "must be >= 0 (0: no jerk limit)" + axis});
   }
   if (!problems.empty()) throw InputError(problems);
+  std::vector<double> j_max(axes, 0.0);
+  if (!request.j_max.empty())
+    for (size_t i = 0; i < axes; ++i) j_max[i] = value_for_axis(request.j_max, i);
+  if (std::any_of(j_max.begin(), j_max.end(), [](double j) { return j > 0.0; }))
+    return jerk_limited_move_json(moves, j_max);
   const SynchronizedMove move = synchronized_move(moves);
 
   Json out;
@@ -82,24 +155,16 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
   Json axes_json = Json::array();
   for (size_t i = 0; i < axes; ++i) {
     const AxisMove& m = moves[i];
-    Json phases = Json::array();
-    for (const Phase& phase : move.axes[i].phases())
-      phases.push_back(Json{{"t_start_s", phase.t_begin_s},
-                            {"duration_s", phase.duration_s},
-                            {"acceleration", phase.a},
-                            {"v_start", phase.v0},
-                            {"v_end", phase.v_end()},
-                            {"q_start", phase.q0},
-                            {"q_end", phase.q_end()}});
-    axes_json.push_back(Json{
-        {"q0", m.boundary.q0},
-        {"q1", m.boundary.q1},
-        {"v0", m.boundary.v0},
-        {"v1", m.boundary.v1},
-        {"v_max", m.v_max},
-        {"a_max", m.a_max},
-        {"min_duration_s", feasible_durations(m.boundary, m.v_max, m.a_max).t_min()},
-        {"phases", phases}});
+    const Json phases = phases_json(move.axes[i]);
+    axes_json.push_back(
+        Json{{"q0", m.boundary.q0},
+             {"q1", m.boundary.q1},
+             {"v0", m.boundary.v0},
+             {"v1", m.boundary.v1},
+             {"v_max", m.v_max},
+             {"a_max", m.a_max},
+             {"min_duration_s", feasible_durations(m.boundary, m.v_max, m.a_max).t_min()},
+             {"phases", phases}});
   }
   out["axes"] = axes_json;
   return out;
