@@ -1,0 +1,102 @@
+#include "kinematics/xy_stage.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace depotwin {
+
+namespace {
+
+// the stage of models/xy_stage.xml: +-50 mm soft travel (hard stops at +-52 mm in the MJCF),
+// direct-drive linear motors far faster than any print job needs
+constexpr double kTravel_mm = 50.0;
+constexpr double kJointVelocityMax_mm_s = 200.0;
+constexpr double kJointAccelerationMax_mm_s2 = 2000.0;
+// the nozzle point in the plate frame when both carriages are at 0 (models/xy_stage.xml)
+constexpr double kNozzleX_mm = 0.0;
+constexpr double kNozzleY_mm = 0.0;
+// the plate cannot move in z: a TCP off the substrate plane is unreachable
+constexpr double kPlaneTolerance_mm = 1e-6;
+
+std::string format_mm(double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.4g", value);
+  return text;
+}
+
+class XyStage : public Machine {
+ public:
+  XyStage()
+      : limits_{
+            {"x", -kTravel_mm, kTravel_mm, kJointVelocityMax_mm_s, kJointAccelerationMax_mm_s2},
+            {"y", -kTravel_mm, kTravel_mm, kJointVelocityMax_mm_s, kJointAccelerationMax_mm_s2}} {}
+
+  std::string name() const override { return "xy_stage"; }
+  std::string model_file() const override { return "xy_stage.xml"; }
+  int joint_count() const override { return 2; }
+  const std::vector<JointLimit>& joint_limits() const override { return limits_; }
+
+  // the plate moves under a fixed nozzle: tcp = nozzle - carriage, so carriage = nozzle - tcp
+  bool inverse(const Vec3& tcp_mm, JointVector& joints, std::string* why) const override {
+    joints.resize(2);
+    joints[0] = kNozzleX_mm - tcp_mm.x();
+    joints[1] = kNozzleY_mm - tcp_mm.y();
+    if (!tcp_mm.allFinite()) {
+      if (why) *why = "the TCP position is not a finite number";
+      return false;
+    }
+    if (std::abs(tcp_mm.z()) > kPlaneTolerance_mm) {
+      if (why)
+        *why = "the XY stage has no z axis: the TCP must lie on the substrate (z = 0), got z = " +
+               format_mm(tcp_mm.z()) + " mm";
+      return false;
+    }
+    static const char* kTcpAxis[2] = {"x", "y"};
+    for (int i = 0; i < 2; ++i) {
+      const JointLimit& limit = limits_[i];
+      if (joints[i] < limit.min || joints[i] > limit.max) {
+        if (why)
+          *why = "joint " + limit.name + " at " + format_mm(joints[i]) +
+                 " mm is outside its travel [" + format_mm(limit.min) + ", " +
+                 format_mm(limit.max) + "] mm (TCP " + kTcpAxis[i] + " = " + format_mm(tcp_mm[i]) +
+                 " mm)";
+        return false;
+      }
+    }
+    return true;
+  }
+
+  Vec3 forward(const JointVector& joints) const override {
+    return Vec3(kNozzleX_mm - joints.at(0), kNozzleY_mm - joints.at(1), 0.0);
+  }
+
+  // the Jacobian is -I on x and y
+  JointVector joint_velocity(const JointVector& /*joints*/,
+                             const Vec3& tcp_velocity) const override {
+    return JointVector{-tcp_velocity.x(), -tcp_velocity.y()};
+  }
+
+  // each TCP axis is one carriage: the per-axis limits are the tighter of the two;
+  // nothing moves in z, so z keeps what was asked for
+  MachineLimits cartesian_limits(const MachineLimits& requested, const Vec3& /*lo*/,
+                                 const Vec3& /*hi*/) const override {
+    MachineLimits limits = requested;
+    for (int i = 0; i < 2; ++i) {
+      limits.axes[i].v_max_mm_s = std::min(requested.axes[i].v_max_mm_s, limits_[i].v_max);
+      limits.axes[i].a_max_mm_s2 = std::min(requested.axes[i].a_max_mm_s2, limits_[i].a_max);
+    }
+    return limits;
+  }
+
+ private:
+  std::vector<JointLimit> limits_;
+};
+
+}  // namespace
+
+std::unique_ptr<Machine> make_xy_stage() {
+  return std::make_unique<XyStage>();
+}
+
+}  // namespace depotwin

@@ -1,0 +1,319 @@
+#include "render/scene.hpp"
+
+#include <GL/osmesa.h>
+#include <stb_image_write.h>
+
+#include <unistd.h>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.hpp"
+#include "core/types.hpp"
+#include "sim/mujoco_boundary.hpp"
+#include "sim/simulation.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr const char* kCameraName = "render_cam";
+constexpr const char* kSubstrateBody = "substrate";
+// margin around the framed region, and the smallest region framed (mm)
+constexpr double kFrameMargin = 1.25;
+constexpr double kMinFrameRadius_mm = 3.0;
+// framed renders: the key light comes from above, tilted this much towards the view
+// direction, from this far away
+constexpr double kShoulderLight = 0.35;
+constexpr double kLightDistance_m = 0.6;
+// the nozzle counts as apart from the deposit beyond this fraction of the deposit's radius
+constexpr double kNozzleApartFraction = 0.2;
+// deposit boxes float this far above the plate so they never z-fight with it (mm)
+constexpr double kLift_mm = 0.005;
+
+// an OSMesa context made current on its own colour buffer; destroyed last
+class OsMesaContext {
+ public:
+  OsMesaContext(int width, int height) : buffer_(static_cast<size_t>(width) * height * 4) {
+    context_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
+    if (!context_) throw InternalError("OSMesa could not create a rendering context");
+    if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height)) {
+      OSMesaDestroyContext(context_);
+      throw InternalError("OSMesa could not make its rendering context current");
+    }
+  }
+  ~OsMesaContext() { OSMesaDestroyContext(context_); }
+  OsMesaContext(const OsMesaContext&) = delete;
+  OsMesaContext& operator=(const OsMesaContext&) = delete;
+
+ private:
+  std::vector<unsigned char> buffer_;
+  OSMesaContext context_ = nullptr;
+};
+
+// mjvScene / mjrContext owners (freed before the GL context goes)
+struct SceneOwner {
+  mjvScene scene;
+  SceneOwner(const mjModel& model, int max_geoms) {
+    mjv_defaultScene(&scene);
+    mjv_makeScene(&model, &scene, max_geoms);
+  }
+  ~SceneOwner() { mjv_freeScene(&scene); }
+  SceneOwner(const SceneOwner&) = delete;
+  SceneOwner& operator=(const SceneOwner&) = delete;
+};
+struct RenderContextOwner {
+  mjrContext context;
+  explicit RenderContextOwner(const mjModel& model) {
+    mjr_defaultContext(&context);
+    mjr_makeContext(&model, &context, mjFONTSCALE_100);
+  }
+  ~RenderContextOwner() { mjr_freeContext(&context); }
+  RenderContextOwner(const RenderContextOwner&) = delete;
+  RenderContextOwner& operator=(const RenderContextOwner&) = delete;
+};
+
+// substrate-frame point (mm) -> world (m)
+Vec3 substrate_to_world(const mjData& data, int body, const Vec3& local_mm) {
+  const mjtNum* origin = data.xpos + 3 * body;
+  const mjtNum* rotation = data.xmat + 9 * body;
+  Vec3 world;
+  for (int row = 0; row < 3; ++row) {
+    world[row] = origin[row];
+    for (int col = 0; col < 3; ++col)
+      world[row] += rotation[3 * row + col] * mm_to_m(local_mm[col]);
+  }
+  return world;
+}
+
+// the deposit as boxes: the grid averaged over b x b blocks so that at most max_boxes
+// cells remain, one box per block above the visibility threshold
+void add_deposit_boxes(const mjData& data, int substrate, const HeightMap& deposit,
+                       double relief_mm, const SceneRenderOptions& options, mjvScene& scene) {
+  const float peak = deposit.max_value();
+  if (!(peak > 0.0f)) return;
+  int block = 1;
+  while ((static_cast<long>(deposit.nx + block - 1) / block) * ((deposit.ny + block - 1) / block) >
+         options.max_boxes)
+    ++block;
+
+  // block means, normalised by the largest block mean (the colour scale's top)
+  const int blocks_x = (deposit.nx + block - 1) / block,
+            blocks_y = (deposit.ny + block - 1) / block;
+  std::vector<float> block_mean(static_cast<size_t>(blocks_x) * blocks_y, 0.0f);
+  float block_peak = 0.0f;
+  for (int by = 0; by < blocks_y; ++by)
+    for (int bx = 0; bx < blocks_x; ++bx) {
+      double sum = 0.0;
+      int count = 0;
+      for (int iy = by * block; iy < std::min((by + 1) * block, deposit.ny); ++iy)
+        for (int ix = bx * block; ix < std::min((bx + 1) * block, deposit.nx); ++ix) {
+          sum += deposit.at(ix, iy);
+          ++count;
+        }
+      const float mean = static_cast<float>(sum / count);
+      block_mean[static_cast<size_t>(by) * blocks_x + bx] = mean;
+      block_peak = std::max(block_peak, mean);
+    }
+  if (!(block_peak > 0.0f)) return;
+
+  const mjtNum* rotation = data.xmat + 9 * substrate;
+  mjtNum box_rotation[9];
+  for (int i = 0; i < 9; ++i) box_rotation[i] = rotation[i];
+  const double half_width_mm = 0.5 * block * deposit.cell_mm;
+  for (int by = 0; by < blocks_y; ++by) {
+    for (int bx = 0; bx < blocks_x; ++bx) {
+      const double relative = block_mean[static_cast<size_t>(by) * blocks_x + bx] / block_peak;
+      if (relative < options.min_relative_thickness) continue;
+      if (scene.ngeom >= scene.maxgeom) return;
+
+      // centre of the block's covered area, height proportional to the thickness
+      const double x_mm = deposit.origin_x_mm + (bx * block + 0.5 * (block - 1)) * deposit.cell_mm;
+      const double y_mm = deposit.origin_y_mm + (by * block + 0.5 * (block - 1)) * deposit.cell_mm;
+      const double half_height_mm = 0.5 * relative * relief_mm;
+      const Vec3 centre =
+          substrate_to_world(data, substrate, Vec3(x_mm, y_mm, kLift_mm + half_height_mm));
+      const mjtNum size[3] = {mm_to_m(half_width_mm), mm_to_m(half_width_mm),
+                              mm_to_m(half_height_mm)};
+      const mjtNum position[3] = {centre.x(), centre.y(), centre.z()};
+      float rgba[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+      viridis(relative, rgba);
+      mjvGeom* geom = scene.geoms + scene.ngeom++;
+      mjv_initGeom(geom, mjGEOM_BOX, size, position, box_rotation, rgba);
+      geom->emission = 0.25f;
+      geom->specular = 0.2f;
+    }
+  }
+}
+
+// the free camera that frames the deposit region and the nozzle from render_cam's elevation.
+// Its azimuth points from the deposit towards the nozzle when they are apart, so the print
+// head stands behind the deposit rather than in front of it; otherwise render_cam's azimuth.
+void frame_camera(const mjModel& model, const mjData& data, int camera, int substrate,
+                  const HeightMap& deposit, mjvCamera& view) {
+  // region in the substrate frame: the grid's cells, then the nozzle point
+  Vec3 lo(deposit.origin_x_mm - 0.5 * deposit.cell_mm, deposit.origin_y_mm - 0.5 * deposit.cell_mm,
+          0.0);
+  Vec3 hi(lo.x() + deposit.nx * deposit.cell_mm, lo.y() + deposit.ny * deposit.cell_mm, 0.0);
+  const Vec3 deposit_centre = substrate_to_world(data, substrate, 0.5 * (lo + hi));
+  const double deposit_radius_mm = 0.5 * (hi - lo).norm();
+  Vec3 towards_nozzle = Vec3::Zero();
+  const int nozzle = mj_name2id(&model, mjOBJ_SITE, "nozzle");
+  if (nozzle >= 0) {
+    const mjtNum* origin = data.xpos + 3 * substrate;
+    const mjtNum* rotation = data.xmat + 9 * substrate;
+    const Vec3 nozzle_world(data.site_xpos[3 * nozzle], data.site_xpos[3 * nozzle + 1],
+                            data.site_xpos[3 * nozzle + 2]);
+    Vec3 local = Vec3::Zero();
+    for (int col = 0; col < 3; ++col)
+      for (int row = 0; row < 3; ++row)
+        local[col] += rotation[3 * row + col] * (nozzle_world[row] - origin[row]);
+    local *= kMmPerM;
+    lo = lo.cwiseMin(Vec3(local.x(), local.y(), 0.0));
+    hi = hi.cwiseMax(Vec3(local.x(), local.y(), 0.0));
+    towards_nozzle = nozzle_world - deposit_centre;
+    towards_nozzle.z() = 0.0;
+  }
+  const double radius_mm = std::max(kMinFrameRadius_mm, 0.5 * (hi - lo).norm()) * kFrameMargin;
+  const Vec3 centre = substrate_to_world(data, substrate, 0.5 * (lo + hi));
+
+  // render_cam looks along its -z axis
+  const mjtNum* axes = data.cam_xmat + 9 * camera;
+  const Vec3 forward(-axes[2], -axes[5], -axes[8]);
+  view.type = mjCAMERA_FREE;
+  for (int i = 0; i < 3; ++i) view.lookat[i] = centre[i];
+  view.azimuth = rad_to_deg(std::atan2(forward.y(), forward.x()));
+  if (m_to_mm(towards_nozzle.norm()) > kNozzleApartFraction * deposit_radius_mm)
+    view.azimuth = rad_to_deg(std::atan2(towards_nozzle.y(), towards_nozzle.x()));
+  view.elevation = rad_to_deg(std::asin(std::clamp(forward.z(), -1.0, 1.0)));
+  const double half_fovy_rad = deg_to_rad(0.5 * model.vis.global.fovy);
+  view.distance = mm_to_m(radius_mm) / std::tan(half_fovy_rad);
+}
+
+// the model's shadow-casting lights moved over the framed camera's shoulder: shadows then
+// fall away from the viewer, behind the print head instead of across the deposit
+void light_over_camera(const mjvCamera& view, mjvScene& scene) {
+  const double azimuth_rad = deg_to_rad(view.azimuth);
+  const Vec3 direction =
+      Vec3(kShoulderLight * std::cos(azimuth_rad), kShoulderLight * std::sin(azimuth_rad), -1.0)
+          .normalized();
+  for (int i = 0; i < scene.nlight; ++i) {
+    mjvLight& light = scene.lights[i];
+    if (light.headlight || !light.castshadow) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      light.dir[axis] = static_cast<float>(direction[axis]);
+      light.pos[axis] = static_cast<float>(view.lookat[axis] - kLightDistance_m * direction[axis]);
+    }
+  }
+}
+
+void write_png(const std::string& path, int width, int height,
+               const std::vector<unsigned char>& rgb) {
+  // to a temporary file beside the target, then renamed over it
+  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
+  if (!stbi_write_png(temporary.c_str(), width, height, 3, rgb.data(), width * 3)) {
+    std::remove(temporary.c_str());
+    throw InternalError("cannot write the image " + temporary);
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    std::remove(temporary.c_str());
+    throw InternalError("cannot rename " + temporary + " to " + path);
+  }
+}
+
+}  // namespace
+
+void viridis(double value, float rgb[3]) {
+  // matplotlib's viridis at 0, 1/8, ..., 1 (8-bit), linearly interpolated
+  static const unsigned char kStops[9][3] = {{68, 1, 84},    {71, 44, 122},  {59, 81, 139},
+                                             {44, 113, 142}, {33, 144, 141}, {39, 173, 129},
+                                             {92, 200, 99},  {170, 220, 50}, {253, 231, 37}};
+  const double position = std::clamp(value, 0.0, 1.0) * 8.0;
+  const int index = std::min(7, static_cast<int>(position));
+  const double fraction = position - index;
+  for (int c = 0; c < 3; ++c)
+    rgb[c] = static_cast<float>(
+        ((1.0 - fraction) * kStops[index][c] + fraction * kStops[index + 1][c]) / 255.0);
+}
+
+std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& data,
+                                            const HeightMap& deposit,
+                                            const SceneRenderOptions& options) {
+  install_mujoco_handlers();
+  // the image must fit the model's offscreen buffer
+  if (options.width <= 0 || options.width > model.vis.global.offwidth)
+    throw InputError("outputs.image_width", "must be between 1 and " +
+                                                std::to_string(model.vis.global.offwidth) +
+                                                " (the model's <visual><global offwidth>), got " +
+                                                std::to_string(options.width));
+  if (options.height <= 0 || options.height > model.vis.global.offheight)
+    throw InputError("outputs.image_height", "must be between 1 and " +
+                                                 std::to_string(model.vis.global.offheight) +
+                                                 " (the model's <visual><global offheight>), got " +
+                                                 std::to_string(options.height));
+  if (deposit.nx < 0 || deposit.ny < 0 ||
+      deposit.thickness_um.size() != static_cast<size_t>(deposit.nx) * deposit.ny ||
+      (deposit.nx > 0 && !(deposit.cell_mm > 0.0)))
+    throw InternalError("render: the height map's size does not match its grid");
+  const int camera = require_id(model, mjOBJ_CAMERA, kCameraName, "model", "the scene camera");
+  const int substrate =
+      require_id(model, mjOBJ_BODY, kSubstrateBody, "model", "the frame of the deposit");
+  const int width = options.width, height = options.height;
+
+  // set up: GL context, MuJoCo render context on the offscreen buffer, scene
+  DataPtr state = copy_data(model, data);
+  OsMesaContext gl(width, height);
+  RenderContextOwner context(model);
+  mjr_setBuffer(mjFB_OFFSCREEN, &context.context);
+  if (context.context.currentBuffer != mjFB_OFFSCREEN)
+    throw InternalError("MuJoCo could not select its offscreen buffer");
+  SceneOwner scene(model, 4 * model.ngeom + options.max_boxes + 64);
+
+  // camera: render_cam itself, or its direction aimed at the deposit
+  mjvCamera view;
+  mjv_defaultCamera(&view);
+  view.type = mjCAMERA_FIXED;
+  view.fixedcamid = camera;
+  double relief_mm = 0.0;
+  const bool has_grid = deposit.nx > 0 && deposit.ny > 0;
+  if (has_grid) {
+    const double region_mm = std::max(deposit.nx, deposit.ny) * deposit.cell_mm;
+    relief_mm = options.relief_fraction * region_mm;
+    if (options.frame_deposit) frame_camera(model, *state, camera, substrate, deposit, view);
+  }
+
+  // update the scene, append the deposit, render, read back
+  mjvOption visual_options;
+  mjv_defaultOption(&visual_options);
+  mjvPerturb perturb;
+  mjv_defaultPerturb(&perturb);
+  mjv_updateScene(&model, state.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene.scene);
+  if (view.type == mjCAMERA_FREE) light_over_camera(view, scene.scene);
+  if (has_grid) add_deposit_boxes(*state, substrate, deposit, relief_mm, options, scene.scene);
+  const mjrRect viewport = {0, 0, width, height};
+  mjr_render(viewport, &scene.scene, &context.context);
+  std::vector<unsigned char> bottom_up(static_cast<size_t>(width) * height * 3);
+  mjr_readPixels(bottom_up.data(), nullptr, viewport, &context.context);
+  check_warnings(*state, "while rendering");
+
+  // OpenGL rows run bottom-up: flip for the image file
+  std::vector<unsigned char> rgb(bottom_up.size());
+  const size_t row_bytes = static_cast<size_t>(width) * 3;
+  for (int row = 0; row < height; ++row)
+    std::copy_n(bottom_up.begin() + static_cast<long>(row * row_bytes), row_bytes,
+                rgb.begin() + static_cast<long>((height - 1 - row) * row_bytes));
+  return rgb;
+}
+
+void render_scene_png(const mjModel& model, const mjData& data, const HeightMap& deposit,
+                      const std::string& png_path, const SceneRenderOptions& options) {
+  const std::vector<unsigned char> rgb = render_scene_rgb(model, data, deposit, options);
+  write_png(png_path, options.width, options.height, rgb);
+}
+
+void render_scene_png(const Simulation& simulation, const HeightMap& deposit,
+                      const std::string& png_path, const SceneRenderOptions& options) {
+  render_scene_png(simulation.model(), simulation.data(), deposit, png_path, options);
+}
+
+}  // namespace depotwin

@@ -1,0 +1,55 @@
+// The MuJoCo scene at the end of a job, rendered headless through OSMesa to a PNG
+// (MuJoCo sample/record.cc as one straight line: set up, update, render, read, free),
+// with the deposited material drawn on the substrate as thin boxes coloured by thickness.
+//
+// The model must have a camera `render_cam` and a body `substrate` (the frame the
+// HeightMap is given in); its <visual><global offwidth offheight> bounds the image size.
+// Deposited films are micrometres thick: their height is exaggerated (the tallest deposit
+// is drawn as a fraction of the deposit region's size) and the colour carries the value
+// (viridis, a perceptually uniform colormap: dark purple = thin, yellow = the thickest).
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <string>
+#include <vector>
+
+#include "core/heightmap.hpp"
+
+namespace depotwin {
+
+class Simulation;
+
+struct SceneRenderOptions {
+  int width = 640;
+  int height = 480;
+  // true: look along render_cam's direction at the deposit region and the nozzle, from a
+  // distance that fits them; false: render_cam's own pose and field of view
+  bool frame_deposit = true;
+  // drawn height of the thickest deposit as a fraction of the framed region's size
+  double relief_fraction = 0.04;
+  // at most this many grid cells are drawn (the grid is averaged over square blocks to fit)
+  int max_boxes = 10000;
+  // cells thinner than this fraction of the thickest are not drawn (footprint tails)
+  double min_relative_thickness = 0.02;
+};
+
+// Render to RGB bytes, rows top to bottom (width * height * 3). `data` is not modified
+// (the renderer works on a copy). InputError for an image larger than the model's
+// offscreen buffer or a model without render_cam/substrate; InternalError when OSMesa or
+// MuJoCo's renderer fails.
+std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& data,
+                                            const HeightMap& deposit,
+                                            const SceneRenderOptions& options = {});
+
+// Render and write a PNG: to a temporary file beside `png_path`, then renamed over it.
+void render_scene_png(const mjModel& model, const mjData& data, const HeightMap& deposit,
+                      const std::string& png_path, const SceneRenderOptions& options = {});
+// the state after Simulation::run
+void render_scene_png(const Simulation& simulation, const HeightMap& deposit,
+                      const std::string& png_path, const SceneRenderOptions& options = {});
+
+// viridis colour of a value in [0, 1] (clamped), RGB in [0, 1]
+void viridis(double value, float rgb[3]);
+
+}  // namespace depotwin

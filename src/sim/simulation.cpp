@@ -1,0 +1,520 @@
+#include "sim/simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include <Eigen/Geometry>
+
+#include "core/error.hpp"
+#include "sim/mujoco_boundary.hpp"
+#include "sim/shutter.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr double kMinTimestep_s = 1e-5;
+constexpr double kMaxTimestep_s = 0.01;
+// the names every model shares (see the header)
+constexpr const char* kNozzleSite = "nozzle";
+constexpr const char* kSubstrateBody = "substrate";
+constexpr const char* kShutterJoint = "shutter";
+// how often run() looks at the clock for progress reports
+constexpr long kProgressCheckSteps = 256;
+constexpr double kProgressPeriod_s = 0.1;
+
+std::string format_number(double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+// one servo-driven joint, resolved once at load time
+struct Servo {
+  std::string name;
+  int joint = -1;
+  int actuator = -1;
+  int qpos_adr = -1;
+  int dof_adr = -1;
+  double user_to_si = 1.0;  // mm -> m for slides, 1 for hinges
+  const char* unit = "rad";
+  double kp = 0.0;       // N/m or N m/rad
+  double kv = 0.0;       // N s/m or N m s/rad (actuator velocity gain)
+  double damping = 0.0;  // joint damping, same units as kv
+};
+
+Servo resolve_servo(const mjModel& model, const std::string& name, const std::string& path,
+                    const std::string& purpose) {
+  Servo servo;
+  servo.name = name;
+  servo.joint = require_id(model, mjOBJ_JOINT, name, path, purpose);
+  const int type = model.jnt_type[servo.joint];
+  if (type != mjJNT_SLIDE && type != mjJNT_HINGE)
+    throw InputError(path, 0, "joint " + name, "must be a slide or a hinge joint");
+  servo.user_to_si = type == mjJNT_SLIDE ? 1.0 / kMmPerM : 1.0;
+  servo.unit = type == mjJNT_SLIDE ? "mm" : "rad";
+  servo.qpos_adr = model.jnt_qposadr[servo.joint];
+  servo.dof_adr = model.jnt_dofadr[servo.joint];
+  servo.damping = model.dof_damping[servo.dof_adr];
+
+  // the actuator of the same name must be a position servo on this joint
+  servo.actuator = require_id(model, mjOBJ_ACTUATOR, name, path, "the servo driving joint " + name);
+  const int a = servo.actuator;
+  const mjtNum* gain = model.actuator_gainprm + a * mjNGAIN;
+  const mjtNum* bias = model.actuator_biasprm + a * mjNBIAS;
+  const bool position_servo =
+      model.actuator_trntype[a] == mjTRN_JOINT && model.actuator_trnid[2 * a] == servo.joint &&
+      model.actuator_dyntype[a] == mjDYN_NONE && model.actuator_gaintype[a] == mjGAIN_FIXED &&
+      model.actuator_biastype[a] == mjBIAS_AFFINE && gain[0] > 0.0 && bias[0] == 0.0 &&
+      std::abs(bias[1] + gain[0]) <= 1e-9 * gain[0] && bias[2] <= 0.0 &&
+      std::abs(model.actuator_gear[6 * a] - 1.0) < 1e-12;
+  if (!position_servo)
+    throw InputError(path, 0, "actuator " + name,
+                     "must be a position servo on joint '" + name +
+                         "' with gear 1: <general gaintype=\"fixed\" gainprm=\"kp\" "
+                         "biastype=\"affine\" biasprm=\"0 -kp -kv\"/> or <position kp=\"...\"/>");
+  servo.kp = gain[0];
+  servo.kv = -bias[2];
+  return servo;
+}
+
+// a custom numeric's values; InputError when missing or too short
+const mjtNum* require_numeric(const mjModel& model, const std::string& name, int size,
+                              const std::string& path) {
+  const int id = require_id(model, mjOBJ_NUMERIC, name, path, "the shutter's parameters");
+  if (model.numeric_size[id] < size)
+    throw InputError(path, 0, "custom numeric " + name,
+                     "needs " + std::to_string(size) + " value(s)");
+  return model.numeric_data + model.numeric_adr[id];
+}
+
+}  // namespace
+
+std::string SimSettings::validate() const {
+  if (!std::isfinite(timestep_s) || timestep_s < kMinTimestep_s || timestep_s > kMaxTimestep_s)
+    return "timestep_s must be between " + format_number(kMinTimestep_s) + " and " +
+           format_number(kMaxTimestep_s) + " s, got " + format_number(timestep_s);
+  if (!std::isfinite(control_period_s) || control_period_s <= 0.0)
+    return "control_period_s must be a positive number, got " + format_number(control_period_s);
+  const double ratio = control_period_s / timestep_s;
+  if (ratio > 1.0 && std::abs(ratio - std::round(ratio)) > 1e-6 * ratio)
+    return "control_period_s (" + format_number(control_period_s) +
+           " s) must be a whole number of timesteps (" + format_number(timestep_s) + " s)";
+  if (!std::isfinite(kp_scale) || kp_scale <= 0.0)
+    return "kp_scale must be a positive number, got " + format_number(kp_scale);
+  if (!std::isfinite(settle_s) || settle_s < 0.0)
+    return "settle_s must be >= 0, got " + format_number(settle_s);
+  if (!std::isfinite(shutter_time_s) || shutter_time_s < 0.0)
+    return "shutter_time_s must be >= 0 (0: the model's), got " + format_number(shutter_time_s);
+  return "";
+}
+
+struct Simulation::Impl {
+  std::string model_path;
+  const Machine* machine = nullptr;
+  SimSettings settings;
+  ModelPtr model;
+  DataPtr data;
+  std::vector<Servo> joints;  // in Machine joint order
+  std::vector<std::string> joint_names;
+  bool has_shutter = false;
+  Servo shutter;
+  ShutterGeometry shutter_geometry;
+  int nozzle_site = -1;
+  int substrate_body = -1;
+  long control_stride = 1;
+  FeedForwardHook hook;
+  // scratch reused by every controller update (no allocation in the step loop)
+  std::vector<mjtNum> acceleration_reference;  // nv
+  std::vector<mjtNum> inertia_force;           // nv
+  std::vector<double> hook_force;              // joints
+
+  void read_nozzle(Vec3& position_mm, Vec3& velocity_mm_s) const;
+  double open_fraction(bool deposit_command) const;
+  double constraint_violation_mm() const;
+  void apply_servo(const Servo& servo, double q_si, double v_si, double extra_force) const;
+};
+
+// nozzle site relative to the substrate frame, and its velocity relative to the substrate
+void Simulation::Impl::read_nozzle(Vec3& position_mm, Vec3& velocity_mm_s) const {
+  const mjModel* m = model.get();
+  const mjData* d = data.get();
+  const mjtNum* site = d->site_xpos + 3 * nozzle_site;
+  const mjtNum* origin = d->xpos + 3 * substrate_body;
+  const mjtNum* rotation = d->xmat + 9 * substrate_body;  // row-major, columns = body axes
+
+  // velocity of the substrate point under the nozzle: v_origin + w x (p - origin)
+  mjtNum site_velocity[6], body_velocity[6];
+  mj_objectVelocity(m, d, mjOBJ_SITE, nozzle_site, site_velocity, 0);
+  mj_objectVelocity(m, d, mjOBJ_XBODY, substrate_body, body_velocity, 0);
+  const Vec3 offset(site[0] - origin[0], site[1] - origin[1], site[2] - origin[2]);
+  const Vec3 omega(body_velocity[0], body_velocity[1], body_velocity[2]);
+  const Vec3 substrate_point_velocity =
+      Vec3(body_velocity[3], body_velocity[4], body_velocity[5]) + omega.cross(offset);
+  const Vec3 relative_velocity =
+      Vec3(site_velocity[3], site_velocity[4], site_velocity[5]) - substrate_point_velocity;
+
+  // both into the substrate frame: local = R^T world
+  for (int axis = 0; axis < 3; ++axis) {
+    double p = 0.0, v = 0.0;
+    for (int row = 0; row < 3; ++row) {
+      p += rotation[3 * row + axis] * offset[row];
+      v += rotation[3 * row + axis] * relative_velocity[row];
+    }
+    position_mm[axis] = m_to_mm(p);
+    velocity_mm_s[axis] = m_to_mm(v);
+  }
+}
+
+double Simulation::Impl::open_fraction(bool deposit_command) const {
+  if (!has_shutter) return deposit_command ? 1.0 : 0.0;
+  return shutter_open_fraction(data->qpos[shutter.qpos_adr], shutter_geometry);
+}
+
+// largest residual of the equality constraints (connect closures), mm
+double Simulation::Impl::constraint_violation_mm() const {
+  const mjData* d = data.get();
+  double largest = 0.0;
+  for (int row = 0; row < d->nefc; ++row)
+    if (d->efc_type[row] == mjCNSTR_EQUALITY)
+      largest = std::max(largest, std::abs(d->efc_pos[row]));
+  return m_to_mm(largest);
+}
+
+// ctrl = q_ref + f_ff / kp (see the header for f_ff)
+void Simulation::Impl::apply_servo(const Servo& servo, double q_si, double v_si,
+                                   double extra_force) const {
+  mjData* d = data.get();
+  double force = 0.0;
+  if (settings.feedforward) {
+    force = inertia_force[servo.dof_adr] + d->qfrc_bias[servo.dof_adr] +
+            (servo.damping + servo.kv) * v_si + extra_force;
+  }
+  d->ctrl[servo.actuator] = q_si + force / servo.kp;
+}
+
+Simulation::Simulation(const std::string& model_path, const Machine& machine,
+                       const SimSettings& settings)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  const std::string problem = settings.validate();
+  if (!problem.empty()) throw InputError("sim", problem);
+  s.model_path = model_path;
+  s.machine = &machine;
+  s.settings = settings;
+  s.model = load_model(model_path);
+  mjModel& m = *s.model;
+
+  // the TCP site and the work frame
+  s.nozzle_site = require_id(m, mjOBJ_SITE, kNozzleSite, model_path,
+                             "the TCP: where material meets the substrate");
+  s.substrate_body =
+      require_id(m, mjOBJ_BODY, kSubstrateBody, model_path, "the work frame the TCP is read in");
+
+  // one position servo per machine joint, its range covering the machine's travel
+  for (const JointLimit& limit : machine.joint_limits()) {
+    Servo servo = resolve_servo(m, limit.name, model_path,
+                                "machine " + machine.name() + " drives a joint of this name");
+    if (m.jnt_limited[servo.joint]) {
+      const double lo = m.jnt_range[2 * servo.joint] / servo.user_to_si;
+      const double hi = m.jnt_range[2 * servo.joint + 1] / servo.user_to_si;
+      if (lo > limit.min + 1e-9 || hi < limit.max - 1e-9)
+        throw InputError(model_path, 0, "joint " + limit.name,
+                         "range [" + format_number(lo) + ", " + format_number(hi) + "] " +
+                             servo.unit + " is narrower than the machine's travel [" +
+                             format_number(limit.min) + ", " + format_number(limit.max) + "] " +
+                             servo.unit);
+    }
+    // kp_scale stiffens the servo; kv follows with the square root (same damping ratio)
+    mjtNum* gain = m.actuator_gainprm + servo.actuator * mjNGAIN;
+    mjtNum* bias = m.actuator_biasprm + servo.actuator * mjNBIAS;
+    gain[0] *= settings.kp_scale;
+    bias[1] *= settings.kp_scale;
+    bias[2] *= std::sqrt(settings.kp_scale);
+    servo.kp = gain[0];
+    servo.kv = -bias[2];
+    s.joint_names.push_back(limit.name);
+    s.joints.push_back(std::move(servo));
+  }
+
+  // the optional shutter blade
+  if (mj_name2id(&m, mjOBJ_JOINT, kShutterJoint) >= 0) {
+    s.has_shutter = true;
+    s.shutter = resolve_servo(m, kShutterJoint, model_path, "the shutter blade");
+    if (m.jnt_type[s.shutter.joint] != mjJNT_HINGE)
+      throw InputError(model_path, 0, "joint shutter", "must be a hinge joint");
+    const mjtNum* travel_deg = require_numeric(m, "shutter_travel_deg", 2, model_path);
+    const mjtNum* overtravel = require_numeric(m, "shutter_overtravel", 1, model_path);
+    const mjtNum* time_s = require_numeric(m, "shutter_time_s", 1, model_path);
+    ShutterGeometry& geometry = s.shutter_geometry;
+    geometry.closed_angle_rad = deg_to_rad(travel_deg[0]);
+    geometry.open_angle_rad = deg_to_rad(travel_deg[1]);
+    geometry.overtravel = overtravel[0];
+    geometry.time_s = settings.shutter_time_s > 0.0 ? settings.shutter_time_s : time_s[0];
+    if (!(std::abs(travel_deg[1] - travel_deg[0]) > 1e-9))
+      throw InputError(model_path, 0, "custom numeric shutter_travel_deg",
+                       "the closed and open angles must differ");
+    if (!(geometry.overtravel >= 0.0))
+      throw InputError(model_path, 0, "custom numeric shutter_overtravel", "must be >= 0");
+    if (!(geometry.time_s > 0.0))
+      throw InputError(model_path, 0, "custom numeric shutter_time_s", "must be > 0");
+    // the rest positions must lie inside the hinge's stops
+    const double rest_closed = geometry.angle_at(-geometry.overtravel);
+    const double rest_open = geometry.angle_at(1.0 + geometry.overtravel);
+    if (m.jnt_limited[s.shutter.joint] &&
+        (std::min(rest_closed, rest_open) < m.jnt_range[2 * s.shutter.joint] ||
+         std::max(rest_closed, rest_open) > m.jnt_range[2 * s.shutter.joint + 1]))
+      throw InputError(model_path, 0, "joint shutter",
+                       "range does not contain the blade's rest positions (travel plus "
+                       "overtravel)");
+  }
+
+  m.opt.timestep = settings.timestep_s;
+  s.control_stride = std::max(1L, std::lround(settings.control_period_s / settings.timestep_s));
+  s.data = make_data(m);
+  s.acceleration_reference.assign(m.nv, 0.0);
+  s.inertia_force.assign(m.nv, 0.0);
+  s.hook_force.assign(s.joints.size(), 0.0);
+  mj_forward(s.model.get(), s.data.get());
+  check_warnings(*s.data, "after loading the model");
+}
+
+Simulation::~Simulation() = default;
+Simulation::Simulation(Simulation&&) noexcept = default;
+Simulation& Simulation::operator=(Simulation&&) noexcept = default;
+
+void Simulation::set_feedforward_hook(FeedForwardHook hook) {
+  impl_->hook = std::move(hook);
+}
+const std::string& Simulation::model_path() const {
+  return impl_->model_path;
+}
+const std::vector<std::string>& Simulation::joint_names() const {
+  return impl_->joint_names;
+}
+std::vector<double> Simulation::actuator_force_limits() const {
+  const mjModel& m = *impl_->model;
+  std::vector<double> limits;
+  for (const Servo& servo : impl_->joints) {
+    const int a = servo.actuator;
+    limits.push_back(m.actuator_forcelimited[a]
+                         ? std::max(std::abs(m.actuator_forcerange[2 * a]),
+                                    std::abs(m.actuator_forcerange[2 * a + 1]))
+                         : 0.0);
+  }
+  return limits;
+}
+bool Simulation::has_shutter() const {
+  return impl_->has_shutter;
+}
+double Simulation::shutter_time_s() const {
+  return impl_->has_shutter ? impl_->shutter_geometry.time_s : 0.0;
+}
+double Simulation::shutter_open_fraction_at(double flap_angle_rad) const {
+  return shutter_open_fraction(flap_angle_rad, impl_->shutter_geometry);
+}
+const mjModel& Simulation::model() const {
+  return *impl_->model;
+}
+const mjData& Simulation::data() const {
+  return *impl_->data;
+}
+
+RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on_step,
+                            const ProgressCallback& progress) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point wall_start = Clock::now();
+  Impl& s = *impl_;
+  const mjModel* m = s.model.get();
+  mjData* d = s.data.get();
+  const Machine& machine = *s.machine;
+  if (trajectory.pieces().empty()) throw InputError("trajectory", "the trajectory is empty");
+
+  const double dt = m->opt.timestep;
+  const double duration_s = trajectory.duration_s();
+  const long steps =
+      std::max(1L, static_cast<long>(std::ceil((duration_s + s.settings.settle_s) / dt - 1e-9)));
+  const long stride = s.control_stride;
+  const long updates = steps / stride + 1;
+  const int joint_count = static_cast<int>(s.joints.size());
+  const size_t entries = static_cast<size_t>(steps) + 1;
+
+  RecordedRun run;
+  run.joint_count = joint_count;
+  run.joint_names = s.joint_names;
+  run.timestep_s = dt;
+  run.steps = steps;
+  run.t_s.resize(entries);
+  run.nozzle_mm.resize(entries);
+  run.nozzle_velocity_mm_s.resize(entries);
+  run.open_fraction.resize(entries);
+  run.deposit_command.resize(entries);
+  run.path_index.resize(entries);
+  run.desired_speed_mm_s.resize(entries);
+  run.joint_position.resize(entries * joint_count);
+  run.joint_velocity.resize(entries * joint_count);
+  run.joint_acceleration.resize(entries * joint_count);
+  run.actuator_force.resize(entries * joint_count);
+
+  // plan -> joint references for every controller update (SI), plan flags for every step;
+  // the whole trajectory is checked against the travel before anything is simulated
+  std::vector<double> q_ref(updates * joint_count), v_ref(updates * joint_count),
+      a_ref(updates * joint_count, 0.0), flap_ref(updates, 0.0), flap_rate(updates, 0.0),
+      flap_acceleration(updates, 0.0);
+  ShutterReference shutter_reference;
+  if (s.has_shutter)
+    shutter_reference =
+        ShutterReference(trajectory, s.shutter_geometry.time_s, s.shutter_geometry.overtravel);
+  JointVector joints;
+  std::string why;
+  const std::vector<JointLimit>& limits = machine.joint_limits();
+  for (long k = 0; k <= steps; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    TrajectorySample sample = trajectory.at(t);
+    // after the end the machine holds the final point with the shutter closed
+    if (t > duration_s + 1e-12) {
+      sample.velocity_mm_s.setZero();
+      sample.acceleration_mm_s2.setZero();
+      sample.depositing = false;
+      sample.path_index = -1;
+      sample.desired_speed_mm_s = 0.0;
+    }
+    run.deposit_command[k] = sample.depositing ? 1 : 0;
+    run.path_index[k] = sample.path_index;
+    run.desired_speed_mm_s[k] = static_cast<float>(sample.desired_speed_mm_s);
+
+    why.clear();
+    if (!machine.inverse(sample.position_mm, joints, &why))
+      throw InputError("trajectory", "at t = " + format_number(t) + " s: " + why);
+    if (static_cast<int>(joints.size()) != joint_count)
+      throw InternalError("machine " + machine.name() + " returned " +
+                          std::to_string(joints.size()) + " joints, expected " +
+                          std::to_string(joint_count));
+    for (int j = 0; j < joint_count; ++j) {
+      if (joints[j] < limits[j].min - 1e-9 || joints[j] > limits[j].max + 1e-9)
+        throw InputError("trajectory", "at t = " + format_number(t) + " s: joint " +
+                                           limits[j].name + " at " + format_number(joints[j]) +
+                                           " is outside its travel [" +
+                                           format_number(limits[j].min) + ", " +
+                                           format_number(limits[j].max) + "]");
+    }
+    if (k % stride != 0) continue;
+
+    // joint velocity J v (the acceleration follows below, from consecutive velocities)
+    const long u = k / stride;
+    const JointVector velocity = machine.joint_velocity(joints, sample.velocity_mm_s);
+    for (int j = 0; j < joint_count; ++j) {
+      const double to_si = s.joints[j].user_to_si;
+      q_ref[u * joint_count + j] = joints[j] * to_si;
+      v_ref[u * joint_count + j] = velocity[j] * to_si;
+    }
+    if (s.has_shutter) {
+      double fraction = 0.0, rate = 0.0;
+      shutter_reference.at(t, fraction, rate);
+      const ShutterGeometry& geometry = s.shutter_geometry;
+      flap_ref[u] = geometry.angle_at(fraction);
+      flap_rate[u] = rate * (geometry.open_angle_rad - geometry.closed_angle_rad);
+    }
+  }
+
+  // inertia feed-forward: the mean acceleration over each control period,
+  // (v_ref(t + T_c) - v_ref(t)) / T_c. Under a zero-order hold this reaches the next
+  // velocity reference exactly even when a phase boundary falls between two updates, and it
+  // contains the Jacobian's rate (dJ/dt) v of machines whose Jacobian varies.
+  const double control_period_s = static_cast<double>(stride) * dt;
+  for (long u = 0; u + 1 < updates; ++u) {
+    for (int j = 0; j < joint_count; ++j)
+      a_ref[u * joint_count + j] =
+          (v_ref[(u + 1) * joint_count + j] - v_ref[u * joint_count + j]) / control_period_s;
+    flap_acceleration[u] = (flap_rate[u + 1] - flap_rate[u]) / control_period_s;
+  }
+
+  // start from a reset state exactly on the reference
+  mj_resetData(m, d);
+  clear_warnings(*d);
+  for (int j = 0; j < joint_count; ++j) {
+    d->qpos[s.joints[j].qpos_adr] = q_ref[j];
+    d->qvel[s.joints[j].dof_adr] = v_ref[j];
+  }
+  if (s.has_shutter) {
+    d->qpos[s.shutter.qpos_adr] = flap_ref[0];
+    d->qvel[s.shutter.dof_adr] = flap_rate[0];
+  }
+
+  // the step loop: state after mj_step1, controls, mj_step2 (no allocation in here)
+  StepState before, after;
+  double max_violation_mm = 0.0;
+  Clock::time_point last_progress = wall_start;
+  for (long k = 0; k <= steps; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    d->time = t;
+    mj_step1(m, d);
+
+    // the state at t: nozzle from MuJoCo, flags from the plan
+    after.t_s = t;
+    s.read_nozzle(after.nozzle_mm, after.nozzle_velocity_mm_s);
+    after.deposit_command = run.deposit_command[k] != 0;
+    after.open_fraction = s.open_fraction(after.deposit_command);
+    after.desired_speed_mm_s = run.desired_speed_mm_s[k];
+    after.path_index = run.path_index[k];
+    run.t_s[k] = t;
+    run.nozzle_mm[k] = after.nozzle_mm;
+    run.nozzle_velocity_mm_s[k] = after.nozzle_velocity_mm_s;
+    run.open_fraction[k] = static_cast<float>(after.open_fraction);
+    for (int j = 0; j < joint_count; ++j) {
+      const Servo& servo = s.joints[j];
+      run.joint_position[k * joint_count + j] = d->qpos[servo.qpos_adr] / servo.user_to_si;
+      run.joint_velocity[k * joint_count + j] = d->qvel[servo.dof_adr] / servo.user_to_si;
+    }
+    max_violation_mm = std::max(max_violation_mm, s.constraint_violation_mm());
+    if (k > 0 && on_step) on_step(before, after);
+    before = after;
+
+    // servo controls at the controller rate, held in between
+    if (k % stride == 0) {
+      const long u = k / stride;
+      const double* q = &q_ref[u * joint_count];
+      const double* v = &v_ref[u * joint_count];
+      const double* a = &a_ref[u * joint_count];
+      if (s.settings.feedforward) {
+        std::fill(s.acceleration_reference.begin(), s.acceleration_reference.end(), 0.0);
+        for (int j = 0; j < joint_count; ++j) s.acceleration_reference[s.joints[j].dof_adr] = a[j];
+        if (s.has_shutter) s.acceleration_reference[s.shutter.dof_adr] = flap_acceleration[u];
+        mj_mulM(m, d, s.inertia_force.data(), s.acceleration_reference.data());
+        std::fill(s.hook_force.begin(), s.hook_force.end(), 0.0);
+        if (s.hook) s.hook(*m, *d, JointReference{t, joint_count, q, v, a}, s.hook_force.data());
+      }
+      for (int j = 0; j < joint_count; ++j) s.apply_servo(s.joints[j], q[j], v[j], s.hook_force[j]);
+      if (s.has_shutter) s.apply_servo(s.shutter, flap_ref[u], flap_rate[u], 0.0);
+    }
+
+    // integrate; the last state is only evaluated (for its acceleration and forces)
+    if (k < steps)
+      mj_step2(m, d);
+    else
+      mj_forward(m, d);
+    for (int j = 0; j < joint_count; ++j) {
+      const Servo& servo = s.joints[j];
+      run.joint_acceleration[k * joint_count + j] = d->qacc[servo.dof_adr] / servo.user_to_si;
+      run.actuator_force[k * joint_count + j] = d->actuator_force[servo.actuator];
+    }
+    check_warnings(*d, "in the simulation", t);
+
+    if (progress && k % kProgressCheckSteps == 0) {
+      const Clock::time_point now = Clock::now();
+      if (std::chrono::duration<double>(now - last_progress).count() >= kProgressPeriod_s) {
+        last_progress = now;
+        progress(static_cast<double>(k) / static_cast<double>(steps));
+      }
+    }
+  }
+  if (progress) progress(1.0);
+
+  run.max_constraint_violation_mm = max_violation_mm;
+  run.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  return run;
+}
+
+}  // namespace depotwin

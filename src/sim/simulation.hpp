@@ -1,0 +1,153 @@
+// The machine in MuJoCo following a planned trajectory through its actuators.
+//
+// trajectory --Machine::inverse/joint_velocity--> joint references (q, v, a)
+//   --servo controller at 1 kHz (position servos in the MJCF + feed-forward)--> ctrl
+//   --mj_step1 / ctrl / mj_step2--> simulated nozzle pose, read from MuJoCo.
+//
+// What a model must provide (any machine, found by name once):
+// - one joint per Machine::joint_limits()[i].name (slide: mm, hinge: rad), driven by an
+//   actuator of the same name that is a position servo on that joint: <general> with
+//   gaintype fixed, biastype affine, gainprm kp, biasprm "0 -kp -kv", gear 1 (or <position>);
+// - site `nozzle` (the TCP: where material meets the substrate) and body `substrate` (the
+//   work frame); the nozzle pose is site_xpos relative to the substrate frame, never the plan;
+// - optionally a shutter: hinge `shutter` with a servo `shutter` and custom numerics
+//   `shutter_travel_deg` (closed open), `shutter_overtravel`, `shutter_time_s` (shutter.hpp).
+//   Without one the open fraction is the trajectory's depositing flag.
+// Equality constraints (<connect> closures of a linear delta) are allowed; their largest
+// position violation is recorded.
+//
+// Controller per servo joint (SI units inside):  ctrl = q_ref + f_ff / kp  with
+//   f_ff = (M a_ref)_j + qfrc_bias_j + (damping_j + kv_j) v_ref_j + hook_j
+// where a_ref is the mean reference acceleration over the coming control period
+// so the actuator force kp (ctrl - q) - kv qdot = kp (q_ref - q) + kv (v_ref - qdot) + f_ff:
+// PD on the reference plus inertia, bias (gravity, Coriolis), viscous and optional
+// machine-specific load feed-forward (set_feedforward_hook). Bearing friction is not
+// compensated. Controls are held between updates (zero-order hold).
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/trajectory.hpp"
+#include "core/types.hpp"
+#include "kinematics/machine.hpp"
+
+namespace depotwin {
+
+struct SimSettings {
+  double timestep_s = 0.001;        // physics step (replaces the model's <option timestep>)
+  double control_period_s = 0.001;  // servo update period (1 kHz), a whole number of steps;
+                                    // shorter than the timestep: every step
+  double kp_scale = 1.0;  // multiplies the machine servos' kp (kv by sqrt: same damping ratio)
+  double settle_s = 0.0;  // simulated time after the trajectory ends
+  double shutter_time_s = 0.0;  // flap open/close time; 0: the model's `shutter_time_s`
+  bool feedforward = true;      // false: plain PD on the joint reference (servo lag shows)
+
+  // "" when usable, else what is wrong (names the field)
+  std::string validate() const;
+};
+
+// The simulated state at one step (user units, substrate frame).
+struct StepState {
+  double t_s = 0.0;
+  Vec3 nozzle_mm = Vec3::Zero();             // nozzle site in the substrate frame
+  Vec3 nozzle_velocity_mm_s = Vec3::Zero();  // its velocity relative to the substrate
+  double open_fraction = 0.0;                // shutter: 0 closed .. 1 open (from the flap angle)
+  bool deposit_command = false;              // the trajectory's depositing flag at t
+  double desired_speed_mm_s = 0.0;           // the trajectory piece's desired speed (0: transition)
+  int path_index = -1;                       // the trajectory piece's print path (-1: transition)
+};
+
+// A whole run as a struct of arrays: entry k is the state at t = k * timestep_s,
+// k = 0 .. steps (the initial state plus one entry per step).
+struct RecordedRun {
+  std::vector<double> t_s;
+  std::vector<Vec3> nozzle_mm, nozzle_velocity_mm_s;
+  std::vector<float> open_fraction;
+  std::vector<uint8_t> deposit_command;
+  std::vector<int> path_index;
+  std::vector<float> desired_speed_mm_s;
+  // step-major, joint_count per entry, user units: mm, mm/s, mm/s^2, N for slides and
+  // rad, rad/s, rad/s^2, N m for hinges. Acceleration and force are MuJoCo's qacc and
+  // actuator force at that state under that step's control.
+  int joint_count = 0;
+  std::vector<std::string> joint_names;
+  std::vector<double> joint_position, joint_velocity, joint_acceleration, actuator_force;
+  double timestep_s = 0.0;
+  double wall_s = 0.0;                       // wall-clock time of run()
+  long steps = 0;                            // physics steps taken (entries - 1)
+  double max_constraint_violation_mm = 0.0;  // largest equality-constraint residual; 0 without
+
+  size_t size() const { return t_s.size(); }
+  double joint(const std::vector<double>& values, size_t entry, int joint_index) const {
+    return values[entry * static_cast<size_t>(joint_count) + joint_index];
+  }
+};
+
+// Joint references of one controller update, SI units (m or rad), in Machine joint order;
+// `acceleration` is the mean over the coming control period (v_ref(t + T_c) - v_ref(t)) / T_c.
+struct JointReference {
+  double t_s = 0.0;
+  int count = 0;
+  const double* position = nullptr;
+  const double* velocity = nullptr;
+  const double* acceleration = nullptr;
+};
+
+class Simulation {
+ public:
+  using StepCallback = std::function<void(const StepState& before, const StepState& after)>;
+  using ProgressCallback = std::function<void(double fraction)>;
+  // adds a machine-specific feed-forward force per Machine joint (SI: N or N m) to `force`
+  // (count entries, zero on entry); called at every controller update with the state after
+  // mj_step1 (e.g. a linear delta's platform load through mj_inverse or the constraint Jacobian)
+  using FeedForwardHook = std::function<void(const mjModel& model, const mjData& data,
+                                             const JointReference& reference, double* force)>;
+
+  // Loads the model and resolves every name once. InputError (naming the file and the
+  // element) for a missing or malformed model, a missing `nozzle` site or `substrate` body,
+  // missing joints/actuators, an actuator that is not a position servo, a joint range
+  // narrower than the machine's travel, or bad settings. `machine` must outlive the
+  // Simulation.
+  Simulation(const std::string& model_path, const Machine& machine,
+             const SimSettings& settings = {});
+  ~Simulation();
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  // Checks the whole trajectory against the joint travel first (InputError naming the time
+  // and the joint), then starts on the reference at t = 0 and steps until the trajectory's
+  // end + settle_s. on_step(before, after) is called once per step; progress(fraction) at
+  // most about ten times a second. A MuJoCo warning (divergence) throws InternalError.
+  // Each run starts from a reset state: the same trajectory gives the same RecordedRun.
+  RecordedRun run(const Trajectory& trajectory, const StepCallback& on_step = {},
+                  const ProgressCallback& progress = {});
+
+  void set_feedforward_hook(FeedForwardHook hook);
+
+  const std::string& model_path() const;
+  const std::vector<std::string>& joint_names() const;
+  // each machine joint's actuator force limit (N or N m, the MJCF forcerange); 0: unlimited
+  std::vector<double> actuator_force_limits() const;
+  bool has_shutter() const;
+  double shutter_time_s() const;  // the open/close time in use; 0 without a shutter
+  // the shutter's blade geometry (meaningful only with a shutter)
+  double shutter_open_fraction_at(double flap_angle_rad) const;
+
+  // the MuJoCo state after the last run (initial state before any), for the scene renderer
+  const mjModel& model() const;
+  const mjData& data() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace depotwin
