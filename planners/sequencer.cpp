@@ -1,10 +1,65 @@
 #include "planners/sequencer.hpp"
 
+#include <algorithm>
+#include <limits>
+
 #include "core/error.hpp"
+#include "planners/christofides.hpp"
+#include "planners/local_search.hpp"
+#include "planners/lower_bound.hpp"
+#include "planners/nearest_neighbor.hpp"
+#include "planners/neighbor_lists.hpp"
+#include "planners/random_order.hpp"
+#include "planners/transition_cost.hpp"
 
 namespace depotwin {
 
-std::string OrderSpec::label() const { return refine.empty() ? method : method + "+" + refine; }
+namespace {
+
+bool known(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+void check_spec(const OrderSpec& spec) {
+  std::vector<Problem> problems;
+  if (!known(sequencer_methods(), spec.method))
+    problems.push_back(
+        {"", 0, "order.method",
+         "unknown sequencer '" + spec.method + "' (expected " + joined(sequencer_methods()) + ")"});
+  if (!spec.refine.empty() && !known(refine_methods(), spec.refine))
+    problems.push_back(
+        {"", 0, "order.refine",
+         "unknown refinement '" + spec.refine + "' (expected " + joined(refine_methods()) + ")"});
+  if (!known(cost_models(), spec.cost_model))
+    problems.push_back(
+        {"", 0, "order.cost_model",
+         "unknown cost model '" + spec.cost_model + "' (expected " + joined(cost_models()) + ")"});
+  if (!problems.empty()) throw InputError(std::move(problems));
+}
+
+OrderResult construct(const TransitionCost& cost, const OrderSpec& spec) {
+  if (spec.method == "random") return random_order(cost.path_count(), spec.seed);
+  if (spec.method == "nearest_neighbor") return nearest_neighbor_order(cost);
+  if (spec.method == "christofides") return christofides_order(cost);
+  OrderResult given;  // as_given
+  for (int i = 0; i < cost.path_count(); ++i) {
+    given.order.push_back(i);
+    given.reversed.push_back(false);
+  }
+  return given;
+}
+
+}  // namespace
+
+std::string OrderSpec::label() const {
+  return refine.empty() ? method : method + "+" + refine;
+}
 
 const std::vector<std::string>& sequencer_methods() {
   static const std::vector<std::string> names{"as_given", "random", "nearest_neighbor",
@@ -22,15 +77,22 @@ const std::vector<std::string>& cost_models() {
   return names;
 }
 
-OrderResult sequence(const Toolpath& toolpath, const MachineLimits&, const OrderSpec& spec) {
-  // TODO(issue 6): the other sequencers; until then only the given order
-  if (spec.method != "as_given" || !spec.refine.empty())
-    throw InputError("order", "sequencer '" + spec.label() + "' is not available yet");
-  OrderResult result;
-  for (size_t i = 0; i < toolpath.paths.size(); ++i) {
-    result.order.push_back(static_cast<int>(i));
-    result.reversed.push_back(false);
+OrderResult sequence(const Toolpath& toolpath, const MachineLimits& limits, const OrderSpec& spec,
+                     const SequencerOptions& options) {
+  check_spec(spec);
+  const TransitionCost cost(toolpath, limits, parse_cost_model(spec.cost_model));
+
+  // construct, then refine over neighbour lists
+  OrderResult result = construct(cost, spec);
+  if (!spec.refine.empty()) {
+    const NeighborLists neighbors(cost, options.neighbors);
+    refine_order(result, cost, neighbors, parse_refinement(spec.refine));
   }
+
+  result.cost_s = cost.order_cost(result);
+  result.print_time_s = cost.print_time_s();
+  result.lower_bound_s =
+      options.lower_bound ? matching_lower_bound(cost) : std::numeric_limits<double>::quiet_NaN();
   return result;
 }
 

@@ -22,10 +22,21 @@ struct OrderSpec {
 };
 
 struct OrderResult {
-  std::vector<int> order;        // indices into the input toolpath's paths, in print order
-  std::vector<bool> reversed;    // per entry of `order`: print that path backwards
-  double cost_s = 0.0;           // print time + transitions under the cost model
-  double lower_bound_s = 0.0;    // print time + min-weight perfect matching of all ends
+  std::vector<int> order;      // indices into the input toolpath's paths, in print order
+  std::vector<bool> reversed;  // per entry of `order`: print that path backwards
+  double cost_s = 0.0;         // print time + transitions under the cost model
+  double lower_bound_s = 0.0;  // print time + min-weight perfect matching of all ends
+                               // (exact at any N, see lower_bound.hpp)
+  double print_time_s = 0.0;   // sum of length / speed (the part no order changes)
+};
+
+// knobs for benchmarks and tests; the defaults are what scenarios get
+struct SequencerOptions {
+  int neighbors = 12;  // candidate list length per path end (local search)
+  // the lower bound is exact at any N but costs ~0.6 s at N = 10^4 and ~30 s at 10^5;
+  // above this many paths (or when false) lower_bound_s is NaN
+  bool lower_bound = true;
+  int lower_bound_max_paths = 20000;
 };
 
 // names accepted by OrderSpec::method / refine / cost_model
@@ -33,7 +44,10 @@ const std::vector<std::string>& sequencer_methods();
 const std::vector<std::string>& refine_methods();
 const std::vector<std::string>& cost_models();
 
-OrderResult sequence(const Toolpath& toolpath, const MachineLimits& limits, const OrderSpec& spec);
+// Throws InputError for unknown names (key order.method / order.refine / order.cost_model)
+// and for paths the limits cannot print at their speed.
+OrderResult sequence(const Toolpath& toolpath, const MachineLimits& limits, const OrderSpec& spec,
+                     const SequencerOptions& options = {});
 // the toolpath in the given order and directions (source_index kept)
 Toolpath apply_order(const Toolpath& toolpath, const OrderResult& result);
 
