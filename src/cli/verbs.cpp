@@ -1,9 +1,13 @@
 #include "cli/verbs.hpp"
 
+#include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include "core/error.hpp"
+#include "pipeline/compare.hpp"
 #include "pipeline/job.hpp"
+#include "pipeline/run.hpp"
 
 namespace depotwin {
 
@@ -33,7 +37,68 @@ int validate_verb(const std::string& path) {
   return kExitOk;
 }
 
-int run_verb(const RunOptions&) { throw InternalError("run: not built yet"); }
-int compare_verb(const CompareOptions&) { throw InternalError("compare: not built yet"); }
+namespace {
+
+void print_warnings(const std::vector<MetricsReport>& reports) {
+  for (const MetricsReport& report : reports)
+    for (const std::string& warning : report.warnings)
+      std::cout << "warning (" << report.planner << "): " << warning << '\n';
+}
+
+RunSettings run_settings(const Scenario& scenario, const RunOptions& options) {
+  RunSettings settings;
+  settings.render = scenario.outputs.render && !options.no_render;
+  settings.progress = !options.quiet;
+  return settings;
+}
+
+}  // namespace
+
+int run_verb(const RunOptions& options) {
+  const Scenario scenario = load_scenario(options.scenario);
+  const PreparedJob job = prepare_job(scenario);
+  const std::vector<PlannerSpec> planners = select_planners(scenario, options.planners);
+  const std::string directory = output_directory(scenario, options.out);
+  const RunSettings settings = run_settings(scenario, options);
+  std::vector<MetricsReport> reports;
+  for (const PlannerSpec& spec : planners) {
+    const SimulatedRun run = simulate_job(job, spec, settings);
+    write_run(job, run, (std::filesystem::path(directory) / spec.name).string(), settings);
+    reports.push_back(run.report);
+  }
+  std::cout << "scenario " << scenario.name << " (" << scenario.file << "), machine "
+            << job.machine->name() << ", process " << scenario.process.type << ", order "
+            << scenario.order.label() << "\n\n"
+            << summary_table(reports) << '\n';
+  print_warnings(reports);
+  std::cout << "results written to " << directory << "/<planner>/ (metrics.json, trajectory.csv, "
+            << "thickness.csv" << (settings.render ? ", images" : "") << ")\n";
+  return kExitOk;
+}
+
+int compare_verb(const CompareOptions& options) {
+  const Scenario scenario = load_scenario(options.run.scenario);
+  const std::vector<PlannerSpec> planners = select_planners(scenario, options.run.planners);
+  std::vector<OrderSpec> orders;
+  if (!options.orders.empty()) {
+    std::stringstream list(options.orders);
+    std::string label;
+    while (std::getline(list, label, ','))
+      if (!label.empty()) orders.push_back(parse_order_label(label, scenario.order));
+  }
+  const std::string directory = output_directory(scenario, options.run.out);
+  const RunSettings settings = run_settings(scenario, options.run);
+  const std::vector<ComparisonRow> rows =
+      compare_runs(scenario, planners, orders, directory, settings);
+  std::vector<MetricsReport> reports;
+  for (const ComparisonRow& row : rows) reports.push_back(row.report);
+  std::cout << "scenario " << scenario.name << " (" << scenario.file << "): "
+            << (orders.empty() ? "planners" : "print orders") << " compared\n\n"
+            << summary_table(reports) << '\n';
+  print_warnings(reports);
+  std::cout << "comparison written to " << directory << "/comparison.{json,csv,md"
+            << (settings.render ? ",png" : "") << "}, one folder per run\n";
+  return kExitOk;
+}
 
 }  // namespace depotwin

@@ -23,6 +23,29 @@ double Toolpath::print_length_mm() const {
   return length;
 }
 
+Toolpath merge_joined_paths(const Toolpath& toolpath) {
+  Toolpath merged;
+  merged.start_mm = toolpath.start_mm;
+  merged.end_mm = toolpath.end_mm;
+  for (const PrintPath& path : toolpath.paths) {
+    const bool joins = !merged.paths.empty() &&
+                       (merged.paths.back().back() - path.front()).norm() <= kJoinTolerance_mm;
+    if (!joins) {
+      merged.paths.push_back(path);
+      continue;
+    }
+    // append without repeating the joint (normals only when both paths carry them)
+    PrintPath& last = merged.paths.back();
+    const bool with_normals = !last.normals.empty() && !path.normals.empty();
+    last.points.insert(last.points.end(), path.points.begin() + 1, path.points.end());
+    if (with_normals)
+      last.normals.insert(last.normals.end(), path.normals.begin() + 1, path.normals.end());
+    else
+      last.normals.clear();
+  }
+  return merged;
+}
+
 void Toolpath::bounds(Vec3& lo, Vec3& hi) const {
   lo = start_mm.cwiseMin(end_mm);
   hi = start_mm.cwiseMax(end_mm);

@@ -36,4 +36,10 @@ struct Toolpath {
 // Two path ends closer than this (mm) are one point: printing continues through them.
 constexpr double kJoinTolerance_mm = 1e-6;
 
+// The toolpath with each run of consecutive paths that join end to start (printing goes on
+// through the joint) merged into one polyline: what is printed in one go. The merged path
+// keeps the first path's speed and source index. Used where "a path's ends" matter (the
+// thickness metrics exclude path ends, not joints inside a continuous print).
+Toolpath merge_joined_paths(const Toolpath& toolpath);
+
 }  // namespace depotwin

@@ -171,6 +171,18 @@ void LinearDelta::set_carriage_limits(double v_max_mm_s, double a_max_mm_s2) {
   }
 }
 
+void LinearDelta::closure_feedforward(const Vec3& tcp_mm, const Vec3& tcp_velocity_mm_s,
+                                      const Vec3& tcp_acceleration_mm_s2,
+                                      double* joint_force) const {
+  // the platform term of the full feed-forward alone: no carriage mass, the closure mass
+  LinearDeltaGeometry platform_only = geometry_;
+  platform_only.platform_mass_kg = geometry_.closure_mass_kg;
+  platform_only.carriage_mass_kg = 0.0;
+  const std::array<double, 3> force = linear_delta_feedforward_forces_n(
+      platform_only, tcp_mm, tcp_velocity_mm_s, tcp_acceleration_mm_s2);
+  for (int arm = 0; arm < 3; ++arm) joint_force[arm] += force[arm];
+}
+
 bool LinearDelta::inverse(const Vec3& tcp_mm, JointVector& joints, std::string* why) const {
   const auto fail = [why](const std::string& reason) {
     if (why) *why = reason;

@@ -50,6 +50,9 @@ struct LinearDeltaGeometry {
   // one carriage + half of its two rods
   double platform_mass_kg = 0.66;
   double carriage_mass_kg = 0.27;
+  // the part of the platform load MuJoCo's per-joint terms do not see (platform + substrate
+  // bodies, without the rods, which hang from the carriages in the MJCF tree)
+  double closure_mass_kg = 0.60;
   double gravity_m_s2 = 9.81;
 
   // world z of the carriage rod joints at the home pose (all joints 0, tcp = 0)
@@ -89,6 +92,13 @@ class LinearDelta final : public Machine {
 
   // scenario `limits: {joint: {v_max, a_max}}`: the same limits on every carriage
   void set_carriage_limits(double v_max_mm_s, double a_max_mm_s2);
+  void set_joint_limits(double v_max, double a_max) override { set_carriage_limits(v_max, a_max); }
+  // the platform's load (closure_mass_kg: platform + substrate) through the rods, by the
+  // Jacobian transpose; the carriages and the rods hanging from them are the simulator's
+  // own per-joint terms
+  bool has_closures() const override { return true; }
+  void closure_feedforward(const Vec3& tcp_mm, const Vec3& tcp_velocity_mm_s,
+                           const Vec3& tcp_acceleration_mm_s2, double* joint_force) const override;
   const LinearDeltaGeometry& geometry() const { return geometry_; }
 
  private:

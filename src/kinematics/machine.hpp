@@ -49,6 +49,18 @@ class Machine {
   // user's Cartesian limits (the result is never looser than `requested`).
   virtual MachineLimits cartesian_limits(const MachineLimits& requested, const Vec3& lo,
                                          const Vec3& hi) const = 0;
+
+  // scenario `limits: {joint: {v_max, a_max}}`: the same limits on every joint
+  virtual void set_joint_limits(double v_max, double a_max) = 0;
+
+  // Feed-forward joint forces (N or N m, `joint_force` has joint_count() entries, added to)
+  // for loads that reach the joints through closed kinematic chains, which a simulator's
+  // per-joint rigid-body terms (M a + bias of each joint's own subtree) do not see: e.g.
+  // the platform a linear delta's rods carry. Serial machines have none. No allocation.
+  virtual bool has_closures() const { return false; }
+  virtual void closure_feedforward(const Vec3& /*tcp_mm*/, const Vec3& /*tcp_velocity_mm_s*/,
+                                   const Vec3& /*tcp_acceleration_mm_s2*/,
+                                   double* /*joint_force*/) const {}
 };
 
 // "xy_stage" | "linear_delta"; nullptr for an unknown name

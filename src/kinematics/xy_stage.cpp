@@ -89,6 +89,13 @@ class XyStage : public Machine {
     return limits;
   }
 
+  void set_joint_limits(double v_max, double a_max) override {
+    for (JointLimit& limit : limits_) {
+      limit.v_max = v_max;
+      limit.a_max = a_max;
+    }
+  }
+
  private:
   std::vector<JointLimit> limits_;
 };

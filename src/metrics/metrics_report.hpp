@@ -15,7 +15,7 @@ struct TimeStats {
   double total_s = 0.0, print_s = 0.0, transition_s = 0.0;
 };
 
-struct ThicknessStats {
+struct ThicknessSummary {
   double mean_um = 0.0, cv = 0.0, line_cv = 0.0, min_rel = 0.0, max_rel = 0.0;
 };
 
@@ -54,7 +54,7 @@ struct MetricsReport {
   VelocityErrorStats planned_velocity_error;
   PathErrorStats path_error;                         // simulated when simulated, else planned
   std::optional<PathErrorStats> planned_path_error;  // also given when simulated
-  std::optional<ThicknessStats> thickness;
+  std::optional<ThicknessSummary> thickness;
   std::optional<WasteStats> waste;
   std::optional<MaterialStats> material;
   std::optional<ActuatorStats> actuators;

@@ -42,6 +42,8 @@ PreparedJob prepare_job(const Scenario& scenario) {
   PreparedJob job;
   job.scenario = scenario;
   job.machine = machine_for(scenario, job.model_path);
+  if (scenario.has_joint_limits)
+    job.machine->set_joint_limits(scenario.joint_limits.v_max_mm_s, scenario.joint_limits.a_max_mm_s2);
 
   // every point of the toolpath must be reachable by the machine
   std::vector<Problem> problems;

@@ -30,7 +30,7 @@ Json to_json(const MetricsReport& r) {
   j["path_error_mm"] = to_json(r.path_error);
   if (r.planned_path_error) j["planned_path_error_mm"] = to_json(*r.planned_path_error);
   if (r.thickness) {
-    const ThicknessStats& t = *r.thickness;
+    const ThicknessSummary& t = *r.thickness;
     j["thickness"] = Json{{"mean_um", t.mean_um}, {"cv", t.cv}, {"line_cv", t.line_cv},
                           {"min_rel", t.min_rel}, {"max_rel", t.max_rel}};
   }
