@@ -69,8 +69,7 @@ bool reachable(const AxisBoundary& b, double T, double V, double A) {
 void check_inputs(const AxisBoundary& b, double v_max, double a_max) {
   if (!(v_max > 0.0) || !(a_max > 0.0) || !std::isfinite(v_max) || !std::isfinite(a_max))
     throw InternalError("move: v_max and a_max must be positive and finite");
-  if (!std::isfinite(b.q0) || !std::isfinite(b.q1) || !std::isfinite(b.v0) ||
-      !std::isfinite(b.v1))
+  if (!std::isfinite(b.q0) || !std::isfinite(b.q1) || !std::isfinite(b.v0) || !std::isfinite(b.v1))
     throw InternalError("move: boundary values must be finite");
   if (std::abs(b.v0) > v_max * (1 + 1e-12) || std::abs(b.v1) > v_max * (1 + 1e-12))
     throw InternalError("move: |v0| and |v1| must not exceed v_max");
@@ -125,8 +124,25 @@ FeasibleDurations feasible_durations(const AxisBoundary& b, double v_max, double
   return out;
 }
 
-AxisProfile fixed_time_move(const AxisBoundary& b, double duration_s, double v_max,
-                            double a_max) {
+namespace {
+
+// At the minimum duration the displacement is flat in v_c, so a solve pins v_c only to
+// ~sqrt(eps) and can leave a spurious nanosecond cruise. Replace such a profile by the
+// exact bang-bang one: v_p - v0 = a0 t_b and v1 - v_p = -a0 (T - t_b).
+LspbSolution snap_to_bang_bang(LspbSolution s, const AxisBoundary& b, double v_max) {
+  const double T = s.duration_s;
+  if (s.t_b1 - s.t_b0 >= 1e-6 * std::max(1.0, T) || s.t_b1 == s.t_b0 || s.a1 != -s.a0) return s;
+  const double v_peak = 0.5 * (b.v0 + b.v1 + s.a0 * T);
+  const double t_peak = (v_peak - b.v0) / s.a0;
+  if (std::abs(v_peak) > v_max * (1.0 + 1e-12) || t_peak < 0.0 || t_peak > T) return s;
+  s.v_c = v_peak;
+  s.t_b0 = s.t_b1 = t_peak;
+  return s;
+}
+
+}  // namespace
+
+AxisProfile fixed_time_move(const AxisBoundary& b, double duration_s, double v_max, double a_max) {
   check_inputs(b, v_max, a_max);
   if (duration_s <= 0.0) {
     if (std::abs(b.q1 - b.q0) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12)
@@ -134,7 +150,8 @@ AxisProfile fixed_time_move(const AxisBoundary& b, double duration_s, double v_m
     throw InternalError("move: zero duration for a non-null move");
   }
   // the paper's six LSPB candidates, eqs. (11)-(18)
-  if (auto solution = solve_lspb(b, duration_s, a_max, v_max)) return solution->profile(b);
+  if (auto solution = solve_lspb(b, duration_s, a_max, v_max))
+    return snap_to_bang_bang(*solution, b, v_max).profile(b);
 
   // roundoff at an extreme duration can reject all six: find v_c by bisection on the
   // monotone displacement and rebuild the same LSPB shape
@@ -155,7 +172,7 @@ AxisProfile fixed_time_move(const AxisBoundary& b, double duration_s, double v_m
   s.t_b0 = std::min(std::abs(v_c - b.v0) / a_max, T);
   s.t_b1 = std::clamp(T - std::abs(v_c - b.v1) / a_max, s.t_b0, T);
   s.duration_s = T;
-  return s.profile(b);
+  return snap_to_bang_bang(s, b, v_max).profile(b);
 }
 
 AxisProfile min_time_move(const AxisBoundary& b, double v_max, double a_max) {
@@ -178,8 +195,8 @@ double mtt_paper_duration(const AxisBoundary& b, double v_max, double a_max) {
   for (const Candidate& c : candidates) {
     if (c.lambda < 0.0) continue;  // eq. (27)
     const double v_p = c.v_p * std::sqrt(c.lambda);
-    const double t_b = (v_p - v0) / c.a0;     // eq. (19)
-    const double t_1 = (v1 - v_p) / c.a1 + t_b;  // eq. (20)
+    const double t_b = (v_p - v0) / c.a0;             // eq. (19)
+    const double t_1 = (v1 - v_p) / c.a1 + t_b;       // eq. (20)
     if (t_b < -1e-12 || t_b > t_1 + 1e-12) continue;  // eq. (28)
     if (std::abs(v_p) <= v_max) return t_1;
     // eq. (29): the peak exceeds v_max -> LSPB with v_c = v_max and the signs of
