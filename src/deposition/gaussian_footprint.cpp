@@ -1,5 +1,7 @@
 #include "deposition/gaussian_footprint.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "core/error.hpp"
@@ -10,44 +12,117 @@ namespace {
 
 using Tiles = ThicknessField::Tiles;
 constexpr int kTile = Tiles::kSize;
-constexpr int kMaxNodes = 3;
+constexpr int kMaxNodes = 4;
 // the longest sub-chord deposit_chord hands over, in sigmas (3-point sub-chords)
 constexpr double kMaxSubChordSigmas = 0.3;
+// the footprint fades to zero over this width centred on the truncation radius (quintic
+// smoothstep 1 - s^3 (10 - 15 s + 6 s^2), twice differentiable, w(s) + w(1 - s) = 1):
+// continuous in the node position, with the hard cut's mass to first order
+constexpr double kTaperSigmas = 0.5;
+
+// count Gaussian recurrences side by side: g_k[i] = value_k, value_k *= ratio_k,
+// ratio_k *= step_factor, sum_k += value_k (independent chains, so the multiplies overlap)
+template <int count>
+void fill_chains(const double* first, const double* first_ratio, double step_factor, int n,
+                 double* g, int stride, double* sum) {
+  // locals, so the chains stay in registers while g is written
+  double value[count], ratio[count], total[count];
+  for (int k = 0; k < count; ++k) {
+    value[k] = first[k];
+    ratio[k] = first_ratio[k];
+    total[k] = 0.0;
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < count; ++k) {
+      g[k * stride + i] = value[k];
+      total[k] += value[k];
+      value[k] *= ratio[k];
+      ratio[k] *= step_factor;
+    }
+  }
+  for (int k = 0; k < count; ++k) sum[k] = total[k];
+}
 
 }  // namespace
 
-GaussianFootprint::GaussianFootprint(double sigma_mm, double cell_mm, double truncation_sigmas)
+GaussianFootprint::GaussianFootprint(double sigma_mm, double cell_mm, double truncation_sigmas,
+                                     double max_span_sigmas)
     : sigma_mm_(sigma_mm),
       cell_mm_(cell_mm),
-      reach_mm_(truncation_sigmas * sigma_mm),
+      reach_mm_((truncation_sigmas + 0.5 * kTaperSigmas) * sigma_mm),
+      taper_start_mm_((truncation_sigmas - 0.5 * kTaperSigmas) * sigma_mm),
       step_factor_(std::exp(-(cell_mm * cell_mm) / (sigma_mm * sigma_mm))),
       inv_two_var_(0.5 / (sigma_mm * sigma_mm)) {
-  if (!(sigma_mm > 0.0) || !(cell_mm > 0.0) || !(truncation_sigmas >= 2.0))
-    throw InternalError("GaussianFootprint: sigma, cell must be > 0 and truncation >= 2 sigma");
-  // box side: chord extent + two reaches, plus the rounding of both ends
-  capacity_ = static_cast<int>(
-                  std::ceil((2.0 * truncation_sigmas + kMaxSubChordSigmas) * sigma_mm / cell_mm)) +
-              3;
+  if (!(sigma_mm > 0.0) || !(cell_mm > 0.0) || !(truncation_sigmas >= 2.0) ||
+      !(max_span_sigmas >= 0.0) || !std::isfinite(max_span_sigmas))
+    throw InternalError(
+        "GaussianFootprint: sigma, cell must be > 0, truncation >= 2 sigma, span >= 0");
+  // box side: node spread + two reaches, plus the rounding of both ends
+  const double span_sigmas = std::max(kMaxSubChordSigmas, max_span_sigmas);
+  capacity_ =
+      static_cast<int>(std::ceil(2.0 * reach_mm_ / cell_mm + span_sigmas * sigma_mm / cell_mm)) + 3;
   x_factors_.assign(static_cast<size_t>(kMaxNodes) * capacity_, 0.0);
   y_factors_.assign(static_cast<size_t>(kMaxNodes) * capacity_, 0.0);
 }
 
-void GaussianFootprint::fill_factors(double centre_mm, int i0, int n, double* g) const {
-  // Gaussian by recurrence: g_{i+1} = g_i r_i, r_{i+1} = r_i exp(-h^2/sigma^2) (2 exp per vector)
+void GaussianFootprint::fill_factors(const double* centres_mm, const double* scales, int count,
+                                     int i0, int n, double* g) const {
+  // Gaussian by recurrence: g_{i+1} = g_i r_i, r_{i+1} = r_i exp(-h^2/sigma^2) (2 exp per
+  // vector); each centre's chain is the same arithmetic whether filled alone or side by side
   const double h = cell_mm_;
-  const double d0 = i0 * h - centre_mm;
-  double value = std::exp(-d0 * d0 * inv_two_var_);
-  double ratio = std::exp(-(2.0 * d0 * h + h * h) * inv_two_var_);
-  double sum = 0.0;
-  for (int i = 0; i < n; ++i) {
-    g[i] = value;
-    sum += value;
-    value *= ratio;
-    ratio *= step_factor_;
+  double value[kMaxNodes] = {}, ratio[kMaxNodes] = {}, sum[kMaxNodes] = {};
+  for (int k = 0; k < count; ++k) {
+    const double d0 = i0 * h - centres_mm[k];
+    value[k] = std::exp(-d0 * d0 * inv_two_var_);
+    ratio[k] = std::exp(-(2.0 * d0 * h + h * h) * inv_two_var_);
   }
-  // discrete normalisation: the box receives exactly the node's volume
-  const double inv_sum = 1.0 / sum;
-  for (int i = 0; i < n; ++i) g[i] *= inv_sum;
+  switch (count) {
+    case 4:
+      fill_chains<4>(value, ratio, step_factor_, n, g, capacity_, sum);
+      break;
+    case 3:
+      fill_chains<3>(value, ratio, step_factor_, n, g, capacity_, sum);
+      break;
+    case 2:
+      fill_chains<2>(value, ratio, step_factor_, n, g, capacity_, sum);
+      break;
+    default:
+      fill_chains<1>(value, ratio, step_factor_, n, g, capacity_, sum);
+      break;
+  }
+  // each centre's own truncation (cells within reach of it, whatever box the group
+  // needs), faded out over the taper so a cell's share changes continuously as the centre
+  // moves: only the few cells at the ends change, and the sum with them; then the
+  // discrete normalisation: its cells receive exactly its volume (times its scale)
+  const double inv_taper = 1.0 / (kTaperSigmas * sigma_mm_);
+  for (int k = 0; k < count; ++k) {
+    double* gk = g + static_cast<size_t>(k) * capacity_;
+    const double centre = centres_mm[k];
+    const int first = std::max(0, static_cast<int>(std::ceil((centre - reach_mm_) / h)) - i0);
+    const int last = std::min(n - 1, static_cast<int>(std::floor((centre + reach_mm_) / h)) - i0);
+    // cells where the taper has begun, on either side of the centre
+    const int inner_first = static_cast<int>(std::floor((centre - taper_start_mm_) / h)) - i0;
+    const int inner_last = static_cast<int>(std::ceil((centre + taper_start_mm_) / h)) - i0;
+    double removed = 0.0;
+    auto cut = [&](int i) {
+      removed += gk[i];
+      gk[i] = 0.0;
+    };
+    auto fade = [&](int i) {
+      const double s = (std::abs((i0 + i) * h - centre) - taper_start_mm_) * inv_taper;
+      if (s <= 0.0) return;
+      const double kept =
+          s >= 1.0 ? 0.0 : gk[i] * (1.0 - s * s * s * (10.0 + s * (-15.0 + 6.0 * s)));
+      removed += gk[i] - kept;
+      gk[i] = kept;
+    };
+    for (int i = 0; i < std::min(first, n); ++i) cut(i);
+    for (int i = std::max(last + 1, 0); i < n; ++i) cut(i);
+    for (int i = first; i <= std::min(last, inner_first); ++i) fade(i);
+    for (int i = std::max(first, std::max(inner_last, inner_first + 1)); i <= last; ++i) fade(i);
+    const double factor = scales[k] / (sum[k] - removed);
+    for (int i = 0; i < n; ++i) gk[i] *= factor;
+  }
 }
 
 void GaussianFootprint::deposit_nodes(ThicknessField& field, const FootprintNode* nodes,
@@ -66,27 +141,33 @@ void GaussianFootprint::deposit_nodes(ThicknessField& field, const FootprintNode
   const int iy_hi = static_cast<int>(std::floor((y_max + reach_mm_) / cell_mm_));
   const int nx = ix_hi - ix_lo + 1;
   const int ny = iy_hi - iy_lo + 1;
-  if (nx > capacity_ || ny > capacity_ || count > kMaxNodes)
+  if (nx > capacity_ || ny > capacity_ || count < 1 || count > kMaxNodes)
     throw InternalError("GaussianFootprint: box of " + std::to_string(nx) + " x " +
                         std::to_string(ny) + " cells exceeds capacity " +
                         std::to_string(capacity_));
 
   // per-node column factors, and row factors scaled to thickness (volume / cell area)
   const double inv_area = 1.0 / (cell_mm_ * cell_mm_);
+  double centres_x[kMaxNodes] = {}, centres_y[kMaxNodes] = {};
   for (int k = 0; k < count; ++k) {
-    double* gx = x_factors_.data() + static_cast<size_t>(k) * capacity_;
-    double* gy = y_factors_.data() + static_cast<size_t>(k) * capacity_;
-    fill_factors(nodes[k].x_mm, ix_lo, nx, gx);
-    fill_factors(nodes[k].y_mm, iy_lo, ny, gy);
-    const double amplitude = nodes[k].volume_mm3 * inv_area;
-    for (int j = 0; j < ny; ++j) gy[j] *= amplitude;
+    centres_x[k] = nodes[k].x_mm;
+    centres_y[k] = nodes[k].y_mm;
   }
+  double ones[kMaxNodes] = {}, amplitudes[kMaxNodes] = {};
+  for (int k = 0; k < count; ++k) {
+    ones[k] = 1.0;
+    amplitudes[k] = nodes[k].volume_mm3 * inv_area;
+  }
+  fill_factors(centres_x, ones, count, ix_lo, nx, x_factors_.data());
+  fill_factors(centres_y, amplitudes, count, iy_lo, ny, y_factors_.data());
   const double* gx0 = x_factors_.data();
   const double* gx1 = gx0 + capacity_;
   const double* gx2 = gx1 + capacity_;
+  const double* gx3 = gx2 + capacity_;
   const double* gy0 = y_factors_.data();
   const double* gy1 = gy0 + capacity_;
   const double* gy2 = gy1 + capacity_;
+  const double* gy3 = gy2 + capacity_;
 
   // rank-count update of every tile the box overlaps: cell += sum_k gy_k[row] gx_k[col]
   for (int ty = Tiles::tile_of(iy_lo); ty <= Tiles::tile_of(iy_hi); ++ty) {
@@ -109,12 +190,21 @@ void GaussianFootprint::deposit_nodes(ThicknessField& field, const FootprintNode
           const double a1 = gy1[r];
           const double* __restrict x1 = gx1 + c0;
           for (int c = 0; c < cols; ++c) dst[c] += a0 * x0[c] + a1 * x1[c];
-        } else {
+        } else if (count == 3) {
           const double a1 = gy1[r];
           const double a2 = gy2[r];
           const double* __restrict x1 = gx1 + c0;
           const double* __restrict x2 = gx2 + c0;
           for (int c = 0; c < cols; ++c) dst[c] += a0 * x0[c] + a1 * x1[c] + a2 * x2[c];
+        } else {
+          const double a1 = gy1[r];
+          const double a2 = gy2[r];
+          const double a3 = gy3[r];
+          const double* __restrict x1 = gx1 + c0;
+          const double* __restrict x2 = gx2 + c0;
+          const double* __restrict x3 = gx3 + c0;
+          for (int c = 0; c < cols; ++c)
+            dst[c] += (a0 * x0[c] + a1 * x1[c]) + (a2 * x2[c] + a3 * x3[c]);
         }
       }
     }

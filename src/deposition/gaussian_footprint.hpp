@@ -14,10 +14,15 @@
 // separable, G(x, y) = g(x) g(y), so a node costs two short factor vectors and the cells
 // take one multiply-add per node.
 //
-// Conservation: each node's factors are normalised to sum to one over the truncated box
-// (radius truncation_sigmas around every node), and node volumes are scaled to add up
-// to the step's exact volume V. The cells therefore receive exactly V (to rounding),
-// whatever the truncation radius and cell size.
+// Truncation: each node's factors fade to zero across truncation_sigmas +- 0.25 sigma from
+// the node (a quintic smoothstep; with a hard cut, cells at the edge would pop in and out
+// by exp(-12.5) = 4e-6 of the peak factor as the node moves, visible whenever two
+// quadratures of the same path are compared). The truncation is per node, so a node's
+// footprint does not depend on which other nodes share its box: batched and unbatched
+// deposits truncate alike.
+// Conservation: each node's factors are normalised to sum to one over its own truncated
+// square, and node volumes are scaled to add up to the step's exact volume V. The cells
+// therefore receive exactly V (to rounding), whatever the truncation radius and cell size.
 #pragma once
 
 #include <algorithm>
@@ -37,9 +42,12 @@ struct FootprintNode {
 
 class GaussianFootprint {
  public:
-  // sigma and cell in mm; cells farther than truncation_sigmas * sigma from every node
-  // of a sub-chord receive nothing (that tail is renormalised onto the box)
-  GaussianFootprint(double sigma_mm, double cell_mm, double truncation_sigmas);
+  // sigma and cell in mm; cells farther than truncation_sigmas * sigma from a node (along
+  // x or y) receive nothing from it (that tail is renormalised onto its square).
+  // max_span_sigmas: the widest node group deposit_nodes must take (at least the 0.3 sigma
+  // sub-chords of deposit_chord); it sizes the reusable factor vectors.
+  GaussianFootprint(double sigma_mm, double cell_mm, double truncation_sigmas,
+                    double max_span_sigmas = 0.3);
 
   double sigma_mm() const { return sigma_mm_; }
 
@@ -49,20 +57,26 @@ class GaussianFootprint {
   void deposit_chord(ThicknessField& field, double x0_mm, double y0_mm, double x1_mm, double y1_mm,
                      double volume_mm3, const RateFn& rate);
 
-  // deposit 1..3 nodes over their common box (the separable rank-n update)
+  // deposit 1..4 nodes over their common box (the separable rank-n update); the nodes
+  // must lie within max_span_sigmas of each other
   void deposit_nodes(ThicknessField& field, const FootprintNode* nodes, int count);
 
  private:
-  // fill g[0..n) with exp(-(x_i - c)^2 / 2 sigma^2), x_i = (i0 + i) h, normalised to sum 1
-  void fill_factors(double centre_mm, int i0, int n, double* g) const;
+  // for each of `count` centres c_k: g_k[0..n) = exp(-(x_i - c_k)^2 / 2 sigma^2),
+  // x_i = (i0 + i) h, within reach of c_k (tapered, 0 beyond), normalised to sum scale_k;
+  // g_k starts at g + k * capacity_. The recurrences of all centres run side by side
+  // (independent chains pipeline well).
+  void fill_factors(const double* centres_mm, const double* scales, int count, int i0, int n,
+                    double* g) const;
 
   double sigma_mm_;
   double cell_mm_;
-  double reach_mm_;                // truncation radius
+  double reach_mm_;                // outer truncation radius (end of the taper)
+  double taper_start_mm_;          // the footprint fades from here to reach_mm_
   double step_factor_;             // exp(-h^2 / sigma^2), ratio of successive ratios
   double inv_two_var_;             // 1 / (2 sigma^2)
   int capacity_ = 0;               // longest factor vector one sub-chord can need
-  std::vector<double> x_factors_;  // 3 x capacity_, reused every step
+  std::vector<double> x_factors_;  // 4 x capacity_, reused every step
   std::vector<double> y_factors_;
 };
 
@@ -73,7 +87,7 @@ void GaussianFootprint::deposit_chord(ThicknessField& field, double x0_mm, doubl
   if (!(volume_mm3 > 0.0)) return;
   const double dx = x1_mm - x0_mm;
   const double dy = y1_mm - y0_mm;
-  const double chord_sigmas = std::hypot(dx, dy) / sigma_mm_;
+  const double chord_sigmas = std::sqrt(dx * dx + dy * dy) / sigma_mm_;
 
   // a (nearly) standing nozzle: one node at the chord's midpoint
   if (chord_sigmas <= 1e-4) {

@@ -69,6 +69,8 @@ void DepositionSettings::validate() const {
           "must be >= 0 (0 = default), got " + number(line_width_mm));
   require(truncation_sigmas >= 3.0 && truncation_sigmas <= 12.0, "process.truncation_sigmas",
           "must lie in [3, 12], got " + number(truncation_sigmas));
+  require(batch_length_sigmas >= 0.0 && batch_length_sigmas <= 2.0, "process.batch_length_sigmas",
+          "must lie in [0, 2] (0 = no batching), got " + number(batch_length_sigmas));
   if (type == ProcessType::aerosol) {
     require(positive(sigma_mm), "process.sigma_mm", "must be > 0, got " + number(sigma_mm));
   } else {
@@ -104,7 +106,23 @@ double DepositionSettings::default_cell_mm() const {
 Process::Process(const DepositionSettings& settings, double cell_mm)
     : settings_(settings),
       field_(resolve_cell_mm(settings, cell_mm)),
-      footprint_(settings.footprint_sigma_mm(), field_.cell_mm(), settings.truncation_sigmas) {}
+      footprint_(settings.footprint_sigma_mm(), field_.cell_mm(), settings.truncation_sigmas,
+                 settings.batch_length_sigmas),
+      batch_(settings.footprint_sigma_mm(),
+             settings.batch_length_sigmas * settings.footprint_sigma_mm()) {}
+
+void Process::deposit_step(const DepositionStep& step, double volume_mm3, const StepRate& rate) {
+  BatchStep batch_step;
+  batch_step.t0_s = step.t0_s;
+  batch_step.t1_s = step.t1_s;
+  batch_step.x0_mm = step.p0_mm.x();
+  batch_step.y0_mm = step.p0_mm.y();
+  batch_step.x1_mm = step.p1_mm.x();
+  batch_step.y1_mm = step.p1_mm.y();
+  batch_step.volume_mm3 = volume_mm3;
+  batch_step.rate = rate;
+  batch_.add(footprint_, field_, batch_step);
+}
 
 void Process::check_step(const DepositionStep& step) {
   const bool finite = std::isfinite(step.t0_s) && std::isfinite(step.t1_s) &&
@@ -138,10 +156,10 @@ void AerosolProcess::advance(const DepositionStep& step) {
   account_.closed_time_s += dt_s * (1.0 - mean_open);
 
   // the flap moves linearly within the step: the rate along the chord is linear too
-  const double open_slope = open1 - open0;
-  footprint_.deposit_chord(field_, step.p0_mm.x(), step.p0_mm.y(), step.p1_mm.x(), step.p1_mm.y(),
-                           landed_mm3,
-                           [open0, open_slope](double u) { return open0 + open_slope * u; });
+  StepRate rate;
+  rate.constant = open0;
+  rate.slope = open1 - open0;
+  deposit_step(step, landed_mm3, rate);
 }
 
 ExtrusionProcess::ExtrusionProcess(const DepositionSettings& settings, double cell_mm)
@@ -182,11 +200,12 @@ void ExtrusionProcess::advance(const DepositionStep& step) {
   account_.emitted_mm3 += volume_mm3;
   account_.landed_mm3 += volume_mm3;
 
-  const double excess_mm3_s = tau_s > 0.0 ? flow0_mm3_s - command_mm3_s : 0.0;
-  footprint_.deposit_chord(field_, step.p0_mm.x(), step.p0_mm.y(), step.p1_mm.x(), step.p1_mm.y(),
-                           volume_mm3, [command_mm3_s, excess_mm3_s, decay_per_step](double u) {
-                             return command_mm3_s + excess_mm3_s * std::exp(-decay_per_step * u);
-                           });
+  // rate within the step: Qc + (Q0 - Qc) exp(-u dt / tau)
+  StepRate rate;
+  rate.constant = command_mm3_s;
+  rate.decaying = tau_s > 0.0 ? flow0_mm3_s - command_mm3_s : 0.0;
+  rate.decay = decay_per_step;
+  deposit_step(step, volume_mm3, rate);
 }
 
 std::unique_ptr<Process> make_process(const DepositionSettings& settings, double cell_mm) {

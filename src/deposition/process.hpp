@@ -19,6 +19,10 @@
 //
 // Both integrate their footprint exactly along the step's chord (gaussian_footprint.hpp)
 // and conserve material: landed = field volume, emitted = landed + captured.
+// Consecutive short steps are deposited together (step_batch.hpp: one quadrature per
+// batch_length_sigmas of path, checked against the steps' exact moments), so a 1 ms step
+// costs a fraction of a footprint box. field() deposits the steps still pending first, so
+// reads are always complete; account() is kept per step and never waits for a batch.
 #pragma once
 
 #include <memory>
@@ -26,6 +30,7 @@
 
 #include "core/types.hpp"
 #include "deposition/gaussian_footprint.hpp"
+#include "deposition/step_batch.hpp"
 #include "deposition/thickness_field.hpp"
 
 namespace depotwin {
@@ -48,7 +53,10 @@ struct DepositionSettings {
   double bead_width_mm = 0.4;      // extrusion
   double layer_height_mm = 0.2;    // extrusion
   double tau_s = 0.05;             // extrusion flow lag time constant (0 = no lag)
-  double truncation_sigmas = 5.0;  // footprint evaluated out to this many sigma (tail renormalised)
+  double truncation_sigmas = 5.0;  // footprint fades out at this many sigma (+-0.25; renormalised)
+  // consecutive steps are deposited as one quadrature until their path would exceed this
+  // many sigma (step_batch.hpp); 0 = every step on its own
+  double batch_length_sigmas = 1.0;
 
   // throws InputError naming the process.* key of every bad value
   void validate() const;
@@ -105,8 +113,19 @@ class Process {
   // flow leaving the nozzle now (mm^3/s): aerosol stream Q, extrusion lagged flow
   virtual double nozzle_flow_mm3_s() const = 0;
 
-  const ThicknessField& field() const { return field_; }
+  // the deposit of every step advanced so far (pending batched steps are put down first;
+  // not thread-safe while steps are pending: call flush() before sharing the process)
+  const ThicknessField& field() const {
+    flush_pending();
+    return field_;
+  }
+  // deposit the batched steps now (field() does it when needed; the pipeline calls this
+  // once after the run so the field is complete before anyone reads it)
+  void flush() { flush_pending(); }
+  // exact after every advance, batched or not
   const MaterialAccount& account() const { return account_; }
+  // how the steps were batched so far
+  const StepBatch::Stats& batch_stats() const { return batch_.stats(); }
   const DepositionSettings& settings() const { return settings_; }
   double line_width_mm() const { return settings_.resolved_line_width_mm(); }
   double footprint_sigma_mm() const { return settings_.footprint_sigma_mm(); }
@@ -114,11 +133,21 @@ class Process {
  protected:
   // reject steps the simulator should never produce (InternalError)
   static void check_step(const DepositionStep& step);
+  // put down one step's volume along its chord with the given rate shape (batched)
+  void deposit_step(const DepositionStep& step, double volume_mm3, const StepRate& rate);
 
   DepositionSettings settings_;
-  ThicknessField field_;
-  GaussianFootprint footprint_;
+  // the field and the deposition machinery are mutable: field() completes pending
+  // batches, which changes no observable value (the steps were already taken)
+  mutable ThicknessField field_;
+  mutable GaussianFootprint footprint_;
+  mutable StepBatch batch_;
   MaterialAccount account_;
+
+ private:
+  void flush_pending() const {
+    if (batch_.pending_steps() > 0) batch_.flush(footprint_, field_);
+  }
 };
 
 class AerosolProcess : public Process {

@@ -46,12 +46,23 @@ double ThicknessField::thickness_mm_at(double x_mm, double y_mm) const {
 }
 
 double ThicknessField::total_volume_mm3() const {
-  double sum_mm = 0.0;
+  // rows, then tiles, then a compensated (Neumaier) sum over tiles: a long line's million
+  // cells add up to the deposited volume to ~1e-15, not ~1e-12
+  double sum_mm = 0.0, compensation_mm = 0.0;
   for (const auto& [tx, ty] : tiles_.sorted_tiles()) {
     const double* tile = tiles_.find(tx, ty);
-    for (int k = 0; k < Tiles::kCells; ++k) sum_mm += tile[k];
+    double tile_mm = 0.0;
+    for (int row = 0; row < kTile; ++row) {
+      double row_mm = 0.0;
+      for (int col = 0; col < kTile; ++col) row_mm += tile[row * kTile + col];
+      tile_mm += row_mm;
+    }
+    const double next = sum_mm + tile_mm;
+    compensation_mm += std::abs(sum_mm) >= std::abs(tile_mm) ? (sum_mm - next) + tile_mm
+                                                             : (tile_mm - next) + sum_mm;
+    sum_mm = next;
   }
-  return sum_mm * cell_mm_ * cell_mm_;
+  return (sum_mm + compensation_mm) * cell_mm_ * cell_mm_;
 }
 
 FieldBounds ThicknessField::bounds() const {
