@@ -331,10 +331,10 @@ void Loader::read_toolpath(const Field* field) {
                   "missing: give the print paths, e.g. toolpath: {speed: 3, segments: [...]}");
     return;
   }
-  const MapView view(
-      *field,
-      {"speed", "start", "end", "segments", "polylines", "gcode", "random_segments", "surface"},
-      problems_);
+  const MapView view(*field,
+                     {"speed", "start", "end", "offset", "segments", "polylines", "gcode",
+                      "random_segments", "surface"},
+                     problems_);
   if (!view.is_map()) return;
   Toolpath& toolpath = scenario_.toolpath;
 
@@ -380,6 +380,16 @@ void Loader::read_toolpath(const Field* field) {
   } else {
     problems_.add(kind.line, kind.key,
                   "surface toolpaths are not supported yet (use segments, polylines or gcode)");
+  }
+
+  // an offset moves everything (e.g. a G-code file or a random bed onto the machine)
+  if (const Field* f = view.find("offset")) {
+    if (const std::optional<Vec3> offset = read_point(*f, problems_)) {
+      toolpath.start_mm += *offset;
+      toolpath.end_mm += *offset;
+      for (PrintPath& path : toolpath.paths)
+        for (Vec3& point : path.points) point += *offset;
+    }
   }
 }
 
@@ -773,11 +783,26 @@ void Loader::read_planners(const Field& field) {
 }
 
 void Loader::read_sim(const Field& field) {
-  const MapView view(field, {"timestep_s", "cell_mm", "kp_scale", "settle_s"}, problems_);
+  const MapView view(field, {"timestep_s", "control_period_s", "cell_mm", "kp_scale", "settle_s"},
+                     problems_);
   SimSpec& sim = scenario_.sim;
   if (const Field* f = view.find("timestep_s"))
     sim.timestep_s =
         read_number(*f, problems_, Range{0.0, false, 0.01, true}).value_or(sim.timestep_s);
+  // the servo update period: a whole number of physics steps, by default the one nearest
+  // to 1 ms
+  sim.control_period_s = sim.timestep_s * std::max(1.0, std::round(0.001 / sim.timestep_s));
+  if (const Field* f = view.find("control_period_s")) {
+    if (auto period = read_number(*f, problems_, Range{0.0, false, 0.01, true})) {
+      const double steps = *period / sim.timestep_s;
+      if (std::abs(steps - std::round(steps)) > 1e-9 * steps || std::round(steps) < 1)
+        problems_.add(f->line, f->key,
+                      "must be a whole multiple of sim.timestep_s (" +
+                          std::to_string(sim.timestep_s) + " s)");
+      else
+        sim.control_period_s = *period;
+    }
+  }
   if (const Field* f = view.find("cell_mm"))
     sim.cell_mm = read_number(*f, problems_, Range::non_negative()).value_or(sim.cell_mm);
   if (const Field* f = view.find("kp_scale"))

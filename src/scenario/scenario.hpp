@@ -32,9 +32,11 @@ struct ProcessSpec {
 // `sim:` — simulation and deposition-grid settings.
 struct SimSpec {
   double timestep_s = 0.001;
-  double cell_mm = 0.0;   // 0: sigma / 4 (aerosol) or bead width / 8 (extrusion)
-  double kp_scale = 1.0;  // multiply the model's default servo gains
-  double settle_s = 0.0;  // extra simulated time after the trajectory ends
+  double control_period_s = 0.001;  // servo update period, a multiple of timestep_s (default:
+                                    // the multiple nearest to 1 ms)
+  double cell_mm = 0.0;             // 0: sigma / 4 (aerosol) or bead width / 8 (extrusion)
+  double kp_scale = 1.0;            // multiply the model's default servo gains
+  double settle_s = 0.0;            // extra simulated time after the trajectory ends
 };
 
 // `outputs:` — what a run writes besides metrics.

@@ -323,3 +323,52 @@ limits: {v_max: 4, a_max: 30}
 
 }  // namespace
 }  // namespace depotwin
+
+namespace depotwin {
+namespace {
+
+using ScenarioOffset = testing_scenario::ScenarioFiles;
+
+TEST_F(ScenarioOffset, OffsetMovesEveryPointStartAndEnd) {
+  const Scenario s = load_scenario(write("offset.yaml", R"(
+toolpath:
+  speed: 3
+  start: [0, 0]
+  end: [20, 0]
+  offset: [-50, -40]
+  segments:
+    - [[2, 2], [8, 2]]
+  )"));
+  EXPECT_EQ(s.toolpath.start_mm, Vec3(-50, -40, 0));
+  EXPECT_EQ(s.toolpath.end_mm, Vec3(-30, -40, 0));
+  EXPECT_EQ(s.toolpath.paths[0].points[0], Vec3(-48, -38, 0));
+  EXPECT_EQ(s.toolpath.paths[0].points[1], Vec3(-42, -38, 0));
+  // a malformed offset is reported with its line and key
+  try {
+    load_scenario(
+        write("bad_offset.yaml",
+              "toolpath:\n  speed: 3\n  offset: [1]\n  segments:\n    - [[0, 0], [1, 0]]\n"));
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(":3: toolpath.offset"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ScenarioOffset, ControlPeriodMustBeAWholeNumberOfSteps) {
+  const Scenario fine = load_scenario(
+      write("period.yaml",
+            "toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\nsim: {timestep_s: 0.0005}\n"));
+  EXPECT_DOUBLE_EQ(fine.sim.control_period_s, 0.001);  // the multiple nearest 1 ms
+  try {
+    load_scenario(write("bad_period.yaml",
+                        "toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\n"
+                        "sim: {timestep_s: 0.0004, control_period_s: 0.001}\n"));
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(":2: sim.control_period_s"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace depotwin
