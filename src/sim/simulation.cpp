@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/Dense>
 #include <Eigen/Geometry>
 
 #include "core/error.hpp"
@@ -40,10 +41,15 @@ struct Servo {
   int dof_adr = -1;
   double user_to_si = 1.0;  // mm -> m for slides, 1 for hinges
   const char* unit = "rad";
-  double kp = 0.0;       // N/m or N m/rad
-  double kv = 0.0;       // N s/m or N m s/rad (actuator velocity gain)
-  double damping = 0.0;  // joint damping, same units as kv
+  double kp = 0.0;        // N/m or N m/rad
+  double kv = 0.0;        // N s/m or N m s/rad (actuator velocity gain)
+  double damping = 0.0;   // joint damping, same units as kv
+  double friction = 0.0;  // joint Coulomb friction (frictionloss), N or N m
 };
+
+// below this reference speed (SI) the friction feed-forward fades out smoothly (tanh), so
+// a reversal does not kick the servo
+constexpr double kFrictionFadeSpeed_si = 1e-4;
 
 Servo resolve_servo(const mjModel& model, const std::string& name, const std::string& path,
                     const std::string& purpose) {
@@ -58,6 +64,7 @@ Servo resolve_servo(const mjModel& model, const std::string& name, const std::st
   servo.qpos_adr = model.jnt_qposadr[servo.joint];
   servo.dof_adr = model.jnt_dofadr[servo.joint];
   servo.damping = model.dof_damping[servo.dof_adr];
+  servo.friction = model.dof_frictionloss[servo.dof_adr];
 
   // the actuator of the same name must be a position servo on this joint
   servo.actuator = require_id(model, mjOBJ_ACTUATOR, name, path, "the servo driving joint " + name);
@@ -134,6 +141,7 @@ struct Simulation::Impl {
   void read_nozzle(Vec3& position_mm, Vec3& velocity_mm_s) const;
   double open_fraction(bool deposit_command) const;
   double constraint_violation_mm() const;
+  void assemble_closures();
   void apply_servo(const Servo& servo, double q_si, double v_si, double extra_force) const;
 };
 
@@ -183,6 +191,71 @@ double Simulation::Impl::constraint_violation_mm() const {
   return m_to_mm(largest);
 }
 
+// Close the equality constraints (a linear delta's rods on its platform) around the servo
+// joints as they are set: the other joints (rod hinges, the platform's free joint) start from
+// the model's reference pose, which matches the servo joints only at home. Gauss-Newton on
+// the constraint residuals over the other degrees of freedom (least-norm steps), then their
+// velocities so the constraints' rates vanish too. Without it a run starting away from home
+// would start with the chain torn open by tens of mm and snap it shut in the first steps.
+void Simulation::Impl::assemble_closures() {
+  const mjModel* m = model.get();
+  mjData* d = data.get();
+  if (m->neq == 0) return;
+  std::vector<bool> held(m->nv, false);
+  for (const Servo& servo : joints) held[servo.dof_adr] = true;
+  if (has_shutter) held[shutter.dof_adr] = true;
+  std::vector<int> free_dofs;
+  for (int dof = 0; dof < m->nv; ++dof)
+    if (!held[dof]) free_dofs.push_back(dof);
+  if (free_dofs.empty()) return;
+
+  // the equality rows of the constraint Jacobian (dense or sparse), split into held / free
+  Eigen::MatrixXd jacobian_free, jacobian_held;
+  Eigen::VectorXd residual;
+  const auto equality_rows = [&]() {
+    mj_fwdPosition(m, d);
+    std::vector<int> rows;
+    for (int row = 0; row < d->nefc; ++row)
+      if (d->efc_type[row] == mjCNSTR_EQUALITY) rows.push_back(row);
+    const int n = static_cast<int>(rows.size());
+    Eigen::MatrixXd full = Eigen::MatrixXd::Zero(n, m->nv);
+    residual.resize(n);
+    for (int i = 0; i < n; ++i) {
+      const int row = rows[i];
+      residual[i] = d->efc_pos[row];
+      if (mj_isSparse(m)) {
+        for (int k = 0; k < d->efc_J_rownnz[row]; ++k)
+          full(i, d->efc_J_colind[d->efc_J_rowadr[row] + k]) = d->efc_J[d->efc_J_rowadr[row] + k];
+      } else {
+        for (int col = 0; col < m->nv; ++col) full(i, col) = d->efc_J[row * m->nv + col];
+      }
+    }
+    jacobian_free.resize(n, static_cast<int>(free_dofs.size()));
+    for (size_t c = 0; c < free_dofs.size(); ++c) jacobian_free.col(c) = full.col(free_dofs[c]);
+    jacobian_held = full;
+    return n;
+  };
+
+  // positions: dq = -J_free^+ r until the residual is below 1e-12 m
+  std::vector<mjtNum> step(m->nv, 0.0);
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    if (equality_rows() == 0 || residual.cwiseAbs().maxCoeff() < 1e-12) break;
+    const Eigen::VectorXd dq = -jacobian_free.completeOrthogonalDecomposition().solve(residual);
+    std::fill(step.begin(), step.end(), 0.0);
+    for (size_t c = 0; c < free_dofs.size(); ++c) step[free_dofs[c]] = dq[c];
+    mj_integratePos(m, d->qpos, step.data(), 1.0);
+  }
+
+  // velocities: J_free v_free = -J_held v_held (least norm)
+  if (equality_rows() == 0) return;
+  Eigen::VectorXd held_velocity = Eigen::VectorXd::Zero(m->nv);
+  for (int dof = 0; dof < m->nv; ++dof)
+    if (held[dof]) held_velocity[dof] = d->qvel[dof];
+  const Eigen::VectorXd v_free =
+      -jacobian_free.completeOrthogonalDecomposition().solve(jacobian_held * held_velocity);
+  for (size_t c = 0; c < free_dofs.size(); ++c) d->qvel[free_dofs[c]] = v_free[c];
+}
+
 // ctrl = q_ref + f_ff / kp (see the header for f_ff)
 void Simulation::Impl::apply_servo(const Servo& servo, double q_si, double v_si,
                                    double extra_force) const {
@@ -190,7 +263,8 @@ void Simulation::Impl::apply_servo(const Servo& servo, double q_si, double v_si,
   double force = 0.0;
   if (settings.feedforward) {
     force = inertia_force[servo.dof_adr] + d->qfrc_bias[servo.dof_adr] +
-            (servo.damping + servo.kv) * v_si + extra_force;
+            (servo.damping + servo.kv) * v_si +
+            servo.friction * std::tanh(v_si / kFrictionFadeSpeed_si) + extra_force;
   }
   d->ctrl[servo.actuator] = q_si + force / servo.kp;
 }
@@ -442,6 +516,7 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
     d->qpos[s.shutter.qpos_adr] = flap_ref[0];
     d->qvel[s.shutter.dof_adr] = flap_rate[0];
   }
+  s.assemble_closures();
 
   // the step loop: state after mj_step1, controls, mj_step2 (no allocation in here)
   StepState before, after;

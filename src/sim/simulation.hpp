@@ -17,12 +17,13 @@
 // position violation is recorded.
 //
 // Controller per servo joint (SI units inside):  ctrl = q_ref + f_ff / kp  with
-//   f_ff = (M a_ref)_j + qfrc_bias_j + (damping_j + kv_j) v_ref_j + hook_j
+//   f_ff = (M a_ref)_j + qfrc_bias_j + (damping_j + kv_j) v_ref_j
+//          + frictionloss_j tanh(v_ref_j / 0.1 mm/s) + hook_j
 // where a_ref is the mean reference acceleration over the coming control period
 // so the actuator force kp (ctrl - q) - kv qdot = kp (q_ref - q) + kv (v_ref - qdot) + f_ff:
-// PD on the reference plus inertia, bias (gravity, Coriolis), viscous and optional
-// machine-specific load feed-forward (set_feedforward_hook). Bearing friction is not
-// compensated. Controls are held between updates (zero-order hold).
+// PD on the reference plus inertia, bias (gravity, Coriolis), viscous, Coulomb friction
+// (faded out near zero speed) and optional machine-specific load feed-forward
+// (set_feedforward_hook). Controls are held between updates (zero-order hold).
 #pragma once
 
 #include <mujoco/mujoco.h>
