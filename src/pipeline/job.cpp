@@ -43,7 +43,8 @@ PreparedJob prepare_job(const Scenario& scenario) {
   job.scenario = scenario;
   job.machine = machine_for(scenario, job.model_path);
   if (scenario.has_joint_limits)
-    job.machine->set_joint_limits(scenario.joint_limits.v_max_mm_s, scenario.joint_limits.a_max_mm_s2);
+    job.machine->set_joint_limits(scenario.joint_limits.v_max_mm_s,
+                                  scenario.joint_limits.a_max_mm_s2);
 
   // every point of the toolpath must be reachable by the machine
   std::vector<Problem> problems;
@@ -131,7 +132,8 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   return run;
 }
 
-std::vector<MetricsReport> write_plans(const PreparedJob& job, const std::vector<PlannerSpec>& planners,
+std::vector<MetricsReport> write_plans(const PreparedJob& job,
+                                       const std::vector<PlannerSpec>& planners,
                                        const std::string& directory) {
   std::vector<MetricsReport> reports;
   for (const PlannerSpec& spec : planners) {
@@ -165,7 +167,8 @@ std::string summary_table(const std::vector<MetricsReport>& reports) {
   // one row per planner; simulated columns only when a simulation ran
   const bool simulated = !reports.empty() && reports.front().velocity_error.has_value();
   std::vector<std::vector<std::string>> rows;
-  std::vector<std::string> header{"planner", "time s", "print s", "transit s", "plan vel err max",
+  std::vector<std::string> header{"planner",          "order",      "time s",
+                                  "print s",          "transit s",  "plan vel err max",
                                   "plan vel err rms", "path err mm"};
   if (simulated) {
     header.insert(header.end(), {"sim vel err max", "thickness cv", "line cv", "waste"});
@@ -174,6 +177,7 @@ std::string summary_table(const std::vector<MetricsReport>& reports) {
   rows.push_back(header);
   for (const MetricsReport& r : reports) {
     std::vector<std::string> row{r.planner,
+                                 r.sequencer,
                                  fixed(r.time.total_s, 3),
                                  fixed(r.time.print_s, 3),
                                  fixed(r.time.transition_s, 3),

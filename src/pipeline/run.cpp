@@ -39,7 +39,8 @@ namespace {
 class ProgressLine {
  public:
   ProgressLine(std::string label, bool enabled)
-      : label_(std::move(label)), enabled_(enabled && ::isatty(STDERR_FILENO)),
+      : label_(std::move(label)),
+        enabled_(enabled && ::isatty(STDERR_FILENO)),
         start_(std::chrono::steady_clock::now()) {}
   void update(double fraction) {
     if (!enabled_) return;
@@ -66,6 +67,7 @@ class ProgressLine {
 SimSettings sim_settings(const Scenario& scenario) {
   SimSettings s;
   s.timestep_s = scenario.sim.timestep_s;
+  s.control_period_s = scenario.sim.control_period_s;
   s.kp_scale = scenario.sim.kp_scale;
   s.settle_s = scenario.sim.settle_s;
   s.shutter_time_s = scenario.process.shutter_time_s;
@@ -126,7 +128,7 @@ ActuatorStats actuator_stats(const RecordedRun& record, const Machine& machine,
 }  // namespace
 
 std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
-                                                   const Toolpath& toolpath) {
+                                                    const Toolpath& toolpath) {
   std::vector<plots::LineProfile> profiles;
   const double step_mm = field.cell_mm();
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
@@ -147,7 +149,8 @@ std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
       arc += length;
     }
     profile.arc_length_mm.push_back(arc);
-    profile.thickness_um.push_back(1000.0 * field.thickness_mm_at(points.back().x(), points.back().y()));
+    profile.thickness_um.push_back(1000.0 *
+                                   field.thickness_mm_at(points.back().x(), points.back().y()));
     profiles.push_back(std::move(profile));
   }
   return profiles;
@@ -162,8 +165,7 @@ double target_thickness_um(const Process& process, const Toolpath& toolpath) {
   const double root = sigma * std::sqrt(2.0 * kPi);
   if (s.type == ProcessType::aerosol)
     return 1000.0 * s.aerosol_flow_mm3_s() / (toolpath.paths.front().speed_mm_s * root);
-  if (s.flow_mm3_s > 0.0)
-    return 1000.0 * s.flow_mm3_s / (toolpath.paths.front().speed_mm_s * root);
+  if (s.flow_mm3_s > 0.0) return 1000.0 * s.flow_mm3_s / (toolpath.paths.front().speed_mm_s * root);
   return 1000.0 * s.bead_width_mm * s.layer_height_mm / root;
 }
 
@@ -175,7 +177,8 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   const Scenario& scenario = job.scenario;
 
   // the twin: the machine's MJCF, driven through its actuators
-  run.simulation = std::make_unique<Simulation>(job.model_path, *job.machine, sim_settings(scenario));
+  run.simulation =
+      std::make_unique<Simulation>(job.model_path, *job.machine, sim_settings(scenario));
   const DepositionSettings deposition = deposition_settings(scenario);
   deposition.validate();
   run.process = make_process(deposition, scenario.sim.cell_mm);
@@ -183,12 +186,12 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   // loads carried through closed chains (a delta's platform) by the machine's own model
   if (job.machine->has_closures()) {
     const Machine& machine = *job.machine;
-    run.simulation->set_feedforward_hook(
-        [&machine, &trajectory](const mjModel&, const mjData&, const JointReference& reference,
-                                double* force) {
-          const TrajectorySample s = trajectory.at(reference.t_s);
-          machine.closure_feedforward(s.position_mm, s.velocity_mm_s, s.acceleration_mm_s2, force);
-        });
+    run.simulation->set_feedforward_hook([&machine, &trajectory](const mjModel&, const mjData&,
+                                                                 const JointReference& reference,
+                                                                 double* force) {
+      const TrajectorySample s = trajectory.at(reference.t_s);
+      machine.closure_feedforward(s.position_mm, s.velocity_mm_s, s.acceleration_mm_s2, force);
+    });
   }
 
   // every step of the job deposits along the simulated nozzle's chord; the aerosol stream
@@ -204,15 +207,34 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
     step.p1_mm = after.nozzle_mm;
     step.open0 = before.open_fraction;
     step.open1 = after.open_fraction;
+    // the step that straddles the job's end is cut there (chord and flap linear in time)
+    if (after.t_s > job_end_s) {
+      const double f = (job_end_s - before.t_s) / (after.t_s - before.t_s);
+      step.t1_s = job_end_s;
+      step.p1_mm = before.nozzle_mm + f * (after.nozzle_mm - before.nozzle_mm);
+      step.open1 = before.open_fraction + f * (after.open_fraction - before.open_fraction);
+    }
     step.flow_command = before.deposit_command ? 1.0 : 0.0;
     step.desired_speed_mm_s = before.desired_speed_mm_s;
     process.advance(step);
   };
   ProgressLine progress(scenario.name + "/" + spec.name + ": simulating", settings.progress);
-  run.record = run.simulation->run(trajectory, on_step,
-                                   [&](double fraction) { progress.update(fraction); });
+  run.record =
+      run.simulation->run(trajectory, on_step, [&](double fraction) { progress.update(fraction); });
   progress.finish();
   run.simulation->set_feedforward_hook({});  // it refers to this function's locals
+
+  // extrusion: what still flows from the nozzle when the job ends (the lag's ooze, Q tau)
+  // lands where the nozzle stopped, instead of vanishing with the last step
+  if (deposition.type == ProcessType::extrusion && process.nozzle_flow_mm3_s() > 0.0 &&
+      !run.record.nozzle_mm.empty()) {
+    DepositionStep ooze;
+    ooze.t0_s = job_end_s;
+    ooze.t1_s = job_end_s + 40.0 * deposition.tau_s;  // exp(-40): the rest goes down at once
+    ooze.p0_mm = ooze.p1_mm = run.record.nozzle_mm.back();
+    process.advance(ooze);
+  }
+  process.flush();  // the last batched deposition steps, before anything reads the field
 
   // scores from the recorded run only
   run.simulated = simulated_samples(run.record);
@@ -263,7 +285,8 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
 HeightMap field_heightmap(const ThicknessField& field, size_t max_cells) {
   const FieldBounds b = field.bounds();
   if (b.empty) return HeightMap{};
-  const int stride = field.stride_for_max_cells(b.x_lo_mm, b.y_lo_mm, b.x_hi_mm, b.y_hi_mm, max_cells);
+  const int stride =
+      field.stride_for_max_cells(b.x_lo_mm, b.y_lo_mm, b.x_hi_mm, b.y_hi_mm, max_cells);
   return field.to_heightmap(b.x_lo_mm, b.y_lo_mm, b.x_hi_mm, b.y_hi_mm, stride);
 }
 
