@@ -21,8 +21,9 @@ Trajectory::Trajectory(std::string planner, std::vector<TrajectoryPiece> pieces,
 
 int Trajectory::piece_at(double t) const {
   if (pieces_.empty()) return -1;
-  auto it = std::upper_bound(pieces_.begin(), pieces_.end(), t,
-                             [](double time, const TrajectoryPiece& p) { return time < p.t_begin_s; });
+  auto it =
+      std::upper_bound(pieces_.begin(), pieces_.end(), t,
+                       [](double time, const TrajectoryPiece& p) { return time < p.t_begin_s; });
   if (it == pieces_.begin()) return 0;
   return static_cast<int>(it - pieces_.begin()) - 1;
 }
@@ -96,6 +97,54 @@ TrajectorySample Trajectory::at(double t) const {
   return sample;
 }
 
+TrajectorySample TrajectoryCursor::at(double t) {
+  const std::vector<TrajectoryPiece>& pieces = trajectory_->pieces();
+  TrajectorySample sample;
+  if (pieces.empty()) return sample;
+  t = std::clamp(t, 0.0, trajectory_->duration_s());
+  // the last piece starting at or before t (Trajectory::piece_at), found forwards from the
+  // previous one
+  const int count = static_cast<int>(pieces.size());
+  const int previous_piece = piece_;
+  if (t < pieces[piece_].t_begin_s) piece_ = trajectory_->piece_at(t);
+  while (piece_ + 1 < count && !(t < pieces[piece_ + 1].t_begin_s)) ++piece_;
+  if (piece_ != previous_piece) phase_.fill(0);
+  const TrajectoryPiece& piece = pieces[piece_];
+  sample.t_s = t;
+  sample.piece_index = piece_;
+  sample.path_index = piece.path_index;
+  sample.desired_speed_mm_s = piece.desired_speed_mm_s;
+  sample.depositing = piece.depositing;
+  const double tau = t - piece.t_begin_s;
+  const auto* phases = std::get_if<PhaseMotion>(&piece.motion);
+  if (phases == nullptr) {
+    evaluate_motion(piece, tau, sample.position_mm, sample.velocity_mm_s,
+                    sample.acceleration_mm_s2);
+    return sample;
+  }
+  // AxisProfile::at with the phase found forwards from the previous one: the same arithmetic
+  // (test_step_loop checks the samples bit for bit)
+  for (int axis = 0; axis < 3; ++axis) {
+    const AxisProfile& profile = phases->axes[axis];
+    const std::vector<Phase>& list = profile.phases();
+    if (list.empty() || tau <= 0.0) {
+      sample.position_mm[axis] = profile.q_start();
+      sample.velocity_mm_s[axis] = profile.v_start();
+      sample.acceleration_mm_s2[axis] = list.empty() ? 0.0 : list.front().a;
+      continue;
+    }
+    size_t& index = phase_[axis];
+    if (index >= list.size() || tau < list[index].t_begin_s) index = 0;
+    while (index + 1 < list.size() && !(tau < list[index + 1].t_begin_s)) ++index;
+    const Phase& phase = list[index];
+    const double local = std::min(tau - phase.t_begin_s, phase.duration_s);
+    sample.position_mm[axis] = phase.q0 + phase.v0 * local + 0.5 * phase.a * local * local;
+    sample.velocity_mm_s[axis] = phase.v0 + phase.a * local;
+    sample.acceleration_mm_s2[axis] = phase.a;
+  }
+  return sample;
+}
+
 double Trajectory::depositing_time_s() const {
   double total = 0.0;
   for (const TrajectoryPiece& piece : pieces_)
@@ -103,6 +152,8 @@ double Trajectory::depositing_time_s() const {
   return total;
 }
 
-double Trajectory::transition_time_s() const { return duration_s() - depositing_time_s(); }
+double Trajectory::transition_time_s() const {
+  return duration_s() - depositing_time_s();
+}
 
 }  // namespace depotwin

@@ -31,9 +31,9 @@ struct SampledMotion {
 struct TrajectoryPiece {
   double t_begin_s = 0.0;
   double t_end_s = 0.0;
-  int path_index = -1;               // index into Toolpath::paths, -1 for a transition
-  bool depositing = false;           // shutter open / flow on
-  double desired_speed_mm_s = 0.0;   // 0 in transitions
+  int path_index = -1;              // index into Toolpath::paths, -1 for a transition
+  bool depositing = false;          // shutter open / flow on
+  double desired_speed_mm_s = 0.0;  // 0 in transitions
   std::variant<PhaseMotion, SampledMotion> motion;
 };
 
@@ -74,6 +74,20 @@ class Trajectory {
   std::string planner_;
   std::vector<TrajectoryPiece> pieces_;
   std::vector<std::string> warnings_;
+};
+
+// Samples one trajectory at non-decreasing times (a simulation's steps) without searching the
+// pieces from the start each time: the same samples as Trajectory::at, bit for bit. A time
+// before the previous one searches again (still correct). The trajectory must outlive it.
+class TrajectoryCursor {
+ public:
+  explicit TrajectoryCursor(const Trajectory& trajectory) : trajectory_(&trajectory) {}
+  TrajectorySample at(double t);
+
+ private:
+  const Trajectory* trajectory_;
+  int piece_ = 0;                  // the piece of the last sample
+  std::array<size_t, 3> phase_{};  // per axis, the phase of the last sample (PhaseMotion)
 };
 
 // Evaluate one piece's motion at local time tau (seconds since the piece started).

@@ -7,6 +7,10 @@
 #include <regex>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 #include "core/error.hpp"
 
 namespace depotwin {
@@ -183,5 +187,27 @@ void clear_warnings(mjData& data) {
   for (int i = 0; i < mjNWARNING; ++i) data.warning[i] = mjWarningStat{0, 0};
   tls_has_pending_warning = false;
 }
+
+// MXCSR bit 15 flush-to-zero (subnormal results), bit 6 denormals-are-zero (subnormal inputs)
+#if defined(__SSE2__)
+constexpr unsigned int kFlushSubnormalsMxcsr = 0x8040;
+FlushSubnormalsScope::FlushSubnormalsScope() : saved_mode_(_mm_getcsr()) {
+  _mm_setcsr(saved_mode_ | kFlushSubnormalsMxcsr);
+}
+FlushSubnormalsScope::~FlushSubnormalsScope() {
+  _mm_setcsr(saved_mode_);
+}
+void FlushSubnormalsScope::suspend() {
+  _mm_setcsr(saved_mode_);
+}
+void FlushSubnormalsScope::resume() {
+  _mm_setcsr(saved_mode_ | kFlushSubnormalsMxcsr);
+}
+#else
+FlushSubnormalsScope::FlushSubnormalsScope() = default;
+FlushSubnormalsScope::~FlushSubnormalsScope() = default;
+void FlushSubnormalsScope::suspend() {}
+void FlushSubnormalsScope::resume() {}
+#endif
 
 }  // namespace depotwin
