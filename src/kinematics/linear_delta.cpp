@@ -174,13 +174,41 @@ void LinearDelta::set_carriage_limits(double v_max_mm_s, double a_max_mm_s2) {
 void LinearDelta::closure_feedforward(const Vec3& tcp_mm, const Vec3& tcp_velocity_mm_s,
                                       const Vec3& tcp_acceleration_mm_s2,
                                       double* joint_force) const {
-  // the platform term of the full feed-forward alone: no carriage mass, the closure mass
-  LinearDeltaGeometry platform_only = geometry_;
-  platform_only.platform_mass_kg = geometry_.closure_mass_kg;
-  platform_only.carriage_mass_kg = 0.0;
-  const std::array<double, 3> force = linear_delta_feedforward_forces_n(
-      platform_only, tcp_mm, tcp_velocity_mm_s, tcp_acceleration_mm_s2);
-  for (int arm = 0; arm < 3; ++arm) joint_force[arm] += force[arm];
+  // the pose from the inverse kinematics (no workspace check), exact carriage accelerations
+  const Vec3 platform_mm = linear_delta_platform_position(geometry_, tcp_mm);
+  std::array<double, 3> joints;
+  for (int arm = 0; arm < 3; ++arm)
+    joints[arm] = joint_for_platform_mm(geometry_, arm, platform_mm);
+  const std::array<Vec3, 3> rods = rod_vectors_mm(geometry_, platform_mm, joints.data());
+  const Vec3 carriage_acceleration =
+      carriage_acceleration_mm_s2(rods, -tcp_velocity_mm_s, -tcp_acceleration_mm_s2);
+
+  // forces to supply at the platform joints (SI, N): the platform's m_p (p'' + g e_z), and
+  // per rod, with end a on the carriage (a_a = q''_i e_z) and end b on the platform
+  // (a_b = p''): the inertial force m_r (a_a / 6 + a_b / 3) plus half the weight at b, and
+  // m_r (a_a / 3 + a_b / 6) plus half the weight at a, of which the simulator's tree model
+  // already supplies m_r (q''_i + g) on the carriage
+  const double g_m_s2 = geometry_.gravity_m_s2;
+  const double rod_kg = geometry_.rod_mass_kg;
+  const Vec3 up(0.0, 0.0, 1.0);
+  const Vec3 platform_acceleration_m_s2 = -mm_to_m(1.0) * tcp_acceleration_mm_s2;
+  Vec3 platform_force_n = geometry_.closure_mass_kg * (platform_acceleration_m_s2 + g_m_s2 * up);
+  std::array<double, 3> carriage_force_n{};
+  for (int arm = 0; arm < 3; ++arm) {
+    const double carriage_acceleration_m_s2 = mm_to_m(carriage_acceleration[arm]);
+    const double rods_kg = 2.0 * rod_kg;  // a parallelogram pair: both rods move alike
+    platform_force_n += rods_kg * (carriage_acceleration_m_s2 / 6.0 * up +
+                                   platform_acceleration_m_s2 / 3.0 + 0.5 * g_m_s2 * up);
+    carriage_force_n[arm] = rods_kg * (carriage_acceleration_m_s2 / 3.0 +
+                                       platform_acceleration_m_s2.z() / 6.0 + 0.5 * g_m_s2) -
+                            rods_kg * (carriage_acceleration_m_s2 + g_m_s2);
+  }
+
+  // the platform-side forces through the rods by virtual work: J^T f = F, J's rows w_i / w_iz
+  Eigen::Matrix3d jacobian;
+  for (int arm = 0; arm < 3; ++arm) jacobian.row(arm) = rods[arm].transpose() / rods[arm].z();
+  const Vec3 rod_forces_n = jacobian.transpose().partialPivLu().solve(platform_force_n);
+  for (int arm = 0; arm < 3; ++arm) joint_force[arm] += rod_forces_n[arm] + carriage_force_n[arm];
 }
 
 bool LinearDelta::inverse(const Vec3& tcp_mm, JointVector& joints, std::string* why) const {

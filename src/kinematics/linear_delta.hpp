@@ -53,6 +53,9 @@ struct LinearDeltaGeometry {
   // the part of the platform load MuJoCo's per-joint terms do not see (platform + substrate
   // bodies, without the rods, which hang from the carriages in the MJCF tree)
   double closure_mass_kg = 0.60;
+  // one rod (uniform thin tube, six of them); closure_feedforward moves the part of the rods'
+  // dynamics the MJCF tree puts on the carriages to where the closed chain puts it
+  double rod_mass_kg = 0.02;
   double gravity_m_s2 = 9.81;
 
   // world z of the carriage rod joints at the home pose (all joints 0, tcp = 0)
@@ -93,9 +96,13 @@ class LinearDelta final : public Machine {
   // scenario `limits: {joint: {v_max, a_max}}`: the same limits on every carriage
   void set_carriage_limits(double v_max_mm_s, double a_max_mm_s2);
   void set_joint_limits(double v_max, double a_max) override { set_carriage_limits(v_max, a_max); }
-  // the platform's load (closure_mass_kg: platform + substrate) through the rods, by the
-  // Jacobian transpose; the carriages and the rods hanging from them are the simulator's
-  // own per-joint terms
+  // What the simulator's per-joint terms (each carriage's subtree, carriage + its two rods,
+  // translating with the carriage: m (q'' + g)) miss of the closed chain's rigid-body
+  // dynamics, at the TCP's position, velocity and acceleration: the platform's load
+  // (closure_mass_kg: platform + substrate) through the rods by the Jacobian transpose, and
+  // the rods' true motion (each end follows its own joint: a thin rod's kinetic energy
+  // m/6 (|v_a|^2 + v_a . v_b + |v_b|^2), half its weight at either end) instead of riding
+  // on the carriage
   bool has_closures() const override { return true; }
   void closure_feedforward(const Vec3& tcp_mm, const Vec3& tcp_velocity_mm_s,
                            const Vec3& tcp_acceleration_mm_s2, double* joint_force) const override;

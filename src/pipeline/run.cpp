@@ -183,15 +183,29 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   deposition.validate();
   run.process = make_process(deposition, scenario.sim.cell_mm);
 
-  // loads carried through closed chains (a delta's platform) by the machine's own model
+  // loads carried through closed chains (a delta's platform) by the machine's own model, at
+  // the TCP acceleration the servo's setpoints give over the coming control period (the
+  // second difference of the TCP setpoints, as the joints' references: Simulation)
   if (job.machine->has_closures()) {
     const Machine& machine = *job.machine;
-    run.simulation->set_feedforward_hook([&machine, &trajectory](const mjModel&, const mjData&,
-                                                                 const JointReference& reference,
-                                                                 double* force) {
-      const TrajectorySample s = trajectory.at(reference.t_s);
-      machine.closure_feedforward(s.position_mm, s.velocity_mm_s, s.acceleration_mm_s2, force);
-    });
+    const SimSettings sim = sim_settings(scenario);
+    const double period_s =
+        static_cast<double>(std::max(1L, std::lround(sim.control_period_s / sim.timestep_s))) *
+        sim.timestep_s;
+    run.simulation->set_feedforward_hook(
+        [&machine, &trajectory, period_s](const mjModel&, const mjData&,
+                                          const JointReference& reference, double* force) {
+          const TrajectorySample s = trajectory.at(reference.t_s);
+          const Vec3 next_mm = trajectory.at(reference.t_s + period_s).position_mm;
+          const Vec3 velocity_mm_s =
+              reference.t_s >= period_s
+                  ? Vec3((s.position_mm - trajectory.at(reference.t_s - period_s).position_mm) /
+                         period_s)
+                  : s.velocity_mm_s;
+          const Vec3 acceleration_mm_s2 =
+              ((next_mm - s.position_mm) / period_s - velocity_mm_s) / period_s;
+          machine.closure_feedforward(s.position_mm, velocity_mm_s, acceleration_mm_s2, force);
+        });
   }
 
   // every step of the job deposits along the simulated nozzle's chord; the aerosol stream

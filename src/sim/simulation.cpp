@@ -24,6 +24,8 @@ constexpr const char* kSubstrateBody = "substrate";
 constexpr const char* kShutterJoint = "shutter";
 // how often run() looks at the clock for progress reports
 constexpr long kProgressCheckSteps = 256;
+// how many steps' states run() buffers before handing them to on_step
+constexpr size_t kCallbackChunkSteps = 64;
 constexpr double kProgressPeriod_s = 0.1;
 
 std::string format_number(double value) {
@@ -145,6 +147,51 @@ struct Simulation::Impl {
   void apply_servo(const Servo& servo, double q_si, double v_si, double extra_force) const;
 };
 
+namespace {
+
+// (angular, linear) world velocity of the point at world position `point` moving with `body`:
+// cvel is the body's velocity about its root's subtree centre of mass, moved to the point.
+// The same arithmetic, in the same order, as mj_objectVelocity(.., flg_local = 0) through
+// mju_transformSpatial: linear = v_com - (point - com) x w. Inline because it runs twice a
+// step, where the library call's dispatch cost more than the six products.
+void world_point_velocity(const mjModel& m, const mjData& d, int body, const mjtNum* point,
+                          mjtNum velocity[6]) {
+  const mjtNum* cvel = d.cvel + 6 * body;
+  const mjtNum* com = d.subtree_com + 3 * m.body_rootid[body];
+  const mjtNum dif[3] = {point[0] - com[0], point[1] - com[1], point[2] - com[2]};
+  const mjtNum cross[3] = {dif[1] * cvel[2] - dif[2] * cvel[1], dif[2] * cvel[0] - dif[0] * cvel[2],
+                           dif[0] * cvel[1] - dif[1] * cvel[0]};
+  for (int i = 0; i < 3; ++i) {
+    velocity[i] = cvel[i];
+    velocity[3 + i] = cvel[3 + i] - cross[i];
+  }
+}
+
+// force = M vec with MuJoCo's sparse joint-space inertia (qM, valid after mj_step1): the
+// product mj_mulM forms, with the same operations in the same order (each dof's diagonal,
+// then the entries shared with its ancestors), minus the call and the memset zeroing `force`
+// whose wide stores stalled the first read of each entry (about 15 ns a step on the XY stage).
+// A dof's ancestors come before it, so force[i] is still untouched when dof i starts: it
+// starts from 0.0 + (diagonal term), exactly as mj_mulM's zeroed entry does.
+void inertia_times(const mjModel& m, const mjData& d, const mjtNum* vec, mjtNum* force) {
+  const mjtNum* inertia = d.qM;
+  for (int i = 0; i < m.nv; ++i) {
+    int adr = m.dof_Madr[i];
+    if (m.dof_simplenum[i]) {
+      force[i] = inertia[adr] * vec[i];
+      continue;
+    }
+    force[i] = 0.0 + inertia[adr] * vec[i];
+    ++adr;
+    for (int j = m.dof_parentid[i]; j >= 0; j = m.dof_parentid[j], ++adr) {
+      force[i] += inertia[adr] * vec[j];
+      force[j] += inertia[adr] * vec[i];
+    }
+  }
+}
+
+}  // namespace
+
 // nozzle site relative to the substrate frame, and its velocity relative to the substrate
 void Simulation::Impl::read_nozzle(Vec3& position_mm, Vec3& velocity_mm_s) const {
   const mjModel* m = model.get();
@@ -155,8 +202,8 @@ void Simulation::Impl::read_nozzle(Vec3& position_mm, Vec3& velocity_mm_s) const
 
   // velocity of the substrate point under the nozzle: v_origin + w x (p - origin)
   mjtNum site_velocity[6], body_velocity[6];
-  mj_objectVelocity(m, d, mjOBJ_SITE, nozzle_site, site_velocity, 0);
-  mj_objectVelocity(m, d, mjOBJ_XBODY, substrate_body, body_velocity, 0);
+  world_point_velocity(*m, *d, m->site_bodyid[nozzle_site], site, site_velocity);
+  world_point_velocity(*m, *d, substrate_body, origin, body_velocity);
   const Vec3 offset(site[0] - origin[0], site[1] - origin[1], site[2] - origin[2]);
   const Vec3 omega(body_velocity[0], body_velocity[1], body_velocity[2]);
   const Vec3 substrate_point_velocity =
@@ -256,17 +303,121 @@ void Simulation::Impl::assemble_closures() {
   for (size_t c = 0; c < free_dofs.size(); ++c) d->qvel[free_dofs[c]] = v_free[c];
 }
 
-// ctrl = q_ref + f_ff / kp (see the header for f_ff)
+namespace {
+
+// MuJoCo's friction-loss constraint on a dof, as the solver applies it at zero violation:
+// the force F clamp((J qacc + B v) R^-1 / F), a velocity servo of rate B (1/s) and
+// regulariser R, saturated at the friction loss F. B = 2 / (d_max timeconst) (timeconst at
+// least two timesteps unless refsafe is off; solref's direct form: B = -damping / d_max),
+// R = (1 - d) / d invweight0 (d = solimp's d_min). For a motion at acceleration a the force
+// is F clamp((v + a / B) / v_s) with v_s = F R / B: Coulomb friction above the speed v_s,
+// leading the velocity by 1 / B.
+struct FrictionLaw {
+  double speed_si = 0.0;    // v_s
+  double rate_per_s = 0.0;  // B
+};
+
+FrictionLaw friction_law(const mjModel& m, int dof, double frictionloss) {
+  const mjtNum* solref = m.dof_solref + mjNREF * dof;
+  const mjtNum* solimp = m.dof_solimp + mjNIMP * dof;
+  const double d_min = std::clamp<double>(solimp[0], mjMINIMP, mjMAXIMP);
+  const double d_max = std::clamp<double>(solimp[1], mjMINIMP, mjMAXIMP);
+  FrictionLaw law;
+  if (solref[0] > 0.0) {
+    double timeconst = solref[0];
+    if (!(m.opt.disableflags & mjDSBL_REFSAFE))
+      timeconst = std::max(timeconst, 2.0 * m.opt.timestep);
+    law.rate_per_s = 2.0 / (d_max * timeconst);
+  } else {
+    law.rate_per_s = -solref[1] / d_max;
+  }
+  const double regulariser =
+      std::max<double>(mjMINVAL, (1.0 - d_min) / d_min * m.dof_invweight0[dof]);
+  law.speed_si =
+      law.rate_per_s > 0.0 ? frictionloss * regulariser / law.rate_per_s : kFrictionFadeSpeed_si;
+  return law;
+}
+
+// Velocity and acceleration references from the sampled position setpoints r_u (one per
+// control update, `width` values each), as a digital servo forms its feed-forward: the
+// velocity v_u = (r_u - r_{u-1}) / T, the velocity state a plant stepped by semi-implicit Euler
+// (q_{k+1} = q_k + h v_{k+1}) has at t_u when it is on the setpoints (v_0 stays the plan's,
+// the state the run starts from), and a_u = (v_{u+1} - v_u) / T, which takes it exactly to
+// the next one. The analytic mean (v(t + T) - v(t)) / T is half a step late for such a plant:
+// at every acceleration step of the plan it fed a wrong impulse, and the servo rang.
+void sampled_setpoint_references(const std::vector<double>& position, std::vector<double>& velocity,
+                                 std::vector<double>& acceleration, long updates, int width,
+                                 double period_s) {
+  for (long u = updates - 1; u >= 1; --u)
+    for (int j = 0; j < width; ++j)
+      velocity[u * width + j] =
+          (position[u * width + j] - position[(u - 1) * width + j]) / period_s;
+  for (long u = 0; u < updates; ++u)
+    for (int j = 0; j < width; ++j)
+      acceleration[u * width + j] =
+          u + 1 < updates ? (velocity[(u + 1) * width + j] - velocity[u * width + j]) / period_s
+                          : 0.0;
+}
+
+// What the servo must hold over the coming control period so that the plant tracks the
+// setpoints: the controls are held for n = control_stride steps of h (T = n h), each a
+// semi-implicit Euler step (force at the step's start). On the reference the velocity state
+// at step j is the backward difference over h, v(t + j h) - a h / 2, so over the n steps, with
+// v the reference velocity (the backward difference over T, sampled_setpoint_references) and
+// a the acceleration over the period:
+//   mean position   r + (v + a T / 2) h (n - 1) / 2 + a h^2 (n - 1)(2n - 1) / 12
+//   mean velocity   v + a h (n - 1)          (what the servo's -kv qdot sees)
+//   end velocity    v + a T                  (Euler integrates joint damping implicitly, at a
+//                                             step's end velocity)
+// With n = 1 these are the setpoint, v and the next v: the feed-forward matches the plant
+// step by step. Without them the servo lagged by (kv + damping) a h / 2 / kp at every
+// acceleration.
+struct HeldReference {
+  double position_si = 0.0;
+  double velocity_si = 0.0;
+  double end_velocity_si = 0.0;
+};
+
+HeldReference held_reference(const mjModel& m, long steps, double q_si, double v_si, double a_si) {
+  const double h = m.opt.timestep;
+  const double n = static_cast<double>(steps);
+  const double period_s = n * h;
+  HeldReference held;
+  held.position_si = q_si + (v_si + 0.5 * a_si * period_s) * h * (n - 1.0) / 2.0 +
+                     a_si * h * h * (n - 1.0) * (2.0 * n - 1.0) / 12.0;
+  held.velocity_si = v_si + a_si * h * (n - 1.0);
+  held.end_velocity_si = v_si + a_si * period_s;
+  return held;
+}
+
+}  // namespace
+
+// ctrl = q_held + f_ff / kp (see the header for f_ff), on the held references above. The
+// friction term is the plant's friction law (friction_law) at the reference's velocity and
+// acceleration, its regularisation speed capped at kFrictionFadeSpeed_si: a sharp
+// (near-Coulomb) guide friction gets a sharp feed-forward, switching when the plant's does.
 void Simulation::Impl::apply_servo(const Servo& servo, double q_si, double v_si,
                                    double extra_force) const {
+  const mjModel* m = model.get();
   mjData* d = data.get();
-  double force = 0.0;
-  if (settings.feedforward) {
-    force = inertia_force[servo.dof_adr] + d->qfrc_bias[servo.dof_adr] +
-            (servo.damping + servo.kv) * v_si +
-            servo.friction * std::tanh(v_si / kFrictionFadeSpeed_si) + extra_force;
+  if (!settings.feedforward) {
+    d->ctrl[servo.actuator] = q_si;
+    return;
   }
-  d->ctrl[servo.actuator] = q_si + force / servo.kp;
+  const double a_si = acceleration_reference[servo.dof_adr];
+  const HeldReference held = held_reference(*m, control_stride, q_si, v_si, a_si);
+  double friction_force = 0.0;
+  if (servo.friction > 0.0) {
+    const FrictionLaw law = friction_law(*m, servo.dof_adr, servo.friction);
+    const double speed_si = std::min(kFrictionFadeSpeed_si, law.speed_si);
+    const double leading_si =
+        held.velocity_si + (law.rate_per_s > 0.0 ? a_si / law.rate_per_s : 0.0);
+    friction_force = servo.friction * std::clamp(leading_si / speed_si, -1.0, 1.0);
+  }
+  const double force = inertia_force[servo.dof_adr] + d->qfrc_bias[servo.dof_adr] +
+                       servo.kv * held.velocity_si + servo.damping * held.end_velocity_si +
+                       friction_force + extra_force;
+  d->ctrl[servo.actuator] = held.position_si + force / servo.kp;
 }
 
 Simulation::Simulation(const std::string& model_path, const Machine& machine,
@@ -444,9 +595,11 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
   JointVector joints;
   std::string why;
   const std::vector<JointLimit>& limits = machine.joint_limits();
+  long next_reference_k = 0, u = -1;  // controller updates every `stride` steps
+  TrajectoryCursor plan(trajectory);  // the steps' times only grow
   for (long k = 0; k <= steps; ++k) {
     const double t = static_cast<double>(k) * dt;
-    TrajectorySample sample = trajectory.at(t);
+    TrajectorySample sample = plan.at(t);
     // after the end the machine holds the final point with the shutter closed
     if (t > duration_s + 1e-12) {
       sample.velocity_mm_s.setZero();
@@ -474,10 +627,11 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
                                            format_number(limits[j].min) + ", " +
                                            format_number(limits[j].max) + "]");
     }
-    if (k % stride != 0) continue;
+    if (k != next_reference_k) continue;
+    next_reference_k += stride;
+    ++u;
 
     // joint velocity J v (the acceleration follows below, from consecutive velocities)
-    const long u = k / stride;
     const JointVector velocity = machine.joint_velocity(joints, sample.velocity_mm_s);
     for (int j = 0; j < joint_count; ++j) {
       const double to_si = s.joints[j].user_to_si;
@@ -493,17 +647,11 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
     }
   }
 
-  // inertia feed-forward: the mean acceleration over each control period,
-  // (v_ref(t + T_c) - v_ref(t)) / T_c. Under a zero-order hold this reaches the next
-  // velocity reference exactly even when a phase boundary falls between two updates, and it
-  // contains the Jacobian's rate (dJ/dt) v of machines whose Jacobian varies.
+  // velocity and acceleration feed-forward from the sampled setpoints, as a digital servo
+  // forms them (sampled_setpoint_references, next to apply_servo)
   const double control_period_s = static_cast<double>(stride) * dt;
-  for (long u = 0; u + 1 < updates; ++u) {
-    for (int j = 0; j < joint_count; ++j)
-      a_ref[u * joint_count + j] =
-          (v_ref[(u + 1) * joint_count + j] - v_ref[u * joint_count + j]) / control_period_s;
-    flap_acceleration[u] = (flap_rate[u + 1] - flap_rate[u]) / control_period_s;
-  }
+  sampled_setpoint_references(q_ref, v_ref, a_ref, updates, joint_count, control_period_s);
+  sampled_setpoint_references(flap_ref, flap_rate, flap_acceleration, updates, 1, control_period_s);
 
   // start from a reset state exactly on the reference
   mj_resetData(m, d);
@@ -518,10 +666,26 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
   }
   s.assemble_closures();
 
-  // the step loop: state after mj_step1, controls, mj_step2 (no allocation in here)
-  StepState before, after;
+  // the step loop: state after mj_step1, controls, mj_step2 (no allocation in here), with
+  // subnormals flushed (a servo at rest decays into them and MuJoCo slows to a crawl on
+  // them); callbacks run in the caller's floating-point mode
+  FlushSubnormalsScope flush_subnormals;
+  // on_step runs on chunks of buffered states (the first is the last chunk's end), so the
+  // floating-point mode switches once per chunk rather than twice a step
+  std::vector<StepState> pending_states;
+  if (on_step) pending_states.reserve(kCallbackChunkSteps + 1);
+  const auto deliver_pending_states = [&]() {
+    flush_subnormals.suspend();
+    for (size_t i = 1; i < pending_states.size(); ++i)
+      on_step(pending_states[i - 1], pending_states[i]);
+    flush_subnormals.resume();
+    pending_states.front() = pending_states.back();
+    pending_states.resize(1);
+  };
+  StepState after;
   double max_violation_mm = 0.0;
   Clock::time_point last_progress = wall_start;
+  long next_update_k = 0, update = 0;  // controller updates every `stride` steps
   for (long k = 0; k <= steps; ++k) {
     const double t = static_cast<double>(k) * dt;
     d->time = t;
@@ -543,13 +707,17 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
       run.joint_position[k * joint_count + j] = d->qpos[servo.qpos_adr] / servo.user_to_si;
       run.joint_velocity[k * joint_count + j] = d->qvel[servo.dof_adr] / servo.user_to_si;
     }
-    max_violation_mm = std::max(max_violation_mm, s.constraint_violation_mm());
-    if (k > 0 && on_step) on_step(before, after);
-    before = after;
+    if (m->neq > 0)  // only equality constraints have rows to measure
+      max_violation_mm = std::max(max_violation_mm, s.constraint_violation_mm());
+    if (on_step) {
+      pending_states.push_back(after);  // capacity reserved: no allocation
+      if (pending_states.size() == kCallbackChunkSteps + 1 || k == steps) deliver_pending_states();
+    }
 
     // servo controls at the controller rate, held in between
-    if (k % stride == 0) {
-      const long u = k / stride;
+    if (k == next_update_k) {
+      next_update_k += stride;
+      const long u = update++;
       const double* q = &q_ref[u * joint_count];
       const double* v = &v_ref[u * joint_count];
       const double* a = &a_ref[u * joint_count];
@@ -557,9 +725,13 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
         std::fill(s.acceleration_reference.begin(), s.acceleration_reference.end(), 0.0);
         for (int j = 0; j < joint_count; ++j) s.acceleration_reference[s.joints[j].dof_adr] = a[j];
         if (s.has_shutter) s.acceleration_reference[s.shutter.dof_adr] = flap_acceleration[u];
-        mj_mulM(m, d, s.inertia_force.data(), s.acceleration_reference.data());
+        inertia_times(*m, *d, s.acceleration_reference.data(), s.inertia_force.data());
         std::fill(s.hook_force.begin(), s.hook_force.end(), 0.0);
-        if (s.hook) s.hook(*m, *d, JointReference{t, joint_count, q, v, a}, s.hook_force.data());
+        if (s.hook) {
+          flush_subnormals.suspend();
+          s.hook(*m, *d, JointReference{t, joint_count, q, v, a}, s.hook_force.data());
+          flush_subnormals.resume();
+        }
       }
       for (int j = 0; j < joint_count; ++j) s.apply_servo(s.joints[j], q[j], v[j], s.hook_force[j]);
       if (s.has_shutter) s.apply_servo(s.shutter, flap_ref[u], flap_rate[u], 0.0);
@@ -581,10 +753,13 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
       const Clock::time_point now = Clock::now();
       if (std::chrono::duration<double>(now - last_progress).count() >= kProgressPeriod_s) {
         last_progress = now;
+        flush_subnormals.suspend();
         progress(static_cast<double>(k) / static_cast<double>(steps));
+        flush_subnormals.resume();
       }
     }
   }
+  flush_subnormals.suspend();
   if (progress) progress(1.0);
 
   run.max_constraint_violation_mm = max_violation_mm;

@@ -16,14 +16,19 @@
 // Equality constraints (<connect> closures of a linear delta) are allowed; their largest
 // position violation is recorded.
 //
-// Controller per servo joint (SI units inside):  ctrl = q_ref + f_ff / kp  with
-//   f_ff = (M a_ref)_j + qfrc_bias_j + (damping_j + kv_j) v_ref_j
-//          + frictionloss_j tanh(v_ref_j / 0.1 mm/s) + hook_j
-// where a_ref is the mean reference acceleration over the coming control period
-// so the actuator force kp (ctrl - q) - kv qdot = kp (q_ref - q) + kv (v_ref - qdot) + f_ff:
-// PD on the reference plus inertia, bias (gravity, Coriolis), viscous, Coulomb friction
-// (faded out near zero speed) and optional machine-specific load feed-forward
-// (set_feedforward_hook). Controls are held between updates (zero-order hold).
+// Controller per servo joint (SI units inside):  ctrl = q_held + f_ff / kp  with
+//   f_ff = (M a_ref)_j + qfrc_bias_j + kv_j v_held_j + damping_j v_end_j
+//          + frictionloss_j clamp((v_ref_j + a_ref_j / B_j) / v_s_j, -1, 1) + hook_j
+// where the references come from the sampled position setpoints as a digital servo forms
+// them: v_ref = (q_ref(t) - q_ref(t - T_c)) / T_c, a_ref = (v_ref(t + T_c) - v_ref(t)) / T_c,
+// and q_held, v_held, v_end are what the plant's semi-implicit Euler steps see over the held
+// period (the setpoint, v_ref and the next v_ref when the servo updates every step; see
+// held_reference in simulation.cpp). The friction term is the model's own friction-loss law
+// (Coulomb above v_s, a velocity servo of rate B below; v_s capped at 0.1 mm/s). So the
+// actuator force kp (ctrl - q) - kv qdot = kp (q_held - q) + kv (v_held - qdot) + f_ff: PD on
+// the reference plus inertia, bias (gravity, Coriolis), viscous, Coulomb friction and optional
+// machine-specific load feed-forward (set_feedforward_hook). Controls are held between
+// updates (zero-order hold).
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -91,7 +96,8 @@ struct RecordedRun {
 };
 
 // Joint references of one controller update, SI units (m or rad), in Machine joint order;
-// `acceleration` is the mean over the coming control period (v_ref(t + T_c) - v_ref(t)) / T_c.
+// `velocity` is the setpoints' backward difference (q(t) - q(t - T_c)) / T_c (the plan's at
+// t = 0), `acceleration` the next one's change over T_c: (v_ref(t + T_c) - v_ref(t)) / T_c.
 struct JointReference {
   double t_s = 0.0;
   int count = 0;
@@ -125,8 +131,10 @@ class Simulation {
 
   // Checks the whole trajectory against the joint travel first (InputError naming the time
   // and the joint), then starts on the reference at t = 0 and steps until the trajectory's
-  // end + settle_s. on_step(before, after) is called once per step; progress(fraction) at
-  // most about ten times a second. A MuJoCo warning (divergence) throws InternalError.
+  // end + settle_s. on_step(before, after) is called once per step, in step order, in chunks
+  // of up to 64 steps between physics steps; progress(fraction) at most about ten times a
+  // second. Callbacks run in the caller's floating-point mode (the physics flushes
+  // subnormals, see FlushSubnormalsScope). A MuJoCo warning (divergence) throws InternalError.
   // Each run starts from a reset state: the same trajectory gives the same RecordedRun.
   RecordedRun run(const Trajectory& trajectory, const StepCallback& on_step = {},
                   const ProgressCallback& progress = {});

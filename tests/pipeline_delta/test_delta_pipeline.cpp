@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Dense>
+
 #include "delta_test_util.hpp"
 #include "kinematics/linear_delta.hpp"
 #include "pipeline/compare.hpp"
@@ -57,11 +59,13 @@ std::vector<const TrajectoryPiece*> printing_pieces(const Trajectory& trajectory
   return pieces;
 }
 
-// The paper's speed-variation measure (bezier_checks.hpp) on the simulated nozzle: over the
-// plan's central part [first, last] (the samples whose planned speed is v_c), the distance
-// between consecutive simulated states over the time step, against v_c.
+// The paper's speed-variation measure (bezier_checks.hpp) on the simulated nozzle, as on the
+// plan: over the plan's central part [first, last] (the samples whose planned speed is v_c),
+// the spacing of the nozzle's positions one plan period T_s apart over T_s, against v_c. The
+// record holds every physics step; T_s is a whole number of them (1 with the default 1 ms).
 struct CentralPart {
   double t_first_s = 0.0, t_last_s = 0.0;
+  double period_s = 0.0;  // the plan's T_s
 };
 
 CentralPart central_part(const TrajectoryPiece& piece, double v_c) {
@@ -73,15 +77,19 @@ CentralPart central_part(const TrajectoryPiece& piece, double v_c) {
       last = k;
     }
   }
-  return {piece.t_begin_s + first * motion.period_s, piece.t_begin_s + last * motion.period_s};
+  return {piece.t_begin_s + first * motion.period_s, piece.t_begin_s + last * motion.period_s,
+          motion.period_s};
 }
 
 double simulated_speed_variation(const RecordedRun& record, const CentralPart& part, double v_c) {
+  const double steps_per_sample = part.period_s / record.timestep_s;
+  const size_t stride = static_cast<size_t>(std::lround(steps_per_sample));
+  EXPECT_NEAR(steps_per_sample, static_cast<double>(stride), 1e-9);
   double largest = 0.0;
-  for (size_t k = 0; k + 1 < record.size(); ++k) {
-    if (record.t_s[k] < part.t_first_s || record.t_s[k + 1] > part.t_last_s) continue;
-    const double dt = record.t_s[k + 1] - record.t_s[k];
-    const double v = (record.nozzle_mm[k + 1] - record.nozzle_mm[k]).norm() / dt;
+  for (size_t k = 0; k + stride < record.size(); ++k) {
+    if (record.t_s[k] < part.t_first_s || record.t_s[k + stride] > part.t_last_s) continue;
+    const double dt = record.t_s[k + stride] - record.t_s[k];
+    const double v = (record.nozzle_mm[k + stride] - record.nozzle_mm[k]).norm() / dt;
     largest = std::max(largest, std::abs(v - v_c) / v_c);
   }
   return largest;
@@ -115,6 +123,84 @@ TEST(DeltaPipeline, ClosedChainsStayClosed) {
   }
 }
 
+// The controller's load model is the closed chain's rigid-body dynamics: at a pose off the
+// axis (where giberti_fig3 ends, assembled by the simulation), the simulator's tree terms for
+// each carriage subtree, m_sub (q'' + g), plus LinearDelta::closure_feedforward equal
+// MuJoCo's own inverse dynamics projected on the carriages by virtual work, G^T (M qacc +
+// qfrc_bias), G the map from carriage to all joint velocities (from the closures' Jacobian),
+// within 1 mN per m/s^2 of TCP acceleration (the rods' tube radius, which the thin-rod model
+// leaves out).
+TEST(DeltaPipeline, ClosureFeedForwardIsTheChainsRigidBodyDynamics) {
+  const DeltaRun fig3 = simulate(scenario_path("giberti_fig3.yaml"));
+  const mjModel* m = &fig3.run.simulation->model();
+  mjData* d = mj_makeData(m);
+  mj_copyData(d, m, &fig3.run.simulation->data());
+  mju_zero(d->qvel, m->nv);
+  mj_forward(m, d);
+  const LinearDelta& delta = dynamic_cast<const LinearDelta&>(*fig3.job.machine);
+  const Vec3 tcp_mm = fig3.run.record.nozzle_mm.back();
+  ASSERT_GT(tcp_mm.head<2>().norm(), 50.0);
+
+  // G: held (carriage) columns identity, the others -J_free^+ J_held
+  int held[3];
+  double subtree_kg[3];
+  for (int j = 0; j < 3; ++j) {
+    const int joint = mj_name2id(m, mjOBJ_JOINT, ("carriage" + std::to_string(j + 1)).c_str());
+    held[j] = m->jnt_dofadr[joint];
+    subtree_kg[j] = m->body_subtreemass[m->jnt_bodyid[joint]];
+  }
+  std::vector<int> rows, free_dofs;
+  for (int r = 0; r < d->nefc; ++r)
+    if (d->efc_type[r] == mjCNSTR_EQUALITY) rows.push_back(r);
+  for (int c = 0; c < m->nv; ++c)
+    if (c != held[0] && c != held[1] && c != held[2]) free_dofs.push_back(c);
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(rows.size(), m->nv);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const int r = rows[i];
+    if (mj_isSparse(m)) {
+      for (int k = 0; k < d->efc_J_rownnz[r]; ++k)
+        jacobian(i, d->efc_J_colind[d->efc_J_rowadr[r] + k]) = d->efc_J[d->efc_J_rowadr[r] + k];
+    } else {
+      for (int c = 0; c < m->nv; ++c) jacobian(i, c) = d->efc_J[r * m->nv + c];
+    }
+  }
+  Eigen::MatrixXd jacobian_free(rows.size(), free_dofs.size()), jacobian_held(rows.size(), 3);
+  for (size_t c = 0; c < free_dofs.size(); ++c) jacobian_free.col(c) = jacobian.col(free_dofs[c]);
+  for (int c = 0; c < 3; ++c) jacobian_held.col(c) = jacobian.col(held[c]);
+  const Eigen::MatrixXd free_map =
+      -jacobian_free.completeOrthogonalDecomposition().solve(jacobian_held);
+  Eigen::MatrixXd velocity_map = Eigen::MatrixXd::Zero(m->nv, 3);
+  for (int c = 0; c < 3; ++c) velocity_map(held[c], c) = 1.0;
+  for (size_t c = 0; c < free_dofs.size(); ++c) velocity_map.row(free_dofs[c]) = free_map.row(c);
+
+  JointVector joints;
+  ASSERT_TRUE(delta.inverse(tcp_mm, joints));
+  for (const Vec3& acceleration_mm_s2 :
+       {Vec3(0, 0, 0), Vec3(1000, 0, 0), Vec3(0, 1000, 0), Vec3(0, 0, 1000)}) {
+    // at rest, so J qacc = 0 is the whole acceleration constraint
+    const JointVector carriage_mm_s2 =
+        delta.joint_acceleration(joints, Vec3::Zero(), acceleration_mm_s2);
+    const Eigen::Vector3d carriage_m_s2(mm_to_m(carriage_mm_s2[0]), mm_to_m(carriage_mm_s2[1]),
+                                        mm_to_m(carriage_mm_s2[2]));
+    const Eigen::VectorXd qacc = velocity_map * carriage_m_s2;
+    std::vector<mjtNum> inertia_n(m->nv);
+    mj_mulM(m, d, inertia_n.data(), qacc.data());
+    Eigen::VectorXd generalized_n(m->nv);
+    for (int c = 0; c < m->nv; ++c) generalized_n[c] = inertia_n[c] + d->qfrc_bias[c];
+    const Eigen::Vector3d mujoco_n = velocity_map.transpose() * generalized_n;
+
+    double closure_n[3] = {0, 0, 0};
+    delta.closure_feedforward(tcp_mm, Vec3::Zero(), acceleration_mm_s2, closure_n);
+    for (int j = 0; j < 3; ++j) {
+      const double controller_n =
+          subtree_kg[j] * (carriage_m_s2[j] + delta.geometry().gravity_m_s2) + closure_n[j];
+      EXPECT_NEAR(controller_n, mujoco_n[j], 1e-3)
+          << "carriage " << j + 1 << " at a = " << acceleration_mm_s2.transpose();
+    }
+  }
+  mj_deleteData(d);
+}
+
 // ---------------------------------------------------------------------------------------
 // the circle (Fig. 11)
 
@@ -134,13 +220,19 @@ TEST(DeltaPipeline, CircleNozzleStaysWithinATenthOfAMillimetre) {
               r.path_error.max_mm, r.planned_path_error->max_mm, r.path_error.rms_mm);
 }
 
-// Fig. 11a: constant TCP speed, yet the carriages see acceleration peaks where they reverse.
+// Fig. 11a: constant TCP speed, yet the carriages see acceleration peaks at the corners.
 // Over the constant-speed part of the circle each carriage's largest acceleration is far
 // above what a constant-speed straight line across the same workspace gives (where the
-// carriages only see the kinematics' gentle curvature), and it sits at one of that carriage's
-// reversals (velocity sign changes). Carriage 3 reverses at the sharpest corners (the
-// slicing lines run across its column, giberti_circle.yaml), so its peak is the largest, as
-// in the paper. No carriage exceeds its limits: the planners get LinearDelta::cartesian_limits.
+// carriages only see the kinematics' gentle curvature), and it is the plan's own (the
+// carriage acceleration J a + (dJ/dt) v of the planned TCP motion, within 10 %; measured
+// 6.00 / 5.97 / 7.59 mm/s^2 against the plan's 5.76 / 5.77 / 7.33): the servos add no peaks
+// of their own. Carriage 3 reverses at the sharpest corners (the slicing lines
+// run across its column, giberti_circle.yaml), so, as in the paper, its peak is the largest
+// and lies in the corner where it reverses (within 0.1 s, about half a 0.45 mm blend at
+// 5 mm/s). Carriages 1 and 2 reverse at 5.8-degree corners and peak at the 25-degree ones
+// (measured 2.7 s from their reversals, in the plan too); the earlier simulation put their
+// peaks at their reversals with friction glitches that the plan does not have. No carriage
+// exceeds its limits: the planners get LinearDelta::cartesian_limits.
 TEST(DeltaPipeline, CarriagesSeeAccelerationPeaksWhereTheyReverseOnTheCircle) {
   // the constant-speed print part of a run: depositing, away from the start and stop ramps
   struct PrintPeaks {
@@ -194,18 +286,44 @@ planners: [{name: bezier, delta: 0.45}]
   double line_peak = 0.0;
   for (int j = 0; j < 3; ++j) line_peak = std::max(line_peak, on_line.acceleration_mm_s2[j]);
   EXPECT_LT(line_peak, 1.0);  // ~ |v|^2 / rod height = 25 / 300 mm/s^2, plus servo noise
+  // the plan's carriage accelerations over the same window, at the same instants
+  const LinearDelta& delta = dynamic_cast<const LinearDelta&>(*circle.job.machine);
+  const RecordedRun& record = circle.run.record;
+  double first_s = -1.0, last_s = -1.0;
+  for (size_t k = 0; k < record.size(); ++k) {
+    if (!record.deposit_command[k]) continue;
+    if (first_s < 0) first_s = record.t_s[k];
+    last_s = record.t_s[k];
+  }
+  double planned_peak[3] = {0, 0, 0};
+  JointVector joints;
+  for (size_t k = 1; k < record.size(); ++k) {
+    if (!record.deposit_command[k] || record.t_s[k] < first_s + 0.1 || record.t_s[k] > last_s - 0.1)
+      continue;
+    const TrajectorySample sample = circle.run.plan.trajectory.at(record.t_s[k]);
+    ASSERT_TRUE(delta.inverse(sample.position_mm, joints));
+    const JointVector acceleration =
+        delta.joint_acceleration(joints, sample.velocity_mm_s, sample.acceleration_mm_s2);
+    for (int j = 0; j < 3; ++j)
+      planned_peak[j] = std::max(planned_peak[j], std::abs(acceleration[j]));
+  }
+
   for (int j = 0; j < 3; ++j) {
     EXPECT_GT(on_circle.acceleration_mm_s2[j], 10.0 * line_peak) << "carriage " << j + 1;
-    // the peak is at (within 20 ms of) a reversal of the same carriage
+    EXPECT_NEAR(on_circle.acceleration_mm_s2[j], planned_peak[j], 0.1 * planned_peak[j])
+        << "carriage " << j + 1;
     ASSERT_FALSE(on_circle.reversals_s[j].empty()) << "carriage " << j + 1;
     double nearest_s = 1e9;
     for (double t : on_circle.reversals_s[j])
       nearest_s = std::min(nearest_s, std::abs(t - on_circle.at_s[j]));
-    EXPECT_LT(nearest_s, 0.02) << "carriage " << j + 1;
+    // carriage 3: the peak is in the corner where it reverses
+    if (j == 2) {
+      EXPECT_LT(nearest_s, 0.1) << "carriage " << j + 1;
+    }
     std::printf(
-        "[ carriage %d ] circle print peak %.2f mm/s^2 at %.3f s (reversal %.3f s away); "
-        "line %.3f; whole-run metric %.1f mm/s^2\n",
-        j + 1, on_circle.acceleration_mm_s2[j], on_circle.at_s[j], nearest_s,
+        "[ carriage %d ] circle print peak %.2f mm/s^2 (plan %.2f) at %.3f s (reversal %.3f s "
+        "away); line %.3f; whole-run metric %.1f mm/s^2\n",
+        j + 1, on_circle.acceleration_mm_s2[j], planned_peak[j], on_circle.at_s[j], nearest_s,
         on_line.acceleration_mm_s2[j], circle.run.report.actuators->peak_acc[j]);
   }
   EXPECT_GT(on_circle.acceleration_mm_s2[2], on_circle.acceleration_mm_s2[0]);
@@ -249,15 +367,28 @@ TEST(DeltaPipeline, Fig3PlannedSpeedVariationIsWithinThePapers) {
 }
 
 // The issue's target for the simulated nozzle: within 0.5 % over the same central part,
-// measured the same way. MISSED, so disabled (run it with --gtest_also_run_disabled_tests):
-// measured 4.85 / 12.4 / 5.51 % at 5 / 10 / 20 mm/s. Where (see the report of issue 5):
-// - the first ~50 ms of each central part: every path starts at rest right after a fast
-//   transition (90 mm/s, 1306 mm/s^2), so the carriages break away from Coulomb friction and
-//   the servos ring after the ramp's acceleration step (25 um lag, 12 % overshoot at 10 mm/s);
-// - the corners at x = 0: carriage 1's velocity passes zero there (its column is on +y), so
-//   its guide friction flips: 4.6 / 2.0 / 1.8 %;
-// - without guide friction, the 20 mm/s blends' acceleration steps alone give 0.7 %.
-TEST(DeltaPipeline, DISABLED_Fig3SimulatedSpeedVariationIsWithinHalfAPercent) {
+// measured the same way (sample spacing over T_s). Measured 0.378 / 0.096 / 0.046 % at
+// 5 / 10 / 20 mm/s (before the controller and friction changes: 4.85 / 12.4 / 5.51 %).
+// What it took (the report of issue 5 has the figures):
+// - the guide friction is Coulomb (models/linear_delta.xml): MuJoCo's default regularisation
+//   made it a damper below 1.1 mm/s, so its force followed the carriage speed wherever a
+//   carriage slowed or reversed (every corner, every path start), which no direction-based
+//   compensation could match: 4.6 / 2.0 / 1.8 % at the corners;
+// - the servo's feed-forward comes from its sampled setpoints (velocity and acceleration as
+//   differences, Simulation), held as the plant's Euler steps see them: the analytic
+//   references were half a step late at every acceleration step, so each path's start (right
+//   after a transition's 1300 mm/s^2 stop) rang by 4 % at 5 mm/s, and kv a h / 2 lagged the
+//   carriages by ~5 um in every acceleration;
+// - the closed chain's rigid-body load is exact (the rods as rods, not riding on the carriages).
+// - the friction feed-forward is the plant's friction law at the reference's velocity and
+//   acceleration (Simulation: MuJoCo's friction leads the velocity by 1 / B).
+// The largest figure is each path's first millisecond at 5 mm/s (0.38 %): the print path
+// starts where the transition stops, all three carriages pass zero speed at once there. With
+// 0.5 ms (0.25 ms) steps and servo updates it measures 0.071 / 0.020 / 0.047 %
+// (0.084 / 0.038 / 0.050 %). Not met with a servo period longer than the physics step (0.5 ms
+// steps, 1 ms servo: 2.7 / 2.7 / 1.3 %): the plant moves between updates and the held
+// references match it only on average.
+TEST(DeltaPipeline, Fig3SimulatedSpeedVariationIsWithinHalfAPercent) {
   const DeltaRun fig3 = simulate(scenario_path("giberti_fig3.yaml"));
   for (int path = 0; path < 3; ++path) {
     const double v_c = fig3.job.toolpath.paths[path].speed_mm_s;
