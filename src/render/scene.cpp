@@ -34,7 +34,8 @@ constexpr double kLift_mm = 0.005;
 // an OSMesa context made current on its own colour buffer; destroyed last
 class OsMesaContext {
  public:
-  OsMesaContext(int width, int height) : buffer_(static_cast<size_t>(width) * height * 4) {
+  OsMesaContext(int width, int height)
+      : buffer_(static_cast<size_t>(width) * height * 4), width_(width), height_(height) {
     context_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
     if (!context_) throw InternalError("OSMesa could not create a rendering context");
     if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height)) {
@@ -42,12 +43,21 @@ class OsMesaContext {
       throw InternalError("OSMesa could not make its rendering context current");
     }
   }
+  // current on the calling thread (a renderer may be used from another thread than the one
+  // that built it, one thread at a time)
+  void make_current() {
+    if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width_, height_))
+      throw InternalError("OSMesa could not make its rendering context current");
+  }
+  // no context current on the calling thread, so another thread may take this one
+  void release() { OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0); }
   ~OsMesaContext() { OSMesaDestroyContext(context_); }
   OsMesaContext(const OsMesaContext&) = delete;
   OsMesaContext& operator=(const OsMesaContext&) = delete;
 
  private:
   std::vector<unsigned char> buffer_;
+  int width_ = 0, height_ = 0;
   OSMesaContext context_ = nullptr;
 };
 
@@ -72,6 +82,28 @@ struct RenderContextOwner {
   RenderContextOwner(const RenderContextOwner&) = delete;
   RenderContextOwner& operator=(const RenderContextOwner&) = delete;
 };
+
+// what an mjrContext depends on: models of the same MJCF file have the same shape
+struct ModelShape {
+  int ngeom, nmesh, nmeshvert, ntex, ntexdata, nmat, nskin, nhfield, offwidth, offheight;
+  bool operator==(const ModelShape& o) const {
+    return ngeom == o.ngeom && nmesh == o.nmesh && nmeshvert == o.nmeshvert && ntex == o.ntex &&
+           ntexdata == o.ntexdata && nmat == o.nmat && nskin == o.nskin && nhfield == o.nhfield &&
+           offwidth == o.offwidth && offheight == o.offheight;
+  }
+};
+ModelShape model_shape(const mjModel& m) {
+  return {m.ngeom,
+          m.nmesh,
+          m.nmeshvert,
+          m.ntex,
+          m.ntexdata,
+          m.nmat,
+          m.nskin,
+          m.nhfield,
+          m.vis.global.offwidth,
+          m.vis.global.offheight};
+}
 
 // substrate-frame point (mm) -> world (m)
 Vec3 substrate_to_world(const mjData& data, int body, const Vec3& local_mm) {
@@ -236,9 +268,46 @@ void viridis(double value, float rgb[3]) {
         ((1.0 - fraction) * kStops[index][c] + fraction * kStops[index + 1][c]) / 255.0);
 }
 
-std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& data,
-                                            const HeightMap& deposit,
-                                            const SceneRenderOptions& options) {
+// The GL and MuJoCo render contexts, kept between images. mjr_makeContext is most of an
+// image's cost in software (about 0.15 s: buffers, textures, shader compilation), so a run
+// that renders one scene per planner builds it once.
+struct SceneRenderer::Contexts {
+  OsMesaContext gl;
+  RenderContextOwner render;
+  ModelShape shape;
+  Contexts(const mjModel& model, int width, int height)
+      : gl(width, height), render(model), shape(model_shape(model)) {}
+};
+
+SceneRenderer::SceneRenderer() = default;
+SceneRenderer::~SceneRenderer() {
+  try {
+    finish_preparation();
+  } catch (...) {  // a preparation that failed and was never used
+  }
+}
+
+void SceneRenderer::prepare(const std::string& model_path) {
+  if (contexts_ || preparing_.valid()) return;
+  install_mujoco_handlers();  // before the thread: the handlers are process-wide
+  preparing_ = std::async(std::launch::async, [model_path] {
+    const ModelPtr model = load_model(model_path);
+    auto contexts =
+        std::make_unique<Contexts>(*model, model->vis.global.offwidth, model->vis.global.offheight);
+    contexts->gl.release();  // the rendering thread makes it current
+    return contexts;
+  });
+}
+
+void SceneRenderer::finish_preparation() {
+  if (!preparing_.valid()) return;
+  std::unique_ptr<Contexts> prepared = preparing_.get();
+  if (!contexts_) contexts_ = std::move(prepared);
+}
+
+std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const mjData& data,
+                                                     const HeightMap& deposit,
+                                                     const SceneRenderOptions& options) {
   install_mujoco_handlers();
   // the image must fit the model's offscreen buffer
   if (options.width <= 0 || options.width > model.vis.global.offwidth)
@@ -262,10 +331,22 @@ std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& 
 
   // set up: GL context, MuJoCo render context on the offscreen buffer, scene
   DataPtr state = copy_data(model, data);
-  OsMesaContext gl(width, height);
-  RenderContextOwner context(model);
-  mjr_setBuffer(mjFB_OFFSCREEN, &context.context);
-  if (context.context.currentBuffer != mjFB_OFFSCREEN)
+  // the prepared contexts, or those of the previous image, when the model has the same shape
+  // (the same MJCF);
+  // the GL buffer is the model's offscreen size, so any image size that fits reuses it
+  try {
+    finish_preparation();
+  } catch (const std::exception&) {  // built again below, where an error names this model
+  }
+  if (!contexts_ || !(contexts_->shape == model_shape(model))) {
+    contexts_.reset();
+    contexts_ =
+        std::make_unique<Contexts>(model, model.vis.global.offwidth, model.vis.global.offheight);
+  }
+  contexts_->gl.make_current();
+  mjrContext& context = contexts_->render.context;
+  mjr_setBuffer(mjFB_OFFSCREEN, &context);
+  if (context.currentBuffer != mjFB_OFFSCREEN)
     throw InternalError("MuJoCo could not select its offscreen buffer");
   SceneOwner scene(model, 4 * model.ngeom + options.max_boxes + 64);
 
@@ -289,11 +370,12 @@ std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& 
   mjv_defaultPerturb(&perturb);
   mjv_updateScene(&model, state.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene.scene);
   if (view.type == mjCAMERA_FREE) light_over_camera(view, scene.scene);
+  scene.scene.flags[mjRND_SHADOW] = options.shadows ? 1 : 0;
   if (has_grid) add_deposit_boxes(*state, substrate, deposit, relief_mm, options, scene.scene);
   const mjrRect viewport = {0, 0, width, height};
-  mjr_render(viewport, &scene.scene, &context.context);
+  mjr_render(viewport, &scene.scene, &context);
   std::vector<unsigned char> bottom_up(static_cast<size_t>(width) * height * 3);
-  mjr_readPixels(bottom_up.data(), nullptr, viewport, &context.context);
+  mjr_readPixels(bottom_up.data(), nullptr, viewport, &context);
   check_warnings(*state, "while rendering");
 
   // OpenGL rows run bottom-up: flip for the image file
@@ -303,6 +385,20 @@ std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& 
     std::copy_n(bottom_up.begin() + static_cast<long>(row * row_bytes), row_bytes,
                 rgb.begin() + static_cast<long>((height - 1 - row) * row_bytes));
   return rgb;
+}
+
+void SceneRenderer::render_png(const Simulation& simulation, const HeightMap& deposit,
+                               const std::string& png_path, const SceneRenderOptions& options) {
+  const std::vector<unsigned char> rgb =
+      render_rgb(simulation.model(), simulation.data(), deposit, options);
+  write_png(png_path, options.width, options.height, rgb);
+}
+
+std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& data,
+                                            const HeightMap& deposit,
+                                            const SceneRenderOptions& options) {
+  SceneRenderer renderer;
+  return renderer.render_rgb(model, data, deposit, options);
 }
 
 void render_scene_png(const mjModel& model, const mjData& data, const HeightMap& deposit,

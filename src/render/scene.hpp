@@ -11,6 +11,8 @@
 
 #include <mujoco/mujoco.h>
 
+#include <future>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,39 @@ struct SceneRenderOptions {
   int max_boxes = 10000;
   // cells thinner than this fraction of the thickest are not drawn (footprint tails)
   double min_relative_thickness = 0.02;
+  // shadow mapping: off by default. It costs a second pass in software (about 0.1 s per
+  // image) and the delta's platform throws its shadow over the deposit it should show
+  bool shadows = false;
+};
+
+// Renders scenes, keeping its GL and MuJoCo render contexts between images (rebuilt when
+// a model of another shape comes). Not thread-safe: one thread at a time.
+class SceneRenderer {
+ public:
+  SceneRenderer();
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
+
+  // Build the contexts for the MJCF at `model_path` on a background thread, so that the
+  // costly set-up overlaps the simulation; the first render waits for it. Errors surface
+  // there, or are dropped when the model's shape does not match and the contexts are rebuilt.
+  void prepare(const std::string& model_path);
+
+  // as render_scene_rgb / render_scene_png below
+  std::vector<unsigned char> render_rgb(const mjModel& model, const mjData& data,
+                                        const HeightMap& deposit,
+                                        const SceneRenderOptions& options = {});
+  void render_png(const Simulation& simulation, const HeightMap& deposit,
+                  const std::string& png_path, const SceneRenderOptions& options = {});
+
+ private:
+  struct Contexts;
+  // wait for prepare() and adopt its contexts; rethrows its error
+  void finish_preparation();
+
+  std::unique_ptr<Contexts> contexts_;
+  std::future<std::unique_ptr<Contexts>> preparing_;
 };
 
 // Render to RGB bytes, rows top to bottom (width * height * 3). `data` is not modified

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <thread>
 
 #include "../sim/sim_test_util.hpp"
 #include "core/error.hpp"
@@ -135,6 +136,36 @@ TEST(Scene, RendersTheStateAfterARunFromTheModelCamera) {
   long changed = 0;
   for (size_t i = 0; i < after.size(); ++i) changed += std::abs(after[i] - before[i]) > 40;
   EXPECT_GT(changed, 50);
+}
+
+// A renderer that keeps its contexts (prepared on a background thread, then reused) draws
+// exactly what a fresh one draws, from any thread, for images of any size that fits.
+TEST(Scene, ReusedAndPreparedContextsRenderTheSamePictures) {
+  const auto machine = make_xy_stage();
+  Simulation simulation(xy_stage_model(), *machine);
+  SceneRenderOptions small;
+  small.width = 160;
+  small.height = 120;
+  SceneRenderOptions large;
+  large.width = 320;
+  large.height = 240;
+  const auto fresh_small =
+      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), small);
+  const auto fresh_large =
+      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(false), large);
+
+  SceneRenderer renderer;
+  renderer.prepare(simulation.model_path());
+  std::vector<unsigned char> reused_small, reused_large;
+  std::thread other([&] {  // the prepared contexts move to this thread
+    reused_small =
+        renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(true), small);
+  });
+  other.join();
+  reused_large =
+      renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(false), large);
+  EXPECT_EQ(reused_small, fresh_small);
+  EXPECT_EQ(reused_large, fresh_large);
 }
 
 TEST(Scene, ImageLargerThanTheOffscreenBufferIsBadInput) {
