@@ -8,6 +8,7 @@
 #include "pipeline/compare.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/run.hpp"
+#include "render/scene.hpp"
 
 namespace depotwin {
 
@@ -49,6 +50,7 @@ RunSettings run_settings(const Scenario& scenario, const RunOptions& options) {
   RunSettings settings;
   settings.render = scenario.outputs.render && !options.no_render;
   settings.progress = !options.quiet;
+  if (settings.render) settings.scene_renderer = std::make_shared<SceneRenderer>();
   return settings;
 }
 
@@ -60,12 +62,19 @@ int run_verb(const RunOptions& options) {
   const std::vector<PlannerSpec> planners = select_planners(scenario, options.planners);
   const std::string directory = output_directory(scenario, options.out);
   const RunSettings settings = run_settings(scenario, options);
+  if (settings.scene_renderer) settings.scene_renderer->prepare(job.model_path);
+  // each planner simulates while the previous one's results are written
   std::vector<MetricsReport> reports;
+  std::vector<SimulatedRun> runs;
+  runs.reserve(planners.size());  // the writer holds references: no reallocation
+  BackgroundRunWriter writer;
   for (const PlannerSpec& spec : planners) {
-    const SimulatedRun run = simulate_job(job, spec, settings);
-    write_run(job, run, (std::filesystem::path(directory) / spec.name).string(), settings);
-    reports.push_back(run.report);
+    runs.push_back(simulate_job(job, spec, settings));
+    writer.submit(job, runs.back(), (std::filesystem::path(directory) / spec.name).string(),
+                  settings);
+    reports.push_back(runs.back().report);
   }
+  writer.wait();
   std::cout << "scenario " << scenario.name << " (" << scenario.file << "), machine "
             << job.machine->name() << ", process " << scenario.process.type << ", order "
             << scenario.order.label() << "\n\n"
@@ -92,8 +101,8 @@ int compare_verb(const CompareOptions& options) {
       compare_runs(scenario, planners, orders, directory, settings);
   std::vector<MetricsReport> reports;
   for (const ComparisonRow& row : rows) reports.push_back(row.report);
-  std::cout << "scenario " << scenario.name << " (" << scenario.file << "): "
-            << (orders.empty() ? "planners" : "print orders") << " compared\n\n"
+  std::cout << "scenario " << scenario.name << " (" << scenario.file
+            << "): " << (orders.empty() ? "planners" : "print orders") << " compared\n\n"
             << summary_table(reports) << '\n';
   print_warnings(reports);
   std::cout << "comparison written to " << directory << "/comparison.{json,csv,md"

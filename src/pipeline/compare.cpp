@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "plots/plots.hpp"
+#include "render/scene.hpp"
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
 
@@ -23,7 +24,8 @@ OrderSpec parse_order_label(const std::string& label, const OrderSpec& defaults)
   const auto& refines = refine_methods();
   if (std::find(methods.begin(), methods.end(), spec.method) == methods.end())
     throw InputError("--orders", "unknown order method '" + spec.method + "'");
-  if (!spec.refine.empty() && std::find(refines.begin(), refines.end(), spec.refine) == refines.end())
+  if (!spec.refine.empty() &&
+      std::find(refines.begin(), refines.end(), spec.refine) == refines.end())
     throw InputError("--orders", "unknown refinement '" + spec.refine + "'");
   return spec;
 }
@@ -57,7 +59,8 @@ plots::ComparisonColumn sheet_column(const std::string& label, const SimulatedRu
 
 }  // namespace
 
-std::vector<ComparisonRow> compare_runs(const Scenario& scenario, const std::vector<PlannerSpec>& planners,
+std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
+                                        const std::vector<PlannerSpec>& planners,
                                         const std::vector<OrderSpec>& orders,
                                         const std::string& directory, const RunSettings& settings) {
   // what to run: planners on the scenario's order, or the first planner on each order
@@ -77,16 +80,23 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario, const std::vec
   std::vector<SimulatedRun> runs;
   std::vector<HeightMap> maps;
   std::vector<PreparedJob> jobs;
+  // each case simulates while the previous one's results are written; the writer holds
+  // references into runs and jobs, so neither may reallocate
+  runs.reserve(cases.size());
+  jobs.reserve(cases.size());
+  BackgroundRunWriter writer;
   for (const Case& c : cases) {
     Scenario variant = scenario;
     variant.order = c.order;
     jobs.push_back(prepare_job(variant));
+    if (settings.scene_renderer) settings.scene_renderer->prepare(jobs.back().model_path);
     runs.push_back(simulate_job(jobs.back(), c.planner, settings));
     SimulatedRun& run = runs.back();
     run.report.planner = c.planner.name;
-    write_run(jobs.back(), run, (fs::path(directory) / c.label).string(), settings);
+    writer.submit(jobs.back(), run, (fs::path(directory) / c.label).string(), settings);
     rows.push_back({c.label, run.report});
   }
+  writer.wait();
 
   // the tables, then the side-by-side sheet on a shared colour scale
   fs::create_directories(directory);
@@ -136,30 +146,41 @@ const std::vector<Column>& columns() {
       {"time_s", [](const MetricsReport& r) { return number(r.time.total_s); }},
       {"print_s", [](const MetricsReport& r) { return number(r.time.print_s); }},
       {"transition_s", [](const MetricsReport& r) { return number(r.time.transition_s); }},
-      {"vel_err_max", [](const MetricsReport& r) {
+      {"vel_err_max",
+       [](const MetricsReport& r) {
          return r.velocity_error ? number(r.velocity_error->max_rel) : std::string("");
        }},
-      {"vel_err_rms", [](const MetricsReport& r) {
+      {"vel_err_rms",
+       [](const MetricsReport& r) {
          return r.velocity_error ? number(r.velocity_error->rms_rel) : std::string("");
        }},
-      {"vel_err_frac_over_1pct", [](const MetricsReport& r) {
+      {"vel_err_frac_over_1pct",
+       [](const MetricsReport& r) {
          return r.velocity_error ? number(r.velocity_error->frac_len_over_1pct) : std::string("");
        }},
       {"planned_vel_err_max",
        [](const MetricsReport& r) { return number(r.planned_velocity_error.max_rel); }},
       {"path_err_max_mm", [](const MetricsReport& r) { return number(r.path_error.max_mm); }},
       {"thickness_cv",
-       [](const MetricsReport& r) { return r.thickness ? number(r.thickness->cv) : std::string(""); }},
-      {"line_cv", [](const MetricsReport& r) {
+       [](const MetricsReport& r) {
+         return r.thickness ? number(r.thickness->cv) : std::string("");
+       }},
+      {"line_cv",
+       [](const MetricsReport& r) {
          return r.thickness ? number(r.thickness->line_cv) : std::string("");
        }},
       {"waste_fraction",
-       [](const MetricsReport& r) { return r.waste ? number(r.waste->fraction) : std::string(""); }},
-      {"shutter_captured", [](const MetricsReport& r) {
+       [](const MetricsReport& r) {
+         return r.waste ? number(r.waste->fraction) : std::string("");
+       }},
+      {"shutter_captured",
+       [](const MetricsReport& r) {
          return r.waste ? number(r.waste->shutter_captured) : std::string("");
        }},
       {"overspray",
-       [](const MetricsReport& r) { return r.waste ? number(r.waste->overspray) : std::string(""); }},
+       [](const MetricsReport& r) {
+         return r.waste ? number(r.waste->overspray) : std::string("");
+       }},
       {"warnings", [](const MetricsReport& r) { return std::to_string(r.warnings.size()); }},
   };
   return list;
@@ -193,7 +214,8 @@ std::string comparison_markdown(const std::string& scenario, const std::vector<C
     for (const Column& c : columns()) out += " " + c.value(row.report) + " |";
     out += '\n';
   }
-  out += "\nDefinitions: README.md, \"Metrics\". Speed errors and waste are fractions (0.01 = 1 %).\n";
+  out +=
+      "\nDefinitions: README.md, \"Metrics\". Speed errors and waste are fractions (0.01 = 1 %).\n";
   if (with_images) {
     out += "\n## Images per run\n\n";
     for (const ComparisonRow& row : rows) {

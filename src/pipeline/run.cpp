@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 
 #include "core/error.hpp"
 #include "deposition/deposition_metrics.hpp"
@@ -307,38 +308,76 @@ HeightMap field_heightmap(const ThicknessField& field, size_t max_cells) {
 void write_run(const PreparedJob& job, const SimulatedRun& run, const std::string& run_directory,
                const RunSettings& settings) {
   StagedDirectory out(run_directory);
-  write_file_atomically(out.file("metrics.json"), metrics_json_text(run.report));
-  write_file_atomically(out.file("trajectory.csv"),
-                        planned_and_simulated_csv(run.planned_at_steps, run.simulated));
-
-  // the thickness field: 16-bit PNG and CSV with origin and cell size (at most ~4 M cells)
   const ThicknessField& field = run.process->field();
-  const HeightMap map = field_heightmap(field, kMaxExportCells);
-  if (!map.thickness_um.empty()) {
-    const double scale = write_heightmap_png16(map, out.file("thickness_field.png"));
-    write_heightmap_csv(map, out.file("thickness.csv"), scale);
-  }
+  const HeightMap map = field_heightmap(field, kMaxExportCells);  // at most ~4 M cells
+  const std::string directory = out.path();
 
+  // the paper-style plots and the heat map: one gnuplot process, started first from a
+  // worker thread, so that it draws on the second core while this thread writes the data
+  // files and renders the scene
+  std::future<void> plots_done;
   if (settings.render) {
-    SceneRenderOptions scene;
-    scene.width = job.scenario.outputs.image_width;
-    scene.height = job.scenario.outputs.image_height;
-    render_scene_png(*run.simulation, map, out.file("scene.png"), scene);
-
-    // the paper-style plots and the heat map: one gnuplot process
-    plots::RunPlotInput input;
-    input.title = job.scenario.name + " / " + run.report.planner;
-    input.toolpath = &job.toolpath;
-    input.planned = &run.planned_at_steps;
-    input.simulated = &run.simulated;
-    input.transitions = plots::transition_intervals(run.plan.trajectory);
-    if (!map.thickness_um.empty()) input.thickness = &map;
-    input.profiles = centreline_profiles(field, job.toolpath);
-    input.target_thickness_um = target_thickness_um(*run.process, job.toolpath);
-    if (run.report.thickness) input.mean_thickness_um = run.report.thickness->mean_um;
-    plots::render_run_plots(input, out.path());
+    plots_done = std::async(std::launch::async, [&job, &run, &field, &map, &directory] {
+      plots::RunPlotInput input;
+      input.title = job.scenario.name + " / " + run.report.planner;
+      input.toolpath = &job.toolpath;
+      input.planned = &run.planned_at_steps;
+      input.simulated = &run.simulated;
+      input.transitions = plots::transition_intervals(run.plan.trajectory);
+      if (!map.thickness_um.empty()) input.thickness = &map;
+      input.profiles = centreline_profiles(field, job.toolpath);
+      input.target_thickness_um = target_thickness_um(*run.process, job.toolpath);
+      if (run.report.thickness) input.mean_thickness_um = run.report.thickness->mean_um;
+      plots::render_run_plots(input, directory);
+    });
   }
+
+  // the plots are waited for (and their errors rethrown) even when this part fails, so no
+  // thread outlives its inputs
+  try {
+    write_file_atomically(out.file("metrics.json"), metrics_json_text(run.report));
+    write_file_atomically(out.file("trajectory.csv"),
+                          planned_and_simulated_csv(run.planned_at_steps, run.simulated));
+
+    // the thickness field: 16-bit PNG and CSV with origin and cell size
+    if (!map.thickness_um.empty()) {
+      const double scale = write_heightmap_png16(map, out.file("thickness_field.png"));
+      write_heightmap_csv(map, out.file("thickness.csv"), scale);
+    }
+
+    // the MuJoCo scene through OSMesa
+    if (settings.render) {
+      SceneRenderOptions scene;
+      scene.width = job.scenario.outputs.image_width;
+      scene.height = job.scenario.outputs.image_height;
+      if (settings.scene_renderer)
+        settings.scene_renderer->render_png(*run.simulation, map, out.file("scene.png"), scene);
+      else
+        render_scene_png(*run.simulation, map, out.file("scene.png"), scene);
+    }
+  } catch (...) {
+    if (plots_done.valid()) plots_done.wait();
+    throw;
+  }
+  if (plots_done.valid()) plots_done.get();
   out.commit();
+}
+
+BackgroundRunWriter::~BackgroundRunWriter() {
+  if (pending_.valid()) pending_.wait();
+}
+
+void BackgroundRunWriter::submit(const PreparedJob& job, const SimulatedRun& run,
+                                 std::string run_directory, const RunSettings& settings) {
+  wait();
+  pending_ =
+      std::async(std::launch::async, [&job, &run, directory = std::move(run_directory), &settings] {
+        write_run(job, run, directory, settings);
+      });
+}
+
+void BackgroundRunWriter::wait() {
+  if (pending_.valid()) pending_.get();
 }
 
 }  // namespace depotwin

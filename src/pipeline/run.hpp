@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <future>
 #include <memory>
 #include <string>
 
@@ -13,9 +14,14 @@
 
 namespace depotwin {
 
+class SceneRenderer;
+
 struct RunSettings {
-  bool render = true;  // images and plots
+  bool render = true;    // images and plots
   bool progress = true;  // a progress line on stderr for runs longer than a second
+  // scene renderer shared by the runs of one verb, so its context is built once (null: one
+  // per image)
+  std::shared_ptr<SceneRenderer> scene_renderer;
 };
 
 // One planner's simulated run, kept whole so the outputs can be written from it.
@@ -31,7 +37,7 @@ struct SimulatedRun {
 
 // thickness along each print path's centreline, sampled every cell length
 std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
-                                                   const Toolpath& toolpath);
+                                                    const Toolpath& toolpath);
 // the centreline thickness of a straight line printed at the first path's desired speed
 double target_thickness_um(const Process& process, const Toolpath& toolpath);
 
@@ -46,6 +52,26 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
 // Staged: nothing half-written, an older result replaced only when complete.
 void write_run(const PreparedJob& job, const SimulatedRun& run, const std::string& run_directory,
                const RunSettings& settings);
+
+// write_run on a worker thread, one run at a time, so that the next planner simulates while
+// the previous one's files and images are written. The job, run and settings must outlive
+// the write (until the next submit, wait or destruction).
+class BackgroundRunWriter {
+ public:
+  BackgroundRunWriter() = default;
+  ~BackgroundRunWriter();  // waits; a failure not collected by wait() is dropped
+  BackgroundRunWriter(const BackgroundRunWriter&) = delete;
+  BackgroundRunWriter& operator=(const BackgroundRunWriter&) = delete;
+
+  // waits for the previous write (rethrowing its error), then starts this one
+  void submit(const PreparedJob& job, const SimulatedRun& run, std::string run_directory,
+              const RunSettings& settings);
+  // waits for the write in flight; rethrows its error
+  void wait();
+
+ private:
+  std::future<void> pending_;
+};
 
 // the field over its bounds as a dense grid, block-averaged to at most max_cells cells
 constexpr size_t kMaxExportCells = 4000000;
