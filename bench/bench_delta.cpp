@@ -53,25 +53,14 @@ double raw_steps_seconds(const std::string& model_path, long steps) {
 long full_run(Simulation& simulation, const CircleJob& circle, double& emitted_mm3) {
   const Machine& machine = *circle.job.machine;
   const Trajectory& trajectory = circle.plan.trajectory;
-  simulation.set_feedforward_hook([&machine, &trajectory](const mjModel&, const mjData&,
-                                                          const JointReference& reference,
-                                                          double* force) {
-    const TrajectorySample s = trajectory.at(reference.t_s);
-    machine.closure_feedforward(s.position_mm, s.velocity_mm_s, s.acceleration_mm_s2, force);
-  });
+  simulation.set_feedforward_hook(
+      closure_feedforward_hook(machine, trajectory, sim_settings(circle.job.scenario)));
   const std::unique_ptr<Process> process =
       make_process(deposition_settings(circle.job.scenario), circle.job.scenario.sim.cell_mm);
   const double job_end_s = trajectory.duration_s();
   auto on_step = [&](const StepState& before, const StepState& after) {
-    if (before.t_s >= job_end_s - 1e-12) return;
     DepositionStep step;
-    step.t0_s = before.t_s;
-    step.t1_s = after.t_s;
-    step.p0_mm = before.nozzle_mm;
-    step.p1_mm = after.nozzle_mm;
-    step.flow_command = before.deposit_command ? 1.0 : 0.0;
-    step.desired_speed_mm_s = before.desired_speed_mm_s;
-    process->advance(step);
+    if (deposition_step(before, after, job_end_s, step)) process->advance(step);
   };
   const RecordedRun run = simulation.run(trajectory, on_step);
   simulation.set_feedforward_hook({});

@@ -91,28 +91,6 @@ DepositionSettings aerosol_settings(const Scenario& scenario, bool batched) {
   return settings;
 }
 
-// one step of the job as src/pipeline/run.cpp hands it to the process
-bool to_deposition_step(const StepState& before, const StepState& after, double job_end_s,
-                        DepositionStep& step) {
-  if (before.t_s >= job_end_s - 1e-12) return false;
-  step.t0_s = before.t_s;
-  step.t1_s = after.t_s;
-  step.p0_mm = before.nozzle_mm;
-  step.p1_mm = after.nozzle_mm;
-  step.open0 = before.open_fraction;
-  step.open1 = after.open_fraction;
-  // the step that straddles the job's end is cut there
-  if (after.t_s > job_end_s) {
-    const double f = (job_end_s - before.t_s) / (after.t_s - before.t_s);
-    step.t1_s = job_end_s;
-    step.p1_mm = before.nozzle_mm + f * (after.nozzle_mm - before.nozzle_mm);
-    step.open1 = before.open_fraction + f * (after.open_fraction - before.open_fraction);
-  }
-  step.flow_command = before.deposit_command ? 1.0 : 0.0;
-  step.desired_speed_mm_s = before.desired_speed_mm_s;
-  return true;
-}
-
 // bare physics: mj_step on the same model and timestep, servos holding their start
 double raw_steps_cpu_s(const mjModel& model, mjData& data, long steps) {
   mj_resetData(&model, &data);
@@ -170,7 +148,7 @@ void BM_PipelineOverRaw(benchmark::State& state) {
       Process& p = *process;
       on_step = [&p, job_end_s](const StepState& before, const StepState& after) {
         DepositionStep step;
-        if (to_deposition_step(before, after, job_end_s, step)) p.advance(step);
+        if (deposition_step(before, after, job_end_s, step)) p.advance(step);
       };
     }
     // the full per-step pipeline (and the flush the pipeline does before reading the field)
@@ -217,7 +195,7 @@ void BM_DepositionKernel(benchmark::State& state) {
                           scenario_sim_settings(scenario));
     simulation.run(planned.plan.trajectory, [&](const StepState& before, const StepState& after) {
       DepositionStep step;
-      if (to_deposition_step(before, after, job_end_s, step)) steps.push_back(step);
+      if (deposition_step(before, after, job_end_s, step)) steps.push_back(step);
     });
   }
   const DepositionSettings settings = aerosol_settings(scenario, batched);

@@ -65,16 +65,6 @@ class ProgressLine {
   std::chrono::steady_clock::time_point start_;
 };
 
-SimSettings sim_settings(const Scenario& scenario) {
-  SimSettings s;
-  s.timestep_s = scenario.sim.timestep_s;
-  s.control_period_s = scenario.sim.control_period_s;
-  s.kp_scale = scenario.sim.kp_scale;
-  s.settle_s = scenario.sim.settle_s;
-  s.shutter_time_s = scenario.process.shutter_time_s;
-  return s;
-}
-
 // the recorded nozzle as motion samples (the same shape as the plan's)
 MotionSamples simulated_samples(const RecordedRun& record) {
   MotionSamples samples;
@@ -170,6 +160,59 @@ double target_thickness_um(const Process& process, const Toolpath& toolpath) {
   return 1000.0 * s.bead_width_mm * s.layer_height_mm / root;
 }
 
+SimSettings sim_settings(const Scenario& scenario) {
+  SimSettings s;
+  s.timestep_s = scenario.sim.timestep_s;
+  s.control_period_s = scenario.sim.control_period_s;
+  s.kp_scale = scenario.sim.kp_scale;
+  s.settle_s = scenario.sim.settle_s;
+  s.shutter_time_s = scenario.process.shutter_time_s;
+  return s;
+}
+
+bool deposition_step(const StepState& before, const StepState& after, double job_end_s,
+                     DepositionStep& step) {
+  if (before.t_s >= job_end_s - 1e-12) return false;
+  step.t0_s = before.t_s;
+  step.t1_s = after.t_s;
+  step.p0_mm = before.nozzle_mm;
+  step.p1_mm = after.nozzle_mm;
+  step.open0 = before.open_fraction;
+  step.open1 = after.open_fraction;
+  // the step that straddles the job's end is cut there (chord and flap linear in time)
+  if (after.t_s > job_end_s) {
+    const double f = (job_end_s - before.t_s) / (after.t_s - before.t_s);
+    step.t1_s = job_end_s;
+    step.p1_mm = before.nozzle_mm + f * (after.nozzle_mm - before.nozzle_mm);
+    step.open1 = before.open_fraction + f * (after.open_fraction - before.open_fraction);
+  }
+  step.flow_command = before.deposit_command ? 1.0 : 0.0;
+  step.desired_speed_mm_s = before.desired_speed_mm_s;
+  return true;
+}
+
+Simulation::FeedForwardHook closure_feedforward_hook(const Machine& machine,
+                                                     const Trajectory& trajectory,
+                                                     const SimSettings& sim) {
+  // the TCP acceleration the servo's setpoints give over the coming control period: the
+  // second difference of the TCP setpoints, as the joints' references (Simulation)
+  const double period_s =
+      static_cast<double>(std::max(1L, std::lround(sim.control_period_s / sim.timestep_s))) *
+      sim.timestep_s;
+  return [&machine, &trajectory, period_s](const mjModel&, const mjData&,
+                                           const JointReference& reference, double* force) {
+    const TrajectorySample s = trajectory.at(reference.t_s);
+    const Vec3 next_mm = trajectory.at(reference.t_s + period_s).position_mm;
+    const Vec3 velocity_mm_s =
+        reference.t_s >= period_s
+            ? Vec3((s.position_mm - trajectory.at(reference.t_s - period_s).position_mm) / period_s)
+            : s.velocity_mm_s;
+    const Vec3 acceleration_mm_s2 =
+        ((next_mm - s.position_mm) / period_s - velocity_mm_s) / period_s;
+    machine.closure_feedforward(s.position_mm, velocity_mm_s, acceleration_mm_s2, force);
+  };
+}
+
 SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
                           const RunSettings& settings) {
   SimulatedRun run;
@@ -184,54 +227,18 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   deposition.validate();
   run.process = make_process(deposition, scenario.sim.cell_mm);
 
-  // loads carried through closed chains (a delta's platform) by the machine's own model, at
-  // the TCP acceleration the servo's setpoints give over the coming control period (the
-  // second difference of the TCP setpoints, as the joints' references: Simulation)
-  if (job.machine->has_closures()) {
-    const Machine& machine = *job.machine;
-    const SimSettings sim = sim_settings(scenario);
-    const double period_s =
-        static_cast<double>(std::max(1L, std::lround(sim.control_period_s / sim.timestep_s))) *
-        sim.timestep_s;
+  // loads carried through closed chains (a delta's platform) by the machine's own model
+  if (job.machine->has_closures())
     run.simulation->set_feedforward_hook(
-        [&machine, &trajectory, period_s](const mjModel&, const mjData&,
-                                          const JointReference& reference, double* force) {
-          const TrajectorySample s = trajectory.at(reference.t_s);
-          const Vec3 next_mm = trajectory.at(reference.t_s + period_s).position_mm;
-          const Vec3 velocity_mm_s =
-              reference.t_s >= period_s
-                  ? Vec3((s.position_mm - trajectory.at(reference.t_s - period_s).position_mm) /
-                         period_s)
-                  : s.velocity_mm_s;
-          const Vec3 acceleration_mm_s2 =
-              ((next_mm - s.position_mm) / period_s - velocity_mm_s) / period_s;
-          machine.closure_feedforward(s.position_mm, velocity_mm_s, acceleration_mm_s2, force);
-        });
-  }
+        closure_feedforward_hook(*job.machine, trajectory, sim_settings(scenario)));
 
   // every step of the job deposits along the simulated nozzle's chord; the aerosol stream
   // runs from job start to job end (the end of the trajectory), not through the settling
   Process& process = *run.process;
   const double job_end_s = trajectory.duration_s();
   auto on_step = [&](const StepState& before, const StepState& after) {
-    if (before.t_s >= job_end_s - 1e-12) return;
     DepositionStep step;
-    step.t0_s = before.t_s;
-    step.t1_s = after.t_s;
-    step.p0_mm = before.nozzle_mm;
-    step.p1_mm = after.nozzle_mm;
-    step.open0 = before.open_fraction;
-    step.open1 = after.open_fraction;
-    // the step that straddles the job's end is cut there (chord and flap linear in time)
-    if (after.t_s > job_end_s) {
-      const double f = (job_end_s - before.t_s) / (after.t_s - before.t_s);
-      step.t1_s = job_end_s;
-      step.p1_mm = before.nozzle_mm + f * (after.nozzle_mm - before.nozzle_mm);
-      step.open1 = before.open_fraction + f * (after.open_fraction - before.open_fraction);
-    }
-    step.flow_command = before.deposit_command ? 1.0 : 0.0;
-    step.desired_speed_mm_s = before.desired_speed_mm_s;
-    process.advance(step);
+    if (deposition_step(before, after, job_end_s, step)) process.advance(step);
   };
   ProgressLine progress(scenario.name + "/" + spec.name + ": simulating", settings.progress);
   run.record =

@@ -2,9 +2,6 @@
 // messages naming file/line/key, and nothing half-written on failure.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -19,25 +16,8 @@ using testing_support::fresh_directory;
 using testing_support::scenario_path;
 using testing_support::write_text;
 
-struct Result {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-// run the built CLI with arguments (shell-quoted by the caller where needed)
-Result depotwin(const std::string& arguments) {
-  const std::string command = std::string(DEPOTWIN_BINARY_DIR) + "/depotwin " + arguments + " 2>&1";
-  Result result;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    result.output.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using Result = testing_support::CliResult;
+using testing_support::depotwin;
 
 TEST(Cli, HelpOnEveryVerb) {
   const Result top = depotwin("--help");

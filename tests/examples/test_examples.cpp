@@ -2,10 +2,7 @@
 // (right pixel size, not blank), and a job without transitions draws no shaded band.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <algorithm>
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -30,25 +27,8 @@ using testing_support::read_bytes;
 using testing_support::scenario_path;
 using testing_support::write_text;
 
-struct Result {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-// the built CLI with arguments (paths single-quoted by the caller)
-Result depotwin(const std::string& arguments) {
-  const std::string command = std::string(DEPOTWIN_BINARY_DIR) + "/depotwin " + arguments + " 2>&1";
-  Result result;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    result.output.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using Result = testing_support::CliResult;
+using testing_support::depotwin;
 
 std::string quoted(const std::string& path) {
   return "'" + path + "'";

@@ -1,8 +1,12 @@
-// Helpers for the end-to-end tests: scenario files written to a fresh temporary folder.
+// Helpers for the end-to-end tests (XY and delta pipelines, CLI, examples): scenario files
+// written to a fresh temporary folder, files read back, quiet run settings, the built CLI.
 #pragma once
 
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -33,6 +37,27 @@ inline std::string read_text(const std::string& path) {
 
 inline std::string scenario_path(const std::string& name) {
   return std::string(DEPOTWIN_SCENARIOS_DIR) + "/" + name;
+}
+
+// what the built CLI returned
+struct CliResult {
+  int status = -1;
+  std::string output;  // stdout and stderr
+};
+
+// run the built CLI with arguments (shell-quoted by the caller where needed)
+inline CliResult depotwin(const std::string& arguments) {
+  const std::string command = std::string(DEPOTWIN_BINARY_DIR) + "/depotwin " + arguments + " 2>&1";
+  CliResult result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.output.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
 }
 
 }  // namespace depotwin::testing_support

@@ -12,9 +12,9 @@
 
 #include <Eigen/Dense>
 
-#include "delta_test_util.hpp"
 #include "kinematics/linear_delta.hpp"
 #include "pipeline/compare.hpp"
+#include "pipeline/pipeline_test_util.hpp"
 #include "pipeline/run.hpp"
 #include "planners_bezier/bezier_checks.hpp"
 #include "plots/png_check.hpp"
