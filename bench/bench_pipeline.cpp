@@ -74,17 +74,6 @@ PlannedJob plan_thompson() {
   return planned;
 }
 
-// the simulation settings src/pipeline/run.cpp derives from the scenario
-SimSettings scenario_sim_settings(const Scenario& scenario) {
-  SimSettings s;
-  s.timestep_s = scenario.sim.timestep_s;
-  s.control_period_s = scenario.sim.control_period_s;
-  s.kp_scale = scenario.sim.kp_scale;
-  s.settle_s = scenario.sim.settle_s;
-  s.shutter_time_s = scenario.process.shutter_time_s;
-  return s;
-}
-
 DepositionSettings aerosol_settings(const Scenario& scenario, bool batched) {
   DepositionSettings settings = deposition_settings(scenario);
   if (!batched) settings.batch_length_sigmas = 0.0;
@@ -129,8 +118,7 @@ void BM_PipelineOverRaw(benchmark::State& state) {
   const PlannedJob planned = plan_thompson();
   const Scenario& scenario = planned.job.scenario;
   const Trajectory& trajectory = planned.plan.trajectory;
-  Simulation simulation(planned.job.model_path, *planned.job.machine,
-                        scenario_sim_settings(scenario));
+  Simulation simulation(planned.job.model_path, *planned.job.machine, sim_settings(scenario));
   ModelPtr raw_model = load_model(kModel);
   raw_model->opt.timestep = scenario.sim.timestep_s;
   DataPtr raw_data = make_data(*raw_model);
@@ -191,8 +179,7 @@ void BM_DepositionKernel(benchmark::State& state) {
   // the job's steps, recorded once from the simulation
   std::vector<DepositionStep> steps;
   {
-    Simulation simulation(planned.job.model_path, *planned.job.machine,
-                          scenario_sim_settings(scenario));
+    Simulation simulation(planned.job.model_path, *planned.job.machine, sim_settings(scenario));
     simulation.run(planned.plan.trajectory, [&](const StepState& before, const StepState& after) {
       DepositionStep step;
       if (deposition_step(before, after, job_end_s, step)) steps.push_back(step);

@@ -8,6 +8,7 @@
 #include "pipeline/run.hpp"
 #include "pipeline_test_util.hpp"
 #include "plots/png_check.hpp"
+#include "quiet_settings.hpp"
 #include "render/scene.hpp"
 #include "report/metrics_json.hpp"
 
@@ -18,12 +19,7 @@ using testing_support::fresh_directory;
 using testing_support::scenario_path;
 using testing_support::write_text;
 
-RunSettings quiet(bool render = false) {
-  RunSettings settings;
-  settings.render = render;
-  settings.progress = false;
-  return settings;
-}
+using testing_support::quiet;
 
 PlannerSpec planner(const std::string& name) {
   return PlannerSpec{name, {}, 0};

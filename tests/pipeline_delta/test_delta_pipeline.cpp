@@ -15,6 +15,7 @@
 #include "kinematics/linear_delta.hpp"
 #include "pipeline/compare.hpp"
 #include "pipeline/pipeline_test_util.hpp"
+#include "pipeline/quiet_settings.hpp"
 #include "pipeline/run.hpp"
 #include "planners_bezier/bezier_checks.hpp"
 #include "plots/png_check.hpp"
@@ -28,12 +29,7 @@ using testing_support::fresh_directory;
 using testing_support::scenario_path;
 using testing_support::write_text;
 
-RunSettings quiet(bool render = false) {
-  RunSettings settings;
-  settings.render = render;
-  settings.progress = false;
-  return settings;
-}
+using testing_support::quiet;
 
 // a scenario planned and simulated with its first planner (or the one named)
 struct DeltaRun {
