@@ -2,6 +2,7 @@
 // minimum-time and trapezoidal moves). Plain data, evaluated by time.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 namespace depotwin {
@@ -39,6 +40,9 @@ class AxisProfile {
 
   // state at time t (relative to the profile's start); t is clamped to [0, duration]
   AxisState at(double t) const;
+  // the same, with the phase searched forwards from `phase_hint` (the phase of the previous
+  // call, updated): constant time per call when t only grows
+  AxisState at(double t, size_t& phase_hint) const;
   // largest |v| and |a| over the profile
   double peak_speed() const;
   double peak_acceleration() const;

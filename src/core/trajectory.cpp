@@ -81,17 +81,26 @@ void evaluate_motion(const TrajectoryPiece& piece, double tau, Vec3& position_mm
           velocity_mm_s, acceleration_mm_s2);
 }
 
+namespace {
+
+// what a sample says besides the motion: time, piece, path, deposition, desired speed
+void describe_piece(const TrajectoryPiece& piece, int index, double t, TrajectorySample& sample) {
+  sample.t_s = t;
+  sample.piece_index = index;
+  sample.path_index = piece.path_index;
+  sample.depositing = piece.depositing;
+  sample.desired_speed_mm_s = piece.desired_speed_mm_s;
+}
+
+}  // namespace
+
 TrajectorySample Trajectory::at(double t) const {
   TrajectorySample sample;
   if (pieces_.empty()) return sample;
   t = std::clamp(t, 0.0, duration_s());
   const int index = piece_at(t);
   const TrajectoryPiece& piece = pieces_[index];
-  sample.t_s = t;
-  sample.piece_index = index;
-  sample.path_index = piece.path_index;
-  sample.depositing = piece.depositing;
-  sample.desired_speed_mm_s = piece.desired_speed_mm_s;
+  describe_piece(piece, index, t, sample);
   evaluate_motion(piece, t - piece.t_begin_s, sample.position_mm, sample.velocity_mm_s,
                   sample.acceleration_mm_s2);
   return sample;
@@ -110,11 +119,7 @@ TrajectorySample TrajectoryCursor::at(double t) {
   while (piece_ + 1 < count && !(t < pieces[piece_ + 1].t_begin_s)) ++piece_;
   if (piece_ != previous_piece) phase_.fill(0);
   const TrajectoryPiece& piece = pieces[piece_];
-  sample.t_s = t;
-  sample.piece_index = piece_;
-  sample.path_index = piece.path_index;
-  sample.desired_speed_mm_s = piece.desired_speed_mm_s;
-  sample.depositing = piece.depositing;
+  describe_piece(piece, piece_, t, sample);
   const double tau = t - piece.t_begin_s;
   const auto* phases = std::get_if<PhaseMotion>(&piece.motion);
   if (phases == nullptr) {
@@ -122,25 +127,12 @@ TrajectorySample TrajectoryCursor::at(double t) {
                     sample.acceleration_mm_s2);
     return sample;
   }
-  // AxisProfile::at with the phase found forwards from the previous one: the same arithmetic
-  // (test_step_loop checks the samples bit for bit)
+  // per axis, the phase searched forwards from the previous sample's
   for (int axis = 0; axis < 3; ++axis) {
-    const AxisProfile& profile = phases->axes[axis];
-    const std::vector<Phase>& list = profile.phases();
-    if (list.empty() || tau <= 0.0) {
-      sample.position_mm[axis] = profile.q_start();
-      sample.velocity_mm_s[axis] = profile.v_start();
-      sample.acceleration_mm_s2[axis] = list.empty() ? 0.0 : list.front().a;
-      continue;
-    }
-    size_t& index = phase_[axis];
-    if (index >= list.size() || tau < list[index].t_begin_s) index = 0;
-    while (index + 1 < list.size() && !(tau < list[index + 1].t_begin_s)) ++index;
-    const Phase& phase = list[index];
-    const double local = std::min(tau - phase.t_begin_s, phase.duration_s);
-    sample.position_mm[axis] = phase.q0 + phase.v0 * local + 0.5 * phase.a * local * local;
-    sample.velocity_mm_s[axis] = phase.v0 + phase.a * local;
-    sample.acceleration_mm_s2[axis] = phase.a;
+    const AxisState state = phases->axes[axis].at(tau, phase_[axis]);
+    sample.position_mm[axis] = state.q;
+    sample.velocity_mm_s[axis] = state.v;
+    sample.acceleration_mm_s2[axis] = state.a;
   }
   return sample;
 }
