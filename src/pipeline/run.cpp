@@ -196,9 +196,7 @@ Simulation::FeedForwardHook closure_feedforward_hook(const Machine& machine,
                                                      const SimSettings& sim) {
   // the TCP acceleration the servo's setpoints give over the coming control period: the
   // second difference of the TCP setpoints, as the joints' references (Simulation)
-  const double period_s =
-      static_cast<double>(std::max(1L, std::lround(sim.control_period_s / sim.timestep_s))) *
-      sim.timestep_s;
+  const double period_s = static_cast<double>(sim.control_stride()) * sim.timestep_s;
   return [&machine, &trajectory, period_s](const mjModel&, const mjData&,
                                            const JointReference& reference, double* force) {
     const TrajectorySample s = trajectory.at(reference.t_s);
@@ -357,10 +355,9 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
       SceneRenderOptions scene;
       scene.width = job.scenario.outputs.image_width;
       scene.height = job.scenario.outputs.image_height;
-      if (settings.scene_renderer)
-        settings.scene_renderer->render_png(*run.simulation, map, out.file("scene.png"), scene);
-      else
-        render_scene_png(*run.simulation, map, out.file("scene.png"), scene);
+      SceneRenderer own_renderer;  // used only without a shared one
+      SceneRenderer& renderer = settings.scene_renderer ? *settings.scene_renderer : own_renderer;
+      renderer.render_png(*run.simulation, map, out.file("scene.png"), scene);
     }
   } catch (...) {
     if (plots_done.valid()) plots_done.wait();

@@ -275,8 +275,11 @@ struct SceneRenderer::Contexts {
   OsMesaContext gl;
   RenderContextOwner render;
   ModelShape shape;
-  Contexts(const mjModel& model, int width, int height)
-      : gl(width, height), render(model), shape(model_shape(model)) {}
+  // the GL buffer is the model's offscreen size, so any image size that fits reuses it
+  explicit Contexts(const mjModel& model)
+      : gl(model.vis.global.offwidth, model.vis.global.offheight),
+        render(model),
+        shape(model_shape(model)) {}
 };
 
 SceneRenderer::SceneRenderer() = default;
@@ -292,8 +295,7 @@ void SceneRenderer::prepare(const std::string& model_path) {
   install_mujoco_handlers();  // before the thread: the handlers are process-wide
   preparing_ = std::async(std::launch::async, [model_path] {
     const ModelPtr model = load_model(model_path);
-    auto contexts =
-        std::make_unique<Contexts>(*model, model->vis.global.offwidth, model->vis.global.offheight);
+    auto contexts = std::make_unique<Contexts>(*model);
     contexts->gl.release();  // the rendering thread makes it current
     return contexts;
   });
@@ -332,16 +334,14 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
   // set up: GL context, MuJoCo render context on the offscreen buffer, scene
   DataPtr state = copy_data(model, data);
   // the prepared contexts, or those of the previous image, when the model has the same shape
-  // (the same MJCF);
-  // the GL buffer is the model's offscreen size, so any image size that fits reuses it
+  // (the same MJCF)
   try {
     finish_preparation();
   } catch (const std::exception&) {  // built again below, where an error names this model
   }
   if (!contexts_ || !(contexts_->shape == model_shape(model))) {
     contexts_.reset();
-    contexts_ =
-        std::make_unique<Contexts>(model, model.vis.global.offwidth, model.vis.global.offheight);
+    contexts_ = std::make_unique<Contexts>(model);
   }
   contexts_->gl.make_current();
   mjrContext& context = contexts_->render.context;

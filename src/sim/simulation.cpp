@@ -101,6 +101,10 @@ const mjtNum* require_numeric(const mjModel& model, const std::string& name, int
 
 }  // namespace
 
+long SimSettings::control_stride() const {
+  return std::max(1L, std::lround(control_period_s / timestep_s));
+}
+
 std::string SimSettings::validate() const {
   if (!std::isfinite(timestep_s) || timestep_s < kMinTimestep_s || timestep_s > kMaxTimestep_s)
     return "timestep_s must be between " + format_number(kMinTimestep_s) + " and " +
@@ -497,7 +501,7 @@ Simulation::Simulation(const std::string& model_path, const Machine& machine,
   }
 
   m.opt.timestep = settings.timestep_s;
-  s.control_stride = std::max(1L, std::lround(settings.control_period_s / settings.timestep_s));
+  s.control_stride = settings.control_stride();
   s.data = make_data(m);
   s.acceleration_reference.assign(m.nv, 0.0);
   s.inertia_force.assign(m.nv, 0.0);

@@ -56,6 +56,8 @@ struct SimSettings {
 
   // "" when usable, else what is wrong (names the field)
   std::string validate() const;
+  // physics steps per servo update: control_period_s in whole timesteps, at least one
+  long control_stride() const;
 };
 
 // The simulated state at one step (user units, substrate frame).
