@@ -47,10 +47,14 @@ struct Servo {
   double kv = 0.0;        // N s/m or N m s/rad (actuator velocity gain)
   double damping = 0.0;   // joint damping, same units as kv
   double friction = 0.0;  // joint Coulomb friction (frictionloss), N or N m
+  // the plant's friction law on this dof (friction_law), fixed once the timestep is set:
+  // its regularisation speed capped at kFrictionFadeSpeed_si, and its rate B
+  double friction_speed_si = 0.0;
+  double friction_rate_per_s = 0.0;
 };
 
-// below this reference speed (SI) the friction feed-forward fades out smoothly (tanh), so
-// a reversal does not kick the servo
+// the friction feed-forward switches sign over at most this reference speed (SI), so a
+// reversal does not kick the servo
 constexpr double kFrictionFadeSpeed_si = 1e-4;
 
 Servo resolve_servo(const mjModel& model, const std::string& name, const std::string& path,
@@ -412,11 +416,10 @@ void Simulation::Impl::apply_servo(const Servo& servo, double q_si, double v_si,
   const HeldReference held = held_reference(*m, control_stride, q_si, v_si, a_si);
   double friction_force = 0.0;
   if (servo.friction > 0.0) {
-    const FrictionLaw law = friction_law(*m, servo.dof_adr, servo.friction);
-    const double speed_si = std::min(kFrictionFadeSpeed_si, law.speed_si);
     const double leading_si =
-        held.velocity_si + (law.rate_per_s > 0.0 ? a_si / law.rate_per_s : 0.0);
-    friction_force = servo.friction * std::clamp(leading_si / speed_si, -1.0, 1.0);
+        held.velocity_si +
+        (servo.friction_rate_per_s > 0.0 ? a_si / servo.friction_rate_per_s : 0.0);
+    friction_force = servo.friction * std::clamp(leading_si / servo.friction_speed_si, -1.0, 1.0);
   }
   const double force = inertia_force[servo.dof_adr] + d->qfrc_bias[servo.dof_adr] +
                        servo.kv * held.velocity_si + servo.damping * held.end_velocity_si +
@@ -502,6 +505,15 @@ Simulation::Simulation(const std::string& model_path, const Machine& machine,
 
   m.opt.timestep = settings.timestep_s;
   s.control_stride = settings.control_stride();
+  // the friction law depends on the timestep: fixed here, not per control update
+  const auto fix_friction_law = [&m](Servo& servo) {
+    if (!(servo.friction > 0.0)) return;
+    const FrictionLaw law = friction_law(m, servo.dof_adr, servo.friction);
+    servo.friction_speed_si = std::min(kFrictionFadeSpeed_si, law.speed_si);
+    servo.friction_rate_per_s = law.rate_per_s;
+  };
+  for (Servo& servo : s.joints) fix_friction_law(servo);
+  if (s.has_shutter) fix_friction_law(s.shutter);
   s.data = make_data(m);
   s.acceleration_reference.assign(m.nv, 0.0);
   s.inertia_force.assign(m.nv, 0.0);
