@@ -647,12 +647,12 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
     next_reference_k += stride;
     ++u;
 
-    // joint velocity J v (the acceleration follows below, from consecutive velocities)
-    const JointVector velocity = machine.joint_velocity(joints, sample.velocity_mm_s);
-    for (int j = 0; j < joint_count; ++j) {
-      const double to_si = s.joints[j].user_to_si;
-      q_ref[u * joint_count + j] = joints[j] * to_si;
-      v_ref[u * joint_count + j] = velocity[j] * to_si;
+    for (int j = 0; j < joint_count; ++j)
+      q_ref[u * joint_count + j] = joints[j] * s.joints[j].user_to_si;
+    // the start's joint velocity J v; later ones are differences of the setpoints (below)
+    if (u == 0) {
+      const JointVector velocity = machine.joint_velocity(joints, sample.velocity_mm_s);
+      for (int j = 0; j < joint_count; ++j) v_ref[j] = velocity[j] * s.joints[j].user_to_si;
     }
     if (s.has_shutter) {
       double fraction = 0.0, rate = 0.0;
