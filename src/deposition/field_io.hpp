@@ -4,8 +4,8 @@
 // Orientation (both files): the first image row / first CSV data row is the TOP row of
 // the map (largest y, iy = ny - 1); columns run along +x from origin_x_mm.
 // PNG: gray = round(thickness_um / um_per_level), 0..65535, big-endian 16-bit samples,
-// zlib-compressed (stb_image_write only writes 8-bit PNGs, so this is a small writer on
-// zlib). tEXt chunks carry um_per_level, origin_x_mm, origin_y_mm and cell_mm.
+// zlib-compressed (core/png.hpp). tEXt chunks carry um_per_level,
+// origin_x_mm, origin_y_mm and cell_mm.
 // CSV: '#' comment lines with the same metadata, then ny lines of nx thickness values (um).
 // I/O failures throw InternalError naming the file.
 #pragma once

@@ -12,26 +12,6 @@ namespace depotwin {
 
 namespace fs = std::filesystem;
 
-void write_file_atomically(const std::string& path, const std::string& content) {
-  const std::string temporary = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << content;
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(temporary, ignored);
-      throw InternalError("cannot write " + path);
-    }
-  }
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) {
-    fs::remove(temporary, error);
-    throw InternalError("cannot move " + temporary + " to " + path);
-  }
-}
-
 StagedDirectory::StagedDirectory(std::string final_path) : final_path_(std::move(final_path)) {
   // strip trailing slashes so the staging name sits beside the final directory
   while (final_path_.size() > 1 && final_path_.back() == '/') final_path_.pop_back();

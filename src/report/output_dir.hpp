@@ -1,14 +1,12 @@
-// Nothing half-written: files go to a temporary name and are renamed into place; a run's
-// output directory is staged beside its final place and renamed only when complete.
+// Nothing half-written: a run's output directory is staged beside its final place and
+// renamed only when complete; its files are written with write_file_atomically.
 #pragma once
 
 #include <string>
 
-namespace depotwin {
+#include "core/file_io.hpp"
 
-// Write `content` to `path` through a temporary file in the same directory and a rename.
-// Throws InternalError on I/O failure (the target is then untouched).
-void write_file_atomically(const std::string& path, const std::string& content);
+namespace depotwin {
 
 // A directory built under a temporary name (`<final>.partial-<pid>`) and renamed to its
 // final name by commit(), replacing an older result. Destroyed without commit(), it is

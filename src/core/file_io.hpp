@@ -1,0 +1,13 @@
+// Nothing half-written: a file goes to a temporary name beside its target and is renamed
+// into place, so a reader sees the old file or the whole new one.
+#pragma once
+
+#include <string>
+
+namespace depotwin {
+
+// Write `content` to `path` through a temporary file in the same directory and a rename.
+// Throws InternalError on I/O failure (the target is then untouched).
+void write_file_atomically(const std::string& path, const std::string& content);
+
+}  // namespace depotwin
