@@ -113,11 +113,8 @@ void BM_FullOverRaw(benchmark::State& state) {
 }
 BENCHMARK(BM_FullOverRaw)->Unit(benchmark::kMillisecond)->Iterations(5);
 
-void BM_RenderScene(benchmark::State& state) {
-  const auto machine = make_xy_stage();
-  Simulation simulation(kModel, *machine);
-  simulation.run(straight_print(3.0));
-  // a 10 mm line on a 0.05 mm grid around it
+// the deposit of a 10 mm line on a 0.05 mm grid around it
+HeightMap line_deposit() {
   HeightMap map;
   map.cell_mm = 0.05;
   map.nx = 280;
@@ -132,6 +129,15 @@ void BM_RenderScene(benchmark::State& state) {
         map.thickness_um[static_cast<size_t>(iy) * map.nx + ix] =
             static_cast<float>(2.0 * std::exp(-y * y / 0.02));
     }
+  return map;
+}
+
+// one image with fresh GL and MuJoCo contexts (what a single render costs)
+void BM_RenderScene(benchmark::State& state) {
+  const auto machine = make_xy_stage();
+  Simulation simulation(kModel, *machine);
+  simulation.run(straight_print(3.0));
+  const HeightMap map = line_deposit();
   SceneRenderOptions options;  // 640 x 480
   for (auto _ : state) {
     const auto rgb = render_scene_rgb(simulation.model(), simulation.data(), map, options);
@@ -142,6 +148,26 @@ void BM_RenderScene(benchmark::State& state) {
       benchmark::Counter::kIsRate | benchmark::Counter::kInvert, benchmark::Counter::kIs1000);
 }
 BENCHMARK(BM_RenderScene)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+
+// one more image on the contexts kept from the previous one (each planner after the first
+// in `run` and `compare`)
+void BM_RenderSceneReused(benchmark::State& state) {
+  const auto machine = make_xy_stage();
+  Simulation simulation(kModel, *machine);
+  simulation.run(straight_print(3.0));
+  const HeightMap map = line_deposit();
+  SceneRenderOptions options;  // 640 x 480
+  SceneRenderer renderer;
+  renderer.render_rgb(simulation.model(), simulation.data(), map, options);  // contexts built
+  for (auto _ : state) {
+    const auto rgb = renderer.render_rgb(simulation.model(), simulation.data(), map, options);
+    benchmark::DoNotOptimize(rgb.data());
+  }
+  state.counters["time_per_image"] = benchmark::Counter(
+      static_cast<double>(state.iterations()),
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert, benchmark::Counter::kIs1000);
+}
+BENCHMARK(BM_RenderSceneReused)->Unit(benchmark::kMillisecond)->Iterations(10)->UseRealTime();
 
 }  // namespace
 }  // namespace depotwin

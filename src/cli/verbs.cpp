@@ -62,7 +62,8 @@ int run_verb(const RunOptions& options) {
   const std::vector<PlannerSpec> planners = select_planners(scenario, options.planners);
   const std::string directory = output_directory(scenario, options.out);
   const RunSettings settings = run_settings(scenario, options);
-  if (settings.scene_renderer) settings.scene_renderer->prepare(job.model_path);
+  if (settings.scene_renderer)
+    settings.scene_renderer->prepare(job.model_path, scene_render_options(scenario));
   // each planner simulates while the previous one's results are written
   std::vector<MetricsReport> reports;
   std::vector<SimulatedRun> runs;

@@ -17,7 +17,8 @@ struct ComparisonRow {
 
 // Run every planner named (or, with `orders` non-empty, the first planner under each of the
 // orders) and write DIR/<label>/... plus DIR/comparison.*. Returns the rows in order.
-std::vector<ComparisonRow> compare_runs(const Scenario& scenario, const std::vector<PlannerSpec>& planners,
+std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
+                                        const std::vector<PlannerSpec>& planners,
                                         const std::vector<OrderSpec>& orders,
                                         const std::string& directory, const RunSettings& settings);
 

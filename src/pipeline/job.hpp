@@ -22,7 +22,7 @@ struct PreparedJob {
   std::string model_path;  // the MJCF to simulate
   MachineLimits limits;    // what every planner must respect
   OrderResult order;
-  Toolpath toolpath;       // in print order
+  Toolpath toolpath;  // in print order
 };
 
 // Throws InputError for an unknown machine, an unreachable toolpath, ...
@@ -46,7 +46,8 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec);
 
 // `depotwin plan`: DIR/<planner>/metrics.json and trajectory.csv per planner; returns the
 // reports in planner order
-std::vector<MetricsReport> write_plans(const PreparedJob& job, const std::vector<PlannerSpec>& planners,
+std::vector<MetricsReport> write_plans(const PreparedJob& job,
+                                       const std::vector<PlannerSpec>& planners,
                                        const std::string& directory);
 
 // a fixed-width summary table of the reports

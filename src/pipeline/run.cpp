@@ -302,6 +302,13 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   return run;
 }
 
+SceneRenderOptions scene_render_options(const Scenario& scenario) {
+  SceneRenderOptions options;
+  options.width = scenario.outputs.image_width;
+  options.height = scenario.outputs.image_height;
+  return options;
+}
+
 HeightMap field_heightmap(const ThicknessField& field, size_t max_cells) {
   const FieldBounds b = field.bounds();
   if (b.empty) return HeightMap{};
@@ -352,9 +359,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
 
     // the MuJoCo scene through OSMesa
     if (settings.render) {
-      SceneRenderOptions scene;
-      scene.width = job.scenario.outputs.image_width;
-      scene.height = job.scenario.outputs.image_height;
+      const SceneRenderOptions scene = scene_render_options(job.scenario);
       SceneRenderer own_renderer;  // used only without a shared one
       SceneRenderer& renderer = settings.scene_renderer ? *settings.scene_renderer : own_renderer;
       renderer.render_png(*run.simulation, map, out.file("scene.png"), scene);
@@ -368,20 +373,27 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
 }
 
 BackgroundRunWriter::~BackgroundRunWriter() {
-  if (pending_.valid()) pending_.wait();
+  for (std::future<void>& write : pending_)
+    if (write.valid()) write.wait();
 }
 
 void BackgroundRunWriter::submit(const PreparedJob& job, const SimulatedRun& run,
                                  std::string run_directory, const RunSettings& settings) {
-  wait();
-  pending_ =
+  while (pending_.size() >= kWritesInFlight) wait_oldest();
+  pending_.push_back(
       std::async(std::launch::async, [&job, &run, directory = std::move(run_directory), &settings] {
         write_run(job, run, directory, settings);
-      });
+      }));
+}
+
+void BackgroundRunWriter::wait_oldest() {
+  std::future<void> oldest = std::move(pending_.front());
+  pending_.pop_front();
+  oldest.get();
 }
 
 void BackgroundRunWriter::wait() {
-  if (pending_.valid()) pending_.get();
+  while (!pending_.empty()) wait_oldest();
 }
 
 }  // namespace depotwin

@@ -2,6 +2,7 @@
 // -> write. Everything downstream of the plan reads the simulated nozzle, never the plan.
 #pragma once
 
+#include <deque>
 #include <functional>
 #include <future>
 #include <memory>
@@ -10,11 +11,10 @@
 #include "deposition/process.hpp"
 #include "pipeline/job.hpp"
 #include "plots/plots.hpp"
+#include "render/scene.hpp"
 #include "sim/simulation.hpp"
 
 namespace depotwin {
-
-class SceneRenderer;
 
 struct RunSettings {
   bool render = true;    // images and plots
@@ -63,30 +63,40 @@ Simulation::FeedForwardHook closure_feedforward_hook(const Machine& machine,
 SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
                           const RunSettings& settings);
 
+// the scene image the scenario asks for (outputs.image_width / image_height)
+SceneRenderOptions scene_render_options(const Scenario& scenario);
+
 // run_directory (DIR/<planner>): metrics.json, trajectory.csv, thickness.csv,
 // thickness_field.png and, when rendering, scene.png, thickness.png and the plots.
 // Staged: nothing half-written, an older result replaced only when complete.
 void write_run(const PreparedJob& job, const SimulatedRun& run, const std::string& run_directory,
                const RunSettings& settings);
 
-// write_run on a worker thread, one run at a time, so that the next planner simulates while
-// the previous one's files and images are written. The job, run and settings must outlive
-// the write (until the next submit, wait or destruction).
+// write_run on worker threads, so that the next planner simulates while the previous ones'
+// files and images are written. At most kWritesInFlight writes run at once: their scene
+// renders take turns on the shared renderer while gnuplot and the data files proceed beside
+// them. The job, run and settings of a write must outlive it (until wait() or destruction).
 class BackgroundRunWriter {
  public:
+  static constexpr size_t kWritesInFlight = 2;
+
   BackgroundRunWriter() = default;
   ~BackgroundRunWriter();  // waits; a failure not collected by wait() is dropped
   BackgroundRunWriter(const BackgroundRunWriter&) = delete;
   BackgroundRunWriter& operator=(const BackgroundRunWriter&) = delete;
 
-  // waits for the previous write (rethrowing its error), then starts this one
+  // with kWritesInFlight writes running, waits for the oldest (rethrowing its error); then
+  // starts this one
   void submit(const PreparedJob& job, const SimulatedRun& run, std::string run_directory,
               const RunSettings& settings);
-  // waits for the write in flight; rethrows its error
+  // waits for every write in flight, oldest first; rethrows the first error
   void wait();
 
  private:
-  std::future<void> pending_;
+  // collect the oldest write; rethrows its error
+  void wait_oldest();
+
+  std::deque<std::future<void>> pending_;
 };
 
 // the field over its bounds as a dense grid, block-averaged to at most max_cells cells

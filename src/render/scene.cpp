@@ -1,14 +1,14 @@
 #include "render/scene.hpp"
 
 #include <GL/osmesa.h>
-#include <stb_image_write.h>
 
-#include <unistd.h>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <limits>
 
 #include "core/error.hpp"
+#include "core/file_io.hpp"
+#include "core/png.hpp"
 #include "core/types.hpp"
 #include "sim/mujoco_boundary.hpp"
 #include "sim/simulation.hpp"
@@ -30,6 +30,13 @@ constexpr double kLightDistance_m = 0.6;
 constexpr double kNozzleApartFraction = 0.2;
 // deposit boxes float this far above the plate so they never z-fight with it (mm)
 constexpr double kLift_mm = 0.005;
+// the floor drawn under the machine: colour, half-width and drop below the lowest geom (in
+// model extents)
+constexpr float kBackdropColour[4] = {0.78f, 0.80f, 0.83f, 1.0f};
+constexpr double kBackdropHalfWidth = 20.0;
+constexpr double kBackdropDrop = 0.05;
+// zlib level of the scene PNGs
+constexpr int kSceneZlibLevel = 1;
 
 // an OSMesa context made current on its own colour buffer; destroyed last
 class OsMesaContext {
@@ -44,9 +51,12 @@ class OsMesaContext {
     }
   }
   // current on the calling thread (a renderer may be used from another thread than the one
-  // that built it, one thread at a time)
+  // that built it, one thread at a time); false when OSMesa refuses
+  bool try_make_current() noexcept {
+    return OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width_, height_);
+  }
   void make_current() {
-    if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width_, height_))
+    if (!try_make_current())
       throw InternalError("OSMesa could not make its rendering context current");
   }
   // no context current on the calling thread, so another thread may take this one
@@ -74,25 +84,38 @@ struct SceneOwner {
 };
 struct RenderContextOwner {
   mjrContext context;
-  explicit RenderContextOwner(const mjModel& model) {
+  // made from a copy of the model whose offscreen and shadow sizes are those of `shape`
+  RenderContextOwner(const mjModel& model, int width, int height, int shadow_size) {
+    const ModelPtr sized(mj_copyModel(nullptr, &model));
+    if (!sized) throw InternalError("MuJoCo could not copy the model for its render context");
+    sized->vis.global.offwidth = width;
+    sized->vis.global.offheight = height;
+    sized->vis.quality.offsamples = 0;  // anti-aliased by supersampling instead
+    sized->vis.quality.shadowsize = shadow_size;
     mjr_defaultContext(&context);
-    mjr_makeContext(&model, &context, mjFONTSCALE_100);
+    mjr_makeContext(sized.get(), &context, mjFONTSCALE_100);
   }
   ~RenderContextOwner() { mjr_freeContext(&context); }
   RenderContextOwner(const RenderContextOwner&) = delete;
   RenderContextOwner& operator=(const RenderContextOwner&) = delete;
 };
 
-// what an mjrContext depends on: models of the same MJCF file have the same shape
-struct ModelShape {
-  int ngeom, nmesh, nmeshvert, ntex, ntexdata, nmat, nskin, nhfield, offwidth, offheight;
-  bool operator==(const ModelShape& o) const {
+// what an mjrContext depends on: the model's shape (models of the same MJCF file have the
+// same one) and the buffers it was made with
+struct ContextShape {
+  int ngeom, nmesh, nmeshvert, ntex, ntexdata, nmat, nskin, nhfield;
+  int width, height, shadow_size;
+  bool operator==(const ContextShape& o) const {
     return ngeom == o.ngeom && nmesh == o.nmesh && nmeshvert == o.nmeshvert && ntex == o.ntex &&
            ntexdata == o.ntexdata && nmat == o.nmat && nskin == o.nskin && nhfield == o.nhfield &&
-           offwidth == o.offwidth && offheight == o.offheight;
+           width == o.width && height == o.height && shadow_size == o.shadow_size;
   }
 };
-ModelShape model_shape(const mjModel& m) {
+// The offscreen buffer is the supersampled image's size, not the model's <global offwidth
+// offheight>, without multisampling, and the shadow map is left out when shadows are off: in
+// software GL a multisampled buffer costs its own shader compilation and a resolve pass, and
+// a 2048-pixel shadow map is 16 MB of memory to clear.
+ContextShape context_shape(const mjModel& m, const SceneRenderOptions& options) {
   return {m.ngeom,
           m.nmesh,
           m.nmeshvert,
@@ -101,8 +124,9 @@ ModelShape model_shape(const mjModel& m) {
           m.nmat,
           m.nskin,
           m.nhfield,
-          m.vis.global.offwidth,
-          m.vis.global.offheight};
+          options.width * options.supersampling,
+          options.height * options.supersampling,
+          options.shadows ? m.vis.quality.shadowsize : 0};
 }
 
 // substrate-frame point (mm) -> world (m)
@@ -178,6 +202,26 @@ void add_deposit_boxes(const mjData& data, int substrate, const HeightMap& depos
   }
 }
 
+// A floor under the machine, so that no view shows the empty background (the models have
+// no skybox: in software GL each texture costs a shader compilation per process). Left out
+// when the model has a plane of its own.
+void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene) {
+  double lowest_m = std::numeric_limits<double>::infinity();
+  for (int geom = 0; geom < model.ngeom; ++geom) {
+    if (model.geom_type[geom] == mjGEOM_PLANE) return;
+    lowest_m = std::min(lowest_m, data.geom_xpos[3 * geom + 2] - model.geom_rbound[geom]);
+  }
+  if (!std::isfinite(lowest_m) || scene.ngeom >= scene.maxgeom) return;
+  const double extent_m = model.stat.extent;
+  const double half_thickness_m = 0.01 * extent_m;
+  const mjtNum size[3] = {kBackdropHalfWidth * extent_m, kBackdropHalfWidth * extent_m,
+                          half_thickness_m};
+  const mjtNum position[3] = {model.stat.center[0], model.stat.center[1],
+                              lowest_m - kBackdropDrop * extent_m - half_thickness_m};
+  const mjtNum identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  mjv_initGeom(scene.geoms + scene.ngeom++, mjGEOM_BOX, size, position, identity, kBackdropColour);
+}
+
 // the free camera that frames the deposit region and the nozzle from render_cam's elevation.
 // Its azimuth points from the deposit towards the nozzle when they are apart, so the print
 // head stands behind the deposit rather than in front of it; otherwise render_cam's azimuth.
@@ -239,18 +283,34 @@ void light_over_camera(const mjvCamera& view, mjvScene& scene) {
   }
 }
 
+// The image from a render `factor` times its size: each pixel the mean of a factor x factor
+// block (a box filter), rows flipped from OpenGL's bottom-up order to top-down.
+std::vector<unsigned char> downsample_flipped(const std::vector<unsigned char>& bottom_up,
+                                              int width, int height, int factor) {
+  std::vector<unsigned char> rgb(static_cast<size_t>(width) * height * 3);
+  const size_t source_row = static_cast<size_t>(width) * factor * 3;
+  const unsigned block = static_cast<unsigned>(factor * factor);
+  std::vector<unsigned> sums(static_cast<size_t>(width) * 3);
+  for (int row = 0; row < height; ++row) {
+    std::fill(sums.begin(), sums.end(), 0u);
+    for (int sub_row = 0; sub_row < factor; ++sub_row) {
+      const unsigned char* source =
+          bottom_up.data() + (static_cast<size_t>(row) * factor + sub_row) * source_row;
+      for (int column = 0; column < width; ++column)
+        for (int sub_column = 0; sub_column < factor; ++sub_column)
+          for (int channel = 0; channel < 3; ++channel)
+            sums[3 * column + channel] += source[3 * (column * factor + sub_column) + channel];
+    }
+    unsigned char* target = rgb.data() + static_cast<size_t>(height - 1 - row) * width * 3;
+    for (size_t i = 0; i < sums.size(); ++i)
+      target[i] = static_cast<unsigned char>((sums[i] + block / 2) / block);
+  }
+  return rgb;
+}
+
 void write_png(const std::string& path, int width, int height,
                const std::vector<unsigned char>& rgb) {
-  // to a temporary file beside the target, then renamed over it
-  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
-  if (!stbi_write_png(temporary.c_str(), width, height, 3, rgb.data(), width * 3)) {
-    std::remove(temporary.c_str());
-    throw InternalError("cannot write the image " + temporary);
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    throw InternalError("cannot rename " + temporary + " to " + path);
-  }
+  write_file_atomically(path, encode_png(width, height, PngPixels::rgb8, rgb.data()));
 }
 
 }  // namespace
@@ -269,17 +329,20 @@ void viridis(double value, float rgb[3]) {
 }
 
 // The GL and MuJoCo render contexts, kept between images. mjr_makeContext is most of an
-// image's cost in software (about 0.15 s: buffers, textures, shader compilation), so a run
-// that renders one scene per planner builds it once.
+// image's cost in software (buffers and shader compilation), so a run that renders one
+// scene per planner builds it once.
 struct SceneRenderer::Contexts {
   OsMesaContext gl;
   RenderContextOwner render;
-  ModelShape shape;
-  // the GL buffer is the model's offscreen size, so any image size that fits reuses it
-  explicit Contexts(const mjModel& model)
-      : gl(model.vis.global.offwidth, model.vis.global.offheight),
-        render(model),
-        shape(model_shape(model)) {}
+  ContextShape shape;
+  Contexts(const mjModel& model, const ContextShape& sized)
+      : gl(sized.width, sized.height),
+        render(model, sized.width, sized.height, sized.shadow_size),
+        shape(sized) {}
+  // mjr_freeContext needs the GL context current on the thread that destroys them
+  ~Contexts() { gl.try_make_current(); }
+  Contexts(const Contexts&) = delete;
+  Contexts& operator=(const Contexts&) = delete;
 };
 
 SceneRenderer::SceneRenderer() = default;
@@ -290,12 +353,13 @@ SceneRenderer::~SceneRenderer() {
   }
 }
 
-void SceneRenderer::prepare(const std::string& model_path) {
+void SceneRenderer::prepare(const std::string& model_path, const SceneRenderOptions& options) {
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (contexts_ || preparing_.valid()) return;
   install_mujoco_handlers();  // before the thread: the handlers are process-wide
-  preparing_ = std::async(std::launch::async, [model_path] {
+  preparing_ = std::async(std::launch::async, [model_path, options] {
     const ModelPtr model = load_model(model_path);
-    auto contexts = std::make_unique<Contexts>(*model);
+    auto contexts = std::make_unique<Contexts>(*model, context_shape(*model, options));
     contexts->gl.release();  // the rendering thread makes it current
     return contexts;
   });
@@ -322,6 +386,9 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
                                                  std::to_string(model.vis.global.offheight) +
                                                  " (the model's <visual><global offheight>), got " +
                                                  std::to_string(options.height));
+  if (options.supersampling < 1 || options.supersampling > kMaxSupersampling)
+    throw InternalError("render: supersampling must be between 1 and " +
+                        std::to_string(kMaxSupersampling));
   if (deposit.nx < 0 || deposit.ny < 0 ||
       deposit.thickness_um.size() != static_cast<size_t>(deposit.nx) * deposit.ny ||
       (deposit.nx > 0 && !(deposit.cell_mm > 0.0)))
@@ -332,6 +399,7 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
   const int width = options.width, height = options.height;
 
   // set up: GL context, MuJoCo render context on the offscreen buffer, scene
+  const std::lock_guard<std::mutex> lock(mutex_);
   DataPtr state = copy_data(model, data);
   // the prepared contexts, or those of the previous image, when the model has the same shape
   // (the same MJCF)
@@ -339,11 +407,17 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
     finish_preparation();
   } catch (const std::exception&) {  // built again below, where an error names this model
   }
-  if (!contexts_ || !(contexts_->shape == model_shape(model))) {
+  const ContextShape shape = context_shape(model, options);
+  if (!contexts_ || !(contexts_->shape == shape)) {
     contexts_.reset();
-    contexts_ = std::make_unique<Contexts>(model);
+    contexts_ = std::make_unique<Contexts>(model, shape);
   }
+  // current for this render only, so that the next may come from another thread
   contexts_->gl.make_current();
+  struct ReleaseAtExit {
+    OsMesaContext& gl;
+    ~ReleaseAtExit() { gl.release(); }
+  } release_at_exit{contexts_->gl};
   mjrContext& context = contexts_->render.context;
   mjr_setBuffer(mjFB_OFFSCREEN, &context);
   if (context.currentBuffer != mjFB_OFFSCREEN)
@@ -371,20 +445,15 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
   mjv_updateScene(&model, state.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene.scene);
   if (view.type == mjCAMERA_FREE) light_over_camera(view, scene.scene);
   scene.scene.flags[mjRND_SHADOW] = options.shadows ? 1 : 0;
+  add_backdrop(model, *state, scene.scene);
   if (has_grid) add_deposit_boxes(*state, substrate, deposit, relief_mm, options, scene.scene);
-  const mjrRect viewport = {0, 0, width, height};
+  const int factor = options.supersampling;
+  const mjrRect viewport = {0, 0, width * factor, height * factor};
   mjr_render(viewport, &scene.scene, &context);
-  std::vector<unsigned char> bottom_up(static_cast<size_t>(width) * height * 3);
+  std::vector<unsigned char> bottom_up(static_cast<size_t>(viewport.width) * viewport.height * 3);
   mjr_readPixels(bottom_up.data(), nullptr, viewport, &context);
   check_warnings(*state, "while rendering");
-
-  // OpenGL rows run bottom-up: flip for the image file
-  std::vector<unsigned char> rgb(bottom_up.size());
-  const size_t row_bytes = static_cast<size_t>(width) * 3;
-  for (int row = 0; row < height; ++row)
-    std::copy_n(bottom_up.begin() + static_cast<long>(row * row_bytes), row_bytes,
-                rgb.begin() + static_cast<long>((height - 1 - row) * row_bytes));
-  return rgb;
+  return downsample_flipped(bottom_up, width, height, factor);
 }
 
 void SceneRenderer::render_png(const Simulation& simulation, const HeightMap& deposit,

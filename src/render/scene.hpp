@@ -13,6 +13,7 @@
 
 #include <future>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -34,13 +35,18 @@ struct SceneRenderOptions {
   int max_boxes = 10000;
   // cells thinner than this fraction of the thickest are not drawn (footprint tails)
   double min_relative_thickness = 0.02;
+  // anti-aliasing: the scene is rendered this many times larger in each direction and each
+  // image pixel is the mean of its block (1 = none). Supersampling rather than the model's
+  // multisampling, which in software GL costs more (its own shader compilation, a resolve)
+  int supersampling = 2;
   // shadow mapping: off by default. It costs a second pass in software (about 0.1 s per
   // image) and the delta's platform throws its shadow over the deposit it should show
   bool shadows = false;
 };
 
 // Renders scenes, keeping its GL and MuJoCo render contexts between images (rebuilt when
-// a model of another shape comes). Not thread-safe: one thread at a time.
+// a model of another shape, another image size or another shadow setting comes). Callable
+// from several threads: renders take turns (there is one GL context).
 class SceneRenderer {
  public:
   SceneRenderer();
@@ -48,10 +54,11 @@ class SceneRenderer {
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
-  // Build the contexts for the MJCF at `model_path` on a background thread, so that the
-  // costly set-up overlaps the simulation; the first render waits for it. Errors surface
-  // there, or are dropped when the model's shape does not match and the contexts are rebuilt.
-  void prepare(const std::string& model_path);
+  // Build the contexts for the MJCF at `model_path` and images made with `options` on a
+  // background thread, so that the costly set-up overlaps the simulation; the first render
+  // waits for it. Errors surface there, or are dropped when the render needs other contexts
+  // and they are rebuilt.
+  void prepare(const std::string& model_path, const SceneRenderOptions& options);
 
   // as render_scene_rgb / render_scene_png below
   std::vector<unsigned char> render_rgb(const mjModel& model, const mjData& data,
@@ -65,6 +72,7 @@ class SceneRenderer {
   // wait for prepare() and adopt its contexts; rethrows its error
   void finish_preparation();
 
+  std::mutex mutex_;  // one render or preparation at a time
   std::unique_ptr<Contexts> contexts_;
   std::future<std::unique_ptr<Contexts>> preparing_;
 };
@@ -83,6 +91,9 @@ void render_scene_png(const mjModel& model, const mjData& data, const HeightMap&
 // the state after Simulation::run
 void render_scene_png(const Simulation& simulation, const HeightMap& deposit,
                       const std::string& png_path, const SceneRenderOptions& options = {});
+
+// the largest SceneRenderOptions::supersampling
+constexpr int kMaxSupersampling = 4;
 
 // viridis colour of a value in [0, 1] (clamped), RGB in [0, 1]
 void viridis(double value, float rgb[3]);

@@ -138,8 +138,9 @@ TEST(Scene, RendersTheStateAfterARunFromTheModelCamera) {
   EXPECT_GT(changed, 50);
 }
 
-// A renderer that keeps its contexts (prepared on a background thread, then reused) draws
-// exactly what a fresh one draws, from any thread, for images of any size that fits.
+// A renderer that keeps its contexts (prepared on a background thread, then reused, rebuilt
+// for another image size) draws exactly what a fresh one draws, from any thread, also when
+// two threads render at once.
 TEST(Scene, ReusedAndPreparedContextsRenderTheSamePictures) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
@@ -155,7 +156,7 @@ TEST(Scene, ReusedAndPreparedContextsRenderTheSamePictures) {
       render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(false), large);
 
   SceneRenderer renderer;
-  renderer.prepare(simulation.model_path());
+  renderer.prepare(simulation.model_path(), small);
   std::vector<unsigned char> reused_small, reused_large;
   std::thread other([&] {  // the prepared contexts move to this thread
     reused_small =
@@ -166,6 +167,21 @@ TEST(Scene, ReusedAndPreparedContextsRenderTheSamePictures) {
       renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(false), large);
   EXPECT_EQ(reused_small, fresh_small);
   EXPECT_EQ(reused_large, fresh_large);
+
+  // two threads at once: the renders take turns on the one GL context
+  std::vector<unsigned char> concurrent_small, concurrent_large;
+  std::thread first([&] {
+    concurrent_small =
+        renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(true), small);
+  });
+  std::thread second([&] {
+    concurrent_large =
+        renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(false), large);
+  });
+  first.join();
+  second.join();
+  EXPECT_EQ(concurrent_small, fresh_small);
+  EXPECT_EQ(concurrent_large, fresh_large);
 }
 
 TEST(Scene, ImageLargerThanTheOffscreenBufferIsBadInput) {
