@@ -290,20 +290,24 @@ std::vector<unsigned char> downsample_flipped(const std::vector<unsigned char>& 
   std::vector<unsigned char> rgb(static_cast<size_t>(width) * height * 3);
   const size_t source_row = static_cast<size_t>(width) * factor * 3;
   const unsigned block = static_cast<unsigned>(factor * factor);
-  std::vector<unsigned> sums(static_cast<size_t>(width) * 3);
+  std::vector<unsigned> column_sums(source_row);  // the block's rows added, per source byte
   for (int row = 0; row < height; ++row) {
-    std::fill(sums.begin(), sums.end(), 0u);
+    // add the block's source rows (a plain loop the compiler vectorises), then each pixel's
+    // `factor` neighbours in them
+    std::fill(column_sums.begin(), column_sums.end(), 0u);
     for (int sub_row = 0; sub_row < factor; ++sub_row) {
       const unsigned char* source =
           bottom_up.data() + (static_cast<size_t>(row) * factor + sub_row) * source_row;
-      for (int column = 0; column < width; ++column)
-        for (int sub_column = 0; sub_column < factor; ++sub_column)
-          for (int channel = 0; channel < 3; ++channel)
-            sums[3 * column + channel] += source[3 * (column * factor + sub_column) + channel];
+      for (size_t i = 0; i < source_row; ++i) column_sums[i] += source[i];
     }
     unsigned char* target = rgb.data() + static_cast<size_t>(height - 1 - row) * width * 3;
-    for (size_t i = 0; i < sums.size(); ++i)
-      target[i] = static_cast<unsigned char>((sums[i] + block / 2) / block);
+    for (int column = 0; column < width; ++column)
+      for (int channel = 0; channel < 3; ++channel) {
+        unsigned sum = 0;
+        for (int sub_column = 0; sub_column < factor; ++sub_column)
+          sum += column_sums[3 * (static_cast<size_t>(column) * factor + sub_column) + channel];
+        target[3 * column + channel] = static_cast<unsigned char>((sum + block / 2) / block);
+      }
   }
   return rgb;
 }
@@ -335,6 +339,7 @@ struct SceneRenderer::Contexts {
   OsMesaContext gl;
   RenderContextOwner render;
   ContextShape shape;
+  std::vector<unsigned char> readback;  // the rendered pixels, bottom row first
   Contexts(const mjModel& model, const ContextShape& sized)
       : gl(sized.width, sized.height),
         render(model, sized.width, sized.height, sized.shadow_size),
@@ -450,7 +455,10 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
   const int factor = options.supersampling;
   const mjrRect viewport = {0, 0, width * factor, height * factor};
   mjr_render(viewport, &scene.scene, &context);
-  std::vector<unsigned char> bottom_up(static_cast<size_t>(viewport.width) * viewport.height * 3);
+  // read back into a buffer kept with the contexts: a fresh one of this size is several
+  // MB of memory to fault in and clear per image
+  std::vector<unsigned char>& bottom_up = contexts_->readback;
+  bottom_up.resize(static_cast<size_t>(viewport.width) * viewport.height * 3);
   mjr_readPixels(bottom_up.data(), nullptr, viewport, &context);
   check_warnings(*state, "while rendering");
   return downsample_flipped(bottom_up, width, height, factor);

@@ -184,6 +184,66 @@ TEST(Scene, ReusedAndPreparedContextsRenderTheSamePictures) {
   EXPECT_EQ(concurrent_large, fresh_large);
 }
 
+// Anti-aliasing by supersampling: a 2x image is exactly the 2 x 2 block mean (rounded) of
+// the render at twice the size without it (the same camera: the aspect ratio is the same).
+TEST(Scene, SupersampledImageIsTheBlockMeanOfTheLargerRender) {
+  const auto machine = make_xy_stage();
+  Simulation simulation(xy_stage_model(), *machine);
+  SceneRenderOptions supersampled;
+  supersampled.width = 160;
+  supersampled.height = 120;
+  supersampled.supersampling = 2;
+  SceneRenderOptions large;
+  large.width = 320;
+  large.height = 240;
+  large.supersampling = 1;
+  const auto small =
+      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), supersampled);
+  const auto full =
+      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), large);
+  ASSERT_EQ(small.size(), 160u * 120u * 3u);
+  long intermediate = 0;  // pixels on edges: none of their block's colours
+  for (int row = 0; row < 120; ++row)
+    for (int column = 0; column < 160; ++column)
+      for (int channel = 0; channel < 3; ++channel) {
+        auto at = [&](int r, int c) {
+          return full[3 * (static_cast<size_t>(r) * 320 + c) + channel];
+        };
+        const int sum = at(2 * row, 2 * column) + at(2 * row, 2 * column + 1) +
+                        at(2 * row + 1, 2 * column) + at(2 * row + 1, 2 * column + 1);
+        const int value = small[3 * (static_cast<size_t>(row) * 160 + column) + channel];
+        ASSERT_EQ(value, (sum + 2) / 4) << "row " << row << " column " << column;
+        if (value != at(2 * row, 2 * column) && value != at(2 * row + 1, 2 * column + 1))
+          ++intermediate;
+      }
+  EXPECT_GT(intermediate, 100);  // edges are smoothed
+}
+
+// The models have no skybox: the renderer's floor fills every view, so no pixel is the
+// empty background's black, from render_cam as placed in the MJCF or framed on a deposit
+// that covers the whole plate (the widest framing, which looks past the machine).
+TEST(Scene, NoViewShowsTheEmptyBackground) {
+  const auto machine = make_xy_stage();
+  Simulation simulation(xy_stage_model(), *machine);
+  HeightMap plate_wide;  // 100 x 100 mm, 1 mm cells, a bead along y = 0
+  plate_wide.cell_mm = 1.0;
+  plate_wide.nx = plate_wide.ny = 100;
+  plate_wide.origin_x_mm = plate_wide.origin_y_mm = -49.5;
+  plate_wide.thickness_um.assign(100 * 100, 0.0f);
+  for (int ix = 10; ix < 90; ++ix) plate_wide.thickness_um[50 * 100 + ix] = 2.0f;
+  for (const bool framed : {false, true}) {
+    SceneRenderOptions options;
+    options.width = 160;
+    options.height = 120;
+    options.frame_deposit = framed;
+    const auto rgb = render_scene_rgb(simulation.model(), simulation.data(), plate_wide, options);
+    long black = 0;
+    for (size_t i = 0; i < rgb.size(); i += 3)
+      black += rgb[i] < 8 && rgb[i + 1] < 8 && rgb[i + 2] < 8;
+    EXPECT_EQ(black, 0) << (framed ? "framed" : "render_cam");
+  }
+}
+
 TEST(Scene, ImageLargerThanTheOffscreenBufferIsBadInput) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
