@@ -50,8 +50,8 @@ std::vector<RunPlot> available_plots(const RunPlotInput& input);
 
 struct PlotOptions {
   std::string gnuplot = "gnuplot";  // program name (PATH) or path
-  size_t max_points_per_curve = 2000;
-  int max_map_cells_per_side = 600;  // thickness maps are block-averaged down to this
+  size_t max_points_per_curve = 1200;
+  int max_map_cells_per_side = 400;  // thickness maps are block-averaged down to this
 };
 
 struct PlotResult {

@@ -11,8 +11,8 @@
 namespace depotwin::plots::style {
 
 // image sizes (px): legible at README width
-constexpr int kRunPlotWidth_px = 900;
-constexpr int kRunPlotHeight_px = 560;
+constexpr int kRunPlotWidth_px = 800;
+constexpr int kRunPlotHeight_px = 500;
 constexpr int kComparisonColumnWidth_px = 460;
 constexpr int kComparisonHeight_px = 1000;
 

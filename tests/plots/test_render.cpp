@@ -94,7 +94,8 @@ TEST(RunPlots, PlanOnlyRunWithoutThickness) {
   const auto result = plots::render_run_plots(input, directory);
   EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
   ASSERT_EQ(result.files.size(), 3u);
-  for (const auto& file : result.files) expect_png(file, 900, 560);
+  for (const auto& file : result.files)
+    expect_png(file, plots::style::kRunPlotWidth_px, plots::style::kRunPlotHeight_px);
   // asking for a thickness plot without a map is the caller's bug
   EXPECT_THROW(plots::render_run_plots(input, directory, {RunPlot::thickness}), InternalError);
 }
@@ -105,7 +106,8 @@ TEST(RunPlots, NoTransitionRunRendersCleanly) {
   const auto result = plots::render_run_plots(f.input("single line"), directory);
   EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
   ASSERT_EQ(result.files.size(), 5u);
-  for (const auto& file : result.files) expect_png(file, 900, 560);
+  for (const auto& file : result.files)
+    expect_png(file, plots::style::kRunPlotWidth_px, plots::style::kRunPlotHeight_px);
 }
 
 TEST(RunPlots, NothingDepositedStillRendersEveryFrame) {
@@ -123,7 +125,8 @@ TEST(RunPlots, NothingDepositedStillRendersEveryFrame) {
   const auto result = plots::render_run_plots(input, directory);
   EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
   ASSERT_EQ(result.files.size(), 3u);
-  for (const auto& file : result.files) expect_png(file, 900, 560);
+  for (const auto& file : result.files)
+    expect_png(file, plots::style::kRunPlotWidth_px, plots::style::kRunPlotHeight_px);
 }
 
 TEST(RunPlots, ManyLinesShareOneProfileKeyEntry) {
@@ -133,7 +136,7 @@ TEST(RunPlots, ManyLinesShareOneProfileKeyEntry) {
       plots::render_run_plots(f.input("12 lines"), directory, {RunPlot::thickness_profile});
   EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
   ASSERT_EQ(result.files.size(), 1u);
-  expect_png(result.files[0], 900, 560);
+  expect_png(result.files[0], plots::style::kRunPlotWidth_px, plots::style::kRunPlotHeight_px);
 }
 
 TEST(Comparison, OneColumnPerPlannerOnASharedScale) {
