@@ -9,7 +9,9 @@ packages=(
   libmujoco-dev libqhull-dev libgl-dev   # MuJoCo 2.2.2 (+ what its CMake config needs)
   libeigen3-dev libassimp-dev libosmesa6-dev
   libgtest-dev libbenchmark-dev
-  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libstb-dev liblemon-dev zlib1g-dev
+  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev liblemon-dev
+  zlib1g-dev                             # PNG writing (core/png)
+  libstb-dev                             # tests read the PNGs back with stb_image
   gnuplot-nox                            # plots (pngcairo terminal, headless)
   fonts-dejavu-core                      # fonts for plot and image text
 )
