@@ -43,6 +43,14 @@ HeightMap deposit_grid(bool with_line) {
   return map;
 }
 
+// render options for an image of this size, the rest default
+SceneRenderOptions sized(int width, int height) {
+  SceneRenderOptions options;
+  options.width = width;
+  options.height = height;
+  return options;
+}
+
 std::string temp_path(const std::string& name) {
   return ::testing::TempDir() + "depotwin_" + std::to_string(::getpid()) + "_" + name;
 }
@@ -80,9 +88,7 @@ TEST(Scene, WritesAPngOfTheRequestedSizeThatIsNotBlank) {
 TEST(Scene, APrintedLineChangesTheMiddleOfThePictureOnly) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
-  SceneRenderOptions options;
-  options.width = 320;
-  options.height = 240;
+  SceneRenderOptions options = sized(320, 240);
   const auto empty =
       render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(false), options);
   const auto printed =
@@ -125,10 +131,8 @@ TEST(Scene, RendersTheStateAfterARunFromTheModelCamera) {
   const auto print =
       straight_print(Vec3(-8, 0, 0), Vec3(1, 0, 0), 3.0, 16.0, MachineLimits::uniform(4, 30));
   simulation.run(print.trajectory);
-  SceneRenderOptions options;
+  SceneRenderOptions options = sized(320, 240);
   options.frame_deposit = false;  // render_cam as placed in the MJCF
-  options.width = 320;
-  options.height = 240;
   const auto before =
       render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(false), options);
   const auto after =
@@ -144,12 +148,8 @@ TEST(Scene, RendersTheStateAfterARunFromTheModelCamera) {
 TEST(Scene, ReusedAndPreparedContextsRenderTheSamePictures) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
-  SceneRenderOptions small;
-  small.width = 160;
-  small.height = 120;
-  SceneRenderOptions large;
-  large.width = 320;
-  large.height = 240;
+  const SceneRenderOptions small = sized(160, 120);
+  const SceneRenderOptions large = sized(320, 240);
   const auto fresh_small =
       render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), small);
   const auto fresh_large =
@@ -189,13 +189,9 @@ TEST(Scene, ReusedAndPreparedContextsRenderTheSamePictures) {
 TEST(Scene, SupersampledImageIsTheBlockMeanOfTheLargerRender) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
-  SceneRenderOptions supersampled;
-  supersampled.width = 160;
-  supersampled.height = 120;
+  SceneRenderOptions supersampled = sized(160, 120);
   supersampled.supersampling = 2;
-  SceneRenderOptions large;
-  large.width = 320;
-  large.height = 240;
+  SceneRenderOptions large = sized(320, 240);
   large.supersampling = 1;
   const auto small =
       render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), supersampled);
@@ -232,9 +228,7 @@ TEST(Scene, NoViewShowsTheEmptyBackground) {
   plate_wide.thickness_um.assign(100 * 100, 0.0f);
   for (int ix = 10; ix < 90; ++ix) plate_wide.thickness_um[50 * 100 + ix] = 2.0f;
   for (const bool framed : {false, true}) {
-    SceneRenderOptions options;
-    options.width = 160;
-    options.height = 120;
+    SceneRenderOptions options = sized(160, 120);
     options.frame_deposit = framed;
     const auto rgb = render_scene_rgb(simulation.model(), simulation.data(), plate_wide, options);
     long black = 0;
