@@ -35,8 +35,6 @@ constexpr double kLift_mm = 0.005;
 constexpr float kBackdropColour[4] = {0.78f, 0.80f, 0.83f, 1.0f};
 constexpr double kBackdropHalfWidth = 20.0;
 constexpr double kBackdropDrop = 0.05;
-// zlib level of the scene PNGs
-constexpr int kSceneZlibLevel = 1;
 
 // an OSMesa context made current on its own colour buffer; destroyed last
 class OsMesaContext {
