@@ -280,20 +280,22 @@ void axes_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
     s += "set ylabel " + style::quoted(style::axis_label(quantity, unit)) + "\n";
     s += "set yrange " + y.gnuplot(0.06, 0.5) + "\n";
     std::vector<std::string> elements;
-    for (int axis : axes) {
-      const std::string name = kAxisNames[axis];
+    // the simulated curves as wide light bands, then the planned ones as lines on top: both
+    // stay visible where they coincide (which they mostly do), and no band hides a line
+    for (int axis : axes)
+      if (simulated[axis].point_count() > 0)
+        elements.push_back(
+            job.data_file(file_stem + "_simulated_" + kAxisNames[axis] + std::string(".dat"),
+                          format_curve(simulated[axis])) +
+            " " + line_style(style::kAxisBandColours[axis], style::kSimulatedBandWidth) +
+            " title '" + kAxisNames[axis] + " simulated'");
+    for (int axis : axes)
       if (planned[axis].point_count() > 0)
         elements.push_back(
-            job.data_file(file_stem + "_planned_" + name + ".dat", format_curve(planned[axis])) +
-            " " + line_style(style::kAxisColours[axis], style::kPlannedLineWidth) + " title '" +
-            name + " planned'");
-      if (simulated[axis].point_count() > 0)
-        elements.push_back(job.data_file(file_stem + "_simulated_" + name + ".dat",
-                                         format_curve(simulated[axis])) +
-                           " " +
-                           line_style(style::kAxisColours[axis], style::kSimulatedLineWidth, 2) +
-                           " title '" + name + " simulated'");
-    }
+            job.data_file(file_stem + "_planned_" + kAxisNames[axis] + std::string(".dat"),
+                          format_curve(planned[axis])) +
+            " " + line_style(style::kAxisColours[axis], style::kThinLineWidth + 0.5) + " title '" +
+            kAxisNames[axis] + " planned'");
     if (with_shading_key) elements.push_back(style::transition_key_entry(data.transitions));
     s += plot_command(elements);
   };

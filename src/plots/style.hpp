@@ -35,6 +35,9 @@ constexpr const char* kMeanColour = "#d62728";
 constexpr const char* kPathOverlayColour = "#ffffff";
 constexpr const char* kMapKeyColour = "#440154";  // key box behind the white overlay sample
 constexpr const char* kAxisColours[3] = {"#1f77b4", "#ff7f0e", "#2ca02c"};  // x, y, z
+// the same, lightened (40 % of the colour on white): the wide band of the simulated axis,
+// under the planned line, so that both show where they coincide
+constexpr const char* kAxisBandColours[3] = {"#a5c9e1", "#ffcb9f", "#abd9ab"};
 // colours cycled over print lines and planners
 constexpr const char* kSeriesColours[8] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728",
                                            "#9467bd", "#8c564b", "#e377c2", "#17becf"};
@@ -44,6 +47,7 @@ constexpr double kPlannedLineWidth = 2.0;
 constexpr double kPathLineWidth = 3.0;  // planned print path under the simulated one
 constexpr double kSimulatedLineWidth = 1.2;
 constexpr double kThinLineWidth = 1.0;
+constexpr double kSimulatedBandWidth = 6.0;  // simulated axis curves, under the planned ones
 
 const char* series_colour(size_t index);
 
