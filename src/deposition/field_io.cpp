@@ -1,12 +1,9 @@
 #include "deposition/field_io.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <sstream>
 #include <vector>
 
