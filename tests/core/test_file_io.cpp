@@ -1,42 +1,30 @@
 // Atomic writes: the file holds exactly what was written, an older file is replaced whole,
 // no temporary is left behind, and a failure leaves the target untouched.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <string>
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "pipeline/pipeline_test_util.hpp"
 
 namespace depotwin {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string read_all(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-fs::path fresh_directory(const std::string& name) {
-  const fs::path directory =
-      fs::path(::testing::TempDir()) / ("depotwin_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(directory);
-  fs::create_directories(directory);
-  return directory;
-}
+using testing_support::fresh_directory;
+using testing_support::read_text;
 
 TEST(FileIo, WritesReplacesAndLeavesNoTemporary) {
   const fs::path directory = fresh_directory("file_io");
   const fs::path target = directory / "out.bin";
   const std::string first("first\0with a zero byte", 22);
   write_file_atomically(target.string(), first);
-  EXPECT_EQ(read_all(target), first);
+  EXPECT_EQ(read_text(target.string()), first);
   write_file_atomically(target.string(), "second");
-  EXPECT_EQ(read_all(target), "second");
+  EXPECT_EQ(read_text(target.string()), "second");
   EXPECT_EQ(std::distance(fs::directory_iterator(directory), fs::directory_iterator()), 1);
   fs::remove_all(directory);
 }
@@ -54,7 +42,7 @@ TEST(FileIo, FailureNamesTheFileAndLeavesTheTargetUntouched) {
   } catch (const InternalError& error) {
     EXPECT_NE(std::string(error.what()).find(blocked.string()), std::string::npos) << error.what();
   }
-  EXPECT_EQ(read_all(target), "kept");
+  EXPECT_EQ(read_text(target.string()), "kept");
   EXPECT_TRUE(fs::is_directory(blocked / "inside"));
   EXPECT_EQ(std::distance(fs::directory_iterator(directory), fs::directory_iterator()), 2);
   fs::remove_all(directory);
