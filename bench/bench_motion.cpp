@@ -6,7 +6,7 @@
 
 #include "motion/mtt.hpp"
 #include "motion/sync.hpp"
-#include "planners/lspb_mtt.hpp"
+#include "planners/motion/lspb_mtt.hpp"
 
 using namespace depotwin;
 

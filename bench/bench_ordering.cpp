@@ -12,10 +12,10 @@
 #include <string>
 #include <utility>
 
-#include "planners/lower_bound.hpp"
-#include "planners/random_instances.hpp"
-#include "planners/sequencer.hpp"
-#include "planners/transition_cost.hpp"
+#include "planners/ordering/lower_bound.hpp"
+#include "toolpath/random_segments.hpp"
+#include "planners/ordering/sequencer.hpp"
+#include "planners/ordering/transition_cost.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <cmath>
 
 #include "kinematics/xy_stage.hpp"
-#include "planners/transition.hpp"
+#include "planners/motion/transition.hpp"
 #include "render/scene.hpp"
 #include "sim/mujoco_boundary.hpp"
 #include "sim/simulation.hpp"

@@ -5,7 +5,7 @@
 //   ganganath_table [--instances K] [--sizes 5,20,100] [--cost-model along_line|machine]
 //                   [--methods all]     also or_opt and the refinements of as_given
 //                   [--redraw-lengths]  redraw a rejected segment's length too (see
-//                                       random_instances.hpp): one reading of the paper
+//                                       toolpath/random_segments.hpp): one reading of the paper
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "planners/ordering_experiment.hpp"
+#include "bench/ordering_experiment.hpp"
 
 namespace {
 

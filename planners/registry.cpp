@@ -3,10 +3,10 @@
 #include <sstream>
 
 #include "core/error.hpp"
-#include "planners/bezier.hpp"
-#include "planners/lspb_mtt.hpp"
+#include "planners/motion/bezier/bezier.hpp"
+#include "planners/motion/lspb_mtt.hpp"
 #include "planners/planner.hpp"
-#include "planners/stop_and_go.hpp"
+#include "planners/motion/stop_and_go.hpp"
 
 namespace depotwin {
 

@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   cmake g++ make pkg-config
   libmujoco-dev libqhull-dev libgl-dev   # MuJoCo 2.2.2 (+ what its CMake config needs)
-  libeigen3-dev libassimp-dev libosmesa6-dev
+  libeigen3-dev libosmesa6-dev
   libgtest-dev libbenchmark-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev liblemon-dev
   zlib1g-dev                             # PNG writing (core/png)

@@ -9,7 +9,7 @@
 #include "kinematics/machine.hpp"
 #include "metrics/metrics_report.hpp"
 #include "planners/planner.hpp"
-#include "planners/sequencer.hpp"
+#include "planners/ordering/sequencer.hpp"
 #include "scenario/scenario.hpp"
 
 namespace depotwin {

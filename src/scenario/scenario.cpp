@@ -8,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "planners/random_instances.hpp"
-#include "scenario/gcode.hpp"
+#include "toolpath/random_segments.hpp"
+#include "toolpath/gcode.hpp"
 #include "scenario/yaml_reader.hpp"
 
 namespace depotwin {

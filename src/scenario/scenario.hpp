@@ -11,7 +11,7 @@
 #include "core/limits.hpp"
 #include "core/toolpath.hpp"
 #include "planners/planner.hpp"
-#include "planners/sequencer.hpp"
+#include "planners/ordering/sequencer.hpp"
 
 namespace depotwin {
 

@@ -6,7 +6,7 @@
 
 #include "core/limits.hpp"
 #include "core/trajectory.hpp"
-#include "planners/transition.hpp"
+#include "planners/motion/transition.hpp"
 
 namespace depotwin {
 namespace testing_util {

@@ -1,0 +1,624 @@
+#include "planners/motion/bezier/bezier.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "planners/motion/bezier/bezier_curve.hpp"
+#include "planners/motion/bezier/bezier_profile.hpp"
+#include "planners/motion/print_segments.hpp"
+#include "planners/motion/transition.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr const char* kAxisName[3] = {"x", "y", "z"};
+// detailed warnings per plan; the rest are counted in one summary line
+constexpr size_t kMaxDetailedWarnings = 20;
+// rounds of slowing blends whose interpolated samples exceed a limit
+constexpr int kMaxSlowDownRounds = 12;
+
+// ---------------------------------------------------------------------------------------
+// geometry: a print path as lines between nodes; a node is the path's start or end, a
+// blended corner, a corner where the path stops, or a straight pass-through (lead-in/out)
+
+struct PathLine {
+  Vec3 from_mm = Vec3::Zero(), to_mm = Vec3::Zero();
+  Vec3 dir = Vec3::UnitX();  // the polyline edge's direction (also when length is 0)
+  double length_mm = 0.0;
+  double accel_mm_s2 = 0.0;             // along-line acceleration every axis allows
+  double cap_mm_s = 0.0;                // print speed
+  std::optional<GridProfile> prebuilt;  // the lead-in ramp, built to end exactly at P_0
+};
+
+struct PathNode {
+  std::optional<BezierBlend> blend;
+  double blend_length_mm = 0.0;
+  double speed_mm_s = 0.0;  // after the passes: the speed through the node
+  double cap_mm_s = 0.0;    // before the passes
+  bool exact = false;       // the line before ends on a sample here (rest, or lead-in end)
+  int corner = -1;          // corner number within the polyline (1-based), -1 if none
+  std::string cap_reason;   // what limits the blend speed, for the warning
+};
+
+struct PathGeometry {
+  std::vector<PathLine> lines;  // line k runs from node k to node k + 1
+  std::vector<PathNode> nodes;
+  bool lead = false;  // lines.front() / lines.back() are lead-in / lead-out
+};
+
+// along-line acceleration every axis allows on direction `dir`
+double line_accel(const Vec3& dir, const MachineLimits& limits) {
+  double a = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis)
+    if (std::abs(dir[axis]) > 1e-12)
+      a = std::min(a, limits.axes[axis].a_max_mm_s2 / std::abs(dir[axis]));
+  return a;
+}
+
+// The highest constant speed through a blend that keeps every axis within its limits:
+// |v T_axis| <= v_max and |v^2 kappa N_axis| <= a_max along the curve; at u = 0 and 1
+// the acceleration jumps between two samples, where cubic Hermite interpolation of the
+// samples overshoots a step by up to 4/3, so the ends count 4/3.
+double blend_speed_cap(const BezierBlend& blend, const MachineLimits& limits, std::string& reason) {
+  constexpr int kIntervals = 256;
+  double cap = std::numeric_limits<double>::infinity();
+  Vec3 p, d1, d2;
+  for (int i = 0; i <= kIntervals; ++i) {
+    const double u = double(i) / kIntervals;
+    blend.derivatives(u, p, d1, d2);
+    const double speed_u = d1.norm();
+    const Vec3 tangent = d1 / speed_u;
+    // curvature vector: the normal part of d2p/du2 over |dp/du|^2
+    const Vec3 curvature = (d2 - d2.dot(tangent) * tangent) / (speed_u * speed_u);
+    const double hermite_factor = (i == 0 || i == kIntervals) ? 4.0 / 3.0 : 1.0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const AxisLimits& lim = limits.axes[axis];
+      if (std::abs(tangent[axis]) > 1e-12 && lim.v_max_mm_s / std::abs(tangent[axis]) < cap) {
+        cap = lim.v_max_mm_s / std::abs(tangent[axis]);
+        reason = std::string("v_max of axis ") + kAxisName[axis];
+      }
+      const double k = hermite_factor * std::abs(curvature[axis]);
+      if (k > 1e-12 && std::sqrt(lim.a_max_mm_s2 / k) < cap) {
+        cap = std::sqrt(lim.a_max_mm_s2 / k);
+        reason = std::string("a_max of axis ") + kAxisName[axis];
+      }
+    }
+  }
+  return cap;
+}
+
+std::string corner_name(const PrintPath& path, int corner) {
+  return "path " + std::to_string(path.source_index) + " corner " + std::to_string(corner);
+}
+
+PathGeometry build_geometry(const PrintPath& path, const BezierSettings& settings,
+                            const MachineLimits& limits, size_t& next_weight,
+                            std::vector<std::string>& warnings) {
+  const std::vector<Vec3>& points = path.points;
+  const size_t edges = points.size() - 1;
+  const double print_speed = path.speed_mm_s;
+  std::vector<Vec3> dirs(edges);
+  std::vector<double> lengths(edges);
+  for (size_t i = 0; i < edges; ++i) {
+    lengths[i] = (points[i + 1] - points[i]).norm();
+    dirs[i] = (points[i + 1] - points[i]) / lengths[i];
+  }
+
+  PathGeometry g;
+  g.nodes.resize(edges + 1);
+  g.nodes.front().exact = true;  // start at rest
+  g.nodes.back().exact = true;   // end at rest
+  for (size_t j = 1; j < edges; ++j) {
+    PathNode& node = g.nodes[j];
+    node.corner = static_cast<int>(j);
+    const double weight =
+        settings.weights.size() == 1 ? settings.weights.front() : settings.weights[next_weight];
+    ++next_weight;
+    const Vec3& in_dir = dirs[j - 1];
+    const Vec3& out_dir = dirs[j];
+    // an exact reversal has no blend (its parabola degenerates to a cusp): stop there
+    if ((in_dir + out_dir).norm() < 1e-9) {
+      node.exact = true;
+      warnings.push_back(corner_name(path, int(j)) +
+                         ": reverses direction; stopping at the corner");
+      continue;
+    }
+    // fillet distance, clipped to half the shorter adjacent line
+    const double room = 0.5 * std::min(lengths[j - 1], lengths[j]);
+    double delta = settings.delta_mm;
+    if (delta > room) {
+      delta = room;
+      std::ostringstream msg;
+      msg << corner_name(path, int(j)) << ": fillet distance clipped from " << settings.delta_mm
+          << " to " << delta << " mm (half the shorter adjacent line)";
+      warnings.push_back(msg.str());
+    }
+    BezierBlend blend = BezierBlend::at_corner(points[j], in_dir, out_dir, delta, weight);
+    const double blend_length = blend.arc_length_mm();
+    std::string reason;
+    const double cap = std::min(print_speed, blend_speed_cap(blend, limits, reason));
+    // A very sharp corner crossed slowly can take longer than stopping at it. Compare the
+    // extra time over cruising at print speed: blend = the slow blend plus the ramps down
+    // to its speed and back, stop = the legs of 2 delta plus ramping to rest and back.
+    const double a = std::min(line_accel(in_dir, limits), line_accel(out_dir, limits));
+    const double blend_extra = blend_length / cap - blend_length / print_speed +
+                               (print_speed - cap) * (print_speed - cap) / (a * print_speed);
+    const double stop_extra = (2.0 * delta - blend_length) / print_speed + print_speed / a;
+    if (blend_extra > stop_extra) {
+      node.exact = true;
+      std::ostringstream msg;
+      msg << corner_name(path, int(j)) << ": blend would need " << cap << " mm/s (" << reason
+          << "); stopping at the corner is faster";
+      warnings.push_back(msg.str());
+      continue;
+    }
+    node.blend = blend;
+    node.blend_length_mm = blend_length;
+    node.cap_mm_s = cap;
+    node.cap_reason = cap < print_speed ? reason : "";
+  }
+
+  // lines between the nodes: trimmed by the blends, full edges at stops and path ends
+  g.lines.resize(edges);
+  for (size_t i = 0; i < edges; ++i) {
+    PathLine& line = g.lines[i];
+    line.from_mm = g.nodes[i].blend ? g.nodes[i].blend->exit_mm : points[i];
+    line.to_mm = g.nodes[i + 1].blend ? g.nodes[i + 1].blend->entry_mm : points[i + 1];
+    line.dir = dirs[i];
+    line.length_mm = std::max(0.0, (line.to_mm - line.from_mm).dot(dirs[i]));
+    line.accel_mm_s2 = line_accel(dirs[i], limits);
+    line.cap_mm_s = print_speed;
+  }
+
+  // lead-in/out: straight extensions of the first and last line, material off; the
+  // path's own ends become pass-through nodes at print speed
+  if (settings.lead_in) {
+    g.lead = true;
+    PathNode first = g.nodes.front(), last = g.nodes.back();
+    first.exact = true;  // the lead-in ramp ends exactly at P_0, on a sample
+    last.exact = false;  // printing runs on through P_n
+    first.cap_mm_s = last.cap_mm_s = print_speed;
+    PathLine lead_in_line = g.lines.front(), lead_out_line = g.lines.back();
+    lead_out_line.from_mm = points.back();
+    // long enough for the final knee and ramp of an exact end plus the entry margin
+    const double a_out = lead_out_line.accel_mm_s2, period = settings.period_s;
+    lead_out_line.length_mm =
+        print_speed * print_speed / (2.0 * a_out) + 5.0 * print_speed * period;
+    lead_out_line.to_mm = lead_out_line.from_mm + lead_out_line.length_mm * lead_out_line.dir;
+    // the lead-in's length is set once its end speed is known (after the passes)
+    lead_in_line.to_mm = points.front();
+    g.nodes.front() = first;
+    g.nodes.back() = last;
+    g.nodes.insert(g.nodes.begin(), PathNode{});
+    g.nodes.front().exact = true;
+    g.nodes.push_back(PathNode{});
+    g.nodes.back().exact = true;
+    g.lines.insert(g.lines.begin(), lead_in_line);
+    g.lines.push_back(lead_out_line);
+  }
+  return g;
+}
+
+// forward/backward passes: node speeds as high as their caps allow while every line
+// can hold the ramps between its end speeds on the sample grid
+void assign_node_speeds(PathGeometry& g, double period_s) {
+  const size_t first = g.lead ? 1 : 0;  // the lead-in line is built to fit afterwards
+  for (PathNode& node : g.nodes)
+    node.speed_mm_s = node.blend || (!node.exact && node.cap_mm_s > 0.0) ? node.cap_mm_s : 0.0;
+  if (g.lead) g.nodes[1].speed_mm_s = g.nodes[1].cap_mm_s;
+  for (size_t k = first; k < g.lines.size(); ++k) {
+    const PathLine& line = g.lines[k];
+    g.nodes[k + 1].speed_mm_s = std::min(
+        g.nodes[k + 1].speed_mm_s,
+        reachable_speed(g.nodes[k].speed_mm_s, line.length_mm, line.accel_mm_s2, period_s));
+  }
+  for (size_t k = g.lines.size(); k-- > first;) {
+    const PathLine& line = g.lines[k];
+    g.nodes[k].speed_mm_s = std::min(
+        g.nodes[k].speed_mm_s,
+        reachable_speed(g.nodes[k + 1].speed_mm_s, line.length_mm, line.accel_mm_s2, period_s));
+  }
+  // the lead-in: one grid ramp from rest to the speed at P_0, its length made to fit
+  if (g.lead) {
+    PathLine& lead_in = g.lines.front();
+    const double v = g.nodes[1].speed_mm_s;
+    const int steps =
+        std::max(1, static_cast<int>(std::ceil(v / (lead_in.accel_mm_s2 * period_s) - 1e-9)));
+    GridProfile ramp;
+    ramp.v_start_mm_s = 0.0;
+    ramp.phases[0] = {steps, v / (steps * period_s)};
+    ramp.v_after_mm_s = v;
+    lead_in.length_mm = ramp.distance_mm(period_s);
+    lead_in.from_mm = lead_in.to_mm - lead_in.length_mm * lead_in.dir;
+    lead_in.prebuilt = ramp;
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// sampling: the Taylor update of the curve parameter along the pieces of one path
+
+class PathSampler {
+ public:
+  PathSampler(const PathGeometry& geometry, double period_s, std::vector<Vec3>& positions,
+              std::vector<Vec3>& velocities, std::vector<int>& nodes)
+      : g_(geometry),
+        period_(period_s),
+        positions_(positions),
+        velocities_(velocities),
+        nodes_(nodes) {}
+
+  // samples from the path's start to its end, both at rest; returns the sample indices
+  // where printing starts and stops (P_0 reached, first sample past P_n) in lead mode
+  void run(size_t& print_begin, size_t& print_end) {
+    print_begin = 0;
+    print_end = 0;
+    enter_line(0, 0.0, g_.nodes[0].speed_mm_s, true);
+    while (true) {
+      if (piece_ % 2 == 0) {
+        if (!step_line()) break;
+      } else {
+        step_blend();
+      }
+    }
+    print_end = g_.lead ? lead_out_begin_ : positions_.size() - 1;
+    print_begin = g_.lead ? lead_in_end_ : 0;
+  }
+
+ private:
+  // pieces: 2k = line k, 2k + 1 = node k + 1
+  int line_of(size_t piece) const { return static_cast<int>(piece / 2); }
+  int node_of(size_t piece) const { return static_cast<int>((piece + 1) / 2); }
+
+  void push(const Vec3& position, const Vec3& velocity) {
+    positions_.push_back(position);
+    velocities_.push_back(velocity);
+    nodes_.push_back(piece_ % 2 == 1 ? node_of(piece_) : -1 - line_of(piece_));
+  }
+
+  // start line k at distance s0 from its start with speed v_in: plan its grid profile
+  void enter_line(int k, double s0_mm, double v_in, bool push_sample) {
+    const PathLine& line = g_.lines[k];
+    const PathNode& end = g_.nodes[k + 1];
+    piece_ = 2 * size_t(k);
+    step_ = 0;
+    line_u_ = line.length_mm > 0.0 ? s0_mm / line.length_mm : 0.0;  // eq. (13)
+    entry_mm_ = s0_mm;
+    std::optional<GridProfile> profile =
+        line.prebuilt ? line.prebuilt
+                      : plan_grid_profile(line.length_mm - s0_mm, v_in, end.speed_mm_s,
+                                          line.cap_mm_s, line.accel_mm_s2, period_, end.exact);
+    if (!profile) {
+      std::ostringstream msg;
+      msg << "bezier: no grid profile on a line of " << line.length_mm - s0_mm << " mm from "
+          << v_in << " to " << end.speed_mm_s << " mm/s";
+      throw InternalError(msg.str());
+    }
+    profile_ = *profile;
+    if (push_sample) push(line.from_mm + s0_mm * line.dir, v_in * line.dir);
+    // printing stops at the first sample on the lead-out (past P_n by less than v T)
+    if (g_.lead && size_t(k) + 1 == g_.lines.size()) lead_out_begin_ = positions_.size() - 1;
+  }
+
+  // one sample period on a line; false once the path's end is reached
+  bool step_line() {
+    const int k = line_of(piece_);
+    const PathLine& line = g_.lines[k];
+    const PathNode& end = g_.nodes[k + 1];
+    if (end.exact && step_ == profile_.total_steps()) {
+      // the profile ends exactly at the line's end, on this sample
+      positions_.back() = line.to_mm;
+      velocities_.back() = end.speed_mm_s * line.dir;
+      if (g_.lead && k == 0) lead_in_end_ = positions_.size() - 1;
+      if (size_t(k) + 1 == g_.lines.size()) return false;
+      // a stop or the lead-in's end: the next line starts here, from this sample
+      enter_line(k + 1, 0.0, end.speed_mm_s, false);
+      return true;
+    }
+    double v = 0.0, a = 0.0;
+    profile_.at_step(step_, period_, v, a);
+    if (!end.exact && v <= 0.0 && a <= 0.0)
+      throw InternalError("bezier: stalled on a line before a moving joint");
+    // eq. (5) on a line: |dp/du| = L and d2p/du2 = 0, so u advances by (v T + a T^2 / 2) / L
+    // exactly (the acceleration changes only at samples). The sum of these steps is taken in
+    // closed form from the line's entry, which keeps rounding from piling up over long lines.
+    const double step_mm = v * period_ + 0.5 * a * period_ * period_;
+    const double remaining_mm = line.length_mm * (1.0 - line_u_);
+    if (end.exact || step_mm < remaining_mm) {
+      ++step_;
+      const double s_mm = entry_mm_ + profile_.distance_after(step_, period_);
+      line_u_ = s_mm / line.length_mm;
+      double v_next = 0.0, a_next = 0.0;
+      profile_.at_step(step_, period_, v_next, a_next);
+      push(line.from_mm + s_mm * line.dir, v_next * line.dir);
+      return true;
+    }
+    // the joint falls inside this period: carry the rest of the step into the next pieces
+    cross_joint(piece_ + 1, step_mm - remaining_mm, v + a * period_);
+    return true;
+  }
+
+  // one sample period on a blend at constant speed, eq. (4)
+  void step_blend() {
+    const PathNode& node = g_.nodes[node_of(piece_)];
+    const BezierBlend& blend = *node.blend;
+    const double v = node.speed_mm_s;
+    Vec3 p, d1, d2;
+    blend.derivatives(blend_u_, p, d1, d2);
+    const double next_u = blend_u_ + taylor_parameter_step(d1, d2, v, 0.0, period_);
+    if (next_u < 1.0) {
+      blend_u_ = next_u;
+      blend.derivatives(blend_u_, p, d1, d2);
+      // velocity from the analytic derivative: p'(u) du/dt with du/dt = v / |p'(u)|, eq. (3).
+      // (Eq. (10) prints the middle coefficient of db/dt as 2 u'(1 - u) - 2 u u''; the
+      // derivative of eq. (8) is 2 u' (1 - 2u), which is what p'(u) u' gives.)
+      push(p, (v / d1.norm()) * d1);
+      return;
+    }
+    // eq. (12): what is left of the blend; the rest of the step continues past it
+    const double left_mm = distance_to_end(d1, d2, blend_u_);
+    cross_joint(piece_ + 1, std::max(0.0, v * period_ - left_mm), v);
+  }
+
+  // Continue `distance_mm` into the pieces from `piece` on at constant speed v and place the
+  // sample there (eqs. (11), (13)); pieces shorter than the distance are passed over.
+  void cross_joint(size_t piece, double distance_mm, double v) {
+    while (true) {
+      if (piece % 2 == 0) {
+        const int k = line_of(piece);
+        const PathLine& line = g_.lines[k];
+        if (distance_mm < line.length_mm || g_.nodes[k + 1].exact) {
+          enter_line(k, std::min(distance_mm, line.length_mm), v, true);
+          return;
+        }
+        distance_mm -= line.length_mm;
+        ++piece;
+        continue;
+      }
+      const PathNode& node = g_.nodes[node_of(piece)];
+      if (node.blend && distance_mm < node.blend_length_mm) {
+        Vec3 p, d1, d2;
+        node.blend->derivatives(0.0, p, d1, d2);
+        blend_u_ = std::clamp(parameter_at_distance_from_start(d1, d2, distance_mm), 0.0, 1.0);
+        node.blend->derivatives(blend_u_, p, d1, d2);
+        piece_ = piece;
+        push(p, (v / d1.norm()) * d1);
+        return;
+      }
+      if (node.blend) distance_mm -= node.blend_length_mm;
+      ++piece;
+    }
+  }
+
+  const PathGeometry& g_;
+  const double period_;
+  std::vector<Vec3>& positions_;
+  std::vector<Vec3>& velocities_;
+  std::vector<int>& nodes_;  // per sample: the blend's node, or -1 - line index on a line
+  size_t piece_ = 0;
+  // line state
+  GridProfile profile_;
+  int step_ = 0;
+  double line_u_ = 0.0;
+  double entry_mm_ = 0.0;  // where on the line the profile started
+  // blend state
+  double blend_u_ = 0.0;
+  size_t lead_in_end_ = 0, lead_out_begin_ = 0;
+};
+
+// How far the interpolated samples go beyond the limits, per blend: cubic Hermite between
+// two samples has a linear acceleration (extremes at the samples) and a quadratic velocity
+// (extreme where the acceleration crosses zero). A blend whose curvature changes a lot within
+// one sample period can overshoot there; `slow_down[j]` < 1 is the factor by which blend j's
+// speed must shrink. Returns false when an excess is not on a blend (not expected: lines
+// carry exact quadratics).
+bool check_sampled_limits(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
+                          const std::vector<int>& nodes, const PathGeometry& g, double period_s,
+                          const MachineLimits& limits, std::vector<double>& slow_down) {
+  // rounding (a ramp at exactly a_max, the last sample put exactly on the path's end)
+  constexpr double kTolerance = 1e-6;
+  bool owned = true;
+  slow_down.assign(g.nodes.size(), 1.0);
+  const double h = period_s;
+  for (size_t k = 0; k + 1 < positions.size(); ++k) {
+    // the blend this interval belongs to (either end on it, or the joint between two lines)
+    int node = nodes[k] >= 0 ? nodes[k] : nodes[k + 1];
+    if (node < 0 && nodes[k] != nodes[k + 1]) node = -1 - nodes[k] + 1;
+    double factor = 1.0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double dp = positions[k + 1][axis] - positions[k][axis];
+      const double v0 = velocities[k][axis], v1 = velocities[k + 1][axis];
+      const double a0 = 6.0 * dp / (h * h) - (4.0 * v0 + 2.0 * v1) / h;
+      const double a1 = -6.0 * dp / (h * h) + (2.0 * v0 + 4.0 * v1) / h;
+      double v_peak = std::max(std::abs(v0), std::abs(v1));
+      if ((a0 > 0.0) != (a1 > 0.0) && a0 != a1) {
+        const double s = a0 / (a0 - a1);
+        v_peak = std::max(v_peak, std::abs(v0 + h * (a0 * s + 0.5 * (a1 - a0) * s * s)));
+      }
+      const double a_ratio = std::max(std::abs(a0), std::abs(a1)) / limits.axes[axis].a_max_mm_s2;
+      const double v_ratio = v_peak / limits.axes[axis].v_max_mm_s;
+      if (a_ratio > 1.0 + kTolerance) factor = std::min(factor, std::sqrt(1.0 / a_ratio));
+      if (v_ratio > 1.0 + kTolerance) factor = std::min(factor, 1.0 / v_ratio);
+    }
+    if (factor >= 1.0) continue;
+    if (node < 0 || !g.nodes[node].blend) {
+      owned = false;
+      continue;
+    }
+    slow_down[node] = std::min(slow_down[node], factor);
+  }
+  return owned;
+}
+
+TrajectoryPiece sampled_piece(double t_begin_s, double period_s, std::vector<Vec3> positions,
+                              std::vector<Vec3> velocities, int path_index, bool depositing,
+                              double desired_speed_mm_s) {
+  TrajectoryPiece piece;
+  piece.t_begin_s = t_begin_s;
+  piece.t_end_s = t_begin_s + period_s * double(positions.size() - 1);
+  piece.path_index = path_index;
+  piece.depositing = depositing;
+  piece.desired_speed_mm_s = desired_speed_mm_s;
+  SampledMotion motion;
+  motion.period_s = period_s;
+  motion.position_mm = std::move(positions);
+  motion.velocity_mm_s = std::move(velocities);
+  piece.motion = std::move(motion);
+  return piece;
+}
+
+}  // namespace
+
+std::vector<PlannerParameter> bezier_parameters() {
+  return {
+      {"delta", 0.5, 1e-6, 100.0,
+       "fillet distance (mm): the blend starts and ends this far from the corner", false},
+      {"weight", 1.0, 0.01, 100.0,
+       "rational weight of each corner (one value, or one per corner of the toolpath in order); "
+       "larger pulls the blend towards the corner, 1 is the parabola",
+       true},
+      {"period_s", 0.001, 1e-5, 0.1, "sample period T_s of the Taylor update (s)", false},
+      {"lead_in", 0.0, 0.0, 1.0,
+       "1: ramp up and down on extensions of the first and last line with material off", false},
+  };
+}
+
+BezierSettings bezier_settings(const PlannerSpec& spec) {
+  BezierSettings settings;
+  settings.delta_mm = spec.get("delta", settings.delta_mm);
+  auto weights = spec.params.find("weight");
+  if (weights != spec.params.end() && !weights->second.empty()) settings.weights = weights->second;
+  settings.period_s = spec.get("period_s", settings.period_s);
+  const double lead_in = spec.get("lead_in", 0.0);
+  if (lead_in != 0.0 && lead_in != 1.0)
+    throw InputError("planners.bezier.lead_in", "must be 0 or 1");
+  settings.lead_in = lead_in == 1.0;
+  return settings;
+}
+
+std::unique_ptr<Planner> make_bezier_planner(const PlannerSpec& spec) {
+  return std::make_unique<BezierPlanner>(bezier_settings(spec));
+}
+
+Trajectory BezierPlanner::plan(const Toolpath& toolpath, const MachineLimits& limits) const {
+  const std::string limits_problem = limits.validate();
+  if (!limits_problem.empty()) throw InputError("limits", limits_problem);
+  // degenerate edges, bad speeds and lines too fast for an axis: as for every planner
+  split_into_segments(toolpath, limits);
+
+  // one weight for all corners, or exactly one per corner
+  size_t corners = 0;
+  for (const PrintPath& path : toolpath.paths) {
+    if (path.points.size() < 2)
+      throw InputError("toolpath path " + std::to_string(path.source_index),
+                       "needs at least two points");
+    corners += path.points.size() - 2;
+  }
+  if (settings_.weights.empty() ||
+      (settings_.weights.size() != 1 && settings_.weights.size() != corners)) {
+    std::ostringstream msg;
+    msg << "has " << settings_.weights.size() << " values; the toolpath has " << corners
+        << " corners (give one value for all, or one per corner in order)";
+    throw InputError("planners.bezier.weight", msg.str());
+  }
+
+  std::vector<TrajectoryPiece> pieces;
+  std::vector<std::string> warnings;
+  double t = 0.0;
+  Vec3 position = toolpath.start_mm;
+  size_t next_weight = 0;
+  std::vector<Vec3> positions, velocities;
+  std::vector<int> owners;
+  std::vector<double> slow_down;
+  for (size_t i = 0; i < toolpath.paths.size(); ++i) {
+    const PrintPath& path = toolpath.paths[i];
+    PathGeometry geometry = build_geometry(path, settings_, limits, next_weight, warnings);
+
+    // the samples: Taylor update along the path; blends whose samples, interpolated,
+    // exceed a limit are slowed and the path sampled again
+    const double estimate = path.length_mm() / path.speed_mm_s / settings_.period_s;
+    positions.reserve(static_cast<size_t>(1.2 * estimate) + 64);
+    velocities.reserve(positions.capacity());
+    owners.reserve(positions.capacity());
+    size_t print_begin = 0, print_end = 0;
+    for (int attempt = 0;; ++attempt) {
+      assign_node_speeds(geometry, settings_.period_s);
+      positions.clear();
+      velocities.clear();
+      owners.clear();
+      PathSampler sampler(geometry, settings_.period_s, positions, velocities, owners);
+      sampler.run(print_begin, print_end);
+      const bool owned = check_sampled_limits(positions, velocities, owners, geometry,
+                                              settings_.period_s, limits, slow_down);
+      const bool within =
+          std::all_of(slow_down.begin(), slow_down.end(), [](double f) { return f >= 1.0; });
+      if (owned && within) break;
+      if (!owned || attempt == kMaxSlowDownRounds)
+        throw InternalError("bezier: sampled motion of path " + std::to_string(path.source_index) +
+                            " exceeds the limits");
+      // the samples fall differently at the new speed: take a growing extra margin so the
+      // rounds settle (1e-4, 1e-3, 1e-2, then 10 %)
+      const double margin = std::pow(10.0, std::min(-1, attempt - 4));
+      for (size_t j = 0; j < slow_down.size(); ++j) {
+        if (slow_down[j] >= 1.0) continue;
+        PathNode& node = geometry.nodes[j];
+        node.cap_mm_s = std::min(node.cap_mm_s, node.speed_mm_s) * slow_down[j] * (1.0 - margin);
+        if (node.cap_reason.empty()) node.cap_reason = "limits between samples on a sharp blend";
+      }
+    }
+    for (const PathNode& node : geometry.nodes) {
+      if (!node.blend || node.speed_mm_s >= path.speed_mm_s * (1.0 - 1e-9)) continue;
+      std::ostringstream msg;
+      msg << corner_name(path, node.corner) << ": blend slowed to " << node.speed_mm_s
+          << " mm/s (print speed " << path.speed_mm_s << " mm/s; "
+          << (node.cap_reason.empty() ? std::string("adjacent lines too short to ramp")
+                                      : node.cap_reason)
+          << ")";
+      warnings.push_back(msg.str());
+    }
+
+    // shutter closed: to the path's first sample, at rest
+    pieces.push_back(
+        transition_piece(t, position, Vec3::Zero(), positions.front(), Vec3::Zero(), limits));
+    t = pieces.back().t_end_s;
+    const int path_index = static_cast<int>(i);
+    auto slice = [&](size_t begin, size_t end) {
+      return std::vector<Vec3>(positions.begin() + begin, positions.begin() + end + 1);
+    };
+    auto slice_v = [&](size_t begin, size_t end) {
+      return std::vector<Vec3>(velocities.begin() + begin, velocities.begin() + end + 1);
+    };
+    if (geometry.lead) {
+      pieces.push_back(sampled_piece(t, settings_.period_s, slice(0, print_begin),
+                                     slice_v(0, print_begin), -1, false, 0.0));
+      t = pieces.back().t_end_s;
+    }
+    pieces.push_back(sampled_piece(t, settings_.period_s, slice(print_begin, print_end),
+                                   slice_v(print_begin, print_end), path_index, true,
+                                   path.speed_mm_s));
+    t = pieces.back().t_end_s;
+    if (geometry.lead) {
+      const size_t last = positions.size() - 1;
+      pieces.push_back(sampled_piece(t, settings_.period_s, slice(print_end, last),
+                                     slice_v(print_end, last), -1, false, 0.0));
+      t = pieces.back().t_end_s;
+    }
+    position = positions.back();
+  }
+  pieces.push_back(
+      transition_piece(t, position, Vec3::Zero(), toolpath.end_mm, Vec3::Zero(), limits));
+
+  // keep the warnings readable on long toolpaths
+  if (warnings.size() > kMaxDetailedWarnings) {
+    const size_t more = warnings.size() - kMaxDetailedWarnings;
+    warnings.resize(kMaxDetailedWarnings);
+    warnings.push_back("... and " + std::to_string(more) + " more corner warnings");
+  }
+  return Trajectory("bezier", std::move(pieces), std::move(warnings));
+}
+
+}  // namespace depotwin

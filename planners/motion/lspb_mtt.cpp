@@ -1,0 +1,92 @@
+#include "planners/motion/lspb_mtt.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "motion/lspb.hpp"
+#include "motion/mtt.hpp"
+#include "planners/motion/print_segments.hpp"
+#include "planners/motion/transition.hpp"
+
+namespace depotwin {
+
+namespace {
+
+// Boundary velocities of every print segment, eqs. (48)-(53): the desired velocity at an
+// isolated end, the average of both segments' desired velocities at a shared joint.
+void assign_boundary_velocities(std::vector<PrintSegment>& segments) {
+  for (size_t i = 0; i < segments.size(); ++i) {
+    PrintSegment& s = segments[i];
+    s.v_begin = s.v_desired;  // eqs. (48)-(49)
+    s.v_end = s.v_desired;
+    if (i > 0 && s.joined_to_previous)
+      s.v_begin = 0.5 * (segments[i - 1].v_desired + s.v_desired);  // eqs. (52)-(53)
+    if (i + 1 < segments.size() && segments[i + 1].joined_to_previous)
+      s.v_end = 0.5 * (s.v_desired + segments[i + 1].v_desired);
+  }
+}
+
+}  // namespace
+
+Trajectory LspbMttPlanner::plan(const Toolpath& toolpath, const MachineLimits& limits) const {
+  std::vector<PrintSegment> segments = split_into_segments(toolpath, limits);
+  assign_boundary_velocities(segments);
+
+  std::vector<TrajectoryPiece> pieces;
+  std::vector<std::string> warnings;
+  double t = 0.0;
+  Vec3 position = toolpath.start_mm;
+  Vec3 velocity = Vec3::Zero();
+  for (const PrintSegment& s : segments) {
+    // shutter closed: minimum-time transition to the segment's start and velocity
+    if (!s.joined_to_previous) {
+      pieces.push_back(transition_piece(t, position, velocity, s.p0, s.v_begin, limits));
+      t = pieces.back().t_end_s;
+    }
+    // shutter open: per-axis LSPB over the segment time L / v, eq. (50)
+    const double nominal_s = s.length_mm / s.speed_mm_s;
+    std::vector<AxisMove> moves = axis_moves(s.p0, s.v_begin, s.p1, s.v_end, limits);
+    std::vector<AxisProfile> axes;
+    bool solved = true;
+    for (const AxisMove& move : moves) {
+      auto lspb = solve_lspb(move.boundary, nominal_s, move.a_max, move.v_max);
+      if (!lspb) {
+        solved = false;
+        break;
+      }
+      axes.push_back(lspb->profile(move.boundary));
+    }
+    double duration_s = nominal_s;
+    if (!solved) {
+      // beyond the paper: no LSPB exists in L / v (the segment is too short for its
+      // boundary velocities); take the shortest longer duration every axis can meet
+      duration_s = synchronized_duration(moves, nominal_s);
+      axes.clear();
+      for (const AxisMove& move : moves)
+        axes.push_back(fixed_time_move(move.boundary, duration_s, move.v_max, move.a_max));
+      std::ostringstream warning;
+      warning << "path " << s.path_index << " segment " << s.edge_index
+              << ": no LSPB in L/v = " << nominal_s << " s; lengthened to " << duration_s
+              << " s (mean speed " << s.length_mm / duration_s << " instead of "
+              << s.speed_mm_s << " mm/s)";
+      warnings.push_back(warning.str());
+    }
+    TrajectoryPiece piece;
+    piece.t_begin_s = t;
+    piece.t_end_s = t + duration_s;
+    piece.path_index = s.path_index;
+    piece.depositing = true;
+    piece.desired_speed_mm_s = s.speed_mm_s;
+    piece.motion = phase_motion(std::move(axes));
+    pieces.push_back(std::move(piece));
+    t += duration_s;
+    position = s.p1;
+    velocity = s.v_end;
+  }
+  // shutter closed: to the end point, at rest
+  pieces.push_back(transition_piece(t, position, velocity, toolpath.end_mm, Vec3::Zero(), limits));
+  return Trajectory("lspb_mtt", std::move(pieces), std::move(warnings));
+}
+
+}  // namespace depotwin

@@ -1,0 +1,110 @@
+#include "planners/ordering/sequencer.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include "core/error.hpp"
+#include "planners/ordering/christofides.hpp"
+#include "planners/ordering/local_search.hpp"
+#include "planners/ordering/lower_bound.hpp"
+#include "planners/ordering/nearest_neighbor.hpp"
+#include "planners/ordering/neighbor_lists.hpp"
+#include "planners/ordering/random_order.hpp"
+#include "planners/ordering/transition_cost.hpp"
+
+namespace depotwin {
+
+namespace {
+
+bool known(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+void check_spec(const OrderSpec& spec) {
+  std::vector<Problem> problems;
+  if (!known(sequencer_methods(), spec.method))
+    problems.push_back(
+        {"", 0, "order.method",
+         "unknown sequencer '" + spec.method + "' (expected " + joined(sequencer_methods()) + ")"});
+  if (!spec.refine.empty() && !known(refine_methods(), spec.refine))
+    problems.push_back(
+        {"", 0, "order.refine",
+         "unknown refinement '" + spec.refine + "' (expected " + joined(refine_methods()) + ")"});
+  if (!known(cost_models(), spec.cost_model))
+    problems.push_back(
+        {"", 0, "order.cost_model",
+         "unknown cost model '" + spec.cost_model + "' (expected " + joined(cost_models()) + ")"});
+  if (!problems.empty()) throw InputError(std::move(problems));
+}
+
+OrderResult construct(const TransitionCost& cost, const OrderSpec& spec) {
+  if (spec.method == "random") return random_order(cost.path_count(), spec.seed);
+  if (spec.method == "nearest_neighbor") return nearest_neighbor_order(cost);
+  if (spec.method == "christofides") return christofides_order(cost);
+  OrderResult given;  // as_given
+  for (int i = 0; i < cost.path_count(); ++i) {
+    given.order.push_back(i);
+    given.reversed.push_back(false);
+  }
+  return given;
+}
+
+}  // namespace
+
+std::string OrderSpec::label() const {
+  return refine.empty() ? method : method + "+" + refine;
+}
+
+const std::vector<std::string>& sequencer_methods() {
+  static const std::vector<std::string> names{"as_given", "random", "nearest_neighbor",
+                                              "christofides"};
+  return names;
+}
+
+const std::vector<std::string>& refine_methods() {
+  static const std::vector<std::string> names{"two_opt", "three_opt", "or_opt"};
+  return names;
+}
+
+const std::vector<std::string>& cost_models() {
+  static const std::vector<std::string> names{"machine", "along_line"};
+  return names;
+}
+
+OrderResult sequence(const Toolpath& toolpath, const MachineLimits& limits, const OrderSpec& spec,
+                     const SequencerOptions& options) {
+  check_spec(spec);
+  const TransitionCost cost(toolpath, limits, parse_cost_model(spec.cost_model));
+
+  // construct, then refine over neighbour lists
+  OrderResult result = construct(cost, spec);
+  if (!spec.refine.empty()) {
+    const NeighborLists neighbors(cost, options.neighbors);
+    refine_order(result, cost, neighbors, parse_refinement(spec.refine));
+  }
+
+  result.cost_s = cost.order_cost(result);
+  result.print_time_s = cost.print_time_s();
+  result.lower_bound_s =
+      options.lower_bound ? matching_lower_bound(cost) : std::numeric_limits<double>::quiet_NaN();
+  return result;
+}
+
+Toolpath apply_order(const Toolpath& toolpath, const OrderResult& result) {
+  Toolpath out;
+  out.start_mm = toolpath.start_mm;
+  out.end_mm = toolpath.end_mm;
+  for (size_t k = 0; k < result.order.size(); ++k) {
+    const PrintPath& path = toolpath.paths.at(result.order[k]);
+    out.paths.push_back(result.reversed[k] ? path.reversed() : path);
+  }
+  return out;
+}
+
+}  // namespace depotwin

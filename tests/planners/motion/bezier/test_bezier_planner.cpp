@@ -1,0 +1,378 @@
+// The bezier planner (Giberti, Sbaglia & Urgo 2017, papers/001) against the paper's numbers,
+// closed forms and the project's planner contract.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+
+#include "bezier_checks.hpp"
+#include "core/error.hpp"
+#include "planners/motion/bezier/bezier.hpp"
+#include "toolpath/random_segments.hpp"
+
+namespace depotwin {
+namespace {
+using namespace bezier_test;
+
+BezierPlanner planner_with(double delta_mm, std::vector<double> weights = {1.0},
+                           bool lead_in = false, double period_s = 0.001) {
+  BezierSettings settings;
+  settings.delta_mm = delta_mm;
+  settings.weights = std::move(weights);
+  settings.lead_in = lead_in;
+  settings.period_s = period_s;
+  return BezierPlanner(settings);
+}
+
+std::vector<const TrajectoryPiece*> printing_pieces(const Trajectory& trajectory) {
+  std::vector<const TrajectoryPiece*> result;
+  for (const TrajectoryPiece& piece : trajectory.pieces())
+    if (piece.depositing) result.push_back(&piece);
+  return result;
+}
+
+// limits that never bind, as in the paper's theoretical example (Sec. 4.1)
+const MachineLimits kUnbound = MachineLimits::uniform(1000.0, 1e6);
+
+// ---------------------------------------------------------------------------------------
+// parameters
+
+TEST(BezierPlanner, DeclaresItsParametersWithRanges) {
+  PlannerSpec spec;
+  spec.name = "bezier";
+  EXPECT_EQ(check_planner_spec(spec), "");
+  spec.params["delta"] = {0.3};
+  spec.params["weight"] = {1.0, 2.0, 0.5};
+  spec.params["period_s"] = {0.0005};
+  spec.params["lead_in"] = {1.0};
+  EXPECT_EQ(check_planner_spec(spec), "");
+  const BezierSettings settings = bezier_settings(spec);
+  EXPECT_EQ(settings.delta_mm, 0.3);
+  EXPECT_EQ(settings.weights, (std::vector<double>{1.0, 2.0, 0.5}));
+  EXPECT_EQ(settings.period_s, 0.0005);
+  EXPECT_TRUE(settings.lead_in);
+
+  spec.params["delta"] = {0.0};
+  EXPECT_NE(check_planner_spec(spec).find("'delta'"), std::string::npos);
+  spec.params["delta"] = {0.3};
+  spec.params["weight"] = {0.0};
+  EXPECT_NE(check_planner_spec(spec).find("'weight'"), std::string::npos);
+  spec.params["weight"] = {1.0};
+  spec.params["period_s"] = {0.001, 0.002};
+  EXPECT_NE(check_planner_spec(spec).find("not a list"), std::string::npos);
+  spec.params["period_s"] = {0.001};
+  spec.params["lead_in"] = {0.5};
+  EXPECT_THROW(make_planner(spec), InputError);
+}
+
+TEST(BezierPlanner, WeightListMustMatchTheCornerCount) {
+  // the four-point path has two corners
+  const Toolpath toolpath = single_path(four_point_path(), 5.0);
+  EXPECT_NO_THROW(planner_with(0.5, {2.0}).plan(toolpath, kUnbound));
+  EXPECT_NO_THROW(planner_with(0.5, {2.0, 0.5}).plan(toolpath, kUnbound));
+  try {
+    planner_with(0.5, {1.0, 2.0, 3.0}).plan(toolpath, kUnbound);
+    FAIL() << "three weights for two corners";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 1u);
+    EXPECT_EQ(e.problems()[0].key, "planners.bezier.weight");
+    EXPECT_NE(e.problems()[0].message.find("2 corners"), std::string::npos);
+  }
+}
+
+TEST(BezierPlanner, LineTooFastForAnAxisIsAnInputError) {
+  const Toolpath toolpath = single_path({Vec3(0, 0, 0), Vec3(10, 0, 0)}, 8.0);
+  EXPECT_THROW(planner_with(0.5).plan(toolpath, MachineLimits::uniform(5.0, 100.0)), InputError);
+}
+
+// ---------------------------------------------------------------------------------------
+// the paper's measurements
+
+// Sec. 4.1 / Fig. 4: four points, two curves, 5, 10 and 20 mm/s, delta 0.45 mm (the value of
+// the paper's application, Sec. 6.2), T_s = 1 ms. The paper reports at most 0.14, 0.27 and
+// 0.22 % speed variation over the central part; the corners of this path turn by 90 degrees.
+TEST(BezierPlanner, SpeedVariationOnAFourPointPathIsBelowThePapers) {
+  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(30, 0, 0), Vec3(30, 20, 0),
+                                    Vec3(60, 20, 0)};
+  const std::vector<std::pair<double, double>> paper = {
+      {5.0, 0.0014}, {10.0, 0.0027}, {20.0, 0.0022}};
+  for (const auto& [speed, paper_variation] : paper) {
+    const Trajectory trajectory = planner_with(0.45).plan(single_path(points, speed), kUnbound);
+    EXPECT_TRUE(trajectory.warnings().empty());
+    const auto pieces = printing_pieces(trajectory);
+    ASSERT_EQ(pieces.size(), 1u);
+    const SpeedVariation variation = speed_variation(sampled(*pieces[0]), speed);
+    // the central part is nearly the whole path (ramps of v/a are a few samples)
+    EXPECT_GT(variation.central_samples, 0.98 * 80.0 / speed / 0.001);
+    EXPECT_LT(variation.max_rel, paper_variation) << speed << " mm/s";
+    std::printf("[ speed variation ] %4.0f mm/s: %.4f %% (paper %.2f %%)\n", speed,
+                100 * variation.max_rel, 100 * paper_variation);
+  }
+}
+
+// The variation comes from the 2nd-order Taylor update, so it grows with the square of the
+// step v T_s: doubling the speed quadruples it (shown on sharp 135-degree corners, where it
+// is largest).
+TEST(BezierPlanner, SpeedVariationGrowsWithTheSquareOfTheStep) {
+  std::vector<double> variations;
+  for (double speed : {5.0, 10.0, 20.0}) {
+    const Trajectory trajectory =
+        planner_with(0.45).plan(single_path(four_point_path(), speed), kUnbound);
+    const auto pieces = printing_pieces(trajectory);
+    variations.push_back(speed_variation(sampled(*pieces[0]), speed).max_rel);
+    std::printf("[ speed variation, 135-degree corners ] %4.0f mm/s: %.4f %%\n", speed,
+                100 * variations.back());
+  }
+  EXPECT_NEAR(variations[1] / variations[0], 4.0, 0.4);
+  EXPECT_NEAR(variations[2] / variations[1], 4.0, 0.4);
+  // a finer sample period gives the same quadratic gain
+  const Trajectory fine =
+      planner_with(0.45, {1.0}, false, 0.0005).plan(single_path(four_point_path(), 20.0), kUnbound);
+  const double fine_variation = speed_variation(sampled(*printing_pieces(fine)[0]), 20.0).max_rel;
+  EXPECT_NEAR(variations[2] / fine_variation, 4.0, 0.4);
+}
+
+// ---------------------------------------------------------------------------------------
+// geometry
+
+TEST(BezierPlanner, PathStaysOnTheLinesOrWithinDeltaOfACorner) {
+  const double delta = 0.8;
+  const std::vector<Vec3> points = four_point_path();
+  const Trajectory trajectory = planner_with(delta).plan(single_path(points, 10.0), kUnbound);
+  const SampledMotion& motion = sampled(*printing_pieces(trajectory)[0]);
+  double farthest = 0.0;
+  for (const Vec3& p : motion.position_mm) {
+    const double off = distance_to_polyline(p, points);
+    farthest = std::max(farthest, off);
+    if (off < 1e-9) continue;
+    const double to_corner = std::min((p - points[1]).norm(), (p - points[2]).norm());
+    EXPECT_LE(to_corner, delta + 1e-12);
+  }
+  // the farthest point is the apex of a corner (both turn by 135 degrees): at
+  // delta sin(turn/2) / 2 from the corner, i.e. delta sin(turn/2) cos(turn/2) / 2 from the
+  // lines. The distance has a kink there (slope sin(turn/2) per mm of arc); the nearest
+  // sample is at most half a step v T away.
+  const double half = deg_to_rad(135.0) / 2;
+  const double apex = delta * std::sin(half) * std::cos(half) / 2;
+  EXPECT_LE(farthest, apex + 1e-12);
+  EXPECT_GE(farthest, apex - std::sin(half) * 10.0 * 0.001 / 2);
+}
+
+TEST(BezierPlanner, PerCornerWeightsPullOnlyTheirCorner) {
+  const std::vector<Vec3> points = four_point_path();
+  auto nearest = [&](const Trajectory& t, const Vec3& corner) {
+    double d = 1e300;
+    for (const Vec3& p : sampled(*printing_pieces(t)[0]).position_mm)
+      d = std::min(d, (p - corner).norm());
+    return d;
+  };
+  const Trajectory plain = planner_with(0.8).plan(single_path(points, 5.0), kUnbound);
+  const Trajectory pulled = planner_with(0.8, {1.0, 10.0}).plan(single_path(points, 5.0), kUnbound);
+  EXPECT_NEAR(nearest(pulled, points[1]), nearest(plain, points[1]), 1e-9);
+  EXPECT_LT(nearest(pulled, points[2]), 0.25 * nearest(plain, points[2]));
+}
+
+TEST(BezierPlanner, ClipsTheFilletWhenCornersAreCloserThanTwoDelta) {
+  // the middle line is 0.6 mm long: both corners get delta = 0.3 mm and a warning
+  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(10, 0.6, 0),
+                                    Vec3(20, 0.6, 0)};
+  const Toolpath toolpath = single_path(points, 5.0);
+  const MachineLimits limits = MachineLimits::uniform(50.0, 2000.0);
+  const Trajectory trajectory = planner_with(0.5).plan(toolpath, limits);
+  int clipped = 0;
+  for (const std::string& w : trajectory.warnings())
+    if (w.find("clipped from 0.5 to 0.3") != std::string::npos) ++clipped;
+  EXPECT_EQ(clipped, 2);
+  for (const Vec3& p : sampled(*printing_pieces(trajectory)[0]).position_mm) {
+    if (distance_to_polyline(p, points) < 1e-9) continue;
+    EXPECT_LE(std::min((p - points[1]).norm(), (p - points[2]).norm()), 0.3 + 1e-12);
+  }
+  expect_contract(trajectory, toolpath, limits, 0.3);
+}
+
+TEST(BezierPlanner, StopsAtAnExactReversal) {
+  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(4, 0, 0)};
+  const Toolpath toolpath = single_path(points, 5.0);
+  const MachineLimits limits = MachineLimits::uniform(20.0, 200.0);
+  const Trajectory trajectory = planner_with(0.5).plan(toolpath, limits);
+  ASSERT_EQ(trajectory.warnings().size(), 1u);
+  EXPECT_NE(trajectory.warnings()[0].find("corner 1: reverses direction"), std::string::npos);
+  bool at_corner_at_rest = false;
+  const SampledMotion& motion = sampled(*printing_pieces(trajectory)[0]);
+  for (size_t k = 0; k < motion.position_mm.size(); ++k)
+    at_corner_at_rest |=
+        (motion.position_mm[k] - points[1]).norm() < 1e-12 && motion.velocity_mm_s[k].norm() == 0.0;
+  EXPECT_TRUE(at_corner_at_rest);
+  expect_contract(trajectory, toolpath, limits, 0.0);
+}
+
+// ---------------------------------------------------------------------------------------
+// limits
+
+TEST(BezierPlanner, SlowsBlendsThatWouldExceedAnAxisAccelerationAndNamesThem) {
+  // 20 mm/s through 90-degree corners with delta 0.45 needs 20^2 sqrt(2) / 0.45 / sqrt(2)
+  // = 889 mm/s^2 per axis at the apex: with 500 mm/s^2 both blends slow down, with
+  // trapezoidal ramps on the lines around them
+  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(30, 0, 0), Vec3(30, 20, 0),
+                                    Vec3(60, 20, 0)};
+  const Toolpath toolpath = single_path(points, 20.0);
+  const MachineLimits limits = MachineLimits::uniform(50.0, 500.0);
+  const Trajectory trajectory = planner_with(0.45).plan(toolpath, limits);
+  int slowed = 0;
+  for (const std::string& w : trajectory.warnings()) {
+    if (w.find("path 0 corner 1: blend slowed") != std::string::npos) ++slowed;
+    if (w.find("path 0 corner 2: blend slowed") != std::string::npos) ++slowed;
+  }
+  EXPECT_EQ(slowed, 2);
+  expect_contract(trajectory, toolpath, limits, 0.45);
+  // the limit is used, not wasted: the sampled peak comes close to a_max
+  const SamplePeaks peaks = sample_peaks(sampled(*printing_pieces(trajectory)[0]));
+  EXPECT_GT(peaks.accel.maxCoeff(), 0.9 * 500.0);
+}
+
+TEST(BezierPlanner, SlowsBlendsForAxisVelocity) {
+  // both lines need 0.8 * 10 = 8 mm/s per axis, but the blend's tangent swings through the
+  // x axis (10 mm/s on x at the apex): with v_max = 9 the blend slows to 9 mm/s
+  const double s = 0.6, c = 0.8;
+  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(20 * c, 20 * s, 0), Vec3(40 * c, 0, 0)};
+  const Toolpath toolpath = single_path(points, 10.0);
+  const MachineLimits limits = MachineLimits::uniform(9.0, 5000.0);
+  const Trajectory trajectory = planner_with(1.0).plan(toolpath, limits);
+  ASSERT_FALSE(trajectory.warnings().empty());
+  EXPECT_NE(trajectory.warnings()[0].find("v_max of axis x"), std::string::npos);
+  expect_contract(trajectory, toolpath, limits, 1.0);
+  const SamplePeaks peaks = sample_peaks(sampled(*printing_pieces(trajectory)[0]));
+  EXPECT_NEAR(peaks.velocity.x(), 9.0, 0.01);
+}
+
+// Fig. 11a: constant speed makes the acceleration peak in the curves. On a Cartesian stage
+// the peak is the blend's v^2 kappa at the apex: 5^2 * sqrt(2) / 0.45 mm/s^2 for 90 degrees.
+TEST(BezierPlanner, AccelerationPeaksAtTheBlendApexWithVSquaredKappa) {
+  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(40, 0, 0), Vec3(40, 30, 0), Vec3(0, 30, 0)};
+  const double v = 5.0, delta = 0.45;
+  const MachineLimits limits = MachineLimits::uniform(100.0, 1000.0);
+  const Trajectory trajectory = planner_with(delta).plan(single_path(points, v), limits);
+  const SampledMotion& motion = sampled(*printing_pieces(trajectory)[0]);
+  double peak = 0.0;
+  size_t peak_at = 0;
+  const double h2 = motion.period_s * motion.period_s;
+  // skip the start and end ramps (a_max along a line), look at the constant-speed part
+  for (size_t k = 60; k + 60 < motion.position_mm.size(); ++k) {
+    const Vec3 a =
+        (motion.position_mm[k + 1] - 2 * motion.position_mm[k] + motion.position_mm[k - 1]) / h2;
+    if (a.norm() > peak) peak = a.norm(), peak_at = k;
+  }
+  EXPECT_NEAR(peak, v * v * std::sqrt(2.0) / delta, 0.005 * v * v * std::sqrt(2.0) / delta);
+  const Vec3& p = motion.position_mm[peak_at];
+  EXPECT_LT(std::min((p - points[1]).norm(), (p - points[2]).norm()), delta);
+  std::printf("[ Fig. 11a ] peak |a| %.2f mm/s^2 at (%.3f, %.3f), v^2 kappa = %.2f\n", peak, p.x(),
+              p.y(), v * v * std::sqrt(2.0) / delta);
+}
+
+// ---------------------------------------------------------------------------------------
+// the planner contract
+
+TEST(BezierPlanner, PrintPathsStartAndEndAtRestAtTheirEnds) {
+  const std::vector<Vec3> points = four_point_path();
+  const Trajectory trajectory = planner_with(0.5).plan(single_path(points, 10.0), kUnbound);
+  const SampledMotion& motion = sampled(*printing_pieces(trajectory)[0]);
+  EXPECT_EQ(motion.position_mm.front(), points.front());
+  EXPECT_EQ(motion.position_mm.back(), points.back());
+  EXPECT_EQ(motion.velocity_mm_s.front().norm(), 0.0);
+  EXPECT_EQ(motion.velocity_mm_s.back().norm(), 0.0);
+}
+
+TEST(BezierPlanner, MeetsTheContractOnRandomSegments) {
+  // the lead's contract instances (Ganganath et al.), with the scenario example's limits
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    RandomSegmentsSpec spec;
+    spec.count = 8;
+    spec.seed = seed;
+    const Toolpath toolpath = make_random_segments(spec);
+    const MachineLimits limits = MachineLimits::uniform(4.0, 30.0);
+    const Trajectory trajectory = planner_with(0.5).plan(toolpath, limits);
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    expect_contract(trajectory, toolpath, limits, 0.5);
+  }
+}
+
+TEST(BezierPlanner, MeetsTheContractOnRandomPolylines) {
+  // 3-D polylines with sharp turns, reversals and short edges; tight limits; with and
+  // without lead-in, at two sample periods
+  for (std::uint64_t seed : {1u, 2u, 3u, 4u}) {
+    const Toolpath toolpath = random_polylines(seed, 5);
+    for (const MachineLimits& limits :
+         {MachineLimits::uniform(25.0, 300.0), MachineLimits::uniform(60.0, 3000.0)}) {
+      const bool lead_in = seed % 2 == 0;
+      const double period = seed < 3 ? 0.001 : 0.004;
+      SCOPED_TRACE("seed " + std::to_string(seed));
+      const Trajectory trajectory =
+          planner_with(0.5, {1.0}, lead_in, period).plan(toolpath, limits);
+      expect_contract(trajectory, toolpath, limits, 0.5);
+    }
+  }
+}
+
+TEST(BezierPlanner, JoinedPathsAreSeparatedByAnEmptyTransition) {
+  // the second path starts where the first ends: both stop there (each path starts and
+  // ends at rest) and the transition between them takes no time
+  Toolpath toolpath = single_path(four_point_path(), 5.0);
+  PrintPath second;
+  second.points = {Vec3(40, 20, 0), Vec3(40, 40, 0), Vec3(0, 40, 0)};
+  second.speed_mm_s = 8.0;
+  second.source_index = 1;
+  toolpath.paths.push_back(second);
+  const MachineLimits limits = MachineLimits::uniform(50.0, 500.0);
+  const Trajectory trajectory = planner_with(0.5).plan(toolpath, limits);
+  ASSERT_EQ(trajectory.pieces().size(), 5u);
+  EXPECT_EQ(trajectory.pieces()[2].path_index, -1);
+  EXPECT_EQ(trajectory.pieces()[2].t_end_s, trajectory.pieces()[2].t_begin_s);
+  expect_contract(trajectory, toolpath, limits, 0.5);
+}
+
+TEST(BezierPlanner, SameInputSamePlan) {
+  const Toolpath toolpath = random_polylines(9, 3);
+  const MachineLimits limits = MachineLimits::uniform(25.0, 300.0);
+  const Trajectory a = planner_with(0.5).plan(toolpath, limits);
+  const Trajectory b = planner_with(0.5).plan(toolpath, limits);
+  ASSERT_EQ(a.pieces().size(), b.pieces().size());
+  EXPECT_EQ(a.duration_s(), b.duration_s());
+  for (size_t i = 0; i < a.pieces().size(); ++i) {
+    if (!std::holds_alternative<SampledMotion>(a.pieces()[i].motion)) continue;
+    EXPECT_EQ(sampled(a.pieces()[i]).position_mm, sampled(b.pieces()[i]).position_mm);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// lead-in / lead-out
+
+TEST(BezierPlanner, LeadInPrintsOnlyAtFullSpeed) {
+  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(30, 0, 0), Vec3(30, 20, 0),
+                                    Vec3(60, 20, 0)};
+  const double v = 10.0, period = 0.001;
+  const Toolpath toolpath = single_path(points, v);
+  const MachineLimits limits = MachineLimits::uniform(50.0, 1000.0);
+  const Trajectory trajectory = planner_with(0.45, {1.0}, true, period).plan(toolpath, limits);
+  const auto pieces = printing_pieces(trajectory);
+  ASSERT_EQ(pieces.size(), 1u);
+  const SampledMotion& motion = sampled(*pieces[0]);
+  // printing starts exactly at P_0 and stops within one step past P_n, at full speed throughout
+  EXPECT_LT((motion.position_mm.front() - points.front()).norm(), 1e-12);
+  const Vec3 past_end = motion.position_mm.back() - points.back();
+  EXPECT_GE(past_end.x(), 0.0);
+  EXPECT_LT(past_end.norm(), v * period + 1e-12);
+  for (const Vec3& velocity : motion.velocity_mm_s) EXPECT_NEAR(velocity.norm(), v, 1e-9 * v);
+  // ramps are separate, material-off pieces on the extensions of the first and last line
+  int ramps = 0;
+  for (const TrajectoryPiece& piece : trajectory.pieces()) {
+    if (piece.depositing || !std::holds_alternative<SampledMotion>(piece.motion)) continue;
+    ++ramps;
+    for (const Vec3& p : sampled(piece).position_mm)
+      EXPECT_TRUE(p.x() <= 1e-12 || p.x() >= 60.0 - 1e-12) << p.transpose();
+  }
+  EXPECT_EQ(ramps, 2);
+  expect_contract(trajectory, toolpath, limits, 0.45);
+}
+
+}  // namespace
+}  // namespace depotwin

@@ -1,0 +1,165 @@
+// The G-code importer: print moves become polylines with the right points and speeds,
+// modal state (G90/G91, M82/M83, G92, G20/G21, F) is followed, bad lines are reported.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "core/error.hpp"
+#include "toolpath/gcode.hpp"
+#include "scenario/scenario_test_util.hpp"
+
+namespace depotwin {
+namespace {
+
+using testing_scenario::dump;
+
+const std::string kFixture = std::string(DEPOTWIN_SOURCE_DIR) + "/tests/toolpath/data/square.gcode";
+
+GcodeImport parse(const std::string& text, double default_speed_mm_s = 0.0) {
+  std::istringstream in(text);
+  return parse_gcode(in, "test.gcode", default_speed_mm_s);
+}
+
+// the problems of G-code text that must not parse
+std::vector<Problem> problems_of(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const InputError& e) {
+    return e.problems();
+  }
+  ADD_FAILURE() << "expected an InputError for:\n" << text;
+  return {};
+}
+
+void expect_points(const PrintPath& path, const std::vector<Vec3>& expected) {
+  ASSERT_EQ(path.points.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    EXPECT_TRUE(path.points[i].isApprox(expected[i], 1e-12) ||
+                (path.points[i] - expected[i]).norm() < 1e-12)
+        << "point " << i << ": " << path.points[i].transpose() << " != " << expected[i].transpose();
+}
+
+TEST(Gcode, FixtureGivesThreePaths) {
+  const GcodeImport imported = read_gcode(kFixture, 0.0);
+  const Toolpath& toolpath = imported.toolpath;
+  ASSERT_EQ(toolpath.paths.size(), 3u);
+  expect_points(toolpath.paths[0], {Vec3(10, 10, 0.2), Vec3(20, 10, 0.2), Vec3(20, 20, 0.2)});
+  expect_points(toolpath.paths[1], {Vec3(20, 20, 0.2), Vec3(10, 20, 0.2)});
+  expect_points(toolpath.paths[2], {Vec3(30, 10, 0.2), Vec3(40, 10, 0.2), Vec3(40, 15, 0.2)});
+  // F600, F1200, F300 mm/min
+  EXPECT_DOUBLE_EQ(toolpath.paths[0].speed_mm_s, 10.0);
+  EXPECT_DOUBLE_EQ(toolpath.paths[1].speed_mm_s, 20.0);
+  EXPECT_DOUBLE_EQ(toolpath.paths[2].speed_mm_s, 5.0);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(toolpath.paths[i].source_index, i);
+  // the scenario sets start and end
+  EXPECT_EQ(toolpath.start_mm, Vec3::Zero());
+  EXPECT_EQ(toolpath.end_mm, Vec3::Zero());
+  // lines of the moves that reached each point
+  EXPECT_EQ(imported.point_lines[0], (std::vector<int>{15, 15, 16}));
+  EXPECT_EQ(imported.point_lines[1], (std::vector<int>{17, 17}));
+  EXPECT_EQ(imported.point_lines[2], (std::vector<int>{23, 23, 25}));
+  // import_gcode is the same paths
+  EXPECT_EQ(import_gcode(kFixture, 0.0).paths.size(), 3u);
+}
+
+TEST(Gcode, RelativePositioningMakesExtrusionRelativeToo) {
+  // G91 makes E relative even under M82 (Marlin, Klipper), so E1 twice prints twice
+  const GcodeImport imported = parse("M82\nG91\nG1 X5 E1 F600\nG1 Y5 E1\n");
+  ASSERT_EQ(imported.toolpath.paths.size(), 1u);
+  expect_points(imported.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(5, 0, 0), Vec3(5, 5, 0)});
+  // absolute E under M82/G90: E1 then E1 again is no extrusion, so a travel
+  const GcodeImport absolute = parse("M82\nG90\nG1 X5 E1 F600\nG1 Y5 E1\n");
+  ASSERT_EQ(absolute.toolpath.paths.size(), 1u);
+  expect_points(absolute.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(5, 0, 0)});
+  // M83 then G90: relative E with absolute positions (Klipper's rule)
+  const GcodeImport m83 = parse("M83\nG90\nG1 X5 E1 F600\nG1 X5 Y5 E1\n");
+  ASSERT_EQ(m83.toolpath.paths.size(), 1u);
+  expect_points(m83.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(5, 0, 0), Vec3(5, 5, 0)});
+}
+
+TEST(Gcode, RetractionIsNotAPrintMove) {
+  // relative E: a negative E move (retract) with motion is a travel and ends the path
+  const GcodeImport imported = parse("M83\nG1 X1 E1 F600\nG1 X2 E-0.5\nG1 X3 E1\n");
+  ASSERT_EQ(imported.toolpath.paths.size(), 2u);
+  expect_points(imported.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(1, 0, 0)});
+  expect_points(imported.toolpath.paths[1], {Vec3(2, 0, 0), Vec3(3, 0, 0)});
+}
+
+TEST(Gcode, InchesAndSetPosition) {
+  // G20: 1 inch = 25.4 mm; F60 in/min = 25.4 mm/s
+  const GcodeImport inches = parse("G20\nG1 X1 Y0 E0.1 F60\n");
+  ASSERT_EQ(inches.toolpath.paths.size(), 1u);
+  expect_points(inches.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(25.4, 0, 0)});
+  EXPECT_DOUBLE_EQ(inches.toolpath.paths[0].speed_mm_s, 25.4);
+  // G92 X0 at X10 shifts the frame: X5 is then 15 on the machine
+  const GcodeImport shifted = parse("G0 X10 F600\nG92 X0 E0\nG1 X5 E1\n");
+  ASSERT_EQ(shifted.toolpath.paths.size(), 1u);
+  expect_points(shifted.toolpath.paths[0], {Vec3(10, 0, 0), Vec3(15, 0, 0)});
+}
+
+TEST(Gcode, DefaultSpeedUntilTheFirstFeedRate) {
+  const GcodeImport imported = parse("G1 X1 E1\nG1 X2 E2 F120\n", 7.0);
+  ASSERT_EQ(imported.toolpath.paths.size(), 2u);
+  EXPECT_DOUBLE_EQ(imported.toolpath.paths[0].speed_mm_s, 7.0);
+  EXPECT_DOUBLE_EQ(imported.toolpath.paths[1].speed_mm_s, 2.0);
+  // without a default: the first print move without F is reported, once
+  const auto problems = problems_of("G1 X1 E1\nG1 X2 E2\nG1 X3 E3 F60\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 1);
+  EXPECT_NE(problems[0].message.find("before any feed rate"), std::string::npos);
+}
+
+TEST(Gcode, EveryMalformedLineIsReported) {
+  const auto problems = problems_of(
+      "G1 X1 E1 F600\n"   // 1 fine
+      "G1 Xabc\n"         // 2 letter without number
+      "G1 X1.2.3 E2\n"    // 3 not a number
+      "G2 X1 Y1 I1 J0\n"  // 4 arcs unsupported
+      "G1 X2 F0\n"        // 5 zero feed
+      "G1 X3 X4 E3\n"     // 6 duplicate word
+      "G90 G21\n"         // 7 two commands
+      "hello world\n"     // 8 not G-code
+      "G1 X5 E5 #\n"      // 9 stray character
+      "M117 anything: goes here\n"
+      "G1 X6 E6\n");
+  ASSERT_EQ(problems.size(), 8u) << dump(problems);
+  const std::vector<int> lines{2, 3, 4, 5, 6, 7, 8, 9};
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    EXPECT_EQ(problems[i].file, "test.gcode");
+    EXPECT_EQ(problems[i].line, lines[i]) << problems[i].str();
+    EXPECT_EQ(problems[i].key, "toolpath.gcode");
+  }
+  EXPECT_EQ(
+      problems[0].str(),
+      "test.gcode:2: toolpath.gcode: malformed word 'Xabc' (expected X followed by a number)");
+  EXPECT_NE(problems[1].message.find("'X1.2.3'"), std::string::npos);
+  EXPECT_NE(problems[2].message.find("G2/G3"), std::string::npos);
+  EXPECT_NE(problems[3].message.find("F0 must be > 0"), std::string::npos);
+  EXPECT_NE(problems[4].message.find("X given twice"), std::string::npos);
+  EXPECT_NE(problems[5].message.find("one command per line"), std::string::npos);
+  EXPECT_NE(problems[6].message.find("'hello' is not a G-code command"), std::string::npos);
+  EXPECT_NE(problems[7].message.find("unexpected '#'"), std::string::npos);
+}
+
+TEST(Gcode, ManyBadLinesAreSummarised) {
+  std::string text;
+  for (int i = 0; i < 25; ++i) text += "G1 Xbad\n";
+  const auto problems = problems_of(text);
+  ASSERT_EQ(problems.size(), 21u);
+  EXPECT_EQ(problems[19].line, 20);
+  EXPECT_EQ(problems[20].message, "5 more problems not listed");
+}
+
+TEST(Gcode, MissingFileNamesIt) {
+  try {
+    import_gcode("/nonexistent/dir/part.gcode", 3.0);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 1u);
+    EXPECT_EQ(e.problems()[0].str(),
+              "/nonexistent/dir/part.gcode: toolpath.gcode: G-code file not found");
+  }
+}
+
+}  // namespace
+}  // namespace depotwin
