@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "motion/jerk.hpp"
+#include "motion/sync.hpp"
 #include "motion/mtt.hpp"
 
 using namespace depotwin;
@@ -31,7 +32,7 @@ void BM_JerkMinimumTimeMove1D(benchmark::State& state) {
   const auto boundaries = random_boundaries(4096);
   size_t i = 0;
   for (auto _ : state) {
-    JerkProfile p = jerk_min_time_move(boundaries[i++ & 4095], kVmax, kAmax, kJmax);
+    AxisProfile p = jerk_min_time_move(boundaries[i++ & 4095], kVmax, kAmax, kJmax);
     benchmark::DoNotOptimize(p);
   }
   state.counters["moves_per_s"] =
@@ -39,20 +40,20 @@ void BM_JerkMinimumTimeMove1D(benchmark::State& state) {
 }
 BENCHMARK(BM_JerkMinimumTimeMove1D);
 
-void BM_JerkSynchronizedMove3D(benchmark::State& state) {
+void BM_SynchronizedMove3D(benchmark::State& state) {
   const auto boundaries = random_boundaries(4096);
-  std::vector<JerkAxisMove> axes(3);
+  std::vector<AxisMove> axes(3);
   size_t i = 0;
   for (auto _ : state) {
     for (size_t k = 0; k < 3; ++k) axes[k] = {boundaries[(i + k) & 4095], kVmax, kAmax, kJmax};
     ++i;
-    JerkSynchronizedMove m = jerk_synchronized_move(axes);
+    SynchronizedMove m = synchronized_move(axes);
     benchmark::DoNotOptimize(m);
   }
   state.counters["moves_per_s"] =
       benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_JerkSynchronizedMove3D);
+BENCHMARK(BM_SynchronizedMove3D);
 
 // the acceleration-limited move on the same boundaries, for scale
 void BM_AccelerationMinimumTimeMove1D(benchmark::State& state) {

@@ -1,6 +1,10 @@
 // The common planner interface and the registry that maps scenario names to planners.
-// A planner turns a Toolpath into a timed Trajectory within the Cartesian limits; it
-// knows nothing of MuJoCo or of the machine's geometry (kinematics hands it limits).
+// A planner turns a Toolpath into a timed Trajectory (TCP position and tool axis) within the
+// TCP limits; it knows nothing of MuJoCo or of the machine's geometry: the kinematics hand it
+// limits per move (TcpLimits), as Klipper's check_move does.
+//
+// Adding a planner: one file pair in planners/motion/ implementing Planner, one entry in
+// planners/registry.cpp (see docs/ARCHITECTURE.md, "Adding a planner").
 #pragma once
 
 #include <functional>
@@ -40,9 +44,10 @@ class Planner {
  public:
   virtual ~Planner() = default;
   // Plan the whole job: from the toolpath's start at rest, through every print path in
-  // order, to its end at rest. Throws InputError when the toolpath cannot be planned
-  // within the limits.
-  virtual Trajectory plan(const Toolpath& toolpath, const MachineLimits& limits) const = 0;
+  // order, to its end at rest, the tool axis following the paths' normals (vertical without).
+  // Every move stays within the limits over its own box (TcpLimits::along, for_transition).
+  // Throws InputError when the toolpath cannot be planned within the limits.
+  virtual Trajectory plan(const Toolpath& toolpath, const TcpLimits& limits) const = 0;
 };
 
 struct PlannerInfo {
@@ -50,6 +55,9 @@ struct PlannerInfo {
   std::string description;
   std::vector<PlannerParameter> parameters;
   std::function<std::unique_ptr<Planner>(const PlannerSpec&)> make;
+  // honours the limits' j_max (jerk-limited transitions and ramps); a planner that does not
+  // refuses limits with one (check_planner_limits)
+  bool honours_jerk_limit = false;
 };
 
 // every registered planner, in a stable order
@@ -57,6 +65,9 @@ const std::vector<PlannerInfo>& planner_registry();
 const PlannerInfo* find_planner(const std::string& name);
 // "" when the spec names a registered planner with known, in-range parameters; else the problem
 std::string check_planner_spec(const PlannerSpec& spec);
+// "" when the planner honours every limit that is set, else why not (a j_max sent to a
+// planner that ignores it)
+std::string check_planner_limits(const PlannerSpec& spec, const MachineLimits& limits);
 // throws InputError when check_planner_spec fails
 std::unique_ptr<Planner> make_planner(const PlannerSpec& spec);
 

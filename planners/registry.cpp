@@ -20,13 +20,16 @@ const std::vector<PlannerInfo>& planner_registry() {
       {"lspb_mtt",
        "Thompson & Yoon 2014: LSPB on print segments, minimum-time transitions",
        {},
-       [](const PlannerSpec&) { return std::make_unique<LspbMttPlanner>(); }},
+       [](const PlannerSpec&) { return std::make_unique<LspbMttPlanner>(); },
+       true},
       {"stop_and_go",
        "naive baseline: rest-to-rest trapezoid per print segment, material on throughout",
        {},
-       [](const PlannerSpec&) { return std::make_unique<StopAndGoPlanner>(); }},
+       [](const PlannerSpec&) { return std::make_unique<StopAndGoPlanner>(); },
+       true},
       {"bezier", "Giberti et al. 2017: lines with Bezier corner blends at constant speed",
-       bezier_parameters(), [](const PlannerSpec& spec) { return make_bezier_planner(spec); }},
+       bezier_parameters(), [](const PlannerSpec& spec) { return make_bezier_planner(spec); },
+       false},
   };
   return registry;
 }
@@ -66,6 +69,18 @@ std::string check_planner_spec(const PlannerSpec& spec) {
     }
   }
   return "";
+}
+
+std::string check_planner_limits(const PlannerSpec& spec, const MachineLimits& limits) {
+  const PlannerInfo* info = find_planner(spec.name);
+  if (info == nullptr || info->honours_jerk_limit || !limits.jerk_limited()) return "";
+  std::string honouring;
+  for (const PlannerInfo& p : planner_registry())
+    if (p.honours_jerk_limit) honouring += (honouring.empty() ? "" : ", ") + p.name;
+  return "planner '" + spec.name +
+         "' does not honour j_max (its motion is acceleration-limited only); remove j_max from "
+         "limits or use a planner that honours it (" +
+         honouring + ")";
 }
 
 std::unique_ptr<Planner> make_planner(const PlannerSpec& spec) {

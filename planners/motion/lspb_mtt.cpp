@@ -6,6 +6,7 @@
 #include "core/error.hpp"
 #include "motion/lspb.hpp"
 #include "motion/mtt.hpp"
+#include "motion/sync.hpp"
 #include "planners/motion/print_segments.hpp"
 #include "planners/motion/transition.hpp"
 
@@ -27,9 +28,50 @@ void assign_boundary_velocities(std::vector<PrintSegment>& segments) {
   }
 }
 
+// The per-axis profiles of one print segment over the duration L / v (eq. 50), or over the
+// shortest longer duration every axis can meet (with a warning). Without a jerk limit: the
+// paper's LSPB (eqs. 11-16); with one: double-S moves, zero acceleration at both ends.
+std::vector<AxisProfile> segment_profiles(const PrintSegment& s, double& duration_s,
+                                          std::vector<std::string>& warnings) {
+  const double nominal_s = s.length_mm / s.speed_mm_s;
+  const std::vector<AxisMove> moves = axis_moves(s.p0, s.v_begin, s.p1, s.v_end, s.limits);
+  std::vector<AxisProfile> axes;
+  duration_s = nominal_s;
+  bool lengthened = false;
+  if (s.limits.jerk_limited()) {
+    duration_s = synchronized_duration(moves, nominal_s);
+    lengthened = duration_s > nominal_s;
+    for (const AxisMove& move : moves) axes.push_back(axis_fixed_time_move(move, duration_s));
+  } else {
+    for (const AxisMove& move : moves) {
+      auto lspb = solve_lspb(move.boundary, nominal_s, move.a_max, move.v_max);
+      if (!lspb) break;
+      axes.push_back(lspb->profile(move.boundary));
+    }
+    // beyond the paper: no LSPB exists in L / v (the segment is too short for its boundary
+    // velocities); take the shortest longer duration every axis can meet
+    if (axes.size() < moves.size()) {
+      lengthened = true;
+      duration_s = synchronized_duration(moves, nominal_s);
+      axes.clear();
+      for (const AxisMove& move : moves) axes.push_back(axis_fixed_time_move(move, duration_s));
+    }
+  }
+  if (lengthened) {
+    std::ostringstream warning;
+    warning << "path " << s.path_index << " segment " << s.edge_index
+            << ": no " << (s.limits.jerk_limited() ? "jerk-limited move" : "LSPB")
+            << " in L/v = " << nominal_s << " s; lengthened to " << duration_s
+            << " s (mean speed " << s.length_mm / duration_s << " instead of " << s.speed_mm_s
+            << " mm/s)";
+    warnings.push_back(warning.str());
+  }
+  return axes;
+}
+
 }  // namespace
 
-Trajectory LspbMttPlanner::plan(const Toolpath& toolpath, const MachineLimits& limits) const {
+Trajectory LspbMttPlanner::plan(const Toolpath& toolpath, const TcpLimits& limits) const {
   std::vector<PrintSegment> segments = split_into_segments(toolpath, limits);
   assign_boundary_velocities(segments);
 
@@ -38,40 +80,17 @@ Trajectory LspbMttPlanner::plan(const Toolpath& toolpath, const MachineLimits& l
   double t = 0.0;
   Vec3 position = toolpath.start_mm;
   Vec3 velocity = Vec3::Zero();
+  Vec3 axis = vertical_tool_axis();
   for (const PrintSegment& s : segments) {
     // shutter closed: minimum-time transition to the segment's start and velocity
     if (!s.joined_to_previous) {
-      pieces.push_back(transition_piece(t, position, velocity, s.p0, s.v_begin, limits));
+      pieces.push_back(
+          transition_piece(t, position, velocity, s.p0, s.v_begin, limits, axis, s.axis0));
       t = pieces.back().t_end_s;
     }
     // shutter open: per-axis LSPB over the segment time L / v, eq. (50)
-    const double nominal_s = s.length_mm / s.speed_mm_s;
-    std::vector<AxisMove> moves = axis_moves(s.p0, s.v_begin, s.p1, s.v_end, limits);
-    std::vector<AxisProfile> axes;
-    bool solved = true;
-    for (const AxisMove& move : moves) {
-      auto lspb = solve_lspb(move.boundary, nominal_s, move.a_max, move.v_max);
-      if (!lspb) {
-        solved = false;
-        break;
-      }
-      axes.push_back(lspb->profile(move.boundary));
-    }
-    double duration_s = nominal_s;
-    if (!solved) {
-      // beyond the paper: no LSPB exists in L / v (the segment is too short for its
-      // boundary velocities); take the shortest longer duration every axis can meet
-      duration_s = synchronized_duration(moves, nominal_s);
-      axes.clear();
-      for (const AxisMove& move : moves)
-        axes.push_back(fixed_time_move(move.boundary, duration_s, move.v_max, move.a_max));
-      std::ostringstream warning;
-      warning << "path " << s.path_index << " segment " << s.edge_index
-              << ": no LSPB in L/v = " << nominal_s << " s; lengthened to " << duration_s
-              << " s (mean speed " << s.length_mm / duration_s << " instead of "
-              << s.speed_mm_s << " mm/s)";
-      warnings.push_back(warning.str());
-    }
+    double duration_s = 0.0;
+    std::vector<AxisProfile> axes = segment_profiles(s, duration_s, warnings);
     TrajectoryPiece piece;
     piece.t_begin_s = t;
     piece.t_end_s = t + duration_s;
@@ -79,13 +98,16 @@ Trajectory LspbMttPlanner::plan(const Toolpath& toolpath, const MachineLimits& l
     piece.depositing = true;
     piece.desired_speed_mm_s = s.speed_mm_s;
     piece.motion = phase_motion(std::move(axes));
+    piece.tool_axis = segment_tool_axis(s.p0, s.axis0, s.p1, s.axis1);
     pieces.push_back(std::move(piece));
     t += duration_s;
     position = s.p1;
     velocity = s.v_end;
+    axis = s.axis1;
   }
   // shutter closed: to the end point, at rest
-  pieces.push_back(transition_piece(t, position, velocity, toolpath.end_mm, Vec3::Zero(), limits));
+  pieces.push_back(
+      transition_piece(t, position, velocity, toolpath.end_mm, Vec3::Zero(), limits, axis));
   return Trajectory("lspb_mtt", std::move(pieces), std::move(warnings));
 }
 

@@ -10,7 +10,7 @@ namespace depotwin {
 
 class LspbMttPlanner : public Planner {
  public:
-  Trajectory plan(const Toolpath& toolpath, const MachineLimits& limits) const override;
+  Trajectory plan(const Toolpath& toolpath, const TcpLimits& limits) const override;
 };
 
 }  // namespace depotwin

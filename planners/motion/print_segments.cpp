@@ -7,8 +7,7 @@
 
 namespace depotwin {
 
-std::vector<PrintSegment> split_into_segments(const Toolpath& toolpath,
-                                              const MachineLimits& limits) {
+std::vector<PrintSegment> split_into_segments(const Toolpath& toolpath, const TcpLimits& tcp_limits) {
   static const char* kAxis[3] = {"x", "y", "z"};
   std::vector<PrintSegment> segments;
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
@@ -27,6 +26,11 @@ std::vector<PrintSegment> split_into_segments(const Toolpath& toolpath,
       // eqs. (40)-(47): the desired velocity along the segment. The paper splits it with
       // the slope m and sgn(x1 - x0); the unit direction gives the same components in 3-D.
       s.v_desired = s.speed_mm_s * (s.p1 - s.p0) / s.length_mm;
+      s.axis0 = path.tool_axis(k);
+      s.axis1 = path.tool_axis(k + 1);
+      // the limits over this segment alone (the machine's, where the tool is)
+      s.limits = tcp_limits.along(s.p0, s.p1);
+      const MachineLimits& limits = s.limits;
       for (int axis = 0; axis < 3; ++axis) {
         if (std::abs(s.v_desired[axis]) > limits.axes[axis].v_max_mm_s * (1 + 1e-12)) {
           std::ostringstream msg;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "motion/jerk.hpp"
 #include "planners/motion/print_segments.hpp"
 #include "planners/motion/transition.hpp"
 
@@ -28,32 +29,45 @@ AxisProfile along_line_trapezoid(double length, double v, double a) {
 // the same timing on one Cartesian axis: q(t) = q0 + u * s(t)
 AxisProfile scaled(const AxisProfile& along, double q0, double u) {
   AxisProfile axis(q0, 0.0);
-  for (const Phase& phase : along.phases()) axis.append(phase.duration_s, u * phase.a);
+  for (const Phase& phase : along.phases()) {
+    if (phase.jerk == 0.0)
+      axis.append(phase.duration_s, u * phase.a0);
+    else
+      axis.append_jerk(phase.duration_s, u * phase.jerk);
+  }
   return axis;
 }
 
 }  // namespace
 
-Trajectory StopAndGoPlanner::plan(const Toolpath& toolpath, const MachineLimits& limits) const {
+Trajectory StopAndGoPlanner::plan(const Toolpath& toolpath, const TcpLimits& limits) const {
   const std::vector<PrintSegment> segments = split_into_segments(toolpath, limits);
   std::vector<TrajectoryPiece> pieces;
   double t = 0.0;
   Vec3 position = toolpath.start_mm;
+  Vec3 tool_axis = vertical_tool_axis();
   for (const PrintSegment& s : segments) {
     // transitions between separate segments: rest to rest, shutter closed
     if (!s.joined_to_previous) {
-      pieces.push_back(transition_piece(t, position, Vec3::Zero(), s.p0, Vec3::Zero(), limits));
+      pieces.push_back(transition_piece(t, position, Vec3::Zero(), s.p0, Vec3::Zero(), limits,
+                                        tool_axis, s.axis0));
       t = pieces.back().t_end_s;
     }
-    // the line's own speed and acceleration caps: no axis beyond its limits
+    // the line's own speed, acceleration and jerk caps: no axis beyond its limits over it
     const Vec3 u = (s.p1 - s.p0) / s.length_mm;
     double v = s.speed_mm_s, a = std::numeric_limits<double>::infinity();
+    double j = std::numeric_limits<double>::infinity();
     for (int axis = 0; axis < 3; ++axis) {
       if (std::abs(u[axis]) < 1e-15) continue;
-      v = std::min(v, limits.axes[axis].v_max_mm_s / std::abs(u[axis]));
-      a = std::min(a, limits.axes[axis].a_max_mm_s2 / std::abs(u[axis]));
+      const AxisLimits& limit = s.limits.axes[axis];
+      v = std::min(v, limit.v_max_mm_s / std::abs(u[axis]));
+      a = std::min(a, limit.a_max_mm_s2 / std::abs(u[axis]));
+      if (limit.j_max_mm_s3 > 0.0) j = std::min(j, limit.j_max_mm_s3 / std::abs(u[axis]));
     }
-    const AxisProfile along = along_line_trapezoid(s.length_mm, v, a);
+    // rest to rest along the line: a trapezoid, or a double-S under a jerk limit
+    const AxisProfile along =
+        std::isfinite(j) ? jerk_min_time_move(AxisBoundary{0.0, s.length_mm, 0.0, 0.0}, v, a, j)
+                         : along_line_trapezoid(s.length_mm, v, a);
     std::vector<AxisProfile> axes;
     for (int axis = 0; axis < 3; ++axis) axes.push_back(scaled(along, s.p0[axis], u[axis]));
     TrajectoryPiece piece;
@@ -63,11 +77,14 @@ Trajectory StopAndGoPlanner::plan(const Toolpath& toolpath, const MachineLimits&
     piece.depositing = true;  // material on throughout, ramps included
     piece.desired_speed_mm_s = s.speed_mm_s;
     piece.motion = phase_motion(std::move(axes));
+    piece.tool_axis = segment_tool_axis(s.p0, s.axis0, s.p1, s.axis1);
     pieces.push_back(std::move(piece));
     t = pieces.back().t_end_s;
     position = s.p1;
+    tool_axis = s.axis1;
   }
-  pieces.push_back(transition_piece(t, position, Vec3::Zero(), toolpath.end_mm, Vec3::Zero(), limits));
+  pieces.push_back(transition_piece(t, position, Vec3::Zero(), toolpath.end_mm, Vec3::Zero(),
+                                    limits, tool_axis));
   return Trajectory("stop_and_go", std::move(pieces));
 }
 

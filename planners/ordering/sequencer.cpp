@@ -4,12 +4,9 @@
 #include <limits>
 
 #include "core/error.hpp"
-#include "planners/ordering/christofides.hpp"
 #include "planners/ordering/local_search.hpp"
 #include "planners/ordering/lower_bound.hpp"
-#include "planners/ordering/nearest_neighbor.hpp"
 #include "planners/ordering/neighbor_lists.hpp"
-#include "planners/ordering/random_order.hpp"
 #include "planners/ordering/transition_cost.hpp"
 
 namespace depotwin {
@@ -43,18 +40,6 @@ void check_spec(const OrderSpec& spec) {
   if (!problems.empty()) throw InputError(std::move(problems));
 }
 
-OrderResult construct(const TransitionCost& cost, const OrderSpec& spec) {
-  if (spec.method == "random") return random_order(cost.path_count(), spec.seed);
-  if (spec.method == "nearest_neighbor") return nearest_neighbor_order(cost);
-  if (spec.method == "christofides") return christofides_order(cost);
-  OrderResult given;  // as_given
-  for (int i = 0; i < cost.path_count(); ++i) {
-    given.order.push_back(i);
-    given.reversed.push_back(false);
-  }
-  return given;
-}
-
 }  // namespace
 
 std::string OrderSpec::label() const {
@@ -62,8 +47,11 @@ std::string OrderSpec::label() const {
 }
 
 const std::vector<std::string>& sequencer_methods() {
-  static const std::vector<std::string> names{"as_given", "random", "nearest_neighbor",
-                                              "christofides"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> list;
+    for (const SequencerInfo& info : sequencer_registry()) list.push_back(info.name);
+    return list;
+  }();
   return names;
 }
 
@@ -77,13 +65,13 @@ const std::vector<std::string>& cost_models() {
   return names;
 }
 
-OrderResult sequence(const Toolpath& toolpath, const MachineLimits& limits, const OrderSpec& spec,
+OrderResult sequence(const Toolpath& toolpath, const TcpLimits& limits, const OrderSpec& spec,
                      const SequencerOptions& options) {
   check_spec(spec);
   const TransitionCost cost(toolpath, limits, parse_cost_model(spec.cost_model));
 
   // construct, then refine over neighbour lists
-  OrderResult result = construct(cost, spec);
+  OrderResult result = find_sequencer(spec.method)->construct(cost, spec);
   if (!spec.refine.empty()) {
     const NeighborLists neighbors(cost, options.neighbors);
     refine_order(result, cost, neighbors, parse_refinement(spec.refine));

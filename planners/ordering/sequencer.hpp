@@ -39,14 +39,30 @@ struct SequencerOptions {
   int lower_bound_max_paths = 20000;
 };
 
-// names accepted by OrderSpec::method / refine / cost_model
+class TransitionCost;
+
+// One registered sequencer: its name (`order.method`), a line of description, and how it
+// builds an order from the transition costs (before any refinement).
+struct SequencerInfo {
+  std::string name;
+  std::string description;
+  OrderResult (*construct)(const TransitionCost& cost, const OrderSpec& spec);
+};
+
+// every registered sequencer, in a stable order (planners/ordering/registry.cpp): the only
+// list of sequencer names
+const std::vector<SequencerInfo>& sequencer_registry();
+const SequencerInfo* find_sequencer(const std::string& name);
+
+// names accepted by OrderSpec::method (the registry's) / refine / cost_model
 const std::vector<std::string>& sequencer_methods();
 const std::vector<std::string>& refine_methods();
 const std::vector<std::string>& cost_models();
 
 // Throws InputError for unknown names (key order.method / order.refine / order.cost_model)
 // and for paths the limits cannot print at their speed.
-OrderResult sequence(const Toolpath& toolpath, const MachineLimits& limits, const OrderSpec& spec,
+// (the transition costs take each move's own limits, as the planners do)
+OrderResult sequence(const Toolpath& toolpath, const TcpLimits& limits, const OrderSpec& spec,
                      const SequencerOptions& options = {});
 // the toolpath in the given order and directions (source_index kept)
 Toolpath apply_order(const Toolpath& toolpath, const OrderResult& result);

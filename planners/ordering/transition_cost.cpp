@@ -31,6 +31,15 @@ bool outward_direction(const std::vector<Vec3>& points, bool at_back, Vec3& dire
   return false;
 }
 
+// the axis-aligned bounds of a path's points
+void path_bounds(const PrintPath& path, Vec3& lo, Vec3& hi) {
+  lo = hi = path.points.front();
+  for (const Vec3& p : path.points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+}
+
 }  // namespace
 
 CostModel parse_cost_model(const std::string& name) {
@@ -40,10 +49,11 @@ CostModel parse_cost_model(const std::string& name) {
                    "unknown cost model '" + name + "' (expected machine or along_line)");
 }
 
-TransitionCost::TransitionCost(const Toolpath& toolpath, const MachineLimits& limits,
+TransitionCost::TransitionCost(const Toolpath& toolpath, const TcpLimits& tcp_limits,
                                CostModel model)
-    : model_(model), limits_(limits) {
-  const std::string limit_problem = limits.validate();
+    : model_(model), tcp_limits_(tcp_limits) {
+  const MachineLimits& requested = tcp_limits.requested();
+  const std::string limit_problem = requested.validate();
   if (!limit_problem.empty()) throw InputError("limits", limit_problem);
 
   const int path_count = static_cast<int>(toolpath.paths.size());
@@ -73,7 +83,11 @@ TransitionCost::TransitionCost(const Toolpath& toolpath, const MachineLimits& li
     print_time_s_ += path.length_mm() / path.speed_mm_s;
 
     // the print velocity at the ends must be reachable: per axis (machine) or along
-    // the line (the paper's model uses the x-axis limits as its single v_max)
+    // the line (the paper's model uses the x-axis limits as its single v_max), under the
+    // limits over the path's box
+    Vec3 lo, hi;
+    path_bounds(path, lo, hi);
+    const MachineLimits limits = tcp_limits.over(lo, hi);
     const int too_fast_axis = clamp_exit_velocities(2 * i, limits, model);
     if (too_fast_axis >= 0)
       problems.push_back(
@@ -87,10 +101,11 @@ TransitionCost::TransitionCost(const Toolpath& toolpath, const MachineLimits& li
   positions_[end_node()] = toolpath.end_mm;
 
   // every move is at least |d_axis| / v_max(axis); over x-y Chebyshev distance r that
-  // is at least r / max(v_x, v_y), and r / v_max along the line
+  // is at least r / max(v_x, v_y), and r / v_max along the line (the user's limits: no
+  // move's limits are looser)
   bound_speed_mm_s_ = model == CostModel::machine
-                          ? std::max(limits.axes[0].v_max_mm_s, limits.axes[1].v_max_mm_s)
-                          : limits.axes[0].v_max_mm_s;
+                          ? std::max(requested.axes[0].v_max_mm_s, requested.axes[1].v_max_mm_s)
+                          : requested.axes[0].v_max_mm_s;
 }
 
 int TransitionCost::clamp_exit_velocities(int front_node, const MachineLimits& limits,
@@ -108,8 +123,9 @@ int TransitionCost::clamp_exit_velocities(int front_node, const MachineLimits& l
   return -1;
 }
 
-double TransitionCost::along_line_time(double d, double v0, double v1) const {
-  const double v_max = limits_.axes[0].v_max_mm_s, a = limits_.axes[0].a_max_mm_s2;
+double TransitionCost::along_line_time(double d, double v0, double v1,
+                                       const MachineLimits& limits) const {
+  const double v_max = limits.axes[0].v_max_mm_s, a = limits.axes[0].a_max_mm_s2;
   // eq. (2) with a1 = a, a2 = -a: the triangular profile's peak speed
   const double v_peak = std::sqrt(a * d + 0.5 * (v0 * v0 + v1 * v1));
   if (v_peak >= std::max(v0, v1)) {
@@ -123,20 +139,24 @@ double TransitionCost::along_line_time(double d, double v0, double v1) const {
 }
 
 double TransitionCost::operator()(int from, int to) const {
+  // the limits over the box the move may sweep, as the planners' transitions take them
+  const MachineLimits limits = tcp_limits_.for_transition(positions_[from], exit_velocity_[from],
+                                                          positions_[to], -exit_velocity_[to]);
   if (model_ == CostModel::along_line)
     return along_line_time((positions_[to] - positions_[from]).norm(), speed_mm_s_[from],
-                           speed_mm_s_[to]);
+                           speed_mm_s_[to], limits);
   // leave `from` along its outward direction, enter `to` against its outward direction
   return synchronized_duration(axis_moves(positions_[from], exit_velocity_[from], positions_[to],
-                                          -exit_velocity_[to], limits_));
+                                          -exit_velocity_[to], limits));
 }
 
 double TransitionCost::bound(int from, int to) const {
   const Vec3 offset = positions_[to] - positions_[from];
-  if (model_ == CostModel::along_line) return offset.norm() / limits_.axes[0].v_max_mm_s;
+  const MachineLimits& limits = tcp_limits_.requested();
+  if (model_ == CostModel::along_line) return offset.norm() / limits.axes[0].v_max_mm_s;
   double time_s = 0.0;
   for (int axis = 0; axis < 3; ++axis)
-    time_s = std::max(time_s, std::abs(offset[axis]) / limits_.axes[axis].v_max_mm_s);
+    time_s = std::max(time_s, std::abs(offset[axis]) / limits.axes[axis].v_max_mm_s);
   return time_s;
 }
 

@@ -29,7 +29,8 @@ class TransitionCost {
  public:
   // Throws InputError when a print path cannot be printed under the limits (speed above
   // v_max, fewer than two distinct points) or the limits are unusable.
-  TransitionCost(const Toolpath& toolpath, const MachineLimits& limits, CostModel model);
+  // (per path and per transition, the limits over their own box: TcpLimits)
+  TransitionCost(const Toolpath& toolpath, const TcpLimits& limits, CostModel model);
 
   static int partner(int node) { return node ^ 1; }
   static int entry_node(int path, bool reversed) { return 2 * path + (reversed ? 1 : 0); }
@@ -62,13 +63,14 @@ class TransitionCost {
   double transition_length_mm(const OrderResult& order) const;
 
  private:
-  double along_line_time(double distance_mm, double v0_mm_s, double v1_mm_s) const;
+  double along_line_time(double distance_mm, double v0_mm_s, double v1_mm_s,
+                         const MachineLimits& limits) const;
   // clamp roundoff in the exit velocities of one path's two ends; the first axis whose
   // limit the print speed really exceeds, or -1
   int clamp_exit_velocities(int front_node, const MachineLimits& limits, CostModel model);
 
   CostModel model_;
-  MachineLimits limits_;
+  TcpLimits tcp_limits_;
   std::vector<Vec3> positions_;
   std::vector<Vec3> exit_velocity_;  // leaving the path through this end (0 at start/end)
   std::vector<double> speed_mm_s_;   // print speed at this end (0 at start/end)

@@ -6,8 +6,6 @@
 #include <sstream>
 
 #include "core/error.hpp"
-#include "motion/jerk.hpp"
-#include "motion/mtt.hpp"
 #include "motion/sync.hpp"
 
 namespace depotwin {
@@ -34,70 +32,22 @@ double value_for_axis(const std::vector<double>& list, size_t axis) {
   return list.size() == 1 ? list[0] : list[axis];
 }
 
-// the phases of an acceleration-limited profile
-nlohmann::ordered_json phases_json(const AxisProfile& profile) {
+// the phases of a profile; a jerk-limited one adds the constant jerk and the acceleration at
+// the phase end ("acceleration" is the one at the phase start)
+nlohmann::ordered_json phases_json(const AxisProfile& profile, bool jerk_limited) {
   nlohmann::ordered_json phases = nlohmann::ordered_json::array();
-  for (const Phase& phase : profile.phases())
-    phases.push_back({{"t_start_s", phase.t_begin_s},
-                      {"duration_s", phase.duration_s},
-                      {"acceleration", phase.a},
-                      {"v_start", phase.v0},
-                      {"v_end", phase.v_end()},
-                      {"q_start", phase.q0},
-                      {"q_end", phase.q_end()}});
-  return phases;
-}
-
-// the phases of a jerk-limited profile: the same keys ("acceleration" at the phase start)
-// plus the constant jerk and the acceleration at the phase end
-nlohmann::ordered_json phases_json(const JerkProfile& profile) {
-  nlohmann::ordered_json phases = nlohmann::ordered_json::array();
-  for (const JerkPhase& phase : profile.phases())
-    phases.push_back({{"t_start_s", phase.t_begin_s},
-                      {"duration_s", phase.duration_s},
-                      {"acceleration", phase.a0},
-                      {"v_start", phase.v0},
-                      {"v_end", phase.v_end()},
-                      {"q_start", phase.q0},
-                      {"q_end", phase.q_end()},
-                      {"jerk", phase.jerk},
-                      {"acceleration_end", phase.a_end()}});
-  return phases;
-}
-
-// Some axes jerk-limited (j_max > 0), the others acceleration-limited: the earliest duration
-// feasible for every axis, each axis re-planned over it with its own kind of profile.
-nlohmann::ordered_json jerk_limited_move_json(const std::vector<AxisMove>& moves,
-                                              const std::vector<double>& j_max) {
-  using Json = nlohmann::ordered_json;
-  std::vector<FeasibleDurations> sets;
-  for (size_t i = 0; i < moves.size(); ++i) {
-    const AxisMove& m = moves[i];
-    sets.push_back(j_max[i] > 0.0 ? jerk_feasible_durations(m.boundary, m.v_max, m.a_max, j_max[i])
-                                  : feasible_durations(m.boundary, m.v_max, m.a_max));
+  for (const Phase& phase : profile.phases()) {
+    nlohmann::ordered_json entry{{"t_start_s", phase.t_begin_s}, {"duration_s", phase.duration_s},
+                                 {"acceleration", phase.a0},     {"v_start", phase.v0},
+                                 {"v_end", phase.v_end()},       {"q_start", phase.q0},
+                                 {"q_end", phase.q_end()}};
+    if (jerk_limited) {
+      entry["jerk"] = phase.jerk;
+      entry["acceleration_end"] = phase.a_end();
+    }
+    phases.push_back(entry);
   }
-  const double duration_s = common_feasible_duration(sets);
-  Json out;
-  out["duration_s"] = duration_s;
-  Json axes_json = Json::array();
-  for (size_t i = 0; i < moves.size(); ++i) {
-    const AxisMove& m = moves[i];
-    const Json phases =
-        j_max[i] > 0.0
-            ? phases_json(jerk_fixed_time_move(m.boundary, duration_s, m.v_max, m.a_max, j_max[i]))
-            : phases_json(fixed_time_move(m.boundary, duration_s, m.v_max, m.a_max));
-    axes_json.push_back(Json{{"q0", m.boundary.q0},
-                             {"q1", m.boundary.q1},
-                             {"v0", m.boundary.v0},
-                             {"v1", m.boundary.v1},
-                             {"v_max", m.v_max},
-                             {"a_max", m.a_max},
-                             {"j_max", j_max[i]},
-                             {"min_duration_s", sets[i].t_min()},
-                             {"phases", phases}});
-  }
-  out["axes"] = axes_json;
-  return out;
+  return phases;
 }
 
 }  // namespace
@@ -143,11 +93,12 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
       problems.push_back({"", 0, "--jmax", "must be >= 0 (0: no jerk limit)" + axis});
   }
   if (!problems.empty()) throw InputError(problems);
-  std::vector<double> j_max(axes, 0.0);
-  if (!request.j_max.empty())
-    for (size_t i = 0; i < axes; ++i) j_max[i] = value_for_axis(request.j_max, i);
-  if (std::any_of(j_max.begin(), j_max.end(), [](double j) { return j > 0.0; }))
-    return jerk_limited_move_json(moves, j_max);
+  // the jerk limits (0: none); "j_max" is reported once any axis has one
+  bool any_jerk_limit = false;
+  for (size_t i = 0; i < axes; ++i) {
+    if (!request.j_max.empty()) moves[i].j_max = value_for_axis(request.j_max, i);
+    any_jerk_limit = any_jerk_limit || moves[i].j_max > 0.0;
+  }
   const SynchronizedMove move = synchronized_move(moves);
 
   Json out;
@@ -155,16 +106,12 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
   Json axes_json = Json::array();
   for (size_t i = 0; i < axes; ++i) {
     const AxisMove& m = moves[i];
-    const Json phases = phases_json(move.axes[i]);
-    axes_json.push_back(
-        Json{{"q0", m.boundary.q0},
-             {"q1", m.boundary.q1},
-             {"v0", m.boundary.v0},
-             {"v1", m.boundary.v1},
-             {"v_max", m.v_max},
-             {"a_max", m.a_max},
-             {"min_duration_s", feasible_durations(m.boundary, m.v_max, m.a_max).t_min()},
-             {"phases", phases}});
+    Json axis{{"q0", m.boundary.q0}, {"q1", m.boundary.q1},       {"v0", m.boundary.v0},
+              {"v1", m.boundary.v1}, {"v_max", m.v_max},          {"a_max", m.a_max}};
+    if (any_jerk_limit) axis["j_max"] = m.j_max;
+    axis["min_duration_s"] = axis_feasible_durations(m).t_min();
+    axis["phases"] = phases_json(move.axes[i], m.j_max > 0.0);
+    axes_json.push_back(axis);
   }
   out["axes"] = axes_json;
   return out;

@@ -1,10 +1,14 @@
-// Kinematic limits the planners must respect, per Cartesian TCP axis (x, y, z).
-// For machines whose joints are not the Cartesian axes (linear delta), the Machine
-// maps its joint limits to these conservative Cartesian limits (see kinematics/).
+// Kinematic limits: per joint (the machine's own, mm or rad) and per Cartesian TCP axis
+// (x, y, z, what the planners honour). A machine whose joints are not its Cartesian axes
+// (a linear delta, an arm) maps its joint limits to TCP limits that depend on where the tool
+// is: TcpLimits asks it per move, as Klipper's kinematics limit each move (check_move).
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string>
+
+#include "core/types.hpp"
 
 namespace depotwin {
 
@@ -21,6 +25,50 @@ struct MachineLimits {
   static MachineLimits uniform(double v_max_mm_s, double a_max_mm_s2, double j_max_mm_s3 = 0.0);
   // "" when usable, else what is wrong (names the axis and field)
   std::string validate() const;
+  // true when some axis has a jerk limit
+  bool jerk_limited() const;
+};
+
+// One joint's range and limits, in its own units: mm, mm/s, mm/s^2, mm/s^3 for a prismatic
+// joint, rad, rad/s, rad/s^2, rad/s^3 for a revolute one.
+struct JointLimit {
+  std::string name;   // the MJCF joint (and actuator) name
+  double min = 0.0;   // position range
+  double max = 0.0;
+  double v_max = 0.0;
+  double a_max = 0.0;
+  double j_max = 0.0;  // 0: no jerk limit
+};
+
+// The TCP limits a planner must honour, which may depend on where the move is.
+class TcpLimits {
+ public:
+  // limits under which no joint exceeds its own anywhere in the box [lo, hi]
+  using BoxLimits = std::function<MachineLimits(const Vec3& lo_mm, const Vec3& hi_mm)>;
+
+  TcpLimits() = default;
+  // the same limits everywhere (a Cartesian machine, or a test)
+  TcpLimits(const MachineLimits& limits);  // NOLINT: implicit on purpose
+  // `requested` (the user's TCP limits, never exceeded) refined per box by the machine
+  TcpLimits(const MachineLimits& requested, BoxLimits over_box);
+
+  // the limits that hold everywhere in the axis-aligned box [lo, hi]
+  MachineLimits over(const Vec3& lo_mm, const Vec3& hi_mm) const;
+  // over a straight move from a to b (the box of its ends)
+  MachineLimits along(const Vec3& a_mm, const Vec3& b_mm) const;
+  // over a move from (a, va) to (b, vb) whose axes may overshoot their ends by up to the
+  // stopping distance v^2 / (2 a_max) (minimum-time transitions): the box is padded until
+  // the padding and the limits over it agree
+  MachineLimits for_transition(const Vec3& a_mm, const Vec3& va_mm_s, const Vec3& b_mm,
+                               const Vec3& vb_mm_s) const;
+  // the user's limits: no box gives looser ones
+  const MachineLimits& requested() const { return requested_; }
+  // true when the limits are the same everywhere
+  bool uniform() const { return !over_box_; }
+
+ private:
+  MachineLimits requested_;
+  BoxLimits over_box_;
 };
 
 }  // namespace depotwin

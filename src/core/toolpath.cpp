@@ -17,6 +17,36 @@ PrintPath PrintPath::reversed() const {
   return out;
 }
 
+Vec3 PrintPath::tool_axis(size_t i) const {
+  return normals.empty() ? vertical_tool_axis() : normals[i];
+}
+
+Vec3 PrintPath::tool_axis_near(const Vec3& p, size_t& edge_hint) const {
+  if (normals.empty() || points.size() < 2) return vertical_tool_axis();
+  const size_t edges = points.size() - 1;
+  // the nearest edge from the hint onwards, stopping once the distance grows again
+  const auto projection = [&](size_t edge, double& fraction) {
+    const Vec3 chord = points[edge + 1] - points[edge];
+    fraction = std::clamp((p - points[edge]).dot(chord) / chord.squaredNorm(), 0.0, 1.0);
+    return (points[edge] + fraction * chord - p).squaredNorm();
+  };
+  size_t best = std::min(edge_hint, edges - 1);
+  double best_fraction = 0.0;
+  double best_distance2 = projection(best, best_fraction);
+  for (size_t edge = best + 1; edge < edges; ++edge) {
+    double fraction = 0.0;
+    const double distance2 = projection(edge, fraction);
+    if (distance2 > best_distance2 + 1e-9 && edge > best + 2) break;
+    if (distance2 < best_distance2) {
+      best = edge;
+      best_fraction = fraction;
+      best_distance2 = distance2;
+    }
+  }
+  edge_hint = best;
+  return slerp_axis(normals[best], normals[best + 1], best_fraction);
+}
+
 double Toolpath::print_length_mm() const {
   double length = 0.0;
   for (const PrintPath& path : paths) length += path.length_mm();

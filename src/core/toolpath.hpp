@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "core/pose.hpp"
 #include "core/types.hpp"
 
 namespace depotwin {
@@ -11,7 +12,8 @@ namespace depotwin {
 // One print path: a polyline (mm) printed at one desired speed with material on.
 struct PrintPath {
   std::vector<Vec3> points;   // at least two, consecutive points distinct
-  std::vector<Vec3> normals;  // optional unit surface normals per point (conformal work)
+  std::vector<Vec3> normals;  // optional unit surface normals per point (conformal work): the
+                              // tool axes the path asks for; none: a vertical nozzle
   double speed_mm_s = 0.0;    // desired TCP speed while printing
   int source_index = 0;       // index in the scenario's list, for messages and reports
 
@@ -20,6 +22,13 @@ struct PrintPath {
   const Vec3& back() const { return points.back(); }
   // the same path printed the other way round
   PrintPath reversed() const;
+  // the tool axis at point i (its normal, or vertical without normals)
+  Vec3 tool_axis(size_t i) const;
+  // the tool axis at the point of the path nearest to p: the normals of the nearest edge
+  // slerped by where p projects onto it. `edge_hint` (in/out) is the edge of the previous
+  // query; the search goes forwards from it a few edges, so points that move along the path
+  // cost constant time.
+  Vec3 tool_axis_near(const Vec3& p, size_t& edge_hint) const;
 };
 
 // Start and end of the job (at rest) and the print paths in print order.

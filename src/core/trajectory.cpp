@@ -81,6 +81,51 @@ void evaluate_motion(const TrajectoryPiece& piece, double tau, Vec3& position_mm
           velocity_mm_s, acceleration_mm_s2);
 }
 
+void evaluate_tool_axis(const TrajectoryPiece& piece, double tau, const Vec3& position_mm,
+                        const Vec3& velocity_mm_s, Vec3& tool_axis, Vec3& angular_velocity_rad_s) {
+  const ToolAxisMotion& motion = piece.tool_axis;
+  // per-sample axes of a sampled piece: slerp between neighbouring samples
+  if (const auto* sampled = std::get_if<SampledMotion>(&piece.motion);
+      sampled != nullptr && !sampled->tool_axis.empty()) {
+    const std::vector<Vec3>& axes = sampled->tool_axis;
+    const double h = sampled->period_s;
+    const double k_real = std::max(0.0, tau / h);
+    const size_t k = static_cast<size_t>(std::floor(k_real));
+    if (k + 1 >= axes.size()) {
+      tool_axis = axes.back();
+      angular_velocity_rad_s.setZero();
+      return;
+    }
+    tool_axis = slerp_axis(axes[k], axes[k + 1], k_real - static_cast<double>(k));
+    angular_velocity_rad_s = slerp_rate(axes[k], axes[k + 1]) / h;
+    return;
+  }
+  if (motion.constant()) {
+    tool_axis = motion.begin;
+    angular_velocity_rad_s.setZero();
+    return;
+  }
+  // the fraction of the rotation done and its rate: along the chord, or smoothstep in time
+  double fraction = 0.0, rate_per_s = 0.0;
+  if (motion.along_chord) {
+    const Vec3 chord = motion.chord_end_mm - motion.chord_begin_mm;
+    const double length2 = chord.squaredNorm();
+    if (length2 > 0.0) {
+      fraction = (position_mm - motion.chord_begin_mm).dot(chord) / length2;
+      rate_per_s = velocity_mm_s.dot(chord) / length2;
+    }
+    if (fraction <= 0.0 || fraction >= 1.0) rate_per_s = 0.0;
+    fraction = std::clamp(fraction, 0.0, 1.0);
+  } else {
+    const double duration_s = piece.t_end_s - piece.t_begin_s;
+    const double x = duration_s > 0.0 ? std::clamp(tau / duration_s, 0.0, 1.0) : 1.0;
+    fraction = x * x * (3.0 - 2.0 * x);
+    rate_per_s = duration_s > 0.0 ? 6.0 * x * (1.0 - x) / duration_s : 0.0;
+  }
+  tool_axis = slerp_axis(motion.begin, motion.end, fraction);
+  angular_velocity_rad_s = rate_per_s * slerp_rate(motion.begin, motion.end);
+}
+
 namespace {
 
 // what a sample says besides the motion: time, piece, path, deposition, desired speed
@@ -103,6 +148,8 @@ TrajectorySample Trajectory::at(double t) const {
   describe_piece(piece, index, t, sample);
   evaluate_motion(piece, t - piece.t_begin_s, sample.position_mm, sample.velocity_mm_s,
                   sample.acceleration_mm_s2);
+  evaluate_tool_axis(piece, t - piece.t_begin_s, sample.position_mm, sample.velocity_mm_s,
+                     sample.tool_axis, sample.angular_velocity_rad_s);
   return sample;
 }
 
@@ -125,15 +172,17 @@ TrajectorySample TrajectoryCursor::at(double t) {
   if (phases == nullptr) {
     evaluate_motion(piece, tau, sample.position_mm, sample.velocity_mm_s,
                     sample.acceleration_mm_s2);
-    return sample;
+  } else {
+    // per axis, the phase searched forwards from the previous sample's
+    for (int axis = 0; axis < 3; ++axis) {
+      const AxisState state = phases->axes[axis].at(tau, phase_[axis]);
+      sample.position_mm[axis] = state.q;
+      sample.velocity_mm_s[axis] = state.v;
+      sample.acceleration_mm_s2[axis] = state.a;
+    }
   }
-  // per axis, the phase searched forwards from the previous sample's
-  for (int axis = 0; axis < 3; ++axis) {
-    const AxisState state = phases->axes[axis].at(tau, phase_[axis]);
-    sample.position_mm[axis] = state.q;
-    sample.velocity_mm_s[axis] = state.v;
-    sample.acceleration_mm_s2[axis] = state.a;
-  }
+  evaluate_tool_axis(piece, tau, sample.position_mm, sample.velocity_mm_s, sample.tool_axis,
+                     sample.angular_velocity_rad_s);
   return sample;
 }
 

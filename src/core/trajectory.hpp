@@ -8,10 +8,25 @@
 #include <variant>
 #include <vector>
 
+#include "core/pose.hpp"
 #include "core/profile.hpp"
 #include "core/types.hpp"
 
 namespace depotwin {
+
+// The tool axis over a piece: from `begin` to `end` by the shortest rotation. Along a print
+// segment the rotation follows the TCP along the segment's chord (the fraction of the way from
+// chord_begin to chord_end), so the axis belongs to the geometry, not to the timing; otherwise
+// it follows time with zero rate at both ends (smoothstep). Planar work keeps it vertical.
+struct ToolAxisMotion {
+  Vec3 begin = vertical_tool_axis();
+  Vec3 end = vertical_tool_axis();
+  bool along_chord = false;
+  Vec3 chord_begin_mm = Vec3::Zero();
+  Vec3 chord_end_mm = Vec3::Zero();
+
+  bool constant() const { return begin == end; }
+};
 
 // Motion given per Cartesian axis as constant-acceleration phases (LSPB, MTT, trapezoids).
 struct PhaseMotion {
@@ -24,6 +39,7 @@ struct SampledMotion {
   double period_s = 0.001;
   std::vector<Vec3> position_mm;    // sample k at time k * period_s
   std::vector<Vec3> velocity_mm_s;  // same size as position_mm
+  std::vector<Vec3> tool_axis;      // per sample (unit); empty: the piece's tool_axis motion
 };
 
 // One time interval of the trajectory with one meaning: printing path `path_index`,
@@ -35,6 +51,7 @@ struct TrajectoryPiece {
   bool depositing = false;          // shutter open / flow on
   double desired_speed_mm_s = 0.0;  // 0 in transitions
   std::variant<PhaseMotion, SampledMotion> motion;
+  ToolAxisMotion tool_axis;  // the orientation channel
 };
 
 // What the trajectory says at one instant.
@@ -43,10 +60,14 @@ struct TrajectorySample {
   Vec3 position_mm = Vec3::Zero();
   Vec3 velocity_mm_s = Vec3::Zero();
   Vec3 acceleration_mm_s2 = Vec3::Zero();
+  Vec3 tool_axis = vertical_tool_axis();      // unit
+  Vec3 angular_velocity_rad_s = Vec3::Zero();  // of the tool axis
   bool depositing = false;
   int path_index = -1;
   int piece_index = -1;
   double desired_speed_mm_s = 0.0;
+
+  Pose pose() const { return Pose(position_mm, tool_axis); }
 };
 
 class Trajectory {
@@ -93,5 +114,9 @@ class TrajectoryCursor {
 // Evaluate one piece's motion at local time tau (seconds since the piece started).
 void evaluate_motion(const TrajectoryPiece& piece, double tau, Vec3& position_mm,
                      Vec3& velocity_mm_s, Vec3& acceleration_mm_s2);
+// The tool axis and its angular velocity at local time tau, where the TCP is at position_mm
+// moving at velocity_mm_s (evaluate_motion's).
+void evaluate_tool_axis(const TrajectoryPiece& piece, double tau, const Vec3& position_mm,
+                        const Vec3& velocity_mm_s, Vec3& tool_axis, Vec3& angular_velocity_rad_s);
 
 }  // namespace depotwin

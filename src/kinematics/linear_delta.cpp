@@ -211,12 +211,15 @@ void LinearDelta::closure_feedforward(const Vec3& tcp_mm, const Vec3& tcp_veloci
   for (int arm = 0; arm < 3; ++arm) joint_force[arm] += rod_forces_n[arm] + carriage_force_n[arm];
 }
 
-bool LinearDelta::inverse(const Vec3& tcp_mm, JointVector& joints, std::string* why) const {
+bool LinearDelta::inverse(const Pose& pose, JointVector& joints, std::string* why) const {
   const auto fail = [why](const std::string& reason) {
     if (why) *why = reason;
     return false;
   };
+  const Vec3& tcp_mm = pose.position_mm;
   if (!tcp_mm.allFinite()) return fail("the point is not finite");
+  if (const std::string tilted = vertical_axis_problem(name(), pose); !tilted.empty())
+    return fail(tilted);
   if (tcp_mm.z() < geometry_.min_tcp_z_mm) {
     return fail("z = " + format_mm(tcp_mm.z()) + " mm puts the nozzle more than " +
                 format_mm(-geometry_.min_tcp_z_mm) + " mm into the substrate");
@@ -249,17 +252,38 @@ bool LinearDelta::inverse(const Vec3& tcp_mm, JointVector& joints, std::string* 
   return true;
 }
 
-Vec3 LinearDelta::forward(const JointVector& joints) const {
-  if (joints.size() != 3) return Vec3(kNaN, kNaN, kNaN);
-  return tcp_from_platform_mm(geometry_, trilaterate_mm(geometry_, joints.data()));
+Pose LinearDelta::forward(const JointVector& joints) const {
+  if (joints.size() != 3) return Pose(Vec3(kNaN, kNaN, kNaN));
+  return Pose(tcp_from_platform_mm(geometry_, trilaterate_mm(geometry_, joints.data())));
 }
 
-JointVector LinearDelta::joint_velocity(const JointVector& joints, const Vec3& tcp_velocity) const {
+Jacobian LinearDelta::jacobian(const JointVector& joints) const {
+  Jacobian j = Jacobian::Zero(6, 3);
+  if (joints.size() != 3) return Jacobian::Constant(6, 3, kNaN);
+  const Vec3 platform_mm = trilaterate_mm(geometry_, joints.data());
+  const std::array<Vec3, 3> rods = rod_vectors_mm(geometry_, platform_mm, joints.data());
+  // q' = M p' with rows w_i / w_iz, and tcp' = -p'
+  Eigen::Matrix3d joint_rate_per_platform;
+  for (int arm = 0; arm < 3; ++arm)
+    joint_rate_per_platform.row(arm) = rods[arm].transpose() / rods[arm].z();
+  j.topRows<3>() = -joint_rate_per_platform.inverse();
+  return j;
+}
+
+JointVector LinearDelta::joint_velocity(const JointVector& joints, const PoseRate& rate) const {
   if (joints.size() != 3) return JointVector(3, kNaN);
   const Vec3 platform_mm = trilaterate_mm(geometry_, joints.data());
   // the platform moves opposite to the TCP
-  return to_joints(
-      carriage_velocity_mm_s(rod_vectors_mm(geometry_, platform_mm, joints.data()), -tcp_velocity));
+  return to_joints(carriage_velocity_mm_s(rod_vectors_mm(geometry_, platform_mm, joints.data()),
+                                          -rate.linear_mm_s));
+}
+
+std::string LinearDelta::set_joint_limits(const AxisLimits& limits) {
+  if (limits.j_max_mm_s3 > 0.0)
+    return "a carriage j_max is not supported on the linear_delta (its TCP limits bound carriage "
+           "speed and acceleration only); set the TCP's limits.j_max instead";
+  set_carriage_limits(limits.v_max_mm_s, limits.a_max_mm_s2);
+  return "";
 }
 
 JointVector LinearDelta::joint_acceleration(const JointVector& joints, const Vec3& tcp_velocity,

@@ -74,10 +74,13 @@ class LinearDelta final : public Machine {
   // joints "carriage1".."carriage3" (MJCF slide joints and actuators, mm from home)
   const std::vector<JointLimit>& joint_limits() const override { return joint_limits_; }
 
-  bool inverse(const Vec3& tcp_mm, JointVector& joints, std::string* why = nullptr) const override;
+  // the nozzle stays vertical: a tilted tool axis is unreachable
+  bool inverse(const Pose& pose, JointVector& joints, std::string* why = nullptr) const override;
   // NaN components when no platform position fits the three carriage heights
-  Vec3 forward(const JointVector& joints) const override;
-  JointVector joint_velocity(const JointVector& joints, const Vec3& tcp_velocity) const override;
+  Pose forward(const JointVector& joints) const override;
+  // d tcp / dq = -(dq/dp)^-1, dq_i/dp = w_i^T / w_iz (the platform moves opposite to the TCP)
+  Jacobian jacobian(const JointVector& joints) const override;
+  JointVector joint_velocity(const JointVector& joints, const PoseRate& rate) const override;
   // exact carriage accelerations q'' = J a + (dJ/dt) v at a pose (mm/s^2)
   JointVector joint_acceleration(const JointVector& joints, const Vec3& tcp_velocity,
                                  const Vec3& tcp_acceleration) const;
@@ -95,7 +98,9 @@ class LinearDelta final : public Machine {
 
   // scenario `limits: {joint: {v_max, a_max}}`: the same limits on every carriage
   void set_carriage_limits(double v_max_mm_s, double a_max_mm_s2);
-  void set_joint_limits(double v_max, double a_max) override { set_carriage_limits(v_max, a_max); }
+  // a carriage jerk limit is refused: cartesian_limits bounds carriage speed and
+  // acceleration only (set the TCP's limits.j_max instead)
+  std::string set_joint_limits(const AxisLimits& limits) override;
   // What the simulator's per-joint terms (each carriage's subtree, carriage + its two rods,
   // translating with the carriage: m (q'' + g)) miss of the closed chain's rigid-body
   // dynamics, at the TCP's position, velocity and acceleration: the platform's load

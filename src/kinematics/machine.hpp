@@ -1,57 +1,65 @@
-// Per-machine kinematics behind one interface (Klipper's kin_*.c): TCP position in the
-// work frame <-> joint positions, joint limits, and the mapping of joint limits to the
-// Cartesian limits the planners honour. No MuJoCo here.
+// Per-machine kinematics behind one interface (Klipper's kin_*.c): tool poses in the work
+// frame <-> joint positions, the Jacobian, joint limits, and the mapping of joint limits to
+// the TCP limits the planners honour over each move. No MuJoCo here.
 //
-// Work frame: the substrate's frame, mm, z up, substrate surface at z = 0. The "TCP" is
-// the nozzle point expressed in that frame (on the XY stage the substrate moves under a
-// fixed nozzle, so the TCP moves opposite to the carriages).
+// Work frame: the substrate's frame, mm, z up, substrate surface at z = 0 for planar work.
+// The "TCP" is the nozzle point expressed in that frame (on the XY stage the substrate moves
+// under a fixed nozzle, so the TCP moves opposite to the carriages); the tool axis points
+// from the nozzle tip up into the tool (core/pose.hpp).
+//
+// Adding a machine: one file pair here implementing this interface, one entry in
+// registry.cpp, one MJCF model in models/ (see docs/ARCHITECTURE.md, "Adding a machine").
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "core/limits.hpp"
+#include "core/pose.hpp"
 #include "core/types.hpp"
 
 namespace depotwin {
 
 using JointVector = std::vector<double>;  // mm for prismatic joints, rad for revolute ones
-
-struct JointLimit {
-  std::string name;          // the MJCF joint name
-  double min = 0.0;          // position range (mm or rad)
-  double max = 0.0;
-  double v_max = 0.0;        // mm/s or rad/s
-  double a_max = 0.0;        // mm/s^2 or rad/s^2
-};
+// 6 x joint_count: rows 0-2 the TCP velocity (mm/s), rows 3-5 the tool's angular velocity
+// (rad/s) per unit joint rate
+using Jacobian = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
 class Machine {
  public:
   virtual ~Machine() = default;
 
+  // the registry name (the kinematics family)
   virtual std::string name() const = 0;
   // the MJCF model shipped for this machine, relative to models/
   virtual std::string model_file() const = 0;
   virtual int joint_count() const = 0;
   virtual const std::vector<JointLimit>& joint_limits() const = 0;
 
-  // TCP (mm, work frame) -> joints. Returns false and says why when the point is not
-  // reachable (outside the travel or the workspace).
-  virtual bool inverse(const Vec3& tcp_mm, JointVector& joints, std::string* why = nullptr) const = 0;
-  // joints -> TCP (mm, work frame)
-  virtual Vec3 forward(const JointVector& joints) const = 0;
-  // joint velocities for a TCP velocity at a pose (the Jacobian applied), for feed-forward
-  virtual JointVector joint_velocity(const JointVector& joints, const Vec3& tcp_velocity) const = 0;
+  // pose -> joints. Returns false and says why when the pose is not reachable (outside the
+  // travel or the workspace, or a tool axis the machine cannot hold).
+  virtual bool inverse(const Pose& pose, JointVector& joints, std::string* why = nullptr) const = 0;
+  // joints -> pose
+  virtual Pose forward(const JointVector& joints) const = 0;
+  // d(pose)/d(joints) at a joint position (see Jacobian)
+  virtual Jacobian jacobian(const JointVector& joints) const = 0;
+  // joint velocities that give a pose rate (least squares over the task rows the machine
+  // can move; the roll about the tool axis is free). The default solves with the Jacobian.
+  virtual JointVector joint_velocity(const JointVector& joints, const PoseRate& rate) const;
 
-  // Cartesian per-axis limits under which no joint exceeds its own velocity and
-  // acceleration limits anywhere in the box [lo, hi] (the toolpath's bounds), given the
-  // user's Cartesian limits (the result is never looser than `requested`).
+  // TCP per-axis limits under which no joint exceeds its own velocity and acceleration
+  // limits anywhere in the box [lo, hi], given the user's TCP limits (the result is never
+  // looser than `requested`).
   virtual MachineLimits cartesian_limits(const MachineLimits& requested, const Vec3& lo,
                                          const Vec3& hi) const = 0;
+  // the user's TCP limits, refined per move by cartesian_limits (the machine must outlive it)
+  TcpLimits tcp_limits(const MachineLimits& requested) const;
 
-  // scenario `limits: {joint: {v_max, a_max}}`: the same limits on every joint
-  virtual void set_joint_limits(double v_max, double a_max) = 0;
+  // scenario `limits: {joint: {v_max, a_max, j_max}}`: the same limits on every joint.
+  // "" when applied, else why the machine cannot honour them.
+  virtual std::string set_joint_limits(const AxisLimits& limits) = 0;
 
   // Feed-forward joint forces (N or N m, `joint_force` has joint_count() entries, added to)
   // for loads that reach the joints through closed kinematic chains, which a simulator's
@@ -63,9 +71,23 @@ class Machine {
                                    double* /*joint_force*/) const {}
 };
 
-// "xy_stage" | "linear_delta"; nullptr for an unknown name
+// A machine that holds the nozzle vertical (translation only): "" when the pose's tool axis
+// is vertical, else why not. For the translational machines' inverse().
+std::string vertical_axis_problem(const std::string& machine, const Pose& pose);
+
+// One registered machine: its name (the scenario's `machine:` and an MJCF's `kinematics:`),
+// a line of description, and a factory with default geometry and limits.
+struct MachineInfo {
+  std::string name;
+  std::string description;
+  std::unique_ptr<Machine> (*make)();
+};
+
+// every registered machine, in a stable order: the only list of machine names
+const std::vector<MachineInfo>& machine_registry();
+// the named machine; nullptr for an unknown name
 std::unique_ptr<Machine> make_machine(const std::string& name);
-// the machine names make_machine knows
+// the registered names
 std::vector<std::string> machine_names();
 
 }  // namespace depotwin

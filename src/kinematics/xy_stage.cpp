@@ -38,12 +38,17 @@ class XyStage : public Machine {
   const std::vector<JointLimit>& joint_limits() const override { return limits_; }
 
   // the plate moves under a fixed nozzle: tcp = nozzle - carriage, so carriage = nozzle - tcp
-  bool inverse(const Vec3& tcp_mm, JointVector& joints, std::string* why) const override {
+  bool inverse(const Pose& pose, JointVector& joints, std::string* why) const override {
+    const Vec3& tcp_mm = pose.position_mm;
     joints.resize(2);
     joints[0] = kNozzleX_mm - tcp_mm.x();
     joints[1] = kNozzleY_mm - tcp_mm.y();
     if (!tcp_mm.allFinite()) {
       if (why) *why = "the TCP position is not a finite number";
+      return false;
+    }
+    if (const std::string tilted = vertical_axis_problem(name(), pose); !tilted.empty()) {
+      if (why) *why = tilted;
       return false;
     }
     if (std::abs(tcp_mm.z()) > kPlaneTolerance_mm) {
@@ -67,14 +72,19 @@ class XyStage : public Machine {
     return true;
   }
 
-  Vec3 forward(const JointVector& joints) const override {
-    return Vec3(kNozzleX_mm - joints.at(0), kNozzleY_mm - joints.at(1), 0.0);
+  Pose forward(const JointVector& joints) const override {
+    return Pose(Vec3(kNozzleX_mm - joints.at(0), kNozzleY_mm - joints.at(1), 0.0));
   }
 
-  // the Jacobian is -I on x and y
-  JointVector joint_velocity(const JointVector& /*joints*/,
-                             const Vec3& tcp_velocity) const override {
-    return JointVector{-tcp_velocity.x(), -tcp_velocity.y()};
+  // the Jacobian is -I on x and y; nothing turns the tool
+  Jacobian jacobian(const JointVector& /*joints*/) const override {
+    Jacobian j = Jacobian::Zero(6, 2);
+    j(0, 0) = -1.0;
+    j(1, 1) = -1.0;
+    return j;
+  }
+  JointVector joint_velocity(const JointVector& /*joints*/, const PoseRate& rate) const override {
+    return JointVector{-rate.linear_mm_s.x(), -rate.linear_mm_s.y()};
   }
 
   // each TCP axis is one carriage: the per-axis limits are the tighter of the two;
@@ -83,17 +93,24 @@ class XyStage : public Machine {
                                  const Vec3& /*hi*/) const override {
     MachineLimits limits = requested;
     for (int i = 0; i < 2; ++i) {
-      limits.axes[i].v_max_mm_s = std::min(requested.axes[i].v_max_mm_s, limits_[i].v_max);
-      limits.axes[i].a_max_mm_s2 = std::min(requested.axes[i].a_max_mm_s2, limits_[i].a_max);
+      AxisLimits& axis = limits.axes[i];
+      axis.v_max_mm_s = std::min(requested.axes[i].v_max_mm_s, limits_[i].v_max);
+      axis.a_max_mm_s2 = std::min(requested.axes[i].a_max_mm_s2, limits_[i].a_max);
+      // a jerk limit of 0 is none: the tighter of the two that are set
+      const double joint_jerk = limits_[i].j_max;
+      if (joint_jerk > 0.0)
+        axis.j_max_mm_s3 = axis.j_max_mm_s3 > 0.0 ? std::min(axis.j_max_mm_s3, joint_jerk) : joint_jerk;
     }
     return limits;
   }
 
-  void set_joint_limits(double v_max, double a_max) override {
+  std::string set_joint_limits(const AxisLimits& joint) override {
     for (JointLimit& limit : limits_) {
-      limit.v_max = v_max;
-      limit.a_max = a_max;
+      limit.v_max = joint.v_max_mm_s;
+      limit.a_max = joint.a_max_mm_s2;
+      limit.j_max = joint.j_max_mm_s3;
     }
+    return "";
   }
 
  private:

@@ -9,91 +9,6 @@
 
 namespace depotwin {
 
-// --- profile ----------------------------------------------------------------------------
-
-double JerkPhase::q_end() const {
-  const double t = duration_s;
-  return q0 + t * (v0 + t * (0.5 * a0 + t * jerk / 6.0));
-}
-
-double JerkPhase::v_end() const {
-  return v0 + duration_s * (a0 + 0.5 * jerk * duration_s);
-}
-
-void JerkProfile::append(double duration_s, double jerk) {
-  if (!(duration_s > 0.0)) return;
-  JerkPhase phase;
-  phase.t_begin_s = this->duration_s();
-  phase.duration_s = duration_s;
-  phase.q0 = q_end();
-  phase.v0 = v_end();
-  phase.a0 = a_end();
-  phase.jerk = jerk;
-  phases_.push_back(phase);
-}
-
-double JerkProfile::duration_s() const {
-  return phases_.empty() ? 0.0 : phases_.back().t_begin_s + phases_.back().duration_s;
-}
-
-double JerkProfile::q_end() const {
-  return phases_.empty() ? q_start_ : phases_.back().q_end();
-}
-double JerkProfile::v_end() const {
-  return phases_.empty() ? v_start_ : phases_.back().v_end();
-}
-double JerkProfile::a_end() const {
-  return phases_.empty() ? a_start_ : phases_.back().a_end();
-}
-
-const JerkPhase* JerkProfile::phase_at(double t) const {
-  if (phases_.empty()) return nullptr;
-  if (t <= 0.0) return &phases_.front();
-  // last phase starting at or before t (phases are sorted by start time)
-  auto it = std::upper_bound(phases_.begin(), phases_.end(), t,
-                             [](double time, const JerkPhase& p) { return time < p.t_begin_s; });
-  return &*(it - 1);
-}
-
-AxisState JerkProfile::at(double t) const {
-  const JerkPhase* phase = phase_at(t);
-  if (phase == nullptr) return AxisState{q_start_, v_start_, a_start_};
-  const double tau = std::clamp(t - phase->t_begin_s, 0.0, phase->duration_s);
-  return AxisState{
-      phase->q0 + tau * (phase->v0 + tau * (0.5 * phase->a0 + tau * phase->jerk / 6.0)),
-      phase->v0 + tau * (phase->a0 + 0.5 * phase->jerk * tau), phase->a0 + phase->jerk * tau};
-}
-
-double JerkProfile::jerk_at(double t) const {
-  const JerkPhase* phase = phase_at(t);
-  return phase == nullptr ? 0.0 : phase->jerk;
-}
-
-double JerkProfile::peak_speed() const {
-  double peak = std::abs(v_start_);
-  for (const JerkPhase& p : phases_) {
-    peak = std::max({peak, std::abs(p.v0), std::abs(p.v_end())});
-    // inside a phase the velocity peaks where the acceleration crosses zero
-    if (p.jerk != 0.0) {
-      const double t = -p.a0 / p.jerk;
-      if (t > 0.0 && t < p.duration_s) peak = std::max(peak, std::abs(p.v0 + 0.5 * p.a0 * t));
-    }
-  }
-  return peak;
-}
-
-double JerkProfile::peak_acceleration() const {
-  double peak = std::abs(a_start_);
-  for (const JerkPhase& p : phases_) peak = std::max({peak, std::abs(p.a0), std::abs(p.a_end())});
-  return peak;
-}
-
-double JerkProfile::peak_jerk() const {
-  double peak = 0.0;
-  for (const JerkPhase& p : phases_) peak = std::max(peak, std::abs(p.jerk));
-  return peak;
-}
-
 // --- planning ---------------------------------------------------------------------------
 
 double s_curve_duration(double dv, double a_max, double j_max) {
@@ -238,42 +153,42 @@ bool reachable(const AxisBoundary& b, double T, const AxisProblem& pr) {
 }
 
 // the S-curve changing the velocity by dv, appended to p
-void append_s_curve(JerkProfile& p, double dv, const AxisProblem& pr) {
+void append_s_curve(AxisProfile& p, double dv, const AxisProblem& pr) {
   const double x = std::abs(dv), sign = dv >= 0.0 ? 1.0 : -1.0;
   if (x <= pr.knee()) {
     // triangular acceleration, peak sqrt(x j) <= a_max
     const double t_ramp = std::sqrt(x / pr.j_max);
-    p.append(t_ramp, sign * pr.j_max);
-    p.append(t_ramp, -sign * pr.j_max);
+    p.append_jerk(t_ramp, sign * pr.j_max);
+    p.append_jerk(t_ramp, -sign * pr.j_max);
   } else {
     // trapezoidal acceleration: ramp to a_max, hold, ramp down
     const double t_ramp = pr.a_max / pr.j_max;
-    p.append(t_ramp, sign * pr.j_max);
-    p.append(x / pr.a_max - t_ramp, 0.0);
-    p.append(t_ramp, -sign * pr.j_max);
+    p.append_jerk(t_ramp, sign * pr.j_max);
+    p.append_jerk(x / pr.a_max - t_ramp, 0.0);
+    p.append_jerk(t_ramp, -sign * pr.j_max);
   }
 }
 
 // the family member: S-curve v0 -> v_p, cruise for the rest of T, S-curve v_p -> v1
-JerkProfile double_s(const AxisBoundary& b, const Peak& peak, double T, const AxisProblem& pr) {
-  JerkProfile p(b.q0, b.v0);
+AxisProfile double_s(const AxisBoundary& b, const Peak& peak, double T, const AxisProblem& pr) {
+  AxisProfile p(b.q0, b.v0);
   append_s_curve(p, peak.dv0, pr);
   // a cruise of a rounding error (the time-optimal member has none) is left out
   const double cruise_s = T - pr.time(peak);
-  if (cruise_s > 1e-13 * (1.0 + T)) p.append(cruise_s, 0.0);
+  if (cruise_s > 1e-13 * (1.0 + T)) p.append_jerk(cruise_s, 0.0);
   append_s_curve(p, -peak.dv1, pr);
   return p;
 }
 
 // (1 - w) first + w second, phase by phase over [0, T]: the jerk of each piece between the
 // union of both profiles' switching times is the same blend, so every state is too
-JerkProfile blend(const JerkProfile& first, const JerkProfile& second, double w, double T) {
-  JerkProfile out(first.q_start(), first.v_start(), first.a_start());
+AxisProfile blend(const AxisProfile& first, const AxisProfile& second, double w, double T) {
+  AxisProfile out(first.q_start(), first.v_start(), first.a_start());
   const auto& p1 = first.phases();
   const auto& p2 = second.phases();
   size_t i = 0, k = 0;
   double t = 0.0;
-  auto end_of = [](const JerkPhase& p) { return p.t_begin_s + p.duration_s; };
+  auto end_of = [](const Phase& p) { return p.t_begin_s + p.duration_s; };
   while (t < T) {
     while (i < p1.size() && end_of(p1[i]) <= t) ++i;
     while (k < p2.size() && end_of(p2[k]) <= t) ++k;
@@ -282,7 +197,7 @@ JerkProfile blend(const JerkProfile& first, const JerkProfile& second, double w,
     const double next = std::min({end1, end2, T});
     const double j1 = i < p1.size() ? p1[i].jerk : 0.0;
     const double j2 = k < p2.size() ? p2[k].jerk : 0.0;
-    out.append(next - t, (1.0 - w) * j1 + w * j2);
+    out.append_jerk(next - t, (1.0 - w) * j1 + w * j2);
     t = next;
   }
   return out;
@@ -326,12 +241,12 @@ FeasibleDurations jerk_feasible_durations(const AxisBoundary& b, double v_max, d
   return out;
 }
 
-JerkProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, double v_max,
+AxisProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, double v_max,
                                  double a_max, double j_max) {
   const AxisProblem pr = checked_problem(b, v_max, a_max, j_max);
   const double T = duration_s, d = b.q1 - b.q0;
   if (T <= 0.0) {
-    if (std::abs(d) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12) return JerkProfile(b.q0, b.v0);
+    if (std::abs(d) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12) return AxisProfile(b.q0, b.v0);
     throw InternalError("jerk-limited move: zero duration for a non-null move");
   }
   if (!reachable(b, T, pr))
@@ -367,41 +282,9 @@ JerkProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, doubl
   return double_s(b, x == x_lo ? lo : member(x), T, pr);
 }
 
-JerkProfile jerk_min_time_move(const AxisBoundary& b, double v_max, double a_max, double j_max) {
+AxisProfile jerk_min_time_move(const AxisBoundary& b, double v_max, double a_max, double j_max) {
   return jerk_fixed_time_move(b, jerk_feasible_durations(b, v_max, a_max, j_max).t_min(), v_max,
                               a_max, j_max);
-}
-
-double common_feasible_duration(const std::vector<FeasibleDurations>& sets, double min_duration_s) {
-  // raise the candidate until every set accepts it; each set has at most one gap, so this
-  // settles after a few rounds
-  double t = std::max(0.0, min_duration_s);
-  for (int round = 0; round < 64; ++round) {
-    double next = t;
-    for (const FeasibleDurations& set : sets) next = std::max(next, set.earliest_at_least(next));
-    if (next == t) return t;
-    t = next;
-  }
-  throw InternalError("synchronised move: no common duration found");
-}
-
-double jerk_synchronized_duration(const std::vector<JerkAxisMove>& axes, double min_duration_s) {
-  std::vector<FeasibleDurations> sets;
-  sets.reserve(axes.size());
-  for (const JerkAxisMove& axis : axes)
-    sets.push_back(jerk_feasible_durations(axis.boundary, axis.v_max, axis.a_max, axis.j_max));
-  return common_feasible_duration(sets, min_duration_s);
-}
-
-JerkSynchronizedMove jerk_synchronized_move(const std::vector<JerkAxisMove>& axes,
-                                            double min_duration_s) {
-  JerkSynchronizedMove move;
-  move.duration_s = jerk_synchronized_duration(axes, min_duration_s);
-  move.axes.reserve(axes.size());
-  for (const JerkAxisMove& axis : axes)
-    move.axes.push_back(
-        jerk_fixed_time_move(axis.boundary, move.duration_s, axis.v_max, axis.a_max, axis.j_max));
-  return move;
 }
 
 }  // namespace depotwin

@@ -38,56 +38,6 @@
 
 namespace depotwin {
 
-// one constant-jerk phase
-struct JerkPhase {
-  double t_begin_s = 0.0;  // relative to the profile's start
-  double duration_s = 0.0;
-  double q0 = 0.0;    // position at the phase start (mm)
-  double v0 = 0.0;    // velocity at the phase start (mm/s)
-  double a0 = 0.0;    // acceleration at the phase start (mm/s^2)
-  double jerk = 0.0;  // constant jerk (mm/s^3)
-
-  double q_end() const;
-  double v_end() const;
-  double a_end() const { return a0 + jerk * duration_s; }
-};
-
-// A one-axis motion made of constant-jerk phases. Plain data, evaluated by time.
-class JerkProfile {
- public:
-  JerkProfile() = default;
-  // an empty profile resting at q0 with velocity v0 and acceleration a0
-  JerkProfile(double q0, double v0, double a0 = 0.0) : q_start_(q0), v_start_(v0), a_start_(a0) {}
-
-  // append a phase of the given duration and constant jerk; zero-length phases are dropped
-  void append(double duration_s, double jerk);
-
-  double duration_s() const;
-  double q_start() const { return q_start_; }
-  double v_start() const { return v_start_; }
-  double a_start() const { return a_start_; }
-  double q_end() const;
-  double v_end() const;
-  double a_end() const;
-  const std::vector<JerkPhase>& phases() const { return phases_; }
-
-  // state at time t (relative to the profile's start); t is clamped to [0, duration]
-  AxisState at(double t) const;
-  double jerk_at(double t) const;
-  // largest |v|, |a| and |jerk| over the profile (|v| also inside phases)
-  double peak_speed() const;
-  double peak_acceleration() const;
-  double peak_jerk() const;
-
- private:
-  const JerkPhase* phase_at(double t) const;
-
-  double q_start_ = 0.0;
-  double v_start_ = 0.0;
-  double a_start_ = 0.0;
-  std::vector<JerkPhase> phases_;
-};
-
 // tau(dv): duration of the fastest rest-acceleration to rest-acceleration velocity change
 // |dv| (see the top of this file)
 double s_curve_duration(double dv, double a_max, double j_max);
@@ -100,34 +50,10 @@ FeasibleDurations jerk_feasible_durations(const AxisBoundary& b, double v_max, d
                                           double j_max);
 
 // the time-optimal jerk-limited profile
-JerkProfile jerk_min_time_move(const AxisBoundary& b, double v_max, double a_max, double j_max);
+AxisProfile jerk_min_time_move(const AxisBoundary& b, double v_max, double a_max, double j_max);
 
 // a profile of exactly `duration_s`, which must be feasible (InternalError otherwise)
-JerkProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, double v_max,
+AxisProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, double v_max,
                                  double a_max, double j_max);
-
-struct JerkAxisMove {
-  AxisBoundary boundary;
-  double v_max = 0.0;
-  double a_max = 0.0;
-  double j_max = 0.0;
-};
-
-struct JerkSynchronizedMove {
-  double duration_s = 0.0;
-  std::vector<JerkProfile> axes;
-};
-
-// smallest duration >= min_duration_s in every one of the feasible sets
-double common_feasible_duration(const std::vector<FeasibleDurations>& sets,
-                                double min_duration_s = 0.0);
-
-// smallest duration >= min_duration_s feasible for every axis
-double jerk_synchronized_duration(const std::vector<JerkAxisMove>& axes,
-                                  double min_duration_s = 0.0);
-
-// every axis re-planned over the common duration
-JerkSynchronizedMove jerk_synchronized_move(const std::vector<JerkAxisMove>& axes,
-                                            double min_duration_s = 0.0);
 
 }  // namespace depotwin

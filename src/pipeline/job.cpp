@@ -18,22 +18,43 @@ namespace {
 
 constexpr double kSamplePeriod_s = 0.001;  // trajectory.csv and planned metrics
 
-// a machine named in the scenario: a built-in name, or an MJCF path driven with the
-// Cartesian-stage kinematics (the model must use the xy_stage joint and site names)
+// The machine named in the scenario, from the registry (the loader checked the name), and the
+// MJCF it is simulated in: the scenario's own model file, else the machine's shipped one.
 std::unique_ptr<Machine> machine_for(const Scenario& scenario, std::string& model_path) {
-  if (auto machine = make_machine(scenario.machine)) {
-    model_path = (fs::path(DEPOTWIN_MODELS_DIR) / machine->model_file()).string();
-    return machine;
+  std::unique_ptr<Machine> machine = make_machine(scenario.machine);
+  if (!machine) {
+    std::string known;
+    for (const std::string& name : machine_names()) known += (known.empty() ? "" : ", ") + name;
+    throw InputError(scenario.file, scenario.machine_line, "machine",
+                     "unknown machine '" + scenario.machine + "' (known: " + known + ")");
   }
-  if (fs::path(scenario.machine).extension() == ".xml") {
-    model_path = scenario.machine;
-    return make_machine("xy_stage");
-  }
-  std::string known;
-  for (const std::string& name : machine_names()) known += (known.empty() ? "" : ", ") + name;
-  throw InputError(scenario.file, 0, "machine",
-                   "'" + scenario.machine + "' is not supported (known: " + known +
-                       ", or a path to an MJCF file of a Cartesian stage)");
+  model_path = scenario.model_path.empty()
+                   ? (fs::path(DEPOTWIN_MODELS_DIR) / machine->model_file()).string()
+                   : scenario.model_path;
+  return machine;
+}
+
+// "" when every toolpath pose is reachable; else one problem per unreachable pose
+std::vector<Problem> unreachable_poses(const Scenario& scenario, const Machine& machine) {
+  std::vector<Problem> problems;
+  JointVector joints;
+  auto check_reachable = [&](const Pose& pose, const std::string& key) {
+    std::string why;
+    if (machine.inverse(pose, joints, &why)) return;
+    const Vec3& p = pose.position_mm;
+    std::ostringstream msg;
+    msg << "point (" << p.x() << ", " << p.y() << ", " << p.z() << ") mm is not reachable by "
+        << machine.name() << ": " << why;
+    problems.push_back(Problem{scenario.file, 0, key, msg.str()});
+  };
+  const Toolpath& toolpath = scenario.toolpath;
+  check_reachable(Pose(toolpath.start_mm), "toolpath.start");
+  check_reachable(Pose(toolpath.end_mm), "toolpath.end");
+  for (const PrintPath& path : toolpath.paths)
+    for (size_t i = 0; i < path.points.size(); ++i)
+      check_reachable(Pose(path.points[i], path.tool_axis(i)),
+                      "toolpath path " + std::to_string(path.source_index));
+  return problems;
 }
 
 }  // namespace
@@ -42,38 +63,21 @@ PreparedJob prepare_job(const Scenario& scenario) {
   PreparedJob job;
   job.scenario = scenario;
   job.machine = machine_for(scenario, job.model_path);
-  if (scenario.has_joint_limits)
-    job.machine->set_joint_limits(scenario.joint_limits.v_max_mm_s,
-                                  scenario.joint_limits.a_max_mm_s2);
+  if (scenario.has_joint_limits) {
+    const std::string problem = job.machine->set_joint_limits(scenario.joint_limits);
+    if (!problem.empty()) throw InputError(scenario.file, 0, "limits.joint", problem);
+  }
 
-  // every point of the toolpath must be reachable by the machine
-  std::vector<Problem> problems;
-  JointVector joints;
-  auto check_reachable = [&](const Vec3& p, const std::string& key) {
-    std::string why;
-    if (!job.machine->inverse(p, joints, &why)) {
-      std::ostringstream msg;
-      msg << "point (" << p.x() << ", " << p.y() << ", " << p.z() << ") mm is not reachable by "
-          << job.machine->name() << ": " << why;
-      problems.push_back(Problem{scenario.file, 0, key, msg.str()});
-    }
-  };
-  const Toolpath& toolpath = scenario.toolpath;
-  check_reachable(toolpath.start_mm, "toolpath.start");
-  check_reachable(toolpath.end_mm, "toolpath.end");
-  for (const PrintPath& path : toolpath.paths)
-    for (const Vec3& p : path.points)
-      check_reachable(p, "toolpath path " + std::to_string(path.source_index));
+  // every pose of the toolpath must be reachable by the machine
+  const std::vector<Problem> problems = unreachable_poses(scenario, *job.machine);
   if (!problems.empty()) throw InputError(problems);
 
-  // the Cartesian limits no joint exceeds anywhere in the toolpath's box
-  Vec3 lo, hi;
-  toolpath.bounds(lo, hi);
-  job.limits = job.machine->cartesian_limits(scenario.limits, lo, hi);
+  // the TCP limits: the user's, refined per move by the machine (Klipper's check_move)
+  job.limits = job.machine->tcp_limits(scenario.limits);
 
   // print order (Ganganath et al.), before every planner
-  job.order = sequence(toolpath, job.limits, scenario.order);
-  job.toolpath = apply_order(toolpath, job.order);
+  job.order = sequence(scenario.toolpath, job.limits, scenario.order);
+  job.toolpath = apply_order(scenario.toolpath, job.order);
   return job;
 }
 
@@ -106,6 +110,12 @@ std::string output_directory(const Scenario& scenario, const std::string& reques
 }
 
 PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
+  // a jerk limit in force (the user's, or the joints' mapped) must be honoured
+  Vec3 lo, hi;
+  job.toolpath.bounds(lo, hi);
+  const std::string ignored = check_planner_limits(spec, job.limits.over(lo, hi));
+  if (!ignored.empty()) throw InputError(job.scenario.file, spec.line, "planners", ignored);
+
   PlannedRun run;
   run.spec = spec;
   run.trajectory = make_planner(spec)->plan(job.toolpath, job.limits);

@@ -14,18 +14,19 @@
 
 namespace depotwin {
 
-// A scenario made ready for planning: its machine, the Cartesian limits the planners get
-// (the machine's joint limits mapped over the toolpath's box), and the print order.
+// A scenario made ready for planning: its machine, the TCP limits the planners get (the
+// machine's joint limits mapped over each move's box), and the print order.
 struct PreparedJob {
   Scenario scenario;
   std::unique_ptr<Machine> machine;
   std::string model_path;  // the MJCF to simulate
-  MachineLimits limits;    // what every planner must respect
+  TcpLimits limits;        // what every planner must respect (refers to *machine)
   OrderResult order;
   Toolpath toolpath;  // in print order
 };
 
-// Throws InputError for an unknown machine, an unreachable toolpath, ...
+// Throws InputError for an unknown machine, joint limits it cannot honour, an unreachable
+// toolpath, a planner that ignores a jerk limit, ...
 PreparedJob prepare_job(const Scenario& scenario);
 
 // the planners to run: all of the scenario's, or those named (comma list); InputError

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "toolpath/random_segments.hpp"
+#include "kinematics/machine.hpp"
 #include "toolpath/gcode.hpp"
 #include "scenario/yaml_reader.hpp"
 
@@ -19,7 +20,6 @@ namespace {
 using namespace scenario_detail;
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kBuiltinMachines{"xy_stage", "linear_delta", "arm6"};
 const std::vector<std::string> kToolpathKinds{"segments", "polylines", "gcode", "random_segments",
                                               "surface"};
 // the paper's stage (Thompson & Yoon) when `limits:` is absent
@@ -200,32 +200,54 @@ void Loader::read_name(const Field& field) {
 }
 
 void Loader::read_machine(const Field& field) {
-  const std::optional<std::string> machine = read_string(field, problems_);
-  if (!machine) return;
-  if (contains(kBuiltinMachines, *machine)) {
-    scenario_.machine = *machine;
-    return;
-  }
-  // otherwise an MJCF file, relative to the scenario file
-  const fs::path given(*machine);
-  std::string extension = given.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (extension != ".xml") {
+  scenario_.machine_line = field.line;
+  const std::string families = join(machine_names());
+  // a registered machine by name
+  if (field.node.IsScalar()) {
+    const std::optional<std::string> machine = read_string(field, problems_);
+    if (!machine) return;
+    if (contains(machine_names(), *machine)) {
+      scenario_.machine = *machine;
+      return;
+    }
+    const bool mjcf = fs::path(*machine).extension() == ".xml";
     problems_.add(field.line, field.key,
-                  "unknown machine '" + *machine + "' (expected " + join(kBuiltinMachines) +
-                      " or a path to an MJCF .xml file)");
+                  mjcf ? "an MJCF file must name its kinematics family, which is never guessed: "
+                         "machine: {model: " + *machine + ", kinematics: " + families + "}"
+                       : "unknown machine '" + *machine + "' (expected " + families +
+                             ", or {model: FILE.xml, kinematics: NAME} for a model of your own)");
     return;
   }
-  const fs::path resolved = resolve(*machine);
-  std::error_code error;
-  if (!fs::is_regular_file(resolved, error)) {
-    problems_.add(field.line, field.key,
-                  "MJCF file '" + *machine + "' not found (looked for " + resolved.string() + ")");
-    return;
+  // an MJCF model of one's own, driven by a registered machine's kinematics
+  const MapView view(field, {"model", "kinematics"}, problems_);
+  if (!view.is_map()) return;
+  for (const char* required : {"model", "kinematics"})
+    if (!view.has(required))
+      problems_.add(field.key_line, field.key,
+                    std::string("missing ") + required +
+                        " (an MJCF machine is {model: FILE.xml, kinematics: " + families + "})");
+  if (const Field* f = view.find("kinematics")) {
+    const std::optional<std::string> family = read_string(*f, problems_);
+    if (family && !contains(machine_names(), *family))
+      problems_.add(f->line, f->key,
+                    "unknown kinematics family '" + *family + "' (expected " + families + ")");
+    else if (family)
+      scenario_.machine = *family;
   }
-  scenario_.machine = fs::absolute(resolved, error).lexically_normal().string();
-  scenario_.model_path = scenario_.machine;
+  if (const Field* f = view.find("model")) {
+    const std::optional<std::string> model = read_string(*f, problems_);
+    if (!model) return;
+    const fs::path resolved = resolve(*model);
+    std::error_code error;
+    if (fs::path(*model).extension() != ".xml") {
+      problems_.add(f->line, f->key, "'" + *model + "' is not an MJCF .xml file");
+    } else if (!fs::is_regular_file(resolved, error)) {
+      problems_.add(f->line, f->key,
+                    "MJCF file '" + *model + "' not found (looked for " + resolved.string() + ")");
+    } else {
+      scenario_.model_path = fs::absolute(resolved, error).lexically_normal().string();
+    }
+  }
 }
 
 void Loader::read_axis_limits(const MapView& view, AxisLimits& axis) {
@@ -742,6 +764,9 @@ void Loader::read_planners(const Field& field) {
       problems_.add(item.line, item.key, name_problem);
       continue;
     }
+    // a jerk limit the planner would ignore
+    const std::string limits_problem = check_planner_limits(spec, scenario_.limits);
+    if (!limits_problem.empty()) problems_.add(item.line, item.key, limits_problem);
     for (const Field* parameter : parameter_fields) {
       const std::string key = parameter->key.substr(parameter->key.rfind('.') + 1);
       std::vector<double> values;

@@ -50,11 +50,14 @@ struct Scenario {
   std::string file;       // the scenario file as given
   std::string directory;  // its directory: relative paths resolve against it
   std::string name;
-  std::string machine = "xy_stage";  // xy_stage | linear_delta | arm6 | path to an MJCF file
-  std::string model_path;  // resolved MJCF path: set by the loader for an MJCF machine file, else
-                           // "" until the pipeline resolves the built-in name
+  // a registered machine (kinematics/registry.cpp): `machine: NAME`, or
+  // `machine: {model: FILE.xml, kinematics: NAME}` for an MJCF model of one's own
+  std::string machine = "xy_stage";
+  int machine_line = 0;    // where it was given, for messages
+  std::string model_path;  // the resolved MJCF file of `machine: {model: ...}`; "" for the
+                           // machine's shipped model
   MachineLimits limits;    // Cartesian TCP limits for the planners
-  bool has_joint_limits = false;  // `limits: {joint: {...}}` given (linear delta carriages)
+  bool has_joint_limits = false;  // `limits: {joint: {...}}` given (every joint alike)
   AxisLimits joint_limits;
   ProcessSpec process;
   Toolpath toolpath;

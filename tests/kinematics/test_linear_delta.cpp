@@ -37,7 +37,7 @@ TEST(LinearDelta, HomeMatchesClosedForm) {
   const JointVector joints = solve(delta, Vec3::Zero());
   ASSERT_EQ(joints.size(), 3u);
   for (double joint_mm : joints) EXPECT_NEAR(joint_mm, 0.0, 1e-12);
-  EXPECT_TRUE(delta.forward({0.0, 0.0, 0.0}).isZero(1e-12));
+  EXPECT_TRUE(delta.forward({0.0, 0.0, 0.0}).position_mm.isZero(1e-12));
 
   // tcp +40 mm in y: the platform moves 40 mm away from column 1 (at 90 deg), its rods
   // now 200 mm out, so carriage 1 rises; columns 2 and 3 stay mirror images
@@ -67,7 +67,7 @@ TEST(LinearDelta, InverseThenForwardIsIdentity) {
   for (int sample = 0; sample < 2000; ++sample) {
     const Vec3 tcp_mm = random_workspace_point(rng);
     const JointVector joints = solve(delta, tcp_mm);
-    worst_mm = std::max(worst_mm, (delta.forward(joints) - tcp_mm).norm());
+    worst_mm = std::max(worst_mm, (delta.forward(joints).position_mm - tcp_mm).norm());
   }
   EXPECT_LT(worst_mm, 1e-9);
 }
@@ -81,7 +81,7 @@ TEST(LinearDelta, ForwardThenInverseIsIdentity) {
     // arbitrary carriage heights near a reachable pose
     JointVector joints = solve(delta, random_workspace_point(rng));
     for (double& joint_mm : joints) joint_mm += shift_mm(rng);
-    const Vec3 tcp_mm = delta.forward(joints);
+    const Vec3 tcp_mm = delta.forward(joints).position_mm;
     ASSERT_TRUE(tcp_mm.allFinite());
     JointVector again;
     if (!delta.inverse(tcp_mm, again)) continue;  // shifted out of the workspace
@@ -94,8 +94,8 @@ TEST(LinearDelta, ForwardThenInverseIsIdentity) {
 TEST(LinearDelta, ForwardOfImpossibleCarriagesIsNaN) {
   const LinearDelta delta;
   // carriages 800 mm apart in height cannot hold 350 mm rods to one point
-  EXPECT_FALSE(delta.forward({0.0, 800.0, 0.0}).allFinite());
-  EXPECT_FALSE(delta.forward({300.0, 300.0}).allFinite());
+  EXPECT_FALSE(delta.forward({0.0, 800.0, 0.0}).position_mm.allFinite());
+  EXPECT_FALSE(delta.forward({300.0, 300.0}).position_mm.allFinite());
 }
 
 TEST(LinearDelta, UnreachablePointsAreRejectedWithAReason) {
@@ -208,8 +208,8 @@ TEST(LinearDelta, CartesianLimitsKeepEveryCarriageWithinItsLimits) {
       JointVector now;
       if (!delta.inverse(tcp_mm, now)) continue;  // box corners may lie outside the workspace
       JointVector before, after;
-      if (!delta.inverse(tcp_mm - v * step_s + 0.5 * a * step_s * step_s, before) ||
-          !delta.inverse(tcp_mm + v * step_s + 0.5 * a * step_s * step_s, after))
+      if (!delta.inverse(Vec3(tcp_mm - v * step_s + 0.5 * a * step_s * step_s), before) ||
+          !delta.inverse(Vec3(tcp_mm + v * step_s + 0.5 * a * step_s * step_s), after))
         continue;
       ++checked;
       const JointVector q_dot = delta.joint_velocity(now, v);

@@ -42,7 +42,7 @@ TEST(XyStage, InverseIsMinusTheTcpAndForwardUndoesIt) {
     ASSERT_EQ(joints.size(), 2u);
     EXPECT_DOUBLE_EQ(joints[0], -tcp.x());
     EXPECT_DOUBLE_EQ(joints[1], -tcp.y());
-    const Vec3 back = machine->forward(joints);
+    const Vec3 back = machine->forward(joints).position_mm;
     EXPECT_NEAR((back - tcp).norm(), 0.0, 1e-12);
   }
 }

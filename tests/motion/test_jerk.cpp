@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "motion/jerk.hpp"
+#include "motion/sync.hpp"
 #include "motion/mtt.hpp"
 
 namespace depotwin {
@@ -19,7 +20,7 @@ namespace {
 constexpr double kV = 4.0, kA = 30.0, kJ = 500.0;
 
 // boundary states, duration, and |v|, |a|, |jerk| at dense samples and inside phases
-void expect_valid(const JerkProfile& p, const AxisBoundary& b, double duration_s, double v_max,
+void expect_valid(const AxisProfile& p, const AxisBoundary& b, double duration_s, double v_max,
                   double a_max, double j_max) {
   EXPECT_NEAR(p.duration_s(), duration_s, 1e-9 * (1 + duration_s));
   const AxisState start = p.at(0.0), end = p.at(p.duration_s());
@@ -42,18 +43,18 @@ void expect_valid(const JerkProfile& p, const AxisBoundary& b, double duration_s
   }
 }
 
-std::vector<double> jerks_of(const JerkProfile& p) {
+std::vector<double> jerks_of(const AxisProfile& p) {
   std::vector<double> out;
-  for (const JerkPhase& phase : p.phases()) out.push_back(phase.jerk);
+  for (const Phase& phase : p.phases()) out.push_back(phase.jerk);
   return out;
 }
 
 // --- closed forms -----------------------------------------------------------------------
 
 TEST(Jerk, ProfileEvaluatesCubicPhases) {
-  JerkProfile p(1.0, 2.0);
-  p.append(0.5, 8.0);   // a: 0 -> 4
-  p.append(1.0, -8.0);  // a: 4 -> -4, v peaks where a = 0
+  AxisProfile p(1.0, 2.0);
+  p.append_jerk(0.5, 8.0);   // a: 0 -> 4
+  p.append_jerk(1.0, -8.0);  // a: 4 -> -4, v peaks where a = 0
   EXPECT_NEAR(p.at(0.5).q, 1 + 2 * 0.5 + 8 * 0.125 / 6, 1e-15);
   EXPECT_NEAR(p.at(0.5).v, 2 + 8 * 0.25 / 2, 1e-15);
   EXPECT_NEAR(p.at(0.5).a, 4.0, 1e-15);
@@ -75,7 +76,7 @@ TEST(Jerk, SCurveDuration) {
 TEST(Jerk, RestToRestReachingBothLimits) {
   // T = d / v + v / a + a / j, jerk pattern +j 0 -j 0 -j 0 +j
   const AxisBoundary b{1, 11, 0, 0};
-  const JerkProfile p = jerk_min_time_move(b, kV, kA, kJ);
+  const AxisProfile p = jerk_min_time_move(b, kV, kA, kJ);
   EXPECT_NEAR(p.duration_s(), 10 / kV + kV / kA + kA / kJ, 1e-12);
   expect_valid(p, b, p.duration_s(), kV, kA, kJ);
   EXPECT_EQ(jerks_of(p), (std::vector<double>{kJ, 0, -kJ, 0, -kJ, 0, kJ}));
@@ -93,7 +94,7 @@ TEST(Jerk, RestToRestReachingVmaxOnly) {
   // T = d / v + 2 sqrt(v / j)
   const double j = 100.0;
   const AxisBoundary b{0, 10, 0, 0};
-  const JerkProfile p = jerk_min_time_move(b, kV, kA, j);
+  const AxisProfile p = jerk_min_time_move(b, kV, kA, j);
   EXPECT_NEAR(p.duration_s(), 10 / kV + 2 * std::sqrt(kV / j), 1e-12);
   EXPECT_NEAR(p.peak_acceleration(), std::sqrt(kV * j), 1e-9);
   EXPECT_EQ(jerks_of(p), (std::vector<double>{j, -j, 0, -j, j}));
@@ -107,7 +108,7 @@ TEST(Jerk, RestToRestReachingAmaxOnly) {
   ASSERT_GT(v_p, knee);
   ASSERT_LT(v_p, kV);
   const AxisBoundary b{0, d, 0, 0};
-  const JerkProfile p = jerk_min_time_move(b, kV, kA, kJ);
+  const AxisProfile p = jerk_min_time_move(b, kV, kA, kJ);
   EXPECT_NEAR(p.duration_s(), 2 * (v_p / kA + kA / kJ), 1e-12);
   EXPECT_NEAR(p.peak_speed(), v_p, 1e-9);
   EXPECT_NEAR(p.peak_acceleration(), kA, 1e-12);
@@ -118,7 +119,7 @@ TEST(Jerk, RestToRestReachingAmaxOnly) {
 TEST(Jerk, RestToRestReachingNeither) {
   // d = 2 v_p sqrt(v_p / j) with v_p under the knee: T = 4 sqrt(v_p / j) = (32 d / j)^(1/3)
   const AxisBoundary b{0, -0.01, 0, 0};
-  const JerkProfile p = jerk_min_time_move(b, kV, kA, kJ);
+  const AxisProfile p = jerk_min_time_move(b, kV, kA, kJ);
   EXPECT_NEAR(p.duration_s(), std::cbrt(32 * 0.01 / kJ), 1e-12);
   EXPECT_EQ(jerks_of(p), (std::vector<double>{-kJ, kJ, kJ, -kJ}));
   expect_valid(p, b, p.duration_s(), kV, kA, kJ);
@@ -127,7 +128,7 @@ TEST(Jerk, RestToRestReachingNeither) {
 TEST(Jerk, ReversalInPlace) {
   // +3 -> -3 mm/s with d = 0: one S-curve, tau(6) = 6 / a + a / j, and it moves (3 - 3) / 2 tau = 0
   const AxisBoundary b{0, 0, 3, -3};
-  const JerkProfile p = jerk_min_time_move(b, kV, kA, kJ);
+  const AxisProfile p = jerk_min_time_move(b, kV, kA, kJ);
   EXPECT_NEAR(p.duration_s(), 6 / kA + kA / kJ, 1e-12);
   expect_valid(p, b, p.duration_s(), kV, kA, kJ);
 }
@@ -140,7 +141,7 @@ TEST(Jerk, OvershootAndComeBack) {
   const double c = v0 * v0 / 2 + v0 * knee / 2 - kA * d;
   const double u = 0.5 * (-knee + std::sqrt(knee * knee + 4 * c));
   const AxisBoundary b{0, d, v0, 0};
-  const JerkProfile p = jerk_min_time_move(b, kV, kA, kJ);
+  const AxisProfile p = jerk_min_time_move(b, kV, kA, kJ);
   EXPECT_NEAR(p.duration_s(), (v0 + 2 * u) / kA + 2 * kA / kJ, 1e-12);
   EXPECT_NEAR(p.duration_s(), 0.397838, 5e-7);
   EXPECT_NEAR(p.at(p.phases()[2].t_begin_s + p.phases()[2].duration_s).v, -u, 1e-9);
@@ -179,10 +180,10 @@ TEST(Jerk, FixedDurationsFillTheReachableInterval) {
     const double d = 2.5 + 1.0 * k / 200;
     const AxisBoundary b{0, d, 0, 2};
     if (!jerk_feasible_durations(b, v_max, a_max, j_max).contains(T)) continue;
-    const JerkProfile p = jerk_fixed_time_move(b, T, v_max, a_max, j_max);
+    const AxisProfile p = jerk_fixed_time_move(b, T, v_max, a_max, j_max);
     expect_valid(p, b, T, v_max, a_max, j_max);
     // a blended profile has phases with a jerk strictly between 0 and j_max
-    for (const JerkPhase& phase : p.phases())
+    for (const Phase& phase : p.phases())
       if (std::abs(phase.jerk) > 1e-9 && std::abs(phase.jerk) < j_max * (1 - 1e-9)) {
         ++blended;
         break;
@@ -400,7 +401,7 @@ TEST(Jerk, RandomCasesAreFeasibleAndNothingShorterIs) {
     SCOPED_TRACE(testing::Message() << "case " << i << " j=" << j_max << " q0=" << b.q0
                                     << " q1=" << b.q1 << " v0=" << b.v0 << " v1=" << b.v1);
     const FeasibleDurations set = jerk_feasible_durations(b, kV, kA, j_max);
-    const JerkProfile p = jerk_min_time_move(b, kV, kA, j_max);
+    const AxisProfile p = jerk_min_time_move(b, kV, kA, j_max);
     const double t_min = set.t_min();
     expect_valid(p, b, t_min, kV, kA, j_max);
     EXPECT_LE(oracle.infeasibility(b, t_min), 1e-9);
@@ -429,7 +430,7 @@ TEST(Jerk, RandomCasesAreFeasibleAndNothingShorterIs) {
       }
     }
     // moves that run against the displacement somewhere
-    for (const JerkPhase& phase : p.phases())
+    for (const Phase& phase : p.phases())
       if (phase.v0 * (b.q1 - b.q0) < -1e-9) {
         ++overshoots;
         break;
@@ -476,9 +477,9 @@ TEST(Jerk, InfiniteJerkLimitIsTheAccelerationLimitedMove) {
 
 TEST(JerkSync, SlowestAxisDecides) {
   // x: 10 mm rest to rest (10/4 + 4/30 + 30/500 s); y: 1 mm and z: -0.2 mm over the same time
-  const std::vector<JerkAxisMove> axes{
+  const std::vector<AxisMove> axes{
       {{0, 10, 0, 0}, kV, kA, kJ}, {{0, 1, 0, 0}, kV, kA, kJ}, {{5, 4.8, 0, 0}, kV, kA, 2 * kJ}};
-  const JerkSynchronizedMove move = jerk_synchronized_move(axes);
+  const SynchronizedMove move = synchronized_move(axes);
   EXPECT_NEAR(move.duration_s, 10 / kV + kV / kA + kA / kJ, 1e-12);
   for (size_t i = 0; i < axes.size(); ++i)
     expect_valid(move.axes[i], axes[i].boundary, move.duration_s, kV, kA, axes[i].j_max);
@@ -487,10 +488,10 @@ TEST(JerkSync, SlowestAxisDecides) {
 TEST(JerkSync, BlockedDurationIsSkipped) {
   // y alone needs (32 * 0.05 / j)^(1/3) = 0.147 s, but x (d = 0, v0 = v1 = 3) is blocked
   // on (0, 0.52): the common duration is 0.52 s
-  const std::vector<JerkAxisMove> axes{{{0, 0, 3, 3}, kV, kA, kJ}, {{0, 0.05, 0, 0}, kV, kA, kJ}};
+  const std::vector<AxisMove> axes{{{0, 0, 3, 3}, kV, kA, kJ}, {{0, 0.05, 0, 0}, kV, kA, kJ}};
   EXPECT_NEAR(jerk_min_time_move(axes[1].boundary, kV, kA, kJ).duration_s(),
               std::cbrt(32 * 0.05 / kJ), 1e-12);
-  const JerkSynchronizedMove move = jerk_synchronized_move(axes);
+  const SynchronizedMove move = synchronized_move(axes);
   EXPECT_NEAR(move.duration_s, 2 * (6 / kA + kA / kJ), 1e-12);
   for (size_t i = 0; i < axes.size(); ++i)
     expect_valid(move.axes[i], axes[i].boundary, move.duration_s, kV, kA, kJ);
@@ -500,17 +501,17 @@ TEST(JerkSync, RandomMovesShareTheEarliestCommonDuration) {
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> pos(-10, 10), vel(-3.9, 3.9), unit(0, 1);
   for (int i = 0; i < 1500; ++i) {
-    std::vector<JerkAxisMove> axes;
+    std::vector<AxisMove> axes;
     const int count = 2 + i % 2;
     for (int k = 0; k < count; ++k) {
       AxisBoundary b{pos(rng), pos(rng), vel(rng), vel(rng)};
       if (unit(rng) < 0.3) b.q1 = b.q0 + 0.02 * pos(rng);
       axes.push_back({b, kV, kA, k == 0 ? kJ : 100 + 4900 * unit(rng)});
     }
-    const JerkSynchronizedMove move = jerk_synchronized_move(axes);
+    const SynchronizedMove move = synchronized_move(axes);
     std::vector<FeasibleDurations> sets;
     for (size_t k = 0; k < axes.size(); ++k) {
-      const JerkAxisMove& m = axes[k];
+      const AxisMove& m = axes[k];
       sets.push_back(jerk_feasible_durations(m.boundary, m.v_max, m.a_max, m.j_max));
       EXPECT_TRUE(sets.back().contains(move.duration_s, 1e-9));
       expect_valid(move.axes[k], m.boundary, move.duration_s, m.v_max, m.a_max, m.j_max);

@@ -21,7 +21,7 @@ void expect_valid(const LspbSolution& s, const AxisBoundary& b, double alpha) {
   EXPECT_DOUBLE_EQ(std::abs(s.a0), alpha);
   EXPECT_DOUBLE_EQ(std::abs(s.a1), alpha);
   for (const Phase& phase : p.phases())
-    EXPECT_TRUE(phase.a == 0.0 || std::abs(phase.a) == alpha) << phase.a;
+    EXPECT_TRUE(phase.a0 == 0.0 || std::abs(phase.a0) == alpha) << phase.a0;
 }
 
 struct SixCase {

@@ -2,6 +2,8 @@
 // and says what is wrong; every problem of a file is reported, not only the first.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "scenario/scenario.hpp"
 #include "scenario_test_util.hpp"
 
@@ -426,13 +428,55 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(unknown.size(), 1u) << dump(unknown);
   expect_problem(unknown, scenario_path(), "machine", 1,
-                 "unknown machine 'scara' (expected xy_stage, linear_delta, arm6 or a path");
+                 "unknown machine 'scara' (expected xy_stage, linear_delta, or {model:");
   const auto missing = problems_of(R"(
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
-machine: models/none.xml
+machine: {model: models/none.xml, kinematics: xy_stage}
 )");
   ASSERT_EQ(missing.size(), 1u) << dump(missing);
-  expect_problem(missing, scenario_path(), "machine", 2, "MJCF file 'models/none.xml' not found");
+  expect_problem(missing, scenario_path(), "machine.model", 2,
+                 "MJCF file 'models/none.xml' not found");
+}
+
+// an MJCF model names its kinematics family; it is never guessed from the file
+TEST_F(ScenarioErrors, MjcfMachineNamesItsKinematics) {
+  std::filesystem::create_directories(dir_ / "models");
+  std::ofstream(dir_ / "models" / "mine.xml") << "<mujoco/>\n";
+  const auto bare = problems_of(R"(
+machine: models/mine.xml
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(bare.size(), 1u) << dump(bare);
+  expect_problem(bare, scenario_path(), "machine", 1,
+                 "must name its kinematics family, which is never guessed: machine: {model: "
+                 "models/mine.xml, kinematics: xy_stage, linear_delta}");
+  const auto unknown_family = problems_of(R"(
+machine: {model: models/mine.xml, kinematics: scara}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(unknown_family.size(), 1u) << dump(unknown_family);
+  expect_problem(unknown_family, scenario_path(), "machine.kinematics", 1,
+                 "unknown kinematics family 'scara' (expected xy_stage, linear_delta)");
+  const auto missing_family = problems_of(R"(
+machine: {model: models/mine.xml}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(missing_family.size(), 1u) << dump(missing_family);
+  expect_problem(missing_family, scenario_path(), "machine", 1, "missing kinematics");
+}
+
+// a j_max the planner would ignore is an error at the planner's line
+TEST_F(ScenarioErrors, JerkLimitRefusedByPlannerThatIgnoresIt) {
+  const auto problems = problems_of(R"(
+limits: {v_max: 4, a_max: 30, j_max: 500}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+planners:
+  - lspb_mtt
+  - bezier
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "planners[1]", 5,
+                 "planner 'bezier' does not honour j_max");
 }
 
 TEST_F(ScenarioErrors, DuplicateKey) {

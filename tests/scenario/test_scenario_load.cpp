@@ -117,7 +117,7 @@ TEST_F(ScenarioLoad, EveryOtherKey) {
   write("models/my_stage.xml", "<mujoco/>\n");
   const std::string path = write("full.yaml", R"(
 name: full_job
-machine: models/my_stage.xml
+machine: {model: models/my_stage.xml, kinematics: linear_delta}
 limits:
   v_max: 50
   a_max: 400
@@ -148,7 +148,7 @@ outputs: {render: false, image_width: 320, image_height: 2048}
   const Scenario s = load_scenario(path);
   EXPECT_EQ(s.name, "full_job");
   const std::string model = (dir_ / "models" / "my_stage.xml").lexically_normal().string();
-  EXPECT_EQ(s.machine, model);
+  EXPECT_EQ(s.machine, "linear_delta");
   EXPECT_EQ(s.model_path, model);
   // limits: common values with per-axis overrides
   EXPECT_EQ(s.limits.axes[0].v_max_mm_s, 60.0);

@@ -456,7 +456,7 @@ bool check_sampled_limits(const std::vector<Vec3>& positions, const std::vector<
 
 TrajectoryPiece sampled_piece(double t_begin_s, double period_s, std::vector<Vec3> positions,
                               std::vector<Vec3> velocities, int path_index, bool depositing,
-                              double desired_speed_mm_s) {
+                              double desired_speed_mm_s, const PrintPath& path) {
   TrajectoryPiece piece;
   piece.t_begin_s = t_begin_s;
   piece.t_end_s = t_begin_s + period_s * double(positions.size() - 1);
@@ -467,8 +467,37 @@ TrajectoryPiece sampled_piece(double t_begin_s, double period_s, std::vector<Vec
   motion.period_s = period_s;
   motion.position_mm = std::move(positions);
   motion.velocity_mm_s = std::move(velocities);
+  // the tool axis of a path with normals: at every sample, the path's axis where it is nearest
+  if (!path.normals.empty()) {
+    size_t edge_hint = 0;
+    motion.tool_axis.reserve(motion.position_mm.size());
+    for (const Vec3& p : motion.position_mm)
+      motion.tool_axis.push_back(path.tool_axis_near(p, edge_hint));
+  }
   piece.motion = std::move(motion);
   return piece;
+}
+
+// The limits over the box a path sweeps: its points, and with a lead-in its extensions of
+// up to v^2 / (2 a) and a few samples beyond either end (the padding follows the limits over
+// the padded box, which are tighter)
+MachineLimits path_limits(const PrintPath& path, const TcpLimits& limits, bool lead_in,
+                          double period_s) {
+  Vec3 lo = path.points.front(), hi = lo;
+  for (const Vec3& p : path.points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  MachineLimits over = limits.over(lo, hi);
+  if (!lead_in) return over;
+  for (int round = 0; round < 3; ++round) {
+    double a_min = std::numeric_limits<double>::infinity();
+    for (const AxisLimits& axis : over.axes) a_min = std::min(a_min, axis.a_max_mm_s2);
+    const double v = path.speed_mm_s;
+    const double pad_mm = v * v / (2.0 * a_min) + 4.0 * v * period_s;
+    over = limits.over((lo.array() - pad_mm).matrix(), (hi.array() + pad_mm).matrix());
+  }
+  return over;
 }
 
 }  // namespace
@@ -504,11 +533,11 @@ std::unique_ptr<Planner> make_bezier_planner(const PlannerSpec& spec) {
   return std::make_unique<BezierPlanner>(bezier_settings(spec));
 }
 
-Trajectory BezierPlanner::plan(const Toolpath& toolpath, const MachineLimits& limits) const {
-  const std::string limits_problem = limits.validate();
+Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_limits) const {
+  const std::string limits_problem = tcp_limits.requested().validate();
   if (!limits_problem.empty()) throw InputError("limits", limits_problem);
   // degenerate edges, bad speeds and lines too fast for an axis: as for every planner
-  split_into_segments(toolpath, limits);
+  split_into_segments(toolpath, tcp_limits);
 
   // one weight for all corners, or exactly one per corner
   size_t corners = 0;
@@ -530,12 +559,15 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const MachineLimits& li
   std::vector<std::string> warnings;
   double t = 0.0;
   Vec3 position = toolpath.start_mm;
+  Vec3 tool_axis = vertical_tool_axis();
   size_t next_weight = 0;
   std::vector<Vec3> positions, velocities;
   std::vector<int> owners;
   std::vector<double> slow_down;
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
     const PrintPath& path = toolpath.paths[i];
+    // the limits over the path's own box (per path: its blends and ramps are planned together)
+    const MachineLimits limits = path_limits(path, tcp_limits, settings_.lead_in, settings_.period_s);
     PathGeometry geometry = build_geometry(path, settings_, limits, next_weight, warnings);
 
     // the samples: Taylor update along the path; blends whose samples, interpolated,
@@ -582,8 +614,8 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const MachineLimits& li
     }
 
     // shutter closed: to the path's first sample, at rest
-    pieces.push_back(
-        transition_piece(t, position, Vec3::Zero(), positions.front(), Vec3::Zero(), limits));
+    pieces.push_back(transition_piece(t, position, Vec3::Zero(), positions.front(), Vec3::Zero(),
+                                      tcp_limits, tool_axis, path.tool_axis(0)));
     t = pieces.back().t_end_s;
     const int path_index = static_cast<int>(i);
     auto slice = [&](size_t begin, size_t end) {
@@ -594,23 +626,24 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const MachineLimits& li
     };
     if (geometry.lead) {
       pieces.push_back(sampled_piece(t, settings_.period_s, slice(0, print_begin),
-                                     slice_v(0, print_begin), -1, false, 0.0));
+                                     slice_v(0, print_begin), -1, false, 0.0, path));
       t = pieces.back().t_end_s;
     }
     pieces.push_back(sampled_piece(t, settings_.period_s, slice(print_begin, print_end),
                                    slice_v(print_begin, print_end), path_index, true,
-                                   path.speed_mm_s));
+                                   path.speed_mm_s, path));
     t = pieces.back().t_end_s;
     if (geometry.lead) {
       const size_t last = positions.size() - 1;
       pieces.push_back(sampled_piece(t, settings_.period_s, slice(print_end, last),
-                                     slice_v(print_end, last), -1, false, 0.0));
+                                     slice_v(print_end, last), -1, false, 0.0, path));
       t = pieces.back().t_end_s;
     }
     position = positions.back();
+    tool_axis = path.tool_axis(path.points.size() - 1);
   }
-  pieces.push_back(
-      transition_piece(t, position, Vec3::Zero(), toolpath.end_mm, Vec3::Zero(), limits));
+  pieces.push_back(transition_piece(t, position, Vec3::Zero(), toolpath.end_mm, Vec3::Zero(),
+                                    tcp_limits, tool_axis));
 
   // keep the warnings readable on long toolpaths
   if (warnings.size() > kMaxDetailedWarnings) {

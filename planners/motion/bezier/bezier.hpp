@@ -9,7 +9,8 @@
 // eq. (4), across joints by eqs. (11)-(13). The path starts and ends at rest; transitions
 // between paths are synchronised minimum-time moves, rest to rest.
 //
-// Limits: a blend's speed is capped so that v^2 kappa on every axis stays within a_max
+// Limits: per path, those over the path's box (TcpLimits; with the lead-in extensions). A
+// blend's speed is capped so that v^2 kappa on every axis stays within a_max
 // (4/3 of it at the blend's ends, where the accel step falls between two samples and the
 // Hermite interpolation overshoots by up to 4/3) and v |tangent| within v_max; the lines
 // around it slow down and speed up with trapezoidal ramps (forward/backward pass). Each
@@ -44,7 +45,7 @@ struct BezierSettings {
 class BezierPlanner : public Planner {
  public:
   explicit BezierPlanner(BezierSettings settings) : settings_(std::move(settings)) {}
-  Trajectory plan(const Toolpath& toolpath, const MachineLimits& limits) const override;
+  Trajectory plan(const Toolpath& toolpath, const TcpLimits& limits) const override;
   const BezierSettings& settings() const { return settings_; }
 
  private:

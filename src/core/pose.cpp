@@ -1,0 +1,40 @@
+#include "core/pose.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace depotwin {
+
+namespace {
+
+// the unit rotation axis that turns a into b: a x b, or for opposite axes a perpendicular
+Vec3 rotation_axis(const Vec3& a, const Vec3& b) {
+  const Vec3 cross = a.cross(b);
+  if (cross.norm() > 1e-12) return cross.normalized();
+  // parallel or opposite: any perpendicular, the one nearest to x, else y
+  Vec3 perpendicular = a.cross(Vec3::UnitX());
+  if (perpendicular.norm() < 1e-6) perpendicular = a.cross(Vec3::UnitY());
+  return perpendicular.normalized();
+}
+
+}  // namespace
+
+double axis_angle_rad(const Vec3& a, const Vec3& b) {
+  // atan2 of |a x b| and a . b: accurate for small and for near-opposite angles
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+Vec3 slerp_axis(const Vec3& a, const Vec3& b, double s) {
+  const double angle = axis_angle_rad(a, b);
+  if (angle < 1e-12) return a;
+  return Eigen::AngleAxisd(s * angle, rotation_axis(a, b)) * a;
+}
+
+Vec3 slerp_rate(const Vec3& a, const Vec3& b) {
+  const double angle = axis_angle_rad(a, b);
+  if (angle < 1e-12) return Vec3::Zero();
+  return angle * rotation_axis(a, b);
+}
+
+}  // namespace depotwin

@@ -1,0 +1,64 @@
+// The machine registry: the only list of machine names. A new machine is one line here.
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+
+#include "kinematics/linear_delta.hpp"
+#include "kinematics/machine.hpp"
+#include "kinematics/xy_stage.hpp"
+
+namespace depotwin {
+
+const std::vector<MachineInfo>& machine_registry() {
+  static const std::vector<MachineInfo> registry{
+      {"xy_stage", "Thompson & Yoon's XY aerosol stage: the substrate moves under a fixed nozzle",
+       &make_xy_stage},
+      {"linear_delta",
+       "Giberti et al.'s linear delta: three vertical carriages carry the substrate platform",
+       &make_linear_delta},
+  };
+  return registry;
+}
+
+std::unique_ptr<Machine> make_machine(const std::string& name) {
+  for (const MachineInfo& info : machine_registry())
+    if (info.name == name) return info.make();
+  return nullptr;
+}
+
+std::vector<std::string> machine_names() {
+  std::vector<std::string> names;
+  for (const MachineInfo& info : machine_registry()) names.push_back(info.name);
+  return names;
+}
+
+JointVector Machine::joint_velocity(const JointVector& joints, const PoseRate& rate) const {
+  // least squares over the six task rows: the roll about the tool axis is free, so the
+  // angular velocity's component along the axis is what the joints' solution gives
+  const Jacobian j = jacobian(joints);
+  Eigen::Matrix<double, 6, 1> task;
+  task << rate.linear_mm_s, rate.angular_rad_s;
+  const Eigen::VectorXd q_rate = j.completeOrthogonalDecomposition().solve(task);
+  return JointVector(q_rate.data(), q_rate.data() + q_rate.size());
+}
+
+TcpLimits Machine::tcp_limits(const MachineLimits& requested) const {
+  return TcpLimits(requested, [this, requested](const Vec3& lo, const Vec3& hi) {
+    return cartesian_limits(requested, lo, hi);
+  });
+}
+
+std::string vertical_axis_problem(const std::string& machine, const Pose& pose) {
+  if (!pose.tool_axis.allFinite() || std::abs(pose.tool_axis.norm() - 1.0) > 1e-9)
+    return "the tool axis is not a finite unit vector";
+  const double tilt_deg = rad_to_deg(axis_angle_rad(pose.tool_axis, vertical_tool_axis()));
+  if (tilt_deg <= 1e-7) return "";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "the %s holds the nozzle vertical: tool axis (%.4g, %.4g, %.4g) is tilted %.4g deg",
+                machine.c_str(), pose.tool_axis.x(), pose.tool_axis.y(), pose.tool_axis.z(),
+                tilt_deg);
+  return text;
+}
+
+}  // namespace depotwin
