@@ -53,6 +53,8 @@ class TransitionCost {
   double bound_for_distance(double distance_mm) const { return distance_mm / bound_speed_mm_s_; }
 
   const Vec3& position(int node) const { return positions_[node]; }
+  // the print velocity leaving the path through this end (0 at the job's start and end)
+  const Vec3& exit_velocity(int node) const { return exit_velocity_[node]; }
   const std::vector<Vec3>& positions() const { return positions_; }
   double print_time_s() const { return print_time_s_; }
   double print_length_mm() const { return print_length_mm_; }

@@ -6,7 +6,7 @@
 #include "metrics/motion_metrics.hpp"
 #include "planners/motion/lspb_mtt.hpp"
 #include "planners/motion/stop_and_go.hpp"
-#include "planner_checks.hpp"
+#include "contract/planner_checks.hpp"
 
 namespace depotwin {
 namespace {

@@ -1,11 +1,13 @@
-// Shared checks for the planner contract (tests/planners and other planner tests).
+// Shared checks for the planner contract (tests/contract and other planner tests).
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <random>
+#include <variant>
 
 #include "core/limits.hpp"
 #include "core/toolpath.hpp"
@@ -39,6 +41,96 @@ inline Toolpath random_toolpath(std::uint64_t seed, double speed_mm_s) {
     toolpath.paths.push_back(path);
   }
   return toolpath;
+}
+
+// A seeded random 3-D toolpath whose tool axes vary: chains of edges over a bumpy surface
+// (z in [0, 6] mm), each point's normal tilted up to 40 deg and turning smoothly along it.
+inline Toolpath random_toolpath_3d(std::uint64_t seed, double speed_mm_s) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> coordinate(-20.0, 20.0), length(1.0, 10.0),
+      heading(0.0, 2 * kPi), height(0.0, 6.0), tilt(0.0, deg_to_rad(40.0));
+  std::uniform_int_distribution<int> chain_length(1, 4), path_count(1, 4);
+  const auto random_axis = [&] {
+    const double t = tilt(rng), h = heading(rng);
+    return Vec3(std::sin(t) * std::cos(h), std::sin(t) * std::sin(h), std::cos(t));
+  };
+  Toolpath toolpath;
+  toolpath.start_mm = Vec3(coordinate(rng), coordinate(rng), height(rng));
+  toolpath.end_mm = Vec3(coordinate(rng), coordinate(rng), height(rng));
+  const int paths = path_count(rng);
+  for (int i = 0; i < paths; ++i) {
+    PrintPath path;
+    path.speed_mm_s = speed_mm_s;
+    path.source_index = i;
+    Vec3 p(coordinate(rng), coordinate(rng), height(rng));
+    path.points.push_back(p);
+    path.normals.push_back(random_axis());
+    const int edges = chain_length(rng);
+    for (int k = 0; k < edges; ++k) {
+      const double h = heading(rng), l = length(rng);
+      p += Vec3(l * std::cos(h), l * std::sin(h), 0);
+      p.z() = height(rng) * 0.3;
+      path.points.push_back(p);
+      path.normals.push_back(random_axis());
+    }
+    toolpath.paths.push_back(path);
+  }
+  return toolpath;
+}
+
+// The orientation channel: a unit tool axis everywhere that turns continuously, and on a
+// print path the path's own axis where the nozzle is (vertical for paths without normals).
+inline void expect_tool_axis_contract(const Trajectory& trajectory, const Toolpath& toolpath) {
+  const double step_s = 0.001;
+  Vec3 previous = trajectory.at(0.0).tool_axis;
+  std::vector<size_t> edge_hint(toolpath.paths.size(), 0);
+  for (double t = 0.0; t <= trajectory.duration_s(); t += step_s) {
+    const TrajectorySample s = trajectory.at(t);
+    ASSERT_NEAR(s.tool_axis.norm(), 1.0, 1e-9) << "t " << t;
+    // at most 0.2 rad per ms: continuous
+    ASSERT_LT(axis_angle_rad(previous, s.tool_axis), 0.2) << "tool axis jumps at t " << t;
+    previous = s.tool_axis;
+    if (!s.depositing || s.path_index < 0) continue;
+    // on the path: the path's axis at the nearest point (close: the nozzle follows the path)
+    const PrintPath& path = toolpath.paths[s.path_index];
+    const Vec3 expected = path.tool_axis_near(s.position_mm, edge_hint[s.path_index]);
+    ASSERT_LT(axis_angle_rad(expected, s.tool_axis), 0.05) << "t " << t;
+  }
+  // exactly the path's axes where a print piece starts or ends on a path point
+  for (const TrajectoryPiece& piece : trajectory.pieces()) {
+    if (!piece.depositing) continue;
+    const PrintPath& path = toolpath.paths[piece.path_index];
+    for (const double t : {piece.t_begin_s, piece.t_end_s}) {
+      const TrajectorySample s = trajectory.at(t == piece.t_end_s ? t - 1e-12 : t);
+      for (size_t i = 0; i < path.points.size(); ++i)
+        if ((path.points[i] - s.position_mm).norm() < 1e-9)
+          EXPECT_LT(axis_angle_rad(path.tool_axis(i), s.tool_axis), 1e-6) << "t " << t;
+    }
+  }
+}
+
+// A jerk-limited plan: every phase of every piece within the jerk and acceleration limits,
+// and the acceleration continuous across phases and pieces (no step anywhere).
+inline void expect_jerk_limited(const Trajectory& trajectory, const MachineLimits& limits) {
+  std::array<double, 3> previous_end{0.0, 0.0, 0.0};
+  for (const TrajectoryPiece& piece : trajectory.pieces()) {
+    const auto* phases = std::get_if<PhaseMotion>(&piece.motion);
+    ASSERT_NE(phases, nullptr) << "a jerk-limited plan is made of constant-jerk phases";
+    for (int axis = 0; axis < 3; ++axis) {
+      const AxisProfile& profile = phases->axes[axis];
+      const AxisLimits& limit = limits.axes[axis];
+      EXPECT_LE(profile.peak_jerk(), limit.j_max_mm_s3 * (1 + 1e-9)) << "axis " << axis;
+      EXPECT_LE(profile.peak_acceleration(), limit.a_max_mm_s2 * (1 + 1e-9)) << "axis " << axis;
+      double a = profile.a_start();
+      EXPECT_NEAR(a, previous_end[axis], 1e-6) << "acceleration step at t " << piece.t_begin_s;
+      for (const Phase& phase : profile.phases()) {
+        EXPECT_NEAR(phase.a0, a, 1e-6) << "acceleration step in axis " << axis;
+        a = phase.a_end();
+      }
+      previous_end[axis] = a;
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis) EXPECT_NEAR(previous_end[axis], 0.0, 1e-6);
 }
 
 // The planner contract: starts and ends at rest at the start and end points, continuous
@@ -104,11 +196,13 @@ inline void expect_contract(const Trajectory& trajectory, const Toolpath& toolpa
     EXPECT_LT(nearest(path.back()), path_tolerance_mm) << "path " << i << " end";
     // edge midpoints are traced closely. LSPB with averaged joint velocities (eqs. 52-53)
     // leaves the straight line while an axis changes its velocity by up to v at a_max; the
-    // offset that builds up is below v^2 / (4 a_max), so allow that, 5 % of the edge and one
-    // sample's travel
-    double a_min = limits.axes[0].a_max_mm_s2;
+    // offset that builds up is below v^2 / (4 a_max) (v (v / a_max + a_max / j_max) / 4 when the
+    // change is a jerk-limited S-curve), so allow that, 5 % of the edge and one sample's travel
+    double a_min = limits.axes[0].a_max_mm_s2, ramp_s = 0.0;
     for (const AxisLimits& axis : limits.axes) a_min = std::min(a_min, axis.a_max_mm_s2);
-    const double blend_offset = path.speed_mm_s * path.speed_mm_s / (4 * a_min);
+    for (const AxisLimits& axis : limits.axes)
+      if (axis.j_max_mm_s3 > 0.0) ramp_s = std::max(ramp_s, axis.a_max_mm_s2 / axis.j_max_mm_s3);
+    const double blend_offset = path.speed_mm_s * (path.speed_mm_s / a_min + ramp_s) / 4;
     for (size_t k = 0; k + 1 < path.points.size(); ++k) {
       const double length = (path.points[k + 1] - path.points[k]).norm();
       const Vec3 mid = 0.5 * (path.points[k] + path.points[k + 1]);
