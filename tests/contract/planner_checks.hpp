@@ -102,9 +102,11 @@ inline void expect_tool_axis_contract(const Trajectory& trajectory, const Toolpa
     const PrintPath& path = toolpath.paths[piece.path_index];
     for (const double t : {piece.t_begin_s, piece.t_end_s}) {
       const TrajectorySample s = trajectory.at(t == piece.t_end_s ? t - 1e-12 : t);
-      for (size_t i = 0; i < path.points.size(); ++i)
-        if ((path.points[i] - s.position_mm).norm() < 1e-9)
+      for (size_t i = 0; i < path.points.size(); ++i) {
+        if ((path.points[i] - s.position_mm).norm() < 1e-9) {
           EXPECT_LT(axis_angle_rad(path.tool_axis(i), s.tool_axis), 1e-6) << "t " << t;
+        }
+      }
     }
   }
 }
