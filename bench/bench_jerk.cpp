@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "motion/jerk.hpp"
-#include "motion/sync.hpp"
 #include "motion/mtt.hpp"
+#include "motion/sync.hpp"
 
 using namespace depotwin;
 

@@ -28,7 +28,8 @@ void BM_MinimumTimeMove1D(benchmark::State& state) {
     AxisProfile p = min_time_move(boundaries[i++ & 4095], 4.0, 30.0);
     benchmark::DoNotOptimize(p);
   }
-  state.counters["moves_per_s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["moves_per_s"] =
+      benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_MinimumTimeMove1D);
 
@@ -36,12 +37,14 @@ void BM_SynchronizedMove2D(benchmark::State& state) {
   const auto boundaries = random_boundaries(4096);
   size_t i = 0;
   for (auto _ : state) {
-    const std::vector<AxisMove> axes{{boundaries[i & 4095], 4, 30}, {boundaries[(i + 1) & 4095], 4, 30}};
+    const std::vector<AxisMove> axes{{boundaries[i & 4095], 4, 30},
+                                     {boundaries[(i + 1) & 4095], 4, 30}};
     ++i;
     SynchronizedMove m = synchronized_move(axes);
     benchmark::DoNotOptimize(m);
   }
-  state.counters["moves_per_s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["moves_per_s"] =
+      benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_SynchronizedMove2D);
 
@@ -78,7 +81,12 @@ void BM_PlanLspbMtt(benchmark::State& state) {
   state.counters["segments_per_s"] =
       benchmark::Counter(state.iterations() * state.range(0), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_PlanLspbMtt)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->Complexity();
+BENCHMARK(BM_PlanLspbMtt)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity();
 
 }  // namespace
 

@@ -13,9 +13,9 @@
 #include <utility>
 
 #include "planners/ordering/lower_bound.hpp"
-#include "toolpath/random_segments.hpp"
 #include "planners/ordering/sequencer.hpp"
 #include "planners/ordering/transition_cost.hpp"
+#include "toolpath/random_segments.hpp"
 
 namespace {
 

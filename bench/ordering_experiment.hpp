@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "core/limits.hpp"
-#include "toolpath/random_segments.hpp"
 #include "planners/ordering/sequencer.hpp"
+#include "toolpath/random_segments.hpp"
 
 namespace depotwin {
 

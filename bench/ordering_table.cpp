@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "core/error.hpp"
 #include "bench/ordering_experiment.hpp"
+#include "core/error.hpp"
 
 namespace {
 

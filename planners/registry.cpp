@@ -5,8 +5,8 @@
 #include "core/error.hpp"
 #include "planners/motion/bezier/bezier.hpp"
 #include "planners/motion/lspb_mtt.hpp"
-#include "planners/planner.hpp"
 #include "planners/motion/stop_and_go.hpp"
+#include "planners/planner.hpp"
 
 namespace depotwin {
 
@@ -52,7 +52,8 @@ std::string check_planner_spec(const PlannerSpec& spec) {
                            [&](const PlannerParameter& p) { return p.name == key; });
     if (it == info->parameters.end()) {
       std::string known;
-      for (const PlannerParameter& p : info->parameters) known += (known.empty() ? "" : ", ") + p.name;
+      for (const PlannerParameter& p : info->parameters)
+        known += (known.empty() ? "" : ", ") + p.name;
       return "planner '" + spec.name + "' has no parameter '" + key + "'" +
              (known.empty() ? std::string(" (it takes none)") : " (known: " + known + ")");
     }

@@ -59,11 +59,10 @@ std::vector<AxisProfile> segment_profiles(const PrintSegment& s, double& duratio
   }
   if (lengthened) {
     std::ostringstream warning;
-    warning << "path " << s.path_index << " segment " << s.edge_index
-            << ": no " << (s.limits.jerk_limited() ? "jerk-limited move" : "LSPB")
-            << " in L/v = " << nominal_s << " s; lengthened to " << duration_s
-            << " s (mean speed " << s.length_mm / duration_s << " instead of " << s.speed_mm_s
-            << " mm/s)";
+    warning << "path " << s.path_index << " segment " << s.edge_index << ": no "
+            << (s.limits.jerk_limited() ? "jerk-limited move" : "LSPB") << " in L/v = " << nominal_s
+            << " s; lengthened to " << duration_s << " s (mean speed " << s.length_mm / duration_s
+            << " instead of " << s.speed_mm_s << " mm/s)";
     warnings.push_back(warning.str());
   }
   return axes;

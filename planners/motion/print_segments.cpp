@@ -7,7 +7,8 @@
 
 namespace depotwin {
 
-std::vector<PrintSegment> split_into_segments(const Toolpath& toolpath, const TcpLimits& tcp_limits) {
+std::vector<PrintSegment> split_into_segments(const Toolpath& toolpath,
+                                              const TcpLimits& tcp_limits) {
   static const char* kAxis[3] = {"x", "y", "z"};
   std::vector<PrintSegment> segments;
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {

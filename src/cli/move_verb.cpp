@@ -106,8 +106,8 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
   Json axes_json = Json::array();
   for (size_t i = 0; i < axes; ++i) {
     const AxisMove& m = moves[i];
-    Json axis{{"q0", m.boundary.q0}, {"q1", m.boundary.q1},       {"v0", m.boundary.v0},
-              {"v1", m.boundary.v1}, {"v_max", m.v_max},          {"a_max", m.a_max}};
+    Json axis{{"q0", m.boundary.q0}, {"q1", m.boundary.q1}, {"v0", m.boundary.v0},
+              {"v1", m.boundary.v1}, {"v_max", m.v_max},    {"a_max", m.a_max}};
     if (any_jerk_limit) axis["j_max"] = m.j_max;
     axis["min_duration_s"] = axis_feasible_durations(m).t_min();
     axis["phases"] = phases_json(move.axes[i], m.j_max > 0.0);

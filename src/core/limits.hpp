@@ -32,8 +32,8 @@ struct MachineLimits {
 // One joint's range and limits, in its own units: mm, mm/s, mm/s^2, mm/s^3 for a prismatic
 // joint, rad, rad/s, rad/s^2, rad/s^3 for a revolute one.
 struct JointLimit {
-  std::string name;   // the MJCF joint (and actuator) name
-  double min = 0.0;   // position range
+  std::string name;  // the MJCF joint (and actuator) name
+  double min = 0.0;  // position range
   double max = 0.0;
   double v_max = 0.0;
   double a_max = 0.0;

@@ -8,7 +8,9 @@
 namespace depotwin {
 
 // The vertical tool axis: a nozzle pointing straight down at a substrate facing up.
-inline Vec3 vertical_tool_axis() { return Vec3::UnitZ(); }
+inline Vec3 vertical_tool_axis() {
+  return Vec3::UnitZ();
+}
 
 struct Pose {
   Vec3 position_mm = Vec3::Zero();  // the TCP (nozzle tip) in the work frame

@@ -60,7 +60,7 @@ struct TrajectorySample {
   Vec3 position_mm = Vec3::Zero();
   Vec3 velocity_mm_s = Vec3::Zero();
   Vec3 acceleration_mm_s2 = Vec3::Zero();
-  Vec3 tool_axis = vertical_tool_axis();      // unit
+  Vec3 tool_axis = vertical_tool_axis();       // unit
   Vec3 angular_velocity_rad_s = Vec3::Zero();  // of the tool axis
   bool depositing = false;
   int path_index = -1;

@@ -99,7 +99,8 @@ class XyStage : public Machine {
       // a jerk limit of 0 is none: the tighter of the two that are set
       const double joint_jerk = limits_[i].j_max;
       if (joint_jerk > 0.0)
-        axis.j_max_mm_s3 = axis.j_max_mm_s3 > 0.0 ? std::min(axis.j_max_mm_s3, joint_jerk) : joint_jerk;
+        axis.j_max_mm_s3 =
+            axis.j_max_mm_s3 > 0.0 ? std::min(axis.j_max_mm_s3, joint_jerk) : joint_jerk;
     }
     return limits;
   }

@@ -32,6 +32,9 @@ struct ActuatorStats {
   std::vector<std::string> joint_names;
   std::vector<double> peak_vel, peak_acc, peak_force;
   std::vector<double> limit_vel, limit_acc, limit_force;
+  // the plan's own peak joint acceleration (what the servo is asked for), and the simulated
+  // peak against it: the servo's overshoot (0 where the plan asks none)
+  std::vector<double> plan_peak_acc, peak_acc_over_plan;
   int limit_violations = 0;  // joints x quantities whose peak exceeds the limit
 };
 

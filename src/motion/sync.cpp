@@ -44,7 +44,8 @@ SynchronizedMove synchronized_move(const std::vector<AxisMove>& axes, double min
   SynchronizedMove move;
   move.duration_s = synchronized_duration(axes, min_duration_s);
   move.axes.reserve(axes.size());
-  for (const AxisMove& axis : axes) move.axes.push_back(axis_fixed_time_move(axis, move.duration_s));
+  for (const AxisMove& axis : axes)
+    move.axes.push_back(axis_fixed_time_move(axis, move.duration_s));
   return move;
 }
 

@@ -8,8 +8,8 @@
 
 #include "kinematics/machine.hpp"
 #include "metrics/metrics_report.hpp"
-#include "planners/planner.hpp"
 #include "planners/ordering/sequencer.hpp"
+#include "planners/planner.hpp"
 #include "scenario/scenario.hpp"
 
 namespace depotwin {

@@ -109,6 +109,11 @@ ActuatorStats actuator_stats(const RecordedRun& record, const Machine& machine,
     stats.limit_vel.push_back(v_lim);
     stats.limit_acc.push_back(a_lim);
     stats.limit_force.push_back(f_lim);
+    const double plan_a = j < static_cast<int>(record.reference_peak_acceleration.size())
+                              ? record.reference_peak_acceleration[j]
+                              : 0.0;
+    stats.plan_peak_acc.push_back(plan_a);
+    stats.peak_acc_over_plan.push_back(plan_a > 0.0 ? a / plan_a : 0.0);
     if (v_lim > 0 && v > v_lim) ++stats.limit_violations;
     if (a_lim > 0 && a > a_lim) ++stats.limit_violations;
     if (f_lim > 0 && f > f_lim) ++stats.limit_violations;

@@ -8,10 +8,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "toolpath/random_segments.hpp"
 #include "kinematics/machine.hpp"
-#include "toolpath/gcode.hpp"
 #include "scenario/yaml_reader.hpp"
+#include "toolpath/gcode.hpp"
+#include "toolpath/random_segments.hpp"
 
 namespace depotwin {
 
@@ -213,7 +213,8 @@ void Loader::read_machine(const Field& field) {
     const bool mjcf = fs::path(*machine).extension() == ".xml";
     problems_.add(field.line, field.key,
                   mjcf ? "an MJCF file must name its kinematics family, which is never guessed: "
-                         "machine: {model: " + *machine + ", kinematics: " + families + "}"
+                         "machine: {model: " +
+                             *machine + ", kinematics: " + families + "}"
                        : "unknown machine '" + *machine + "' (expected " + families +
                              ", or {model: FILE.xml, kinematics: NAME} for a model of your own)");
     return;

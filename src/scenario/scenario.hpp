@@ -10,8 +10,8 @@
 #include "core/error.hpp"
 #include "core/limits.hpp"
 #include "core/toolpath.hpp"
-#include "planners/planner.hpp"
 #include "planners/ordering/sequencer.hpp"
+#include "planners/planner.hpp"
 
 namespace depotwin {
 
@@ -53,10 +53,10 @@ struct Scenario {
   // a registered machine (kinematics/registry.cpp): `machine: NAME`, or
   // `machine: {model: FILE.xml, kinematics: NAME}` for an MJCF model of one's own
   std::string machine = "xy_stage";
-  int machine_line = 0;    // where it was given, for messages
-  std::string model_path;  // the resolved MJCF file of `machine: {model: ...}`; "" for the
-                           // machine's shipped model
-  MachineLimits limits;    // Cartesian TCP limits for the planners
+  int machine_line = 0;           // where it was given, for messages
+  std::string model_path;         // the resolved MJCF file of `machine: {model: ...}`; "" for the
+                                  // machine's shipped model
+  MachineLimits limits;           // Cartesian TCP limits for the planners
   bool has_joint_limits = false;  // `limits: {joint: {...}}` given (every joint alike)
   AxisLimits joint_limits;
   ProcessSpec process;

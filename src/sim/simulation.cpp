@@ -667,6 +667,13 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
   // forms them (sampled_setpoint_references, next to apply_servo)
   const double control_period_s = static_cast<double>(stride) * dt;
   sampled_setpoint_references(q_ref, v_ref, a_ref, updates, joint_count, control_period_s);
+  // the largest acceleration the plan asks of each joint, as the servo is given it
+  run.reference_peak_acceleration.assign(joint_count, 0.0);
+  for (long update = 0; update < updates; ++update)
+    for (int j = 0; j < joint_count; ++j)
+      run.reference_peak_acceleration[j] =
+          std::max(run.reference_peak_acceleration[j],
+                   std::abs(a_ref[update * joint_count + j]) / s.joints[j].user_to_si);
   sampled_setpoint_references(flap_ref, flap_rate, flap_acceleration, updates, 1, control_period_s);
 
   // start from a reset state exactly on the reference

@@ -86,6 +86,9 @@ struct RecordedRun {
   int joint_count = 0;
   std::vector<std::string> joint_names;
   std::vector<double> joint_position, joint_velocity, joint_acceleration, actuator_force;
+  // per joint, the largest |acceleration| of the joint reference the servo is given (the
+  // setpoints' second differences, JointReference::acceleration), user units
+  std::vector<double> reference_peak_acceleration;
   double timestep_s = 0.0;
   double wall_s = 0.0;                       // wall-clock time of run()
   long steps = 0;                            // physics steps taken (entries - 1)

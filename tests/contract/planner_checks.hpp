@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <random>
 #include <variant>
 
@@ -208,8 +208,8 @@ inline void expect_contract(const Trajectory& trajectory, const Toolpath& toolpa
     for (size_t k = 0; k + 1 < path.points.size(); ++k) {
       const double length = (path.points[k + 1] - path.points[k]).norm();
       const Vec3 mid = 0.5 * (path.points[k] + path.points[k + 1]);
-      EXPECT_LT(nearest(mid), blend_offset + 0.05 * length + 0.001 * path.speed_mm_s +
-                                  path_tolerance_mm)
+      EXPECT_LT(nearest(mid),
+                blend_offset + 0.05 * length + 0.001 * path.speed_mm_s + path_tolerance_mm)
           << "path " << i << " edge " << k;
     }
     // the path is printed in one go: its pieces are consecutive in time

@@ -61,7 +61,8 @@ TEST_P(MachineContract, InverseAndForwardAgree) {
     ASSERT_TRUE(machine_->inverse(pose, back, &why)) << why;
     ASSERT_EQ(back.size(), q.size());
     ASSERT_EQ(static_cast<int>(back.size()), machine_->joint_count());
-    for (size_t j = 0; j < q.size(); ++j) worst_joint = std::max(worst_joint, std::abs(back[j] - q[j]));
+    for (size_t j = 0; j < q.size(); ++j)
+      worst_joint = std::max(worst_joint, std::abs(back[j] - q[j]));
     const Pose again = machine_->forward(back);
     worst_mm = std::max(worst_mm, (again.position_mm - pose.position_mm).norm());
     EXPECT_NEAR(again.tool_axis.norm(), 1.0, 1e-12);
@@ -180,11 +181,12 @@ TEST_P(MachineContract, JointJerkLimitIsHonouredOrRefused) {
   const MachineLimits over_origin =
       machine_->tcp_limits(MachineLimits::uniform(50.0, 500.0)).over(Vec3::Zero(), Vec3::Zero());
   EXPECT_TRUE(over_origin.jerk_limited());
-  for (const AxisLimits& axis : over_origin.axes)
-    EXPECT_LE(axis.j_max_mm_s3, 5000.0 * (1 + 1e-12));
+  for (const AxisLimits& axis : over_origin.axes) EXPECT_LE(axis.j_max_mm_s3, 5000.0 * (1 + 1e-12));
 }
 
-std::vector<std::string> registered_machines() { return machine_names(); }
+std::vector<std::string> registered_machines() {
+  return machine_names();
+}
 
 INSTANTIATE_TEST_SUITE_P(EveryMachine, MachineContract, ::testing::ValuesIn(registered_machines()),
                          [](const auto& info) { return info.param; });

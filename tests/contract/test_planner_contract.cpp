@@ -3,9 +3,9 @@
 // that honours it stays jerk-limited and the others refuse it.
 #include <gtest/gtest.h>
 
+#include "contract/planner_checks.hpp"
 #include "core/error.hpp"
 #include "planners/planner.hpp"
-#include "contract/planner_checks.hpp"
 
 namespace depotwin {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <algorithm>
 
+#include "planners/motion/transition.hpp"
 #include "planners/ordering/sequencer.hpp"
 #include "planners/ordering/transition_cost.hpp"
-#include "planners/motion/transition.hpp"
 #include "toolpath/random_segments.hpp"
 
 namespace depotwin {

@@ -216,7 +216,8 @@ TEST_F(DeltaModel, ServosSettleThePlatformAtTheForwardKinematics) {
     mj_kinematics(model_.get(), data_.get());  // positions of the final state
     const Vec3 tcp_mm = simulated_tcp_mm();
     const double to_target_mm = (tcp_mm - target_mm).norm();
-    const double to_forward_mm = (tcp_mm - delta_.forward(simulated_joints_mm()).position_mm).norm();
+    const double to_forward_mm =
+        (tcp_mm - delta_.forward(simulated_joints_mm()).position_mm).norm();
     EXPECT_LT(to_target_mm, 0.05) << target_mm.transpose();
     EXPECT_LT(to_forward_mm, 0.05) << target_mm.transpose();
     EXPECT_LT(max_anchor_gap_mm(), 0.01);

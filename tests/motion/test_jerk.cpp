@@ -11,8 +11,8 @@
 
 #include "core/error.hpp"
 #include "motion/jerk.hpp"
-#include "motion/sync.hpp"
 #include "motion/mtt.hpp"
+#include "motion/sync.hpp"
 
 namespace depotwin {
 namespace {

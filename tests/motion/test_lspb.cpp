@@ -31,7 +31,8 @@ struct SixCase {
 };
 
 TEST(Lspb, EachOfTheSixCandidates) {
-  const double c2 = (15.0 - std::sqrt(105.0)) / 2.0;  // (alpha T - sqrt(alpha^2 T^2 - 4 alpha d)) / 2
+  const double c2 =
+      (15.0 - std::sqrt(105.0)) / 2.0;  // (alpha T - sqrt(alpha^2 T^2 - 4 alpha d)) / 2
   const SixCase cases[] = {
       // v_c1: the larger root of case I is valid only on the triangle (gamma_1 = 0)
       {1, {0, 2, 0, 0}, 2.0, 2.0, 2.0},

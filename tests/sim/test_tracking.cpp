@@ -174,7 +174,8 @@ TEST(Tracking, NozzleFromMujocoMatchesTheKinematicsOfTheSimulatedJoints) {
   for (size_t k = 0; k < run.size(); k += 7) {
     const JointVector joints = {run.joint(run.joint_position, k, 0),
                                 run.joint(run.joint_position, k, 1)};
-    worst_position = std::max(worst_position, (machine->forward(joints).position_mm - run.nozzle_mm[k]).norm());
+    worst_position =
+        std::max(worst_position, (machine->forward(joints).position_mm - run.nozzle_mm[k]).norm());
     // the nozzle moves opposite to the carriages
     const Vec3 expected_velocity(-run.joint(run.joint_velocity, k, 0),
                                  -run.joint(run.joint_velocity, k, 1), 0.0);

@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "core/error.hpp"
-#include "toolpath/gcode.hpp"
 #include "scenario/scenario_test_util.hpp"
+#include "toolpath/gcode.hpp"
 
 namespace depotwin {
 namespace {

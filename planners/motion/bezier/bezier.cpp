@@ -567,7 +567,8 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
     const PrintPath& path = toolpath.paths[i];
     // the limits over the path's own box (per path: its blends and ramps are planned together)
-    const MachineLimits limits = path_limits(path, tcp_limits, settings_.lead_in, settings_.period_s);
+    const MachineLimits limits =
+        path_limits(path, tcp_limits, settings_.lead_in, settings_.period_s);
     PathGeometry geometry = build_geometry(path, settings_, limits, next_weight, warnings);
 
     // the samples: Taylor update along the path; blends whose samples, interpolated,

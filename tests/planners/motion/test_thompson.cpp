@@ -3,10 +3,10 @@
 
 #include <cmath>
 
+#include "contract/planner_checks.hpp"
 #include "metrics/motion_metrics.hpp"
 #include "planners/motion/lspb_mtt.hpp"
 #include "planners/motion/stop_and_go.hpp"
-#include "contract/planner_checks.hpp"
 
 namespace depotwin {
 namespace {
@@ -56,7 +56,8 @@ TEST(ThompsonFig7, AcuteJointSpeedErrorIsOneMinusSinHalfAngle) {
   // the isolated segments 4 and 5 are printed at exactly the desired speed
   for (int piece : {5, 7}) {
     for (double f = 0.0; f <= 1.0; f += 0.05) {
-      const double t = pieces[piece].t_begin_s + f * (pieces[piece].t_end_s - pieces[piece].t_begin_s);
+      const double t =
+          pieces[piece].t_begin_s + f * (pieces[piece].t_end_s - pieces[piece].t_begin_s);
       EXPECT_LT(speed_error_at(plan, t), 1e-9);
     }
   }

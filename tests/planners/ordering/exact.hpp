@@ -7,9 +7,9 @@
 #include <numeric>
 #include <vector>
 
-#include "toolpath/random_segments.hpp"
 #include "planners/ordering/sequencer.hpp"
 #include "planners/ordering/transition_cost.hpp"
+#include "toolpath/random_segments.hpp"
 
 namespace depotwin::testing {
 

@@ -6,8 +6,8 @@
 #include <lemon/smart_graph.h>
 #include <cmath>
 
-#include "planners/ordering/lower_bound.hpp"
 #include "planners/ordering/exact.hpp"
+#include "planners/ordering/lower_bound.hpp"
 
 namespace depotwin {
 namespace {

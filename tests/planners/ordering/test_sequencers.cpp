@@ -6,9 +6,9 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "planners/ordering/exact.hpp"
 #include "planners/ordering/nearest_neighbor.hpp"
 #include "planners/ordering/sequencer.hpp"
-#include "planners/ordering/exact.hpp"
 
 namespace depotwin {
 namespace {

@@ -6,8 +6,8 @@
 
 #include "core/error.hpp"
 #include "motion/mtt.hpp"
-#include "planners/ordering/transition_cost.hpp"
 #include "planners/ordering/exact.hpp"
+#include "planners/ordering/transition_cost.hpp"
 
 namespace depotwin {
 namespace {
