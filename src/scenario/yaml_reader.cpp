@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/number_text.hpp"
+
 namespace depotwin::scenario_detail {
 
 namespace {
@@ -28,18 +30,6 @@ std::string lowercase(std::string text) {
 bool is_yaml_special_float(const std::string& text) {
   const std::string lower = lowercase(text);
   return lower == ".nan" || lower == ".inf" || lower == "+.inf" || lower == "-.inf";
-}
-
-// the whole text as a double (locale-independent), or nothing
-std::optional<double> parse_double(const std::string& text) {
-  if (text.empty()) return std::nullopt;
-  const char* first = text.data();
-  const char* last = text.data() + text.size();
-  if (*first == '+') ++first;
-  double value = 0.0;
-  const auto [end, error] = std::from_chars(first, last, value);
-  if (error != std::errc() || end != last) return std::nullopt;
-  return value;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/number_text.hpp"
 
 namespace depotwin {
 
@@ -26,15 +27,10 @@ struct Word {
   std::string text;  // the number as written
 };
 
-// the whole text as a finite double (locale-independent), or nothing
+// the whole text as a finite double, or nothing
 std::optional<double> parse_number(const std::string& text) {
-  if (text.empty()) return std::nullopt;
-  const char* first = text.data();
-  const char* last = text.data() + text.size();
-  if (*first == '+') ++first;
-  double value = 0.0;
-  const auto [end, error] = std::from_chars(first, last, value);
-  if (error != std::errc() || end != last || !std::isfinite(value)) return std::nullopt;
+  const std::optional<double> value = parse_double(text);
+  if (!value || !std::isfinite(*value)) return std::nullopt;
   return value;
 }
 
