@@ -65,7 +65,8 @@ PreparedJob prepare_job(const Scenario& scenario) {
   job.machine = machine_for(scenario, job.model_path);
   if (scenario.has_joint_limits) {
     const std::string problem = job.machine->set_joint_limits(scenario.joint_limits);
-    if (!problem.empty()) throw InputError(scenario.file, 0, "limits.joint", problem);
+    if (!problem.empty())
+      throw InputError(scenario.file, scenario.joint_limits_line, "limits.joint", problem);
   }
 
   // every pose of the toolpath must be reachable by the machine

@@ -214,7 +214,7 @@ void Loader::read_machine(const Field& field) {
     problems_.add(field.line, field.key,
                   mjcf ? "an MJCF file must name its kinematics family, which is never guessed: "
                          "machine: {model: " +
-                             *machine + ", kinematics: " + families + "}"
+                             *machine + ", kinematics: NAME} with NAME one of " + families
                        : "unknown machine '" + *machine + "' (expected " + families +
                              ", or {model: FILE.xml, kinematics: NAME} for a model of your own)");
     return;
@@ -293,6 +293,7 @@ void Loader::read_limits(const Field& field) {
       read_axis_limits(joint_view, joint);
       scenario_.has_joint_limits = true;
       scenario_.joint_limits = joint;
+      scenario_.joint_limits_line = f->key_line;
     }
   }
   limits_ok_ = problems_.size() == problems_before;

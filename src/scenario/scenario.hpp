@@ -59,6 +59,7 @@ struct Scenario {
   MachineLimits limits;           // Cartesian TCP limits for the planners
   bool has_joint_limits = false;  // `limits: {joint: {...}}` given (every joint alike)
   AxisLimits joint_limits;
+  int joint_limits_line = 0;  // where `limits.joint` was given, for messages
   ProcessSpec process;
   Toolpath toolpath;
   OrderSpec order;

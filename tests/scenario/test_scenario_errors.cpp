@@ -449,7 +449,7 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
   ASSERT_EQ(bare.size(), 1u) << dump(bare);
   expect_problem(bare, scenario_path(), "machine", 1,
                  "must name its kinematics family, which is never guessed: machine: {model: "
-                 "models/mine.xml, kinematics: xy_stage, linear_delta}");
+                 "models/mine.xml, kinematics: NAME} with NAME one of xy_stage, linear_delta");
   const auto unknown_family = problems_of(R"(
 machine: {model: models/mine.xml, kinematics: scara}
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
