@@ -31,15 +31,6 @@ bool outward_direction(const std::vector<Vec3>& points, bool at_back, Vec3& dire
   return false;
 }
 
-// the axis-aligned bounds of a path's points
-void path_bounds(const PrintPath& path, Vec3& lo, Vec3& hi) {
-  lo = hi = path.points.front();
-  for (const Vec3& p : path.points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-}
-
 }  // namespace
 
 CostModel parse_cost_model(const std::string& name) {
@@ -86,7 +77,7 @@ TransitionCost::TransitionCost(const Toolpath& toolpath, const TcpLimits& tcp_li
     // the line (the paper's model uses the x-axis limits as its single v_max), under the
     // limits over the path's box
     Vec3 lo, hi;
-    path_bounds(path, lo, hi);
+    path.bounds(lo, hi);
     const MachineLimits limits = tcp_limits.over(lo, hi);
     const int too_fast_axis = clamp_exit_velocities(2 * i, limits, model);
     if (too_fast_axis >= 0)

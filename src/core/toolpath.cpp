@@ -17,6 +17,14 @@ PrintPath PrintPath::reversed() const {
   return out;
 }
 
+void PrintPath::bounds(Vec3& lo, Vec3& hi) const {
+  lo = hi = points.front();
+  for (const Vec3& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+}
+
 Vec3 PrintPath::tool_axis(size_t i) const {
   return normals.empty() ? vertical_tool_axis() : normals[i];
 }
@@ -80,10 +88,11 @@ void Toolpath::bounds(Vec3& lo, Vec3& hi) const {
   lo = start_mm.cwiseMin(end_mm);
   hi = start_mm.cwiseMax(end_mm);
   for (const PrintPath& path : paths) {
-    for (const Vec3& p : path.points) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
+    if (path.points.empty()) continue;
+    Vec3 path_lo, path_hi;
+    path.bounds(path_lo, path_hi);
+    lo = lo.cwiseMin(path_lo);
+    hi = hi.cwiseMax(path_hi);
   }
 }
 

@@ -22,6 +22,8 @@ struct PrintPath {
   const Vec3& back() const { return points.back(); }
   // the same path printed the other way round
   PrintPath reversed() const;
+  // axis-aligned bounds of its points
+  void bounds(Vec3& lo, Vec3& hi) const;
   // the tool axis at point i (its normal, or vertical without normals)
   Vec3 tool_axis(size_t i) const;
   // the tool axis at the point of the path nearest to p: the normals of the nearest edge

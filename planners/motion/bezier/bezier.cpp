@@ -483,11 +483,8 @@ TrajectoryPiece sampled_piece(double t_begin_s, double period_s, std::vector<Vec
 // the padded box, which are tighter)
 MachineLimits path_limits(const PrintPath& path, const TcpLimits& limits, bool lead_in,
                           double period_s) {
-  Vec3 lo = path.points.front(), hi = lo;
-  for (const Vec3& p : path.points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
+  Vec3 lo, hi;
+  path.bounds(lo, hi);
   MachineLimits over = limits.over(lo, hi);
   if (!lead_in) return over;
   for (int round = 0; round < 3; ++round) {
