@@ -152,8 +152,7 @@ void BM_RenderScene(benchmark::State& state) {
   const LineJob job;
   const SceneRenderOptions options;  // 640 x 480
   for (auto _ : state) {
-    const auto rgb =
-        render_scene_rgb(job.simulation.model(), job.simulation.data(), job.deposit, options);
+    const auto rgb = render_scene_rgb(job.simulation, job.deposit, options);
     benchmark::DoNotOptimize(rgb.data());
   }
   count_time_per_image(state);
@@ -166,11 +165,10 @@ void BM_RenderSceneReused(benchmark::State& state) {
   const LineJob job;
   const SceneRenderOptions options;  // 640 x 480
   SceneRenderer renderer;
-  renderer.render_rgb(job.simulation.model(), job.simulation.data(), job.deposit,
+  renderer.render_rgb(job.simulation, job.deposit,
                       options);  // contexts built
   for (auto _ : state) {
-    const auto rgb =
-        renderer.render_rgb(job.simulation.model(), job.simulation.data(), job.deposit, options);
+    const auto rgb = renderer.render_rgb(job.simulation, job.deposit, options);
     benchmark::DoNotOptimize(rgb.data());
   }
   count_time_per_image(state);

@@ -202,8 +202,7 @@ Simulation::FeedForwardHook closure_feedforward_hook(const Machine& machine,
   // the TCP acceleration the servo's setpoints give over the coming control period: the
   // second difference of the TCP setpoints, as the joints' references (Simulation)
   const double period_s = static_cast<double>(sim.control_stride()) * sim.timestep_s;
-  return [&machine, &trajectory, period_s](const mjModel&, const mjData&,
-                                           const JointReference& reference, double* force) {
+  return [&machine, &trajectory, period_s](const JointReference& reference, double* force) {
     const TrajectorySample s = trajectory.at(reference.t_s);
     const Vec3 next_mm = trajectory.at(reference.t_s + period_s).position_mm;
     const Vec3 velocity_mm_s =

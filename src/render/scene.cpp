@@ -10,6 +10,7 @@
 #include "core/file_io.hpp"
 #include "core/png.hpp"
 #include "core/types.hpp"
+#include "sim/mujoco_access.hpp"
 #include "sim/mujoco_boundary.hpp"
 #include "sim/simulation.hpp"
 
@@ -374,9 +375,11 @@ void SceneRenderer::finish_preparation() {
   if (!contexts_) contexts_ = std::move(prepared);
 }
 
-std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const mjData& data,
+std::vector<unsigned char> SceneRenderer::render_rgb(const Simulation& simulation,
                                                      const HeightMap& deposit,
                                                      const SceneRenderOptions& options) {
+  const mjModel& model = SimulationAccess::model(simulation);
+  const mjData& data = SimulationAccess::data(simulation);
   install_mujoco_handlers();
   // the image must fit the model's offscreen buffer
   if (options.width <= 0 || options.width > model.vis.global.offwidth)
@@ -464,27 +467,20 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
 
 void SceneRenderer::render_png(const Simulation& simulation, const HeightMap& deposit,
                                const std::string& png_path, const SceneRenderOptions& options) {
-  const std::vector<unsigned char> rgb =
-      render_rgb(simulation.model(), simulation.data(), deposit, options);
+  const std::vector<unsigned char> rgb = render_rgb(simulation, deposit, options);
   write_png(png_path, options.width, options.height, rgb);
 }
 
-std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& data,
-                                            const HeightMap& deposit,
+std::vector<unsigned char> render_scene_rgb(const Simulation& simulation, const HeightMap& deposit,
                                             const SceneRenderOptions& options) {
   SceneRenderer renderer;
-  return renderer.render_rgb(model, data, deposit, options);
-}
-
-void render_scene_png(const mjModel& model, const mjData& data, const HeightMap& deposit,
-                      const std::string& png_path, const SceneRenderOptions& options) {
-  const std::vector<unsigned char> rgb = render_scene_rgb(model, data, deposit, options);
-  write_png(png_path, options.width, options.height, rgb);
+  return renderer.render_rgb(simulation, deposit, options);
 }
 
 void render_scene_png(const Simulation& simulation, const HeightMap& deposit,
                       const std::string& png_path, const SceneRenderOptions& options) {
-  render_scene_png(simulation.model(), simulation.data(), deposit, png_path, options);
+  const std::vector<unsigned char> rgb = render_scene_rgb(simulation, deposit, options);
+  write_png(png_path, options.width, options.height, rgb);
 }
 
 }  // namespace depotwin

@@ -9,8 +9,6 @@
 // (viridis, a perceptually uniform colormap: dark purple = thin, yellow = the thickest).
 #pragma once
 
-#include <mujoco/mujoco.h>
-
 #include <future>
 #include <memory>
 #include <mutex>
@@ -61,8 +59,7 @@ class SceneRenderer {
   void prepare(const std::string& model_path, const SceneRenderOptions& options);
 
   // as render_scene_rgb / render_scene_png below
-  std::vector<unsigned char> render_rgb(const mjModel& model, const mjData& data,
-                                        const HeightMap& deposit,
+  std::vector<unsigned char> render_rgb(const Simulation& simulation, const HeightMap& deposit,
                                         const SceneRenderOptions& options = {});
   void render_png(const Simulation& simulation, const HeightMap& deposit,
                   const std::string& png_path, const SceneRenderOptions& options = {});
@@ -77,18 +74,13 @@ class SceneRenderer {
   std::future<std::unique_ptr<Contexts>> preparing_;
 };
 
-// Render to RGB bytes, rows top to bottom (width * height * 3). `data` is not modified
-// (the renderer works on a copy). InputError for an image larger than the model's
-// offscreen buffer or a model without render_cam/substrate; InternalError when OSMesa or
-// MuJoCo's renderer fails.
-std::vector<unsigned char> render_scene_rgb(const mjModel& model, const mjData& data,
-                                            const HeightMap& deposit,
+// Render the state after Simulation::run (its initial state before any) to RGB bytes, rows
+// top to bottom (width * height * 3); the simulation is not modified (the renderer works on
+// a copy of its state). InputError for an image larger than the model's offscreen buffer or a
+// model without render_cam/substrate; InternalError when OSMesa or MuJoCo's renderer fails.
+std::vector<unsigned char> render_scene_rgb(const Simulation& simulation, const HeightMap& deposit,
                                             const SceneRenderOptions& options = {});
-
 // Render and write a PNG: to a temporary file beside `png_path`, then renamed over it.
-void render_scene_png(const mjModel& model, const mjData& data, const HeightMap& deposit,
-                      const std::string& png_path, const SceneRenderOptions& options = {});
-// the state after Simulation::run
 void render_scene_png(const Simulation& simulation, const HeightMap& deposit,
                       const std::string& png_path, const SceneRenderOptions& options = {});
 

@@ -16,22 +16,15 @@
 // Equality constraints (<connect> closures of a linear delta) are allowed; their largest
 // position violation is recorded.
 //
-// Controller per servo joint (SI units inside):  ctrl = q_held + f_ff / kp  with
-//   f_ff = (M a_ref)_j + qfrc_bias_j + kv_j v_held_j + damping_j v_end_j
-//          + frictionloss_j clamp((v_ref_j + a_ref_j / B_j) / v_s_j, -1, 1) + hook_j
-// where the references come from the sampled position setpoints as a digital servo forms
-// them: v_ref = (q_ref(t) - q_ref(t - T_c)) / T_c, a_ref = (v_ref(t + T_c) - v_ref(t)) / T_c,
-// and q_held, v_held, v_end are what the plant's semi-implicit Euler steps see over the held
-// period (the setpoint, v_ref and the next v_ref when the servo updates every step; see
-// held_reference in simulation.cpp). The friction term is the model's own friction-loss law
-// (Coulomb above v_s, a velocity servo of rate B below; v_s capped at 0.1 mm/s). So the
-// actuator force kp (ctrl - q) - kv qdot = kp (q_held - q) + kv (v_held - qdot) + f_ff: PD on
-// the reference plus inertia, bias (gravity, Coriolis), viscous, Coulomb friction and optional
-// machine-specific load feed-forward (set_feedforward_hook). Controls are held between
-// updates (zero-order hold).
+// Controller per servo joint: position servos with inertia, bias, viscous, friction and
+// machine-specific load feed-forward on references formed as a digital servo forms them
+// (sim/servo_controller.hpp has the law). Controls are held between updates (zero-order hold).
+//
+// Inside sim/: model_binding (the model loaded and its names resolved), joint_reference (the
+// plan through the inverse kinematics), servo_controller, closures (closed chains), and this
+// file's step loop. No MuJoCo type appears in this header; sim/mujoco_access.hpp gives the
+// renderer the model and state.
 #pragma once
-
-#include <mujoco/mujoco.h>
 
 #include <cstdint>
 #include <functional>
@@ -116,10 +109,9 @@ class Simulation {
   using StepCallback = std::function<void(const StepState& before, const StepState& after)>;
   using ProgressCallback = std::function<void(double fraction)>;
   // adds a machine-specific feed-forward force per Machine joint (SI: N or N m) to `force`
-  // (count entries, zero on entry); called at every controller update with the state after
-  // mj_step1 (e.g. a linear delta's platform load through mj_inverse or the constraint Jacobian)
-  using FeedForwardHook = std::function<void(const mjModel& model, const mjData& data,
-                                             const JointReference& reference, double* force)>;
+  // (count entries, zero on entry); called at every controller update with that update's
+  // references (e.g. a linear delta's platform load, Machine::closure_feedforward)
+  using FeedForwardHook = std::function<void(const JointReference& reference, double* force)>;
 
   // Loads the model and resolves every name once. InputError (naming the file and the
   // element) for a missing or malformed model, a missing `nozzle` site or `substrate` body,
@@ -155,9 +147,8 @@ class Simulation {
   // the shutter's blade geometry (meaningful only with a shutter)
   double shutter_open_fraction_at(double flap_angle_rad) const;
 
-  // the MuJoCo state after the last run (initial state before any), for the scene renderer
-  const mjModel& model() const;
-  const mjData& data() const;
+  // (the MuJoCo model and state: SimulationAccess in sim/mujoco_access.hpp)
+  friend class SimulationAccess;
 
  private:
   struct Impl;

@@ -21,6 +21,7 @@
 #include "plots/png_check.hpp"
 #include "plots/style.hpp"
 #include "scenario/scenario.hpp"
+#include "sim/mujoco_access.hpp"
 
 namespace depotwin {
 namespace {
@@ -128,9 +129,9 @@ TEST(DeltaPipeline, ClosedChainsStayClosed) {
 // leaves out).
 TEST(DeltaPipeline, ClosureFeedForwardIsTheChainsRigidBodyDynamics) {
   const DeltaRun fig3 = simulate(scenario_path("giberti_fig3.yaml"));
-  const mjModel* m = &fig3.run.simulation->model();
+  const mjModel* m = &SimulationAccess::model(*fig3.run.simulation);
   mjData* d = mj_makeData(m);
-  mj_copyData(d, m, &fig3.run.simulation->data());
+  mj_copyData(d, m, &SimulationAccess::data(*fig3.run.simulation));
   mju_zero(d->qvel, m->nv);
   mj_forward(m, d);
   const LinearDelta& delta = dynamic_cast<const LinearDelta&>(*fig3.job.machine);

@@ -131,9 +131,8 @@ TEST(XyPipeline, WritesEveryOutputAndImagesShowTheDeposit) {
   // the same end state with the shutter never opened (no deposit) looks different on the
   // substrate: count pixels that differ
   const HeightMap deposit = field_heightmap(run.process->field());
-  const auto with = render_scene_rgb(run.simulation->model(), run.simulation->data(), deposit);
-  const auto without =
-      render_scene_rgb(run.simulation->model(), run.simulation->data(), HeightMap{});
+  const auto with = render_scene_rgb(*run.simulation, deposit);
+  const auto without = render_scene_rgb(*run.simulation, HeightMap{});
   ASSERT_EQ(with.size(), without.size());
   size_t differing = 0;
   for (size_t i = 0; i < with.size(); i += 3)

@@ -89,10 +89,8 @@ TEST(Scene, APrintedLineChangesTheMiddleOfThePictureOnly) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
   SceneRenderOptions options = sized(320, 240);
-  const auto empty =
-      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(false), options);
-  const auto printed =
-      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), options);
+  const auto empty = render_scene_rgb(simulation, deposit_grid(false), options);
+  const auto printed = render_scene_rgb(simulation, deposit_grid(true), options);
   ASSERT_EQ(empty.size(), 320u * 240u * 3u);
   ASSERT_EQ(printed.size(), empty.size());
   // pixels that changed clearly, and where they are
@@ -121,8 +119,7 @@ TEST(Scene, APrintedLineChangesTheMiddleOfThePictureOnly) {
   // far from the substrate (the top of the picture: the print head and beyond) nothing moves
   EXPECT_EQ(changed_in_top_rows, 0);
   // the same inputs render the same picture
-  EXPECT_EQ(render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), options),
-            printed);
+  EXPECT_EQ(render_scene_rgb(simulation, deposit_grid(true), options), printed);
 }
 
 TEST(Scene, RendersTheStateAfterARunFromTheModelCamera) {
@@ -133,10 +130,8 @@ TEST(Scene, RendersTheStateAfterARunFromTheModelCamera) {
   simulation.run(print.trajectory);
   SceneRenderOptions options = sized(320, 240);
   options.frame_deposit = false;  // render_cam as placed in the MJCF
-  const auto before =
-      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(false), options);
-  const auto after =
-      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), options);
+  const auto before = render_scene_rgb(simulation, deposit_grid(false), options);
+  const auto after = render_scene_rgb(simulation, deposit_grid(true), options);
   long changed = 0;
   for (size_t i = 0; i < after.size(); ++i) changed += std::abs(after[i] - before[i]) > 40;
   EXPECT_GT(changed, 50);
@@ -150,34 +145,26 @@ TEST(Scene, ReusedAndPreparedContextsRenderTheSamePictures) {
   Simulation simulation(xy_stage_model(), *machine);
   const SceneRenderOptions small = sized(160, 120);
   const SceneRenderOptions large = sized(320, 240);
-  const auto fresh_small =
-      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), small);
-  const auto fresh_large =
-      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(false), large);
+  const auto fresh_small = render_scene_rgb(simulation, deposit_grid(true), small);
+  const auto fresh_large = render_scene_rgb(simulation, deposit_grid(false), large);
 
   SceneRenderer renderer;
   renderer.prepare(simulation.model_path(), small);
   std::vector<unsigned char> reused_small, reused_large;
   std::thread other([&] {  // the prepared contexts move to this thread
-    reused_small =
-        renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(true), small);
+    reused_small = renderer.render_rgb(simulation, deposit_grid(true), small);
   });
   other.join();
-  reused_large =
-      renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(false), large);
+  reused_large = renderer.render_rgb(simulation, deposit_grid(false), large);
   EXPECT_EQ(reused_small, fresh_small);
   EXPECT_EQ(reused_large, fresh_large);
 
   // two threads at once: the renders take turns on the one GL context
   std::vector<unsigned char> concurrent_small, concurrent_large;
-  std::thread first([&] {
-    concurrent_small =
-        renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(true), small);
-  });
-  std::thread second([&] {
-    concurrent_large =
-        renderer.render_rgb(simulation.model(), simulation.data(), deposit_grid(false), large);
-  });
+  std::thread first(
+      [&] { concurrent_small = renderer.render_rgb(simulation, deposit_grid(true), small); });
+  std::thread second(
+      [&] { concurrent_large = renderer.render_rgb(simulation, deposit_grid(false), large); });
   first.join();
   second.join();
   EXPECT_EQ(concurrent_small, fresh_small);
@@ -193,10 +180,8 @@ TEST(Scene, SupersampledImageIsTheBlockMeanOfTheLargerRender) {
   supersampled.supersampling = 2;
   SceneRenderOptions large = sized(320, 240);
   large.supersampling = 1;
-  const auto small =
-      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), supersampled);
-  const auto full =
-      render_scene_rgb(simulation.model(), simulation.data(), deposit_grid(true), large);
+  const auto small = render_scene_rgb(simulation, deposit_grid(true), supersampled);
+  const auto full = render_scene_rgb(simulation, deposit_grid(true), large);
   ASSERT_EQ(small.size(), 160u * 120u * 3u);
   long intermediate = 0;  // pixels on edges: none of their block's colours
   for (int row = 0; row < 120; ++row)
@@ -230,7 +215,7 @@ TEST(Scene, NoViewShowsTheEmptyBackground) {
   for (const bool framed : {false, true}) {
     SceneRenderOptions options = sized(160, 120);
     options.frame_deposit = framed;
-    const auto rgb = render_scene_rgb(simulation.model(), simulation.data(), plate_wide, options);
+    const auto rgb = render_scene_rgb(simulation, plate_wide, options);
     long black = 0;
     for (size_t i = 0; i < rgb.size(); i += 3)
       black += rgb[i] < 8 && rgb[i + 1] < 8 && rgb[i + 2] < 8;
@@ -244,7 +229,7 @@ TEST(Scene, ImageLargerThanTheOffscreenBufferIsBadInput) {
   SceneRenderOptions options;
   options.width = 4000;
   try {
-    render_scene_rgb(simulation.model(), simulation.data(), HeightMap{}, options);
+    render_scene_rgb(simulation, HeightMap{}, options);
     FAIL() << "no InputError";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("offwidth"), std::string::npos) << error.what();

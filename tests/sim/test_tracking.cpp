@@ -139,8 +139,7 @@ TEST(Tracking, FeedForwardHookAddsItsForce) {
   Simulation hooked(xy_stage_model(), *machine);
   long calls = 0;
   double worst_reference_mismatch_mm = 0.0;
-  hooked.set_feedforward_hook([&](const mjModel&, const mjData&, const JointReference& reference,
-                                  double* force) {
+  hooked.set_feedforward_hook([&](const JointReference& reference, double* force) {
     ASSERT_EQ(reference.count, 2);
     // the references are the machine's inverse of the plan, in metres
     JointVector joints;

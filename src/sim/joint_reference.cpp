@@ -1,0 +1,131 @@
+#include "sim/joint_reference.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "core/error.hpp"
+#include "sim/servo_controller.hpp"
+#include "sim/shutter.hpp"
+
+namespace depotwin {
+
+namespace {
+
+std::string format_number(double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+// the trajectory at step time t; after its end the final pose at rest, the shutter closed
+TrajectorySample planned_sample(TrajectoryCursor& plan, double t, double duration_s) {
+  TrajectorySample sample = plan.at(t);
+  if (t > duration_s + 1e-12) {
+    sample.velocity_mm_s.setZero();
+    sample.acceleration_mm_s2.setZero();
+    sample.angular_velocity_rad_s.setZero();
+    sample.depositing = false;
+    sample.path_index = -1;
+    sample.desired_speed_mm_s = 0.0;
+  }
+  return sample;
+}
+
+// the joints of a sample's pose, within their travel; InputError naming the time otherwise
+void joints_at(const Machine& machine, const TrajectorySample& sample, JointVector& joints) {
+  std::string why;
+  const double t = sample.t_s;
+  if (!machine.inverse(sample.pose(), joints, &why))
+    throw InputError("trajectory", "at t = " + format_number(t) + " s: " + why);
+  const std::vector<JointLimit>& limits = machine.joint_limits();
+  if (joints.size() != limits.size())
+    throw InternalError("machine " + machine.name() + " returned " + std::to_string(joints.size()) +
+                        " joints, expected " + std::to_string(limits.size()));
+  for (size_t j = 0; j < joints.size(); ++j) {
+    if (joints[j] < limits[j].min - 1e-9 || joints[j] > limits[j].max + 1e-9)
+      throw InputError("trajectory", "at t = " + format_number(t) + " s: joint " + limits[j].name +
+                                         " at " + format_number(joints[j]) +
+                                         " is outside its travel [" + format_number(limits[j].min) +
+                                         ", " + format_number(limits[j].max) + "]");
+  }
+}
+
+}  // namespace
+
+JointReferences plan_joint_references(const BoundModel& bound, const Trajectory& trajectory,
+                                      long steps, RecordedRun& run) {
+  const Machine& machine = *bound.machine;
+  const double dt = bound.model->opt.timestep;
+  const double duration_s = trajectory.duration_s();
+  const long stride = bound.control_stride;
+  JointReferences refs;
+  refs.updates = steps / stride + 1;
+  refs.joint_count = static_cast<int>(bound.joints.size());
+  const int joint_count = refs.joint_count;
+  refs.position.assign(refs.updates * joint_count, 0.0);
+  refs.velocity.assign(refs.updates * joint_count, 0.0);
+  refs.acceleration.assign(refs.updates * joint_count, 0.0);
+  refs.flap.assign(refs.updates, 0.0);
+  refs.flap_rate.assign(refs.updates, 0.0);
+  refs.flap_acceleration.assign(refs.updates, 0.0);
+  run.deposit_command.resize(steps + 1);
+  run.path_index.resize(steps + 1);
+  run.desired_speed_mm_s.resize(steps + 1);
+
+  // every step: the plan's flags, and its pose checked against the machine; every control
+  // period: the joint setpoints and the shutter blade's
+  ShutterReference shutter_reference;
+  if (bound.has_shutter)
+    shutter_reference = ShutterReference(trajectory, bound.shutter_geometry.time_s,
+                                         bound.shutter_geometry.overtravel);
+  JointVector joints;
+  TrajectoryCursor plan(trajectory);  // the steps' times only grow
+  for (long k = 0, u = 0; k <= steps; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    const TrajectorySample sample = planned_sample(plan, t, duration_s);
+    run.deposit_command[k] = sample.depositing ? 1 : 0;
+    run.path_index[k] = sample.path_index;
+    run.desired_speed_mm_s[k] = static_cast<float>(sample.desired_speed_mm_s);
+    joints_at(machine, sample, joints);
+    if (k % stride != 0) continue;
+
+    for (int j = 0; j < joint_count; ++j)
+      refs.position[u * joint_count + j] = joints[j] * bound.joints[j].user_to_si;
+    // the start's joint velocity J^-1 v; later ones are differences of the setpoints (below)
+    if (u == 0) {
+      const JointVector velocity = machine.joint_velocity(
+          joints, PoseRate(sample.velocity_mm_s, sample.angular_velocity_rad_s));
+      for (int j = 0; j < joint_count; ++j)
+        refs.velocity[j] = velocity[j] * bound.joints[j].user_to_si;
+    }
+    if (bound.has_shutter) {
+      double fraction = 0.0, rate = 0.0;
+      shutter_reference.at(t, fraction, rate);
+      const ShutterGeometry& geometry = bound.shutter_geometry;
+      refs.flap[u] = geometry.angle_at(fraction);
+      refs.flap_rate[u] = rate * (geometry.open_angle_rad - geometry.closed_angle_rad);
+    }
+    ++u;
+  }
+
+  // velocity and acceleration feed-forward from the sampled setpoints, as a digital servo
+  // forms them
+  const double control_period_s = static_cast<double>(stride) * dt;
+  sampled_setpoint_references(refs.position, refs.velocity, refs.acceleration, refs.updates,
+                              joint_count, control_period_s);
+  sampled_setpoint_references(refs.flap, refs.flap_rate, refs.flap_acceleration, refs.updates, 1,
+                              control_period_s);
+
+  // the largest acceleration the plan asks of each joint, as the servo is given it
+  run.reference_peak_acceleration.assign(joint_count, 0.0);
+  for (long update = 0; update < refs.updates; ++update)
+    for (int j = 0; j < joint_count; ++j)
+      run.reference_peak_acceleration[j] = std::max(
+          run.reference_peak_acceleration[j],
+          std::abs(refs.acceleration[update * joint_count + j]) / bound.joints[j].user_to_si);
+  return refs;
+}
+
+}  // namespace depotwin
