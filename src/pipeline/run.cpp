@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "deposition/deposition_metrics.hpp"
 #include "deposition/field_io.hpp"
+#include "metrics/run_report.hpp"
 #include "plots/plots.hpp"
 #include "render/scene.hpp"
 #include "report/metrics_json.hpp"
@@ -65,62 +66,6 @@ class ProgressLine {
   std::chrono::steady_clock::time_point start_;
 };
 
-// the recorded nozzle as motion samples (the same shape as the plan's)
-MotionSamples simulated_samples(const RecordedRun& record) {
-  MotionSamples samples;
-  samples.reserve(record.size());
-  for (size_t k = 0; k < record.size(); ++k)
-    samples.push_back(record.t_s[k], record.nozzle_mm[k], record.nozzle_velocity_mm_s[k],
-                      record.deposit_command[k], record.path_index[k],
-                      record.desired_speed_mm_s[k]);
-  return samples;
-}
-
-MotionSamples plan_at(const Trajectory& trajectory, const std::vector<double>& times) {
-  MotionSamples samples;
-  samples.reserve(times.size());
-  for (double t : times) {
-    const TrajectorySample s = trajectory.at(t);
-    samples.push_back(t, s.position_mm, s.velocity_mm_s, s.depositing, s.path_index,
-                      s.desired_speed_mm_s);
-  }
-  return samples;
-}
-
-// peaks of joint velocity, acceleration and force against the machine's limits
-ActuatorStats actuator_stats(const RecordedRun& record, const Machine& machine,
-                             const std::vector<double>& force_limits) {
-  ActuatorStats stats;
-  const auto& limits = machine.joint_limits();
-  for (int j = 0; j < record.joint_count; ++j) {
-    double v = 0.0, a = 0.0, f = 0.0;
-    for (size_t k = 0; k < record.size(); ++k) {
-      v = std::max(v, std::abs(record.joint(record.joint_velocity, k, j)));
-      a = std::max(a, std::abs(record.joint(record.joint_acceleration, k, j)));
-      f = std::max(f, std::abs(record.joint(record.actuator_force, k, j)));
-    }
-    stats.joint_names.push_back(record.joint_names[j]);
-    stats.peak_vel.push_back(v);
-    stats.peak_acc.push_back(a);
-    stats.peak_force.push_back(f);
-    const double v_lim = j < static_cast<int>(limits.size()) ? limits[j].v_max : 0.0;
-    const double a_lim = j < static_cast<int>(limits.size()) ? limits[j].a_max : 0.0;
-    const double f_lim = j < static_cast<int>(force_limits.size()) ? force_limits[j] : 0.0;
-    stats.limit_vel.push_back(v_lim);
-    stats.limit_acc.push_back(a_lim);
-    stats.limit_force.push_back(f_lim);
-    const double plan_a = j < static_cast<int>(record.reference_peak_acceleration.size())
-                              ? record.reference_peak_acceleration[j]
-                              : 0.0;
-    stats.plan_peak_acc.push_back(plan_a);
-    stats.peak_acc_over_plan.push_back(plan_a > 0.0 ? a / plan_a : 0.0);
-    if (v_lim > 0 && v > v_lim) ++stats.limit_violations;
-    if (a_lim > 0 && a > a_lim) ++stats.limit_violations;
-    if (f_lim > 0 && f > f_lim) ++stats.limit_violations;
-  }
-  return stats;
-}
-
 }  // namespace
 
 std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
@@ -152,19 +97,6 @@ std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
   return profiles;
 }
 
-double target_thickness_um(const Process& process, const Toolpath& toolpath) {
-  // a straight line at its desired speed peaks at Q / (v sigma sqrt(2 pi)); extrusion's
-  // nominal flow is v w h, so its peak is w h / (sigma sqrt(2 pi)) at any speed
-  if (toolpath.paths.empty()) return 0.0;
-  const DepositionSettings& s = process.settings();
-  const double sigma = s.footprint_sigma_mm();
-  const double root = sigma * std::sqrt(2.0 * kPi);
-  if (s.type == ProcessType::aerosol)
-    return 1000.0 * s.aerosol_flow_mm3_s() / (toolpath.paths.front().speed_mm_s * root);
-  if (s.flow_mm3_s > 0.0) return 1000.0 * s.flow_mm3_s / (toolpath.paths.front().speed_mm_s * root);
-  return 1000.0 * s.bead_width_mm * s.layer_height_mm / root;
-}
-
 SimSettings sim_settings(const Scenario& scenario) {
   SimSettings s;
   s.timestep_s = scenario.sim.timestep_s;
@@ -173,27 +105,6 @@ SimSettings sim_settings(const Scenario& scenario) {
   s.settle_s = scenario.sim.settle_s;
   s.shutter_time_s = scenario.process.shutter_time_s;
   return s;
-}
-
-bool deposition_step(const StepState& before, const StepState& after, double job_end_s,
-                     DepositionStep& step) {
-  if (before.t_s >= job_end_s - 1e-12) return false;
-  step.t0_s = before.t_s;
-  step.t1_s = after.t_s;
-  step.p0_mm = before.nozzle_mm;
-  step.p1_mm = after.nozzle_mm;
-  step.open0 = before.open_fraction;
-  step.open1 = after.open_fraction;
-  // the step that straddles the job's end is cut there (chord and flap linear in time)
-  if (after.t_s > job_end_s) {
-    const double f = (job_end_s - before.t_s) / (after.t_s - before.t_s);
-    step.t1_s = job_end_s;
-    step.p1_mm = before.nozzle_mm + f * (after.nozzle_mm - before.nozzle_mm);
-    step.open1 = before.open_fraction + f * (after.open_fraction - before.open_fraction);
-  }
-  step.flow_command = before.deposit_command ? 1.0 : 0.0;
-  step.desired_speed_mm_s = before.desired_speed_mm_s;
-  return true;
 }
 
 Simulation::FeedForwardHook closure_feedforward_hook(const Machine& machine,
@@ -248,61 +159,21 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   progress.finish();
   run.simulation->set_feedforward_hook({});  // it refers to this function's locals
 
-  // extrusion: what still flows from the nozzle when the job ends (the lag's ooze, Q tau)
-  // lands where the nozzle stopped, instead of vanishing with the last step
-  if (deposition.type == ProcessType::extrusion && process.nozzle_flow_mm3_s() > 0.0 &&
-      !run.record.nozzle_mm.empty()) {
-    DepositionStep ooze;
-    ooze.t0_s = job_end_s;
-    ooze.t1_s = job_end_s + 40.0 * deposition.tau_s;  // exp(-40): the rest goes down at once
-    ooze.p0_mm = ooze.p1_mm = run.record.nozzle_mm.back();
-    process.advance(ooze);
-  }
+  // extrusion: what still flows when the job ends lands where the nozzle stopped
+  if (!run.record.nozzle_mm.empty())
+    deposit_remaining_flow(process, run.record.nozzle_mm.back(), job_end_s);
   process.flush();  // the last batched deposition steps, before anything reads the field
 
-  // scores from the recorded run only
-  run.simulated = simulated_samples(run.record);
-  run.planned_at_steps = plan_at(trajectory, run.record.t_s);
-  MetricsReport& r = run.report;
-  r = run.plan.report;
-  r.planned_path_error = r.path_error;
-  r.velocity_error = velocity_error(run.simulated);
-  r.path_error = path_error(run.simulated, job.toolpath);
-
-  // thickness over what is printed in one go: joints inside a continuous print are not ends
+  // scores from the recorded run only: joints inside a continuous print are not path ends
+  run.simulated = recorded_motion(run.record);
+  run.planned_at_steps = trajectory_motion_at(trajectory, run.record.t_s);
+  run.report = run.plan.report;
   const DepositionMetrics deposited =
       evaluate_deposition(process.field(), merge_joined_paths(job.toolpath),
                           process.line_width_mm(), process.account());
-  ThicknessSummary thickness;
-  thickness.mean_um = deposited.thickness.mean_um;
-  thickness.cv = deposited.thickness.cv;
-  thickness.line_cv = deposited.thickness.line_cv;
-  thickness.min_rel = deposited.thickness.min_rel;
-  thickness.max_rel = deposited.thickness.max_rel;
-  r.thickness = thickness;
-  const MaterialSplit& m = deposited.material;
-  MaterialStats material;
-  material.emitted = m.emitted_mm3;
-  material.on_target = m.on_target_mm3;
-  material.overspray = m.overspray_mm3;
-  material.captured = m.captured_mm3;
-  r.material = material;
-  WasteStats waste;
-  waste.fraction = m.fraction;
-  waste.shutter_captured = m.emitted_mm3 > 0 ? m.captured_mm3 / m.emitted_mm3 : 0.0;
-  waste.overspray = m.emitted_mm3 > 0 ? m.overspray_mm3 / m.emitted_mm3 : 0.0;
-  waste.closed_time_s = m.closed_time_s;
-  r.waste = waste;
-  r.actuators = actuator_stats(run.record, *job.machine, run.simulation->actuator_force_limits());
-
-  SimStats sim;
-  sim.steps = run.record.steps;
-  sim.timestep_s = run.record.timestep_s;
-  sim.wall_s = run.record.wall_s;
-  const double simulated_s = run.record.t_s.empty() ? 0.0 : run.record.t_s.back();
-  sim.realtime_factor = run.record.wall_s > 0 ? simulated_s / run.record.wall_s : 0.0;
-  sim.max_constraint_violation_mm = run.record.max_constraint_violation_mm;
-  r.sim = sim;
+  add_simulated_metrics(run.report, run.record, run.simulated, job.toolpath, deposited);
+  run.report.actuators = actuator_stats(run.record, job.machine->joint_limits(),
+                                        run.simulation->actuator_force_limits());
   return run;
 }
 

@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "deposition/job_deposition.hpp"
 #include "deposition/process.hpp"
 #include "pipeline/job.hpp"
 #include "plots/plots.hpp"
@@ -38,20 +39,10 @@ struct SimulatedRun {
 // thickness along each print path's centreline, sampled every cell length
 std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
                                                     const Toolpath& toolpath);
-// the centreline thickness of a straight line printed at the first path's desired speed
-double target_thickness_um(const Process& process, const Toolpath& toolpath);
-
 // the scenario's deposition settings
 DepositionSettings deposition_settings(const Scenario& scenario);
 // the scenario's simulation settings
 SimSettings sim_settings(const Scenario& scenario);
-
-// The deposition step between two recorded states: the nozzle's chord, the shutter's open
-// fraction at both ends and the flow command. The aerosol stream runs from job start to job
-// end, so the step that straddles job_end_s is cut there (chord and flap linear in time);
-// false for a step after the job's end (settling).
-bool deposition_step(const StepState& before, const StepState& after, double job_end_s,
-                     DepositionStep& step);
 
 // The load feed-forward of a machine with closed chains (Machine::closure_feedforward), at
 // the TCP velocity and acceleration the servo's setpoints give: first and second

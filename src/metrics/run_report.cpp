@@ -1,0 +1,113 @@
+#include "metrics/run_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace depotwin {
+
+MotionSamples recorded_motion(const RecordedRun& record) {
+  MotionSamples samples;
+  samples.reserve(record.size());
+  for (size_t k = 0; k < record.size(); ++k)
+    samples.push_back(record.t_s[k], record.nozzle_mm[k], record.nozzle_velocity_mm_s[k],
+                      record.deposit_command[k], record.path_index[k],
+                      record.desired_speed_mm_s[k]);
+  return samples;
+}
+
+MotionSamples trajectory_motion_at(const Trajectory& trajectory, const std::vector<double>& times) {
+  MotionSamples samples;
+  samples.reserve(times.size());
+  for (double t : times) {
+    const TrajectorySample s = trajectory.at(t);
+    samples.push_back(t, s.position_mm, s.velocity_mm_s, s.depositing, s.path_index,
+                      s.desired_speed_mm_s);
+  }
+  return samples;
+}
+
+ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointLimit>& limits,
+                             const std::vector<double>& force_limits) {
+  ActuatorStats stats;
+  for (int j = 0; j < record.joint_count; ++j) {
+    double v = 0.0, a = 0.0, f = 0.0;
+    for (size_t k = 0; k < record.size(); ++k) {
+      v = std::max(v, std::abs(record.joint(record.joint_velocity, k, j)));
+      a = std::max(a, std::abs(record.joint(record.joint_acceleration, k, j)));
+      f = std::max(f, std::abs(record.joint(record.actuator_force, k, j)));
+    }
+    stats.joint_names.push_back(record.joint_names[j]);
+    stats.peak_vel.push_back(v);
+    stats.peak_acc.push_back(a);
+    stats.peak_force.push_back(f);
+    const double v_lim = j < static_cast<int>(limits.size()) ? limits[j].v_max : 0.0;
+    const double a_lim = j < static_cast<int>(limits.size()) ? limits[j].a_max : 0.0;
+    const double f_lim = j < static_cast<int>(force_limits.size()) ? force_limits[j] : 0.0;
+    stats.limit_vel.push_back(v_lim);
+    stats.limit_acc.push_back(a_lim);
+    stats.limit_force.push_back(f_lim);
+    const double plan_a = j < static_cast<int>(record.reference_peak_acceleration.size())
+                              ? record.reference_peak_acceleration[j]
+                              : 0.0;
+    stats.plan_peak_acc.push_back(plan_a);
+    stats.peak_acc_over_plan.push_back(plan_a > 0.0 ? a / plan_a : 0.0);
+    if (v_lim > 0 && v > v_lim) ++stats.limit_violations;
+    if (a_lim > 0 && a > a_lim) ++stats.limit_violations;
+    if (f_lim > 0 && f > f_lim) ++stats.limit_violations;
+  }
+  return stats;
+}
+
+namespace {
+
+ThicknessSummary thickness_summary(const ThicknessStats& stats) {
+  ThicknessSummary thickness;
+  thickness.mean_um = stats.mean_um;
+  thickness.cv = stats.cv;
+  thickness.line_cv = stats.line_cv;
+  thickness.min_rel = stats.min_rel;
+  thickness.max_rel = stats.max_rel;
+  return thickness;
+}
+
+// volumes, and the waste as fractions of what was emitted
+void material_and_waste(const MaterialSplit& m, MetricsReport& r) {
+  MaterialStats material;
+  material.emitted = m.emitted_mm3;
+  material.on_target = m.on_target_mm3;
+  material.overspray = m.overspray_mm3;
+  material.captured = m.captured_mm3;
+  r.material = material;
+  WasteStats waste;
+  waste.fraction = m.fraction;
+  waste.shutter_captured = m.emitted_mm3 > 0 ? m.captured_mm3 / m.emitted_mm3 : 0.0;
+  waste.overspray = m.emitted_mm3 > 0 ? m.overspray_mm3 / m.emitted_mm3 : 0.0;
+  waste.closed_time_s = m.closed_time_s;
+  r.waste = waste;
+}
+
+SimStats sim_stats(const RecordedRun& record) {
+  SimStats sim;
+  sim.steps = record.steps;
+  sim.timestep_s = record.timestep_s;
+  sim.wall_s = record.wall_s;
+  const double simulated_s = record.t_s.empty() ? 0.0 : record.t_s.back();
+  sim.realtime_factor = record.wall_s > 0 ? simulated_s / record.wall_s : 0.0;
+  sim.max_constraint_violation_mm = record.max_constraint_violation_mm;
+  return sim;
+}
+
+}  // namespace
+
+void add_simulated_metrics(MetricsReport& r, const RecordedRun& record,
+                           const MotionSamples& simulated, const Toolpath& toolpath,
+                           const DepositionMetrics& deposited) {
+  r.planned_path_error = r.path_error;
+  r.velocity_error = velocity_error(simulated);
+  r.path_error = path_error(simulated, toolpath);
+  r.thickness = thickness_summary(deposited.thickness);
+  material_and_waste(deposited.material, r);
+  r.sim = sim_stats(record);
+}
+
+}  // namespace depotwin

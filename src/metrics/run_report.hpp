@@ -1,0 +1,35 @@
+// The simulated sections of metrics.json: pure functions of the recorded run, the toolpath
+// and the deposit (docs/ARCHITECTURE.md, "Metrics").
+#pragma once
+
+#include <vector>
+
+#include "core/limits.hpp"
+#include "core/recorded_run.hpp"
+#include "core/toolpath.hpp"
+#include "core/trajectory.hpp"
+#include "deposition/deposition_metrics.hpp"
+#include "metrics/metrics_report.hpp"
+#include "metrics/motion_metrics.hpp"
+
+namespace depotwin {
+
+// the recorded nozzle as motion samples (the same shape as the plan's)
+MotionSamples recorded_motion(const RecordedRun& record);
+// the plan at the given times
+MotionSamples trajectory_motion_at(const Trajectory& trajectory, const std::vector<double>& times);
+
+// Per joint: the peaks of velocity, acceleration and force against the joint's limits and
+// actuator force range (0: none), and the simulated acceleration peak against the plan's own
+// (RecordedRun::reference_peak_acceleration)
+ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointLimit>& limits,
+                             const std::vector<double>& force_limits);
+
+// Adds to a planned report (plan_job's) what the simulation scored: the simulated velocity
+// and path error (the planned path error kept as planned_path_error), thickness, material and
+// waste from the deposit, and the simulation's own statistics.
+void add_simulated_metrics(MetricsReport& report, const RecordedRun& record,
+                           const MotionSamples& simulated, const Toolpath& toolpath,
+                           const DepositionMetrics& deposited);
+
+}  // namespace depotwin
