@@ -17,6 +17,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr double kSamplePeriod_s = 0.001;  // trajectory.csv and planned metrics
+// the longest job planned, sampled and simulated (at 1 ms, about 14 M samples)
+constexpr double kMaxJobDuration_s = 4.0 * 3600.0;
 
 // The machine named in the scenario, from the registry (the loader checked the name), and the
 // MJCF it is simulated in: the scenario's own model file, else the machine's shipped one.
@@ -120,6 +122,16 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   PlannedRun run;
   run.spec = spec;
   run.trajectory = make_planner(spec)->plan(job.toolpath, job.limits);
+  // a job far beyond any real print (e.g. a j_max of 1e-9 mm/s^3) would be sampled every
+  // millisecond: refuse it before sampling anything
+  if (!(run.trajectory.duration_s() <= kMaxJobDuration_s)) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the %s plan lasts %.4g s, beyond the %.0f h a job may last here; check the "
+                  "print speeds and the limits (v_max, a_max, j_max)",
+                  spec.name.c_str(), run.trajectory.duration_s(), kMaxJobDuration_s / 3600.0);
+    throw InputError(job.scenario.file, spec.line, "planners", text);
+  }
   run.planned = sample_trajectory(run.trajectory, kSamplePeriod_s);
 
   MetricsReport& r = run.report;

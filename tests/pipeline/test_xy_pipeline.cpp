@@ -202,3 +202,23 @@ TEST(XyPipeline, JerkLimitLengthensThePlanAndLowersTheAccelerationOvershoot) {
 
 }  // namespace
 }  // namespace depotwin
+
+namespace depotwin {
+namespace {
+
+// an absurd jerk limit makes a job of days: refused before anything is sampled
+TEST(XyPipeline, AJobBeyondFourHoursIsRefused) {
+  Scenario fig7 = load_scenario(testing_support::scenario_path("thompson_fig7.yaml"));
+  for (AxisLimits& axis : fig7.limits.axes) axis.j_max_mm_s3 = 1e-9;
+  const PreparedJob job = prepare_job(fig7);
+  try {
+    plan_job(job, PlannerSpec{"lspb_mtt", {}, 0});
+    FAIL() << "expected an InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("beyond the 4 h a job may last"), std::string::npos)
+        << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace depotwin
