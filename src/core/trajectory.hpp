@@ -28,7 +28,8 @@ struct ToolAxisMotion {
   bool constant() const { return begin == end; }
 };
 
-// Motion given per Cartesian axis as constant-acceleration phases (LSPB, MTT, trapezoids).
+// Motion given per Cartesian axis as constant-jerk phases (LSPB, MTT, trapezoids with jerk 0,
+// double-S moves under a jerk limit).
 struct PhaseMotion {
   std::array<AxisProfile, 3> axes;  // x, y, z; time relative to the piece's start
 };
