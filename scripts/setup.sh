@@ -10,6 +10,9 @@ packages=(
   libeigen3-dev libosmesa6-dev
   libgtest-dev libbenchmark-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev liblemon-dev
+  libassimp-dev                          # STL import (toolpath/stl)
+  libembree-dev                          # ray casting onto a part's surface (toolpath/surface_projection)
+  libfcl-dev                             # arm-to-part clearance (collision/)
   zlib1g-dev                             # PNG writing (core/png)
   libstb-dev                             # tests read the PNGs back with stb_image
   gnuplot-nox                            # plots (pngcairo terminal, headless)

@@ -79,12 +79,12 @@ Trajectory LspbMttPlanner::plan(const Toolpath& toolpath, const TcpLimits& limit
   double t = 0.0;
   Vec3 position = toolpath.start_mm;
   Vec3 velocity = Vec3::Zero();
-  Vec3 axis = vertical_tool_axis();
+  ToolOrientation tool = toolpath.start_orientation();
   for (const PrintSegment& s : segments) {
     // shutter closed: minimum-time transition to the segment's start and velocity
     if (!s.joined_to_previous) {
       pieces.push_back(
-          transition_piece(t, position, velocity, s.p0, s.v_begin, limits, axis, s.axis0));
+          transition_piece(t, position, velocity, s.p0, s.v_begin, limits, tool, s.tool0));
       t = pieces.back().t_end_s;
     }
     // shutter open: per-axis LSPB over the segment time L / v, eq. (50)
@@ -97,16 +97,16 @@ Trajectory LspbMttPlanner::plan(const Toolpath& toolpath, const TcpLimits& limit
     piece.depositing = true;
     piece.desired_speed_mm_s = s.speed_mm_s;
     piece.motion = phase_motion(std::move(axes));
-    piece.tool_axis = segment_tool_axis(s.p0, s.axis0, s.p1, s.axis1);
+    piece.tool_axis = segment_tool_axis(s.p0, s.tool0, s.p1, s.tool1);
     pieces.push_back(std::move(piece));
     t += duration_s;
     position = s.p1;
     velocity = s.v_end;
-    axis = s.axis1;
+    tool = s.tool1;
   }
   // shutter closed: to the end point, at rest
-  pieces.push_back(
-      transition_piece(t, position, velocity, toolpath.end_mm, Vec3::Zero(), limits, axis));
+  pieces.push_back(transition_piece(t, position, velocity, toolpath.end_mm, Vec3::Zero(), limits,
+                                    tool, toolpath.end_orientation()));
   return Trajectory("lspb_mtt", std::move(pieces), std::move(warnings));
 }
 

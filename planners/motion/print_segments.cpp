@@ -27,8 +27,8 @@ std::vector<PrintSegment> split_into_segments(const Toolpath& toolpath,
       // eqs. (40)-(47): the desired velocity along the segment. The paper splits it with
       // the slope m and sgn(x1 - x0); the unit direction gives the same components in 3-D.
       s.v_desired = s.speed_mm_s * (s.p1 - s.p0) / s.length_mm;
-      s.axis0 = path.tool_axis(k);
-      s.axis1 = path.tool_axis(k + 1);
+      s.tool0 = path.orientation(k);
+      s.tool1 = path.orientation(k + 1);
       // the limits over this segment alone (the machine's, where the tool is)
       s.limits = tcp_limits.along(s.p0, s.p1);
       const MachineLimits& limits = s.limits;

@@ -14,8 +14,8 @@ struct PrintSegment {
   double length_mm = 0.0;                     // eq. (51)
   double speed_mm_s = 0.0;
   Vec3 v_desired = Vec3::Zero();  // speed times the unit direction, eqs. (40)-(47)
-  Vec3 v_begin = Vec3::Zero(), v_end = Vec3::Zero();                // boundary velocities (planner)
-  Vec3 axis0 = vertical_tool_axis(), axis1 = vertical_tool_axis();  // tool axes at p0, p1
+  Vec3 v_begin = Vec3::Zero(), v_end = Vec3::Zero();  // boundary velocities (planner)
+  ToolOrientation tool0, tool1;                       // tool axes (and rolls) at p0, p1
   MachineLimits limits;             // the TCP limits over the segment's box (TcpLimits::along)
   int path_index = 0;               // index into Toolpath::paths
   int edge_index = 0;               // edge within that path

@@ -45,12 +45,12 @@ Trajectory StopAndGoPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
   std::vector<TrajectoryPiece> pieces;
   double t = 0.0;
   Vec3 position = toolpath.start_mm;
-  Vec3 tool_axis = vertical_tool_axis();
+  ToolOrientation tool = toolpath.start_orientation();
   for (const PrintSegment& s : segments) {
     // transitions between separate segments: rest to rest, shutter closed
     if (!s.joined_to_previous) {
-      pieces.push_back(transition_piece(t, position, Vec3::Zero(), s.p0, Vec3::Zero(), limits,
-                                        tool_axis, s.axis0));
+      pieces.push_back(
+          transition_piece(t, position, Vec3::Zero(), s.p0, Vec3::Zero(), limits, tool, s.tool0));
       t = pieces.back().t_end_s;
     }
     // the line's own speed, acceleration and jerk caps: no axis beyond its limits over it
@@ -77,14 +77,14 @@ Trajectory StopAndGoPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     piece.depositing = true;  // material on throughout, ramps included
     piece.desired_speed_mm_s = s.speed_mm_s;
     piece.motion = phase_motion(std::move(axes));
-    piece.tool_axis = segment_tool_axis(s.p0, s.axis0, s.p1, s.axis1);
+    piece.tool_axis = segment_tool_axis(s.p0, s.tool0, s.p1, s.tool1);
     pieces.push_back(std::move(piece));
     t = pieces.back().t_end_s;
     position = s.p1;
-    tool_axis = s.axis1;
+    tool = s.tool1;
   }
   pieces.push_back(transition_piece(t, position, Vec3::Zero(), toolpath.end_mm, Vec3::Zero(),
-                                    limits, tool_axis));
+                                    limits, tool, toolpath.end_orientation()));
   return Trajectory("stop_and_go", std::move(pieces));
 }
 

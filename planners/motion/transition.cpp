@@ -20,11 +20,13 @@ PhaseMotion phase_motion(std::vector<AxisProfile> axes) {
   return motion;
 }
 
-ToolAxisMotion segment_tool_axis(const Vec3& p0, const Vec3& axis0, const Vec3& p1,
-                                 const Vec3& axis1) {
+ToolAxisMotion segment_tool_axis(const Vec3& p0, const ToolOrientation& tool0, const Vec3& p1,
+                                 const ToolOrientation& tool1) {
   ToolAxisMotion motion;
-  motion.begin = axis0;
-  motion.end = axis1;
+  motion.begin = tool0.axis;
+  motion.end = tool1.axis;
+  motion.roll_begin = tool0.roll_rad;
+  motion.roll_end = tool1.roll_rad;
   motion.along_chord = true;
   motion.chord_begin_mm = p0;
   motion.chord_end_mm = p1;
@@ -32,8 +34,8 @@ ToolAxisMotion segment_tool_axis(const Vec3& p0, const Vec3& axis0, const Vec3& 
 }
 
 TrajectoryPiece transition_piece(double t_begin_s, const Vec3& p0, const Vec3& v0, const Vec3& p1,
-                                 const Vec3& v1, const TcpLimits& limits, const Vec3& axis0,
-                                 const Vec3& axis1) {
+                                 const Vec3& v1, const TcpLimits& limits,
+                                 const ToolOrientation& tool0, const ToolOrientation& tool1) {
   const MachineLimits box_limits = limits.for_transition(p0, v0, p1, v1);
   SynchronizedMove move = synchronized_move(axis_moves(p0, v0, p1, v1, box_limits));
   TrajectoryPiece piece;
@@ -43,8 +45,10 @@ TrajectoryPiece transition_piece(double t_begin_s, const Vec3& p0, const Vec3& v
   piece.depositing = false;
   piece.motion = phase_motion(std::move(move.axes));
   // the axis turns in time, at rest at both ends
-  piece.tool_axis.begin = axis0;
-  piece.tool_axis.end = axis1;
+  piece.tool_axis.begin = tool0.axis;
+  piece.tool_axis.end = tool1.axis;
+  piece.tool_axis.roll_begin = tool0.roll_rad;
+  piece.tool_axis.roll_end = tool1.roll_rad;
   return piece;
 }
 

@@ -33,8 +33,9 @@ bool MachineLimits::jerk_limited() const {
 
 TcpLimits::TcpLimits(const MachineLimits& limits) : requested_(limits) {}
 
-TcpLimits::TcpLimits(const MachineLimits& requested, BoxLimits over_box)
-    : requested_(requested), over_box_(std::move(over_box)) {}
+TcpLimits::TcpLimits(const MachineLimits& requested, BoxLimits over_box,
+                     std::shared_ptr<const JointMap> joint_map)
+    : requested_(requested), over_box_(std::move(over_box)), joint_map_(std::move(joint_map)) {}
 
 MachineLimits TcpLimits::over(const Vec3& lo_mm, const Vec3& hi_mm) const {
   if (!over_box_) return requested_;

@@ -6,8 +6,11 @@
 
 #include <array>
 #include <functional>
+#include <memory>
 #include <string>
+#include <vector>
 
+#include "core/pose.hpp"
 #include "core/types.hpp"
 
 namespace depotwin {
@@ -40,6 +43,20 @@ struct JointLimit {
   double j_max = 0.0;  // 0: no jerk limit
 };
 
+using JointVector = std::vector<double>;  // mm for prismatic joints, rad for revolute ones
+
+// The machine's joints along a path, for planners that parametrise a path in time under the
+// joints' own limits (the joint positions q(s) along the path give q'(s) and q''(s)). The
+// planner still never sees the machine's geometry, only joint positions and limits.
+struct JointMap {
+  std::vector<JointLimit> limits;  // per joint
+  // joints at each pose, each solution the one nearest to the previous pose's (continuous
+  // along the path); false, saying why and at which pose index, when a pose is unreachable
+  std::function<bool(const std::vector<Pose>& poses, std::vector<JointVector>& joints,
+                     std::string* why)>
+      solve;
+};
+
 // The TCP limits a planner must honour, which may depend on where the move is.
 class TcpLimits {
  public:
@@ -49,8 +66,10 @@ class TcpLimits {
   TcpLimits() = default;
   // the same limits everywhere (a Cartesian machine, or a test)
   TcpLimits(const MachineLimits& limits);  // NOLINT: implicit on purpose
-  // `requested` (the user's TCP limits, never exceeded) refined per box by the machine
-  TcpLimits(const MachineLimits& requested, BoxLimits over_box);
+  // `requested` (the user's TCP limits, never exceeded) refined per box by the machine, and
+  // optionally the machine's joint map
+  TcpLimits(const MachineLimits& requested, BoxLimits over_box,
+            std::shared_ptr<const JointMap> joint_map = nullptr);
 
   // the limits that hold everywhere in the axis-aligned box [lo, hi]
   MachineLimits over(const Vec3& lo_mm, const Vec3& hi_mm) const;
@@ -65,10 +84,13 @@ class TcpLimits {
   const MachineLimits& requested() const { return requested_; }
   // true when the limits are the same everywhere
   bool uniform() const { return !over_box_; }
+  // the machine's joints along a path; null when the limits come without a machine
+  const JointMap* joint_map() const { return joint_map_.get(); }
 
  private:
   MachineLimits requested_;
   BoxLimits over_box_;
+  std::shared_ptr<const JointMap> joint_map_;
 };
 
 }  // namespace depotwin

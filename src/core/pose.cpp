@@ -31,6 +31,20 @@ Vec3 slerp_axis(const Vec3& a, const Vec3& b, double s) {
   return Eigen::AngleAxisd(s * angle, rotation_axis(a, b)) * a;
 }
 
+Eigen::Matrix3d tool_frame(const Vec3& axis, double roll_rad) {
+  // the shortest rotation from +z to the axis (a fixed half turn about x for -z)
+  const Eigen::Matrix3d tilt =
+      Eigen::Quaterniond::FromTwoVectors(vertical_tool_axis(), axis).toRotationMatrix();
+  return tilt * Eigen::AngleAxisd(roll_rad, Vec3::UnitZ()).toRotationMatrix();
+}
+
+double roll_of_frame(const Eigen::Matrix3d& frame) {
+  // the x column in the un-rolled frame of the same axis
+  const Eigen::Matrix3d reference = tool_frame(frame.col(2).normalized(), 0.0);
+  const Vec3 x = reference.transpose() * frame.col(0);
+  return std::atan2(x.y(), x.x());
+}
+
 Vec3 slerp_rate(const Vec3& a, const Vec3& b) {
   const double angle = axis_angle_rad(a, b);
   if (angle < 1e-12) return Vec3::Zero();

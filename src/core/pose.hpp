@@ -1,7 +1,11 @@
 // A tool pose: where the nozzle tip is and which way the nozzle points. The nozzle is
 // symmetric about its axis, so a pose has five degrees of freedom: the roll about the axis
-// is free (a machine with a wrist may choose it).
+// is free. A machine with a wrist (arm6) chooses it and carries it as `roll_rad`: the tool's
+// rotation about its axis, measured from the reference frame of that axis (tool_frame).
+// Machines that hold the nozzle by translation only ignore it.
 #pragma once
+
+#include <Eigen/Core>
 
 #include "core/types.hpp"
 
@@ -17,12 +21,31 @@ struct Pose {
   // unit vector from the tip up into the tool, so along the surface normal when printing
   // square to a surface; +z for a vertical nozzle over a flat substrate
   Vec3 tool_axis = vertical_tool_axis();
+  // the roll about the tool axis (rad, not wrapped), from tool_frame(tool_axis, 0)
+  double roll_rad = 0.0;
 
   Pose() = default;
   // implicit from a position alone: a vertical nozzle there
-  Pose(const Vec3& position, const Vec3& axis = vertical_tool_axis())  // NOLINT
-      : position_mm(position), tool_axis(axis) {}
+  Pose(const Vec3& position, const Vec3& axis = vertical_tool_axis(),  // NOLINT
+       double roll = 0.0)
+      : position_mm(position), tool_axis(axis), roll_rad(roll) {}
 };
+
+// The tool's orientation alone: its unit axis and the roll about it (rad).
+struct ToolOrientation {
+  Vec3 axis = vertical_tool_axis();
+  double roll_rad = 0.0;
+};
+
+// The tool frame of an axis and a roll: columns x, y, z with z = axis, and x the work
+// frame's x turned onto the plane normal to the axis by the shortest rotation from +z to
+// the axis, then rolled by roll_rad about the axis. Continuous in the axis everywhere but at
+// -z (a nozzle pointing up), where the shortest rotation is undefined (a fixed choice there).
+Eigen::Matrix3d tool_frame(const Vec3& axis, double roll_rad);
+
+// The roll of a frame whose z column is the unit axis: the angle (rad, in (-pi, pi]) that
+// tool_frame(axis, roll) needs to reproduce its x column.
+double roll_of_frame(const Eigen::Matrix3d& frame);
 
 // The rate of a pose: TCP velocity and the tool's angular velocity (its component along the
 // tool axis, the roll, moves nothing).

@@ -17,8 +17,9 @@ struct StepState {
   Vec3 nozzle_velocity_mm_s = Vec3::Zero();  // its velocity relative to the substrate
   double open_fraction = 0.0;                // shutter: 0 closed .. 1 open (from the flap angle)
   bool deposit_command = false;              // the trajectory's depositing flag at t
-  double desired_speed_mm_s = 0.0;           // the trajectory piece's desired speed (0: transition)
-  int path_index = -1;                       // the trajectory piece's print path (-1: transition)
+  double flow_fraction = 0.0;       // the trajectory's commanded flow / nominal at t (extrusion)
+  double desired_speed_mm_s = 0.0;  // the trajectory piece's desired speed (0: transition)
+  int path_index = -1;              // the trajectory piece's print path (-1: transition)
 };
 
 // A whole run as a struct of arrays: entry k is the state at t = k * timestep_s,
@@ -28,6 +29,7 @@ struct RecordedRun {
   std::vector<Vec3> nozzle_mm, nozzle_velocity_mm_s;
   std::vector<float> open_fraction;
   std::vector<uint8_t> deposit_command;
+  std::vector<float> flow_fraction;
   std::vector<int> path_index;
   std::vector<float> desired_speed_mm_s;
   // step-major, joint_count per entry, user units: mm, mm/s, mm/s^2, N for slides and

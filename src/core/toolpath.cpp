@@ -14,6 +14,7 @@ PrintPath PrintPath::reversed() const {
   PrintPath out = *this;
   std::reverse(out.points.begin(), out.points.end());
   std::reverse(out.normals.begin(), out.normals.end());
+  std::reverse(out.rolls.begin(), out.rolls.end());
   return out;
 }
 
@@ -29,8 +30,17 @@ Vec3 PrintPath::tool_axis(size_t i) const {
   return normals.empty() ? vertical_tool_axis() : normals[i];
 }
 
+double PrintPath::roll(size_t i) const {
+  return rolls.empty() ? 0.0 : rolls[i];
+}
+
 Vec3 PrintPath::tool_axis_near(const Vec3& p, size_t& edge_hint) const {
   if (normals.empty() || points.size() < 2) return vertical_tool_axis();
+  return orientation_near(p, edge_hint).axis;
+}
+
+ToolOrientation PrintPath::orientation_near(const Vec3& p, size_t& edge_hint) const {
+  if ((normals.empty() && rolls.empty()) || points.size() < 2) return orientation(0);
   const size_t edges = points.size() - 1;
   // the nearest edge from the hint onwards, stopping once the distance grows again
   const auto projection = [&](size_t edge, double& fraction) {
@@ -52,7 +62,12 @@ Vec3 PrintPath::tool_axis_near(const Vec3& p, size_t& edge_hint) const {
     }
   }
   edge_hint = best;
-  return slerp_axis(normals[best], normals[best + 1], best_fraction);
+  ToolOrientation near;
+  near.axis = normals.empty() ? vertical_tool_axis()
+                              : slerp_axis(normals[best], normals[best + 1], best_fraction);
+  near.roll_rad =
+      rolls.empty() ? 0.0 : rolls[best] + best_fraction * (rolls[best + 1] - rolls[best]);
+  return near;
 }
 
 double Toolpath::print_length_mm() const {
@@ -66,22 +81,33 @@ Toolpath merge_joined_paths(const Toolpath& toolpath) {
   merged.start_mm = toolpath.start_mm;
   merged.end_mm = toolpath.end_mm;
   for (const PrintPath& path : toolpath.paths) {
-    const bool joins = !merged.paths.empty() &&
+    const bool joins = !merged.paths.empty() && merged.paths.back().layer == path.layer &&
                        (merged.paths.back().back() - path.front()).norm() <= kJoinTolerance_mm;
     if (!joins) {
       merged.paths.push_back(path);
       continue;
     }
-    // append without repeating the joint (normals only when both paths carry them)
+    // append without repeating the joint (normals and rolls only when both paths carry them)
     PrintPath& last = merged.paths.back();
     const bool with_normals = !last.normals.empty() && !path.normals.empty();
+    const bool with_rolls = !last.rolls.empty() && !path.rolls.empty();
     last.points.insert(last.points.end(), path.points.begin() + 1, path.points.end());
     if (with_normals)
       last.normals.insert(last.normals.end(), path.normals.begin() + 1, path.normals.end());
     else
       last.normals.clear();
+    if (with_rolls)
+      last.rolls.insert(last.rolls.end(), path.rolls.begin() + 1, path.rolls.end());
+    else
+      last.rolls.clear();
   }
   return merged;
+}
+
+int Toolpath::layer_count() const {
+  int layers = 1;
+  for (const PrintPath& path : paths) layers = std::max(layers, path.layer + 1);
+  return layers;
 }
 
 void Toolpath::bounds(Vec3& lo, Vec3& hi) const {

@@ -14,8 +14,11 @@ struct PrintPath {
   std::vector<Vec3> points;   // at least two, consecutive points distinct
   std::vector<Vec3> normals;  // optional unit surface normals per point (conformal work): the
                               // tool axes the path asks for; none: a vertical nozzle
+  std::vector<double> rolls;  // optional roll about the tool axis per point (rad, Pose), chosen
+                              // by a machine with a wrist; none: roll 0 everywhere
   double speed_mm_s = 0.0;    // desired TCP speed while printing
   int source_index = 0;       // index in the scenario's list, for messages and reports
+  int layer = 0;              // the layer it belongs to (surface toolpaths; 0 otherwise)
 
   double length_mm() const;
   const Vec3& front() const { return points.front(); }
@@ -26,18 +29,32 @@ struct PrintPath {
   void bounds(Vec3& lo, Vec3& hi) const;
   // the tool axis at point i (its normal, or vertical without normals)
   Vec3 tool_axis(size_t i) const;
+  // the roll at point i (0 without rolls)
+  double roll(size_t i) const;
+  // axis and roll at point i
+  ToolOrientation orientation(size_t i) const { return ToolOrientation{tool_axis(i), roll(i)}; }
   // the tool axis at the point of the path nearest to p: the normals of the nearest edge
   // slerped by where p projects onto it. `edge_hint` (in/out) is the edge of the previous
   // query; the search goes forwards from it a few edges, so points that move along the path
   // cost constant time.
   Vec3 tool_axis_near(const Vec3& p, size_t& edge_hint) const;
+  // axis and roll (linear along the edge) at the point of the path nearest to p, as above
+  ToolOrientation orientation_near(const Vec3& p, size_t& edge_hint) const;
 };
 
 // Start and end of the job (at rest) and the print paths in print order.
 struct Toolpath {
   Vec3 start_mm = Vec3::Zero();
   Vec3 end_mm = Vec3::Zero();
+  // the roll at start and end (the tool axis there is vertical)
+  double start_roll_rad = 0.0;
+  double end_roll_rad = 0.0;
   std::vector<PrintPath> paths;
+
+  ToolOrientation start_orientation() const { return {vertical_tool_axis(), start_roll_rad}; }
+  ToolOrientation end_orientation() const { return {vertical_tool_axis(), end_roll_rad}; }
+  // the number of layers (1 + the largest PrintPath::layer; 1 for an empty toolpath)
+  int layer_count() const;
 
   double print_length_mm() const;
   // axis-aligned bounds over start, end and every path point

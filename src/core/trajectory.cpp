@@ -81,28 +81,48 @@ void evaluate_motion(const TrajectoryPiece& piece, double tau, Vec3& position_mm
           velocity_mm_s, acceleration_mm_s2);
 }
 
+namespace {
+
+// the sample interval of a sampled piece at local time tau: index k and fraction in [0, 1];
+// false past the last sample
+bool sample_interval(const SampledMotion& sampled, size_t count, double tau, size_t& k,
+                     double& fraction) {
+  const double k_real = std::max(0.0, tau / sampled.period_s);
+  k = static_cast<size_t>(std::floor(k_real));
+  if (k + 1 >= count) return false;
+  fraction = k_real - static_cast<double>(k);
+  return true;
+}
+
+}  // namespace
+
 void evaluate_tool_axis(const TrajectoryPiece& piece, double tau, const Vec3& position_mm,
-                        const Vec3& velocity_mm_s, Vec3& tool_axis, Vec3& angular_velocity_rad_s) {
+                        const Vec3& velocity_mm_s, Vec3& tool_axis, Vec3& angular_velocity_rad_s,
+                        double& roll_rad) {
   const ToolAxisMotion& motion = piece.tool_axis;
-  // per-sample axes of a sampled piece: slerp between neighbouring samples
+  // per-sample axes (and rolls) of a sampled piece: slerp between neighbouring samples
   if (const auto* sampled = std::get_if<SampledMotion>(&piece.motion);
       sampled != nullptr && !sampled->tool_axis.empty()) {
     const std::vector<Vec3>& axes = sampled->tool_axis;
-    const double h = sampled->period_s;
-    const double k_real = std::max(0.0, tau / h);
-    const size_t k = static_cast<size_t>(std::floor(k_real));
-    if (k + 1 >= axes.size()) {
+    const std::vector<double>& rolls = sampled->roll_rad;
+    size_t k = 0;
+    double fraction = 0.0;
+    if (!sample_interval(*sampled, axes.size(), tau, k, fraction)) {
       tool_axis = axes.back();
       angular_velocity_rad_s.setZero();
+      roll_rad = rolls.empty() ? motion.roll_end : rolls.back();
       return;
     }
-    tool_axis = slerp_axis(axes[k], axes[k + 1], k_real - static_cast<double>(k));
-    angular_velocity_rad_s = slerp_rate(axes[k], axes[k + 1]) / h;
+    tool_axis = slerp_axis(axes[k], axes[k + 1], fraction);
+    angular_velocity_rad_s = slerp_rate(axes[k], axes[k + 1]) / sampled->period_s;
+    roll_rad = rolls.empty() ? motion.roll_begin + fraction * (motion.roll_end - motion.roll_begin)
+                             : rolls[k] + fraction * (rolls[k + 1] - rolls[k]);
     return;
   }
   if (motion.constant()) {
     tool_axis = motion.begin;
     angular_velocity_rad_s.setZero();
+    roll_rad = motion.roll_begin;
     return;
   }
   // the fraction of the rotation done and its rate: along the chord, or smoothstep in time
@@ -124,6 +144,18 @@ void evaluate_tool_axis(const TrajectoryPiece& piece, double tau, const Vec3& po
   }
   tool_axis = slerp_axis(motion.begin, motion.end, fraction);
   angular_velocity_rad_s = rate_per_s * slerp_rate(motion.begin, motion.end);
+  roll_rad = motion.roll_begin + fraction * (motion.roll_end - motion.roll_begin);
+}
+
+double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau) {
+  if (!piece.depositing) return 0.0;
+  const auto* sampled = std::get_if<SampledMotion>(&piece.motion);
+  if (sampled == nullptr || sampled->flow_fraction.empty()) return piece.flow_fraction;
+  const std::vector<double>& flow = sampled->flow_fraction;
+  size_t k = 0;
+  double fraction = 0.0;
+  if (!sample_interval(*sampled, flow.size(), tau, k, fraction)) return flow.back();
+  return flow[k] + fraction * (flow[k + 1] - flow[k]);
 }
 
 namespace {
@@ -149,7 +181,8 @@ TrajectorySample Trajectory::at(double t) const {
   evaluate_motion(piece, t - piece.t_begin_s, sample.position_mm, sample.velocity_mm_s,
                   sample.acceleration_mm_s2);
   evaluate_tool_axis(piece, t - piece.t_begin_s, sample.position_mm, sample.velocity_mm_s,
-                     sample.tool_axis, sample.angular_velocity_rad_s);
+                     sample.tool_axis, sample.angular_velocity_rad_s, sample.roll_rad);
+  sample.flow_fraction = evaluate_flow_fraction(piece, t - piece.t_begin_s);
   return sample;
 }
 
@@ -182,7 +215,8 @@ TrajectorySample TrajectoryCursor::at(double t) {
     }
   }
   evaluate_tool_axis(piece, tau, sample.position_mm, sample.velocity_mm_s, sample.tool_axis,
-                     sample.angular_velocity_rad_s);
+                     sample.angular_velocity_rad_s, sample.roll_rad);
+  sample.flow_fraction = evaluate_flow_fraction(piece, tau);
   return sample;
 }
 

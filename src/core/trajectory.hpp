@@ -18,14 +18,18 @@ namespace depotwin {
 // segment the rotation follows the TCP along the segment's chord (the fraction of the way from
 // chord_begin to chord_end), so the axis belongs to the geometry, not to the timing; otherwise
 // it follows time with zero rate at both ends (smoothstep). Planar work keeps it vertical.
+// The roll about the axis (Pose::roll_rad) goes from roll_begin to roll_end linearly in the
+// same fraction.
 struct ToolAxisMotion {
   Vec3 begin = vertical_tool_axis();
   Vec3 end = vertical_tool_axis();
+  double roll_begin = 0.0;
+  double roll_end = 0.0;
   bool along_chord = false;
   Vec3 chord_begin_mm = Vec3::Zero();
   Vec3 chord_end_mm = Vec3::Zero();
 
-  bool constant() const { return begin == end; }
+  bool constant() const { return begin == end && roll_begin == roll_end; }
 };
 
 // Motion given per Cartesian axis as constant-jerk phases (LSPB, MTT, trapezoids with jerk 0,
@@ -41,6 +45,10 @@ struct SampledMotion {
   std::vector<Vec3> position_mm;    // sample k at time k * period_s
   std::vector<Vec3> velocity_mm_s;  // same size as position_mm
   std::vector<Vec3> tool_axis;      // per sample (unit); empty: the piece's tool_axis motion
+  std::vector<double> roll_rad;     // per sample; empty: the piece's tool_axis motion's roll
+  // per sample, the commanded flow as a fraction of the nominal (extrusion flow control);
+  // empty: the piece's flow_fraction
+  std::vector<double> flow_fraction;
 };
 
 // One time interval of the trajectory with one meaning: printing path `path_index`,
@@ -51,6 +59,10 @@ struct TrajectoryPiece {
   int path_index = -1;              // index into Toolpath::paths, -1 for a transition
   bool depositing = false;          // shutter open / flow on
   double desired_speed_mm_s = 0.0;  // 0 in transitions
+  // while depositing, the commanded flow as a fraction of the nominal flow at the desired
+  // speed (extrusion: 1 = nominal; a planner that slows a path may lower it, SampledMotion
+  // may give it per sample). An aerosol stream cannot be modulated: it ignores this.
+  double flow_fraction = 1.0;
   std::variant<PhaseMotion, SampledMotion> motion;
   ToolAxisMotion tool_axis;  // the orientation channel
 };
@@ -63,12 +75,14 @@ struct TrajectorySample {
   Vec3 acceleration_mm_s2 = Vec3::Zero();
   Vec3 tool_axis = vertical_tool_axis();       // unit
   Vec3 angular_velocity_rad_s = Vec3::Zero();  // of the tool axis
+  double roll_rad = 0.0;                       // about the tool axis (Pose::roll_rad)
   bool depositing = false;
   int path_index = -1;
   int piece_index = -1;
   double desired_speed_mm_s = 0.0;
+  double flow_fraction = 0.0;  // commanded flow / nominal while depositing, else 0
 
-  Pose pose() const { return Pose(position_mm, tool_axis); }
+  Pose pose() const { return Pose(position_mm, tool_axis, roll_rad); }
 };
 
 class Trajectory {
@@ -115,9 +129,12 @@ class TrajectoryCursor {
 // Evaluate one piece's motion at local time tau (seconds since the piece started).
 void evaluate_motion(const TrajectoryPiece& piece, double tau, Vec3& position_mm,
                      Vec3& velocity_mm_s, Vec3& acceleration_mm_s2);
-// The tool axis and its angular velocity at local time tau, where the TCP is at position_mm
-// moving at velocity_mm_s (evaluate_motion's).
+// The tool axis, its angular velocity and the roll at local time tau, where the TCP is at
+// position_mm moving at velocity_mm_s (evaluate_motion's).
 void evaluate_tool_axis(const TrajectoryPiece& piece, double tau, const Vec3& position_mm,
-                        const Vec3& velocity_mm_s, Vec3& tool_axis, Vec3& angular_velocity_rad_s);
+                        const Vec3& velocity_mm_s, Vec3& tool_axis, Vec3& angular_velocity_rad_s,
+                        double& roll_rad);
+// The commanded flow fraction at local time tau (0 when the piece does not deposit).
+double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau);
 
 }  // namespace depotwin

@@ -20,7 +20,7 @@ bool deposition_step(const StepState& before, const StepState& after, double job
     step.p1_mm = before.nozzle_mm + f * (after.nozzle_mm - before.nozzle_mm);
     step.open1 = before.open_fraction + f * (after.open_fraction - before.open_fraction);
   }
-  step.flow_command = before.deposit_command ? 1.0 : 0.0;
+  step.flow_command = before.deposit_command ? before.flow_fraction : 0.0;
   step.desired_speed_mm_s = before.desired_speed_mm_s;
   return true;
 }

@@ -22,7 +22,6 @@
 
 namespace depotwin {
 
-using JointVector = std::vector<double>;  // mm for prismatic joints, rad for revolute ones
 // 6 x joint_count: rows 0-2 the TCP velocity (mm/s), rows 3-5 the tool's angular velocity
 // (rad/s) per unit joint rate
 using Jacobian = Eigen::Matrix<double, 6, Eigen::Dynamic>;
@@ -39,8 +38,13 @@ class Machine {
   virtual const std::vector<JointLimit>& joint_limits() const = 0;
 
   // pose -> joints. Returns false and says why when the pose is not reachable (outside the
-  // travel or the workspace, or a tool axis the machine cannot hold).
+  // travel or the workspace, or a tool axis the machine cannot hold). A machine with several
+  // solutions returns the one of its configured branch (see inverse_near).
   virtual bool inverse(const Pose& pose, JointVector& joints, std::string* why = nullptr) const = 0;
+  // pose -> the joints nearest to `seed` among the pose's solutions, for continuity along a
+  // path (an arm's branch and joint wrap follow the seed). The default: inverse().
+  virtual bool inverse_near(const Pose& pose, const JointVector& seed, JointVector& joints,
+                            std::string* why = nullptr) const;
   // joints -> pose
   virtual Pose forward(const JointVector& joints) const = 0;
   // d(pose)/d(joints) at a joint position (see Jacobian)
@@ -54,7 +58,8 @@ class Machine {
   // looser than `requested`).
   virtual MachineLimits cartesian_limits(const MachineLimits& requested, const Vec3& lo,
                                          const Vec3& hi) const = 0;
-  // the user's TCP limits, refined per move by cartesian_limits (the machine must outlive it)
+  // the user's TCP limits, refined per move by cartesian_limits, with the machine's joint map
+  // (joint positions along a path by inverse_near; the machine must outlive it)
   TcpLimits tcp_limits(const MachineLimits& requested) const;
 
   // scenario `limits: {joint: {v_max, a_max, j_max}}`: the same limits on every joint.

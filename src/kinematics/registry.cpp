@@ -42,10 +42,34 @@ JointVector Machine::joint_velocity(const JointVector& joints, const PoseRate& r
   return JointVector(q_rate.data(), q_rate.data() + q_rate.size());
 }
 
+bool Machine::inverse_near(const Pose& pose, const JointVector& /*seed*/, JointVector& joints,
+                           std::string* why) const {
+  return inverse(pose, joints, why);
+}
+
 TcpLimits Machine::tcp_limits(const MachineLimits& requested) const {
-  return TcpLimits(requested, [this, requested](const Vec3& lo, const Vec3& hi) {
-    return cartesian_limits(requested, lo, hi);
-  });
+  auto joint_map = std::make_shared<JointMap>();
+  joint_map->limits = joint_limits();
+  joint_map->solve = [this](const std::vector<Pose>& poses, std::vector<JointVector>& joints,
+                            std::string* why) {
+    joints.resize(poses.size());
+    for (size_t i = 0; i < poses.size(); ++i) {
+      std::string reason;
+      const bool solved = i == 0 ? inverse(poses[i], joints[i], &reason)
+                                 : inverse_near(poses[i], joints[i - 1], joints[i], &reason);
+      if (!solved) {
+        if (why) *why = "pose " + std::to_string(i) + ": " + reason;
+        return false;
+      }
+    }
+    return true;
+  };
+  return TcpLimits(
+      requested,
+      [this, requested](const Vec3& lo, const Vec3& hi) {
+        return cartesian_limits(requested, lo, hi);
+      },
+      std::move(joint_map));
 }
 
 std::string vertical_axis_problem(const std::string& machine, const Pose& pose) {

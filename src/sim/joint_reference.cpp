@@ -33,12 +33,15 @@ TrajectorySample planned_sample(TrajectoryCursor& plan, double t, double duratio
   return sample;
 }
 
-// the joints of a sample's pose, within their travel; InputError naming the time otherwise
-void joints_at(const Machine& machine, const TrajectorySample& sample, JointVector& joints) {
+// the joints of a sample's pose (the solution nearest to `seed` when given: continuous along
+// the plan), within their travel; InputError naming the time otherwise
+void joints_at(const Machine& machine, const TrajectorySample& sample, const JointVector* seed,
+               JointVector& joints) {
   std::string why;
   const double t = sample.t_s;
-  if (!machine.inverse(sample.pose(), joints, &why))
-    throw InputError("trajectory", "at t = " + format_number(t) + " s: " + why);
+  const bool solved = seed ? machine.inverse_near(sample.pose(), *seed, joints, &why)
+                           : machine.inverse(sample.pose(), joints, &why);
+  if (!solved) throw InputError("trajectory", "at t = " + format_number(t) + " s: " + why);
   const std::vector<JointLimit>& limits = machine.joint_limits();
   if (joints.size() != limits.size())
     throw InternalError("machine " + machine.name() + " returned " + std::to_string(joints.size()) +
@@ -71,6 +74,7 @@ JointReferences plan_joint_references(const BoundModel& bound, const Trajectory&
   refs.flap_rate.assign(refs.updates, 0.0);
   refs.flap_acceleration.assign(refs.updates, 0.0);
   run.deposit_command.resize(steps + 1);
+  run.flow_fraction.resize(steps + 1);
   run.path_index.resize(steps + 1);
   run.desired_speed_mm_s.resize(steps + 1);
 
@@ -80,15 +84,18 @@ JointReferences plan_joint_references(const BoundModel& bound, const Trajectory&
   if (bound.has_shutter)
     shutter_reference = ShutterReference(trajectory, bound.shutter_geometry.time_s,
                                          bound.shutter_geometry.overtravel);
-  JointVector joints;
+  JointVector joints, next_joints;
   TrajectoryCursor plan(trajectory);  // the steps' times only grow
   for (long k = 0, u = 0; k <= steps; ++k) {
     const double t = static_cast<double>(k) * dt;
     const TrajectorySample sample = planned_sample(plan, t, duration_s);
     run.deposit_command[k] = sample.depositing ? 1 : 0;
+    run.flow_fraction[k] = static_cast<float>(sample.flow_fraction);
     run.path_index[k] = sample.path_index;
     run.desired_speed_mm_s[k] = static_cast<float>(sample.desired_speed_mm_s);
-    joints_at(machine, sample, joints);
+    // each step's solution follows the previous one's (an arm's branch and joint wrap)
+    joints_at(machine, sample, k == 0 ? nullptr : &joints, next_joints);
+    joints.swap(next_joints);
     if (k % stride != 0) continue;
 
     for (int j = 0; j < joint_count; ++j)

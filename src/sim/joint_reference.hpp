@@ -25,7 +25,7 @@ struct JointReferences {
 };
 
 // The references of a run of `steps` steps (steps + 1 states). Also writes the plan's
-// per-step flags into `run` (deposit_command, path_index, desired_speed_mm_s, sized
+// per-step flags into `run` (deposit_command, flow_fraction, path_index, desired_speed_mm_s, sized
 // steps + 1) and the plan's peak joint accelerations (reference_peak_acceleration). After
 // the trajectory's end the machine holds its final pose with the shutter closed. The whole
 // trajectory is checked first: InputError naming the time for a pose the machine cannot reach

@@ -154,6 +154,7 @@ void Simulation::Impl::record_state(long k, RecordedRun& run, StepState& state) 
   state.t_s = run.t_s[k];
   read_nozzle(bound, state.nozzle_mm, state.nozzle_velocity_mm_s);
   state.deposit_command = run.deposit_command[k] != 0;
+  state.flow_fraction = run.flow_fraction[k];
   state.open_fraction = open_fraction(bound, state.deposit_command);
   state.desired_speed_mm_s = run.desired_speed_mm_s[k];
   state.path_index = run.path_index[k];

@@ -467,12 +467,17 @@ TrajectoryPiece sampled_piece(double t_begin_s, double period_s, std::vector<Vec
   motion.period_s = period_s;
   motion.position_mm = std::move(positions);
   motion.velocity_mm_s = std::move(velocities);
-  // the tool axis of a path with normals: at every sample, the path's axis where it is nearest
-  if (!path.normals.empty()) {
+  // the tool axis (and roll) of a path with normals or rolls: at every sample, the path's
+  // where it is nearest
+  if (!path.normals.empty() || !path.rolls.empty()) {
     size_t edge_hint = 0;
     motion.tool_axis.reserve(motion.position_mm.size());
-    for (const Vec3& p : motion.position_mm)
-      motion.tool_axis.push_back(path.tool_axis_near(p, edge_hint));
+    if (!path.rolls.empty()) motion.roll_rad.reserve(motion.position_mm.size());
+    for (const Vec3& p : motion.position_mm) {
+      const ToolOrientation tool = path.orientation_near(p, edge_hint);
+      motion.tool_axis.push_back(tool.axis);
+      if (!path.rolls.empty()) motion.roll_rad.push_back(tool.roll_rad);
+    }
   }
   piece.motion = std::move(motion);
   return piece;
@@ -556,7 +561,7 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
   std::vector<std::string> warnings;
   double t = 0.0;
   Vec3 position = toolpath.start_mm;
-  Vec3 tool_axis = vertical_tool_axis();
+  ToolOrientation tool = toolpath.start_orientation();
   size_t next_weight = 0;
   std::vector<Vec3> positions, velocities;
   std::vector<int> owners;
@@ -613,7 +618,7 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
 
     // shutter closed: to the path's first sample, at rest
     pieces.push_back(transition_piece(t, position, Vec3::Zero(), positions.front(), Vec3::Zero(),
-                                      tcp_limits, tool_axis, path.tool_axis(0)));
+                                      tcp_limits, tool, path.orientation(0)));
     t = pieces.back().t_end_s;
     const int path_index = static_cast<int>(i);
     auto slice = [&](size_t begin, size_t end) {
@@ -638,10 +643,10 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
       t = pieces.back().t_end_s;
     }
     position = positions.back();
-    tool_axis = path.tool_axis(path.points.size() - 1);
+    tool = path.orientation(path.points.size() - 1);
   }
   pieces.push_back(transition_piece(t, position, Vec3::Zero(), toolpath.end_mm, Vec3::Zero(),
-                                    tcp_limits, tool_axis));
+                                    tcp_limits, tool, toolpath.end_orientation()));
 
   // keep the warnings readable on long toolpaths
   if (warnings.size() > kMaxDetailedWarnings) {
