@@ -52,24 +52,31 @@ class MachineContract : public ::testing::TestWithParam<std::string> {
   std::unique_ptr<Machine> machine_;
 };
 
+// forward(inverse(pose)) is the pose (position, tool axis and roll); a machine with several
+// solutions per pose returns, near a seed, the seed's own (inverse_near: forward∘inverse and
+// inverse∘forward are both the identity)
 TEST_P(MachineContract, InverseAndForwardAgree) {
-  double worst_mm = 0.0, worst_joint = 0.0;
+  double worst_mm = 0.0, worst_joint = 0.0, worst_roll = 0.0;
   for (const JointVector& q : reachable_joints(1, 300)) {
     const Pose pose = machine_->forward(q);
-    JointVector back;
+    JointVector back, near;
     std::string why;
     ASSERT_TRUE(machine_->inverse(pose, back, &why)) << why;
     ASSERT_EQ(back.size(), q.size());
     ASSERT_EQ(static_cast<int>(back.size()), machine_->joint_count());
-    for (size_t j = 0; j < q.size(); ++j)
-      worst_joint = std::max(worst_joint, std::abs(back[j] - q[j]));
     const Pose again = machine_->forward(back);
     worst_mm = std::max(worst_mm, (again.position_mm - pose.position_mm).norm());
+    worst_roll =
+        std::max(worst_roll, std::abs(std::remainder(again.roll_rad - pose.roll_rad, 2.0 * kPi)));
     EXPECT_NEAR(again.tool_axis.norm(), 1.0, 1e-12);
     EXPECT_LT(axis_angle_rad(again.tool_axis, pose.tool_axis), 1e-9);
+    ASSERT_TRUE(machine_->inverse_near(pose, q, near, &why)) << why;
+    for (size_t j = 0; j < q.size(); ++j)
+      worst_joint = std::max(worst_joint, std::abs(near[j] - q[j]));
   }
   EXPECT_LT(worst_mm, 1e-9);
   EXPECT_LT(worst_joint, 1e-9);
+  EXPECT_LT(worst_roll, 1e-9);
 }
 
 TEST_P(MachineContract, JacobianMatchesFiniteDifferences) {
