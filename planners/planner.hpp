@@ -19,14 +19,21 @@
 
 namespace depotwin {
 
-// A planner named in a scenario with its parameters (each a number or a list of numbers).
+// A planner named in a scenario with its parameters: numbers (or lists of numbers), and
+// choices (a word from the parameter's list, e.g. `control: both`).
 struct PlannerSpec {
   std::string name;
   std::map<std::string, std::vector<double>> params;
   int line = 0;  // where it was declared, for messages
+  std::map<std::string, std::string> choices;
+  std::string label;  // names the run and its results folder when given (a planner run twice)
 
   // the parameter's first value, or `fallback` when absent
   double get(const std::string& key, double fallback) const;
+  // the chosen word, or `fallback` when absent
+  std::string get_choice(const std::string& key, const std::string& fallback) const;
+  // the run's name: its label, else the planner's name
+  const std::string& run_label() const { return label.empty() ? name : label; }
 };
 
 // A parameter a planner declares by name with its range (OMPL's declareParam), so a
@@ -38,6 +45,8 @@ struct PlannerParameter {
   double max_value = 0.0;
   std::string description;
   bool list_allowed = false;  // may be given as a list (e.g. one weight per corner)
+  // a choice parameter: one of these words (the first is the default); numbers are refused
+  std::vector<std::string> choices = {};
 };
 
 class Planner {

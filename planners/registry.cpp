@@ -15,6 +15,11 @@ double PlannerSpec::get(const std::string& key, double fallback) const {
   return it == params.end() || it->second.empty() ? fallback : it->second.front();
 }
 
+std::string PlannerSpec::get_choice(const std::string& key, const std::string& fallback) const {
+  auto it = choices.find(key);
+  return it == choices.end() ? fallback : it->second;
+}
+
 const std::vector<PlannerInfo>& planner_registry() {
   static const std::vector<PlannerInfo> registry = {
       {"lspb_mtt",
@@ -47,16 +52,36 @@ std::string check_planner_spec(const PlannerSpec& spec) {
     for (const PlannerInfo& p : planner_registry()) known += (known.empty() ? "" : ", ") + p.name;
     return "unknown planner '" + spec.name + "' (known: " + known + ")";
   }
-  for (const auto& [key, values] : spec.params) {
+  const auto find_parameter = [&](const std::string& key) -> const PlannerParameter* {
     auto it = std::find_if(info->parameters.begin(), info->parameters.end(),
                            [&](const PlannerParameter& p) { return p.name == key; });
-    if (it == info->parameters.end()) {
-      std::string known;
-      for (const PlannerParameter& p : info->parameters)
-        known += (known.empty() ? "" : ", ") + p.name;
-      return "planner '" + spec.name + "' has no parameter '" + key + "'" +
-             (known.empty() ? std::string(" (it takes none)") : " (known: " + known + ")");
-    }
+    return it == info->parameters.end() ? nullptr : &*it;
+  };
+  const auto unknown = [&](const std::string& key) {
+    std::string known;
+    for (const PlannerParameter& p : info->parameters)
+      known += (known.empty() ? "" : ", ") + p.name;
+    return "planner '" + spec.name + "' has no parameter '" + key + "'" +
+           (known.empty() ? std::string(" (it takes none)") : " (known: " + known + ")");
+  };
+  const auto choice_list = [](const PlannerParameter& p) {
+    std::string list;
+    for (const std::string& c : p.choices) list += (list.empty() ? "" : " | ") + c;
+    return list;
+  };
+  for (const auto& [key, word] : spec.choices) {
+    const PlannerParameter* parameter = find_parameter(key);
+    if (!parameter) return unknown(key);
+    if (parameter->choices.empty()) return "parameter '" + key + "' takes a number, not a word";
+    if (std::find(parameter->choices.begin(), parameter->choices.end(), word) ==
+        parameter->choices.end())
+      return "parameter '" + key + "' = '" + word + "' is not one of " + choice_list(*parameter);
+  }
+  for (const auto& [key, values] : spec.params) {
+    const PlannerParameter* it = find_parameter(key);
+    if (!it) return unknown(key);
+    if (!it->choices.empty())
+      return "parameter '" + key + "' takes one of " + choice_list(*it) + ", not a number";
     if (values.empty()) return "parameter '" + key + "' has no value";
     if (values.size() > 1 && !it->list_allowed)
       return "parameter '" + key + "' takes a single number, not a list";

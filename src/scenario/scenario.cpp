@@ -771,6 +771,33 @@ void Loader::read_planners(const Field& field) {
     if (!limits_problem.empty()) problems_.add(item.line, item.key, limits_problem);
     for (const Field* parameter : parameter_fields) {
       const std::string key = parameter->key.substr(parameter->key.rfind('.') + 1);
+      // `label:` names the run (its results folder) when a planner runs more than once
+      if (key == "label") {
+        const std::optional<std::string> label = read_string(*parameter, problems_);
+        if (!label) continue;
+        if (label->empty() || label->find_first_of("/\\ \t") != std::string::npos ||
+            *label == "." || *label == "..")
+          problems_.add(parameter->line, parameter->key,
+                        "'" + *label + "' cannot name a results folder (no spaces, '/' or '\\')");
+        else
+          spec.label = *label;
+        continue;
+      }
+      // a choice parameter takes a word from its list
+      const PlannerInfo* info = find_planner(spec.name);
+      const auto declared = std::find_if(info->parameters.begin(), info->parameters.end(),
+                                         [&](const PlannerParameter& p) { return p.name == key; });
+      if (declared != info->parameters.end() && !declared->choices.empty()) {
+        const std::optional<std::string> word = read_string(*parameter, problems_);
+        if (!word) continue;
+        PlannerSpec single{spec.name, {}, spec.line, {{key, *word}}};
+        const std::string problem = check_planner_spec(single);
+        if (!problem.empty())
+          problems_.add(parameter->line, parameter->key, problem);
+        else
+          spec.choices[key] = *word;
+        continue;
+      }
       std::vector<double> values;
       bool ok = true;
       if (parameter->node.IsSequence()) {
@@ -797,11 +824,16 @@ void Loader::read_planners(const Field& field) {
       }
       spec.params[key] = values;
     }
-    // each planner once: results are written per planner name
-    const bool repeated = std::any_of(planners.begin(), planners.end(),
-                                      [&](const PlannerSpec& p) { return p.name == spec.name; });
+    // each run once: results are written per label (the planner's name unless given)
+    const bool repeated = std::any_of(planners.begin(), planners.end(), [&](const PlannerSpec& p) {
+      return p.run_label() == spec.run_label();
+    });
     if (repeated) {
-      problems_.add(item.line, item.key, "planner '" + spec.name + "' is listed twice");
+      problems_.add(
+          item.line, item.key,
+          spec.label.empty()
+              ? "planner '" + spec.name + "' is listed twice (give each a label: to run it twice)"
+              : "label '" + spec.label + "' is used twice");
       continue;
     }
     planners.push_back(std::move(spec));
