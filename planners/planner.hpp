@@ -25,8 +25,8 @@ struct PlannerSpec {
   std::string name;
   std::map<std::string, std::vector<double>> params;
   int line = 0;  // where it was declared, for messages
-  std::map<std::string, std::string> choices;
-  std::string label;  // names the run and its results folder when given (a planner run twice)
+  std::map<std::string, std::string> choices = {};
+  std::string label = {};  // names the run and its results folder when given (a planner run twice)
 
   // the parameter's first value, or `fallback` when absent
   double get(const std::string& key, double fallback) const;
