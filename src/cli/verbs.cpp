@@ -24,7 +24,8 @@ int plan_verb(const RunOptions& options) {
             << summary_table(reports) << '\n';
   for (const MetricsReport& report : reports)
     for (const std::string& warning : report.warnings)
-      std::cout << "warning (" << report.planner << "): " << warning << '\n';
+      std::cout << "warning (" << (report.label.empty() ? report.planner : report.label)
+                << "): " << warning << '\n';
   std::cout << "plans written to " << directory << "/<planner>/{metrics.json,trajectory.csv}\n";
   return kExitOk;
 }
@@ -71,7 +72,7 @@ int run_verb(const RunOptions& options) {
   BackgroundRunWriter writer;
   for (const PlannerSpec& spec : planners) {
     runs.push_back(simulate_job(job, spec, settings));
-    writer.submit(job, runs.back(), (std::filesystem::path(directory) / spec.name).string(),
+    writer.submit(job, runs.back(), (std::filesystem::path(directory) / spec.run_label()).string(),
                   settings);
     reports.push_back(runs.back().report);
   }

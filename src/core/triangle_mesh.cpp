@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <utility>
 
 namespace depotwin {
 
@@ -46,6 +47,47 @@ std::vector<Vec3> TriangleMesh::vertex_normals() const {
   for (Vec3& n : normals) {
     const double length = n.norm();
     if (length > 0.0) n /= length;
+  }
+  return normals;
+}
+
+std::vector<std::array<Vec3, 3>> TriangleMesh::corner_normals(double crease_angle_rad) const {
+  const size_t n_triangles = triangles.size();
+  std::vector<Vec3> facet(n_triangles);
+  std::vector<std::array<double, 3>> angle(n_triangles);
+  // the triangles around each vertex (compressed rows: first[v] .. first[v + 1])
+  std::vector<int> first(vertices.size() + 1, 0);
+  for (size_t t = 0; t < n_triangles; ++t) {
+    facet[t] = facet_normal(t);
+    for (int corner = 0; corner < 3; ++corner) {
+      const Vec3& p = vertices[triangles[t][corner]];
+      const Vec3 a = vertices[triangles[t][(corner + 1) % 3]] - p;
+      const Vec3 b = vertices[triangles[t][(corner + 2) % 3]] - p;
+      angle[t][corner] = std::atan2(a.cross(b).norm(), a.dot(b));
+      ++first[triangles[t][corner] + 1];
+    }
+  }
+  for (size_t v = 0; v < vertices.size(); ++v) first[v + 1] += first[v];
+  std::vector<int> fill(first.begin(), first.end() - 1);
+  std::vector<std::pair<int, int>> around(static_cast<size_t>(first.back()));  // (t, corner)
+  for (size_t t = 0; t < n_triangles; ++t)
+    for (int corner = 0; corner < 3; ++corner)
+      around[fill[triangles[t][corner]]++] = {static_cast<int>(t), corner};
+
+  const double cos_crease = std::cos(crease_angle_rad);
+  std::vector<std::array<Vec3, 3>> normals(n_triangles);
+  for (size_t t = 0; t < n_triangles; ++t) {
+    for (int corner = 0; corner < 3; ++corner) {
+      const int v = triangles[t][corner];
+      Vec3 sum = Vec3::Zero();
+      for (int k = first[v]; k < first[v + 1]; ++k) {
+        const auto [u, u_corner] = around[k];
+        if (facet[u].isZero() || facet[u].dot(facet[t]) < cos_crease) continue;
+        sum += angle[u][u_corner] * facet[u];
+      }
+      const double length = sum.norm();
+      normals[t][corner] = length > 0.0 ? Vec3(sum / length) : facet[t];
+    }
   }
   return normals;
 }

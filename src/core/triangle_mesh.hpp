@@ -27,6 +27,13 @@ struct TriangleMesh {
   // weighted by their corner angle there (independent of how the surface is tessellated);
   // zero for a vertex of degenerate triangles only
   std::vector<Vec3> vertex_normals() const;
+  // unit normals per triangle corner, smooth across edges but not across creases: the normal
+  // at corner c of triangle t is the angle-weighted mean (as vertex_normals) of the facet
+  // normals around that vertex that lie within crease_angle_rad of t's own facet normal. On a
+  // smooth surface this is vertex_normals(); at a sharp edge (a solid's rim, where the top
+  // meets a side wall) each side keeps its own normal instead of a 45-degree average. The
+  // facet normal for a corner of a degenerate triangle (zero: degenerate triangles only).
+  std::vector<std::array<Vec3, 3>> corner_normals(double crease_angle_rad) const;
   // x -> rotation x + offset on every vertex (triangle orientation is kept: rotations only)
   void transform(const Eigen::Matrix3d& rotation, const Vec3& offset);
 };

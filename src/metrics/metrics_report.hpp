@@ -52,6 +52,7 @@ struct SimStats {
 
 struct MetricsReport {
   std::string scenario, machine, planner, sequencer = "as_given";
+  std::string label;  // the run's name (PlannerSpec::run_label): the planner's, or its label
   TimeStats time;
   std::optional<VelocityErrorStats> velocity_error;  // simulated
   VelocityErrorStats planned_velocity_error;

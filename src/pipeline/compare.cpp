@@ -71,7 +71,7 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
   };
   std::vector<Case> cases;
   if (orders.empty()) {
-    for (const PlannerSpec& p : planners) cases.push_back({p.name, p, scenario.order});
+    for (const PlannerSpec& p : planners) cases.push_back({p.run_label(), p, scenario.order});
   } else {
     for (const OrderSpec& o : orders) cases.push_back({o.label(), planners.front(), o});
   }
@@ -94,6 +94,7 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
     runs.push_back(simulate_job(jobs.back(), c.planner, settings));
     SimulatedRun& run = runs.back();
     run.report.planner = c.planner.name;
+    run.report.label = c.label;
     writer.submit(jobs.back(), run, (fs::path(directory) / c.label).string(), settings);
     rows.push_back({c.label, run.report});
   }

@@ -92,6 +92,13 @@ std::vector<PlannerSpec> select_planners(const Scenario& scenario, const std::st
   while (std::getline(list, name, ',')) {
     if (name.empty()) continue;
     bool found = false;
+    // a run's label, else every run of the planner of that name
+    for (const PlannerSpec& spec : scenario.planners) {
+      if (spec.label != name) continue;
+      selected.push_back(spec);
+      found = true;
+    }
+    if (found) continue;
     for (const PlannerSpec& spec : scenario.planners) {
       if (spec.name != name) continue;
       selected.push_back(spec);
@@ -138,6 +145,7 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   r.scenario = job.scenario.name;
   r.machine = job.machine->name();
   r.planner = spec.name;
+  r.label = spec.run_label();
   r.sequencer = job.scenario.order.label();
   r.time.total_s = run.trajectory.duration_s();
   r.time.print_s = run.trajectory.depositing_time_s();
@@ -161,7 +169,7 @@ std::vector<MetricsReport> write_plans(const PreparedJob& job,
   std::vector<MetricsReport> reports;
   for (const PlannerSpec& spec : planners) {
     const PlannedRun run = plan_job(job, spec);
-    StagedDirectory out((fs::path(directory) / spec.name).string());
+    StagedDirectory out((fs::path(directory) / spec.run_label()).string());
     write_file_atomically(out.file("metrics.json"), metrics_json_text(run.report));
     write_file_atomically(out.file("trajectory.csv"), planned_trajectory_csv(run.planned));
     out.commit();
@@ -199,7 +207,7 @@ std::string summary_table(const std::vector<MetricsReport>& reports) {
   header.push_back("warnings");
   rows.push_back(header);
   for (const MetricsReport& r : reports) {
-    std::vector<std::string> row{r.planner,
+    std::vector<std::string> row{r.label.empty() ? r.planner : r.label,
                                  r.sequencer,
                                  fixed(r.time.total_s, 3),
                                  fixed(r.time.print_s, 3),

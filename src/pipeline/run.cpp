@@ -153,7 +153,7 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
     DepositionStep step;
     if (deposition_step(before, after, job_end_s, step)) process.advance(step);
   };
-  ProgressLine progress(scenario.name + "/" + spec.name + ": simulating", settings.progress);
+  ProgressLine progress(scenario.name + "/" + spec.run_label() + ": simulating", settings.progress);
   run.record =
       run.simulation->run(trajectory, on_step, [&](double fraction) { progress.update(fraction); });
   progress.finish();

@@ -24,6 +24,7 @@ Json to_json(const MetricsReport& r) {
   j["scenario"] = r.scenario;
   j["machine"] = r.machine;
   j["planner"] = r.planner;
+  j["run"] = r.label.empty() ? r.planner : r.label;
   j["sequencer"] = r.sequencer;
   j["time_s"] = Json{
       {"total", r.time.total_s}, {"print", r.time.print_s}, {"transition", r.time.transition_s}};
