@@ -64,7 +64,8 @@ int run_verb(const RunOptions& options) {
   const std::string directory = output_directory(scenario, options.out);
   const RunSettings settings = run_settings(scenario, options);
   if (settings.scene_renderer)
-    settings.scene_renderer->prepare(job.model_path, scene_render_options(scenario));
+    settings.scene_renderer->prepare(job.model_path, scene_render_options(scenario),
+                                     job.model_text);
   // each planner simulates while the previous one's results are written
   std::vector<MetricsReport> reports;
   std::vector<SimulatedRun> runs;

@@ -90,7 +90,8 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
     variant.order = c.order;
     jobs.push_back(prepare_job(variant));
     if (settings.scene_renderer)
-      settings.scene_renderer->prepare(jobs.back().model_path, scene_render_options(variant));
+      settings.scene_renderer->prepare(jobs.back().model_path, scene_render_options(variant),
+                                       jobs.back().model_text);
     runs.push_back(simulate_job(jobs.back(), c.planner, settings));
     SimulatedRun& run = runs.back();
     run.report.planner = c.planner.name;

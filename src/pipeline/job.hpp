@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/triangle_mesh.hpp"
 #include "kinematics/machine.hpp"
 #include "metrics/metrics_report.hpp"
 #include "planners/ordering/sequencer.hpp"
@@ -20,7 +21,12 @@ struct PreparedJob {
   Scenario scenario;
   std::unique_ptr<Machine> machine;
   std::string model_path;  // the MJCF to simulate
-  TcpLimits limits;        // what every planner must respect (refers to *machine)
+  // the MJCF text compiled in its place when the job adds a part to it (sim/part_model.hpp);
+  // empty: the file as it is
+  std::string model_text;
+  // the part printed on (conformal work), placed in the work frame; null for planar work
+  std::shared_ptr<const TriangleMesh> part;
+  TcpLimits limits;  // what every planner must respect (refers to *machine)
   OrderResult order;
   Toolpath toolpath;  // in print order
 };

@@ -134,8 +134,8 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   const Scenario& scenario = job.scenario;
 
   // the twin: the machine's MJCF, driven through its actuators
-  run.simulation =
-      std::make_unique<Simulation>(job.model_path, *job.machine, sim_settings(scenario));
+  run.simulation = std::make_unique<Simulation>(job.model_path, *job.machine,
+                                                sim_settings(scenario), job.model_text);
   const DepositionSettings deposition = deposition_settings(scenario);
   deposition.validate();
   run.process = make_process(deposition, scenario.sim.cell_mm);

@@ -357,12 +357,14 @@ SceneRenderer::~SceneRenderer() {
   }
 }
 
-void SceneRenderer::prepare(const std::string& model_path, const SceneRenderOptions& options) {
+void SceneRenderer::prepare(const std::string& model_path, const SceneRenderOptions& options,
+                            const std::string& model_text) {
   const std::lock_guard<std::mutex> lock(mutex_);
   if (contexts_ || preparing_.valid()) return;
   install_mujoco_handlers();  // before the thread: the handlers are process-wide
-  preparing_ = std::async(std::launch::async, [model_path, options] {
-    const ModelPtr model = load_model(model_path);
+  preparing_ = std::async(std::launch::async, [model_path, options, model_text] {
+    const ModelPtr model = model_text.empty() ? load_model(model_path)
+                                              : load_model_from_string(model_text, model_path);
     auto contexts = std::make_unique<Contexts>(*model, context_shape(*model, options));
     contexts->gl.release();  // the rendering thread makes it current
     return contexts;

@@ -56,7 +56,9 @@ class SceneRenderer {
   // background thread, so that the costly set-up overlaps the simulation; the first render
   // waits for it. Errors surface there, or are dropped when the render needs other contexts
   // and they are rebuilt.
-  void prepare(const std::string& model_path, const SceneRenderOptions& options);
+  // `model_text`: the MJCF to compile in place of the file's (Simulation's constructor)
+  void prepare(const std::string& model_path, const SceneRenderOptions& options,
+               const std::string& model_text = {});
 
   // as render_scene_rgb / render_scene_png below
   std::vector<unsigned char> render_rgb(const Simulation& simulation, const HeightMap& deposit,

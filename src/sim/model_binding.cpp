@@ -87,12 +87,13 @@ void bind_shutter(BoundModel& bound, const SimSettings& settings) {
 }  // namespace
 
 BoundModel bind_model(const std::string& model_path, const Machine& machine,
-                      const SimSettings& settings) {
+                      const SimSettings& settings, const std::string& model_text) {
   BoundModel bound;
   bound.model_path = model_path;
   bound.machine = &machine;
   bound.settings = settings;
-  bound.model = load_model(model_path);
+  bound.model =
+      model_text.empty() ? load_model(model_path) : load_model_from_string(model_text, model_path);
   mjModel& m = *bound.model;
   // the TCP site and the work frame
   bound.nozzle_site = require_id(m, mjOBJ_SITE, kNozzleSite, model_path,

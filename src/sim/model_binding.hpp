@@ -32,10 +32,11 @@ struct BoundModel {
   long control_stride = 1;
 };
 
-// Loads the model and resolves every name (see Simulation's constructor for the InputErrors);
-// the state is mj_forward-ed at the model's reference pose.
+// Loads the model (its file, or `model_text` in its place when given: sim/part_model.hpp) and
+// resolves every name (see Simulation's constructor for the InputErrors); the state is
+// mj_forward-ed at the model's reference pose.
 BoundModel bind_model(const std::string& model_path, const Machine& machine,
-                      const SimSettings& settings);
+                      const SimSettings& settings, const std::string& model_text = {});
 
 // the nozzle site relative to the substrate frame, and its velocity relative to the substrate
 void read_nozzle(const BoundModel& bound, Vec3& position_mm, Vec3& velocity_mm_s);

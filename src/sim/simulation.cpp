@@ -77,12 +77,12 @@ struct Simulation::Impl {
 };
 
 Simulation::Simulation(const std::string& model_path, const Machine& machine,
-                       const SimSettings& settings)
+                       const SimSettings& settings, const std::string& model_text)
     : impl_(std::make_unique<Impl>()) {
   const std::string problem = settings.validate();
   if (!problem.empty()) throw InputError("sim", problem);
   Impl& s = *impl_;
-  s.bound = bind_model(model_path, machine, settings);
+  s.bound = bind_model(model_path, machine, settings, model_text);
   const int nv = s.bound.model->nv;
   s.acceleration_reference.assign(nv, 0.0);
   s.inertia_force.assign(nv, 0.0);

@@ -79,8 +79,10 @@ class Simulation {
   // missing joints/actuators, an actuator that is not a position servo, a joint range
   // narrower than the machine's travel, or bad settings. `machine` must outlive the
   // Simulation.
+  // `model_text`, when given, is compiled in place of the file's own text (the model with the
+  // job's part added, sim/part_model.hpp); relative paths in it resolve against model_path.
   Simulation(const std::string& model_path, const Machine& machine,
-             const SimSettings& settings = {});
+             const SimSettings& settings = {}, const std::string& model_text = {});
   ~Simulation();
   Simulation(Simulation&&) noexcept;
   Simulation& operator=(Simulation&&) noexcept;
