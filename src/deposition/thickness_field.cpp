@@ -166,6 +166,28 @@ int ThicknessField::stride_for_max_cells(double x_lo_mm, double y_lo_mm, double 
   return stride;
 }
 
+void ThicknessField::add(const ThicknessField& other) {
+  if (other.cell_mm_ != cell_mm_)
+    throw InternalError("ThicknessField::add: fields with different cells");
+  for (const auto& [tx, ty] : other.tiles_.sorted_tiles()) {
+    const double* from = other.tiles_.find(tx, ty);
+    double* to = tiles_.get_or_create(tx, ty);
+    for (int k = 0; k < Tiles::kCells; ++k) to[k] += from[k];
+  }
+}
+
+void ThicknessField::scale_cells(const std::function<double(double x_mm, double y_mm)>& factor) {
+  for (const auto& [tx, ty] : tiles_.sorted_tiles()) {
+    double* cells = tiles_.find(tx, ty);
+    for (int k = 0; k < Tiles::kCells; ++k) {
+      if (cells[k] == 0.0) continue;
+      const int ix = tx * Tiles::kSize + k % Tiles::kSize;
+      const int iy = ty * Tiles::kSize + k / Tiles::kSize;
+      cells[k] *= factor(ix * cell_mm_, iy * cell_mm_);
+    }
+  }
+}
+
 void ThicknessField::add_to_cell(int ix, int iy, double thickness_mm) {
   tiles_.get_or_create(Tiles::tile_of(ix), Tiles::tile_of(iy))[Tiles::local_index(ix, iy)] +=
       thickness_mm;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 
 #include "core/heightmap.hpp"
 #include "deposition/sparse_tiles.hpp"
@@ -60,6 +61,12 @@ class ThicknessField {
 
   // add material to one cell (thickness in mm); used by tests and importers
   void add_to_cell(int ix, int iy, double thickness_mm);
+  // add another field's material cell by cell (the same cell size; InternalError otherwise):
+  // the layers of a multi-layer print stacked into one deposit
+  void add(const ThicknessField& other);
+  // every cell multiplied by factor(x, y) at its centre (mm): e.g. the vertical thickness of a
+  // deposit on a sloped surface turned into the thickness along the surface normal
+  void scale_cells(const std::function<double(double x_mm, double y_mm)>& factor);
   void clear() { tiles_.clear(); }
 
   // raw tile access for the deposition kernel and the metrics

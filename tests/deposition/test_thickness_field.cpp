@@ -99,5 +99,33 @@ TEST(ThicknessField, MemoryGrowsWithPrintedAreaNotBed) {
               1e-12 * process.account().landed_mm3);
 }
 
+// layers stacked: the sum of two fields, cell by cell, volumes adding up; fields of other cells
+// refused
+TEST(ThicknessField, AddStacksFieldsCellByCell) {
+  ThicknessField a(0.1), b(0.1);
+  a.add_to_cell(3, -70, 0.002);
+  a.add_to_cell(200, 5, 0.001);
+  b.add_to_cell(3, -70, 0.0005);
+  b.add_to_cell(-1, -1, 0.004);
+  a.add(b);
+  EXPECT_DOUBLE_EQ(a.cell_thickness_mm(3, -70), 0.0025);
+  EXPECT_DOUBLE_EQ(a.cell_thickness_mm(200, 5), 0.001);
+  EXPECT_DOUBLE_EQ(a.cell_thickness_mm(-1, -1), 0.004);
+  EXPECT_NEAR(a.total_volume_mm3(), (0.0025 + 0.001 + 0.004) * 0.01, 1e-15);
+  ThicknessField c(0.2);
+  EXPECT_THROW(a.add(c), InternalError);
+}
+
+// the normal-thickness correction: each cell times a factor of its centre's position
+TEST(ThicknessField, ScaleCellsUsesEachCellCentre) {
+  ThicknessField field(0.5);
+  field.add_to_cell(4, -2, 1.0);  // centre (2, -1)
+  field.add_to_cell(-3, 6, 2.0);  // centre (-1.5, 3)
+  field.scale_cells([](double x, double y) { return 0.5 + 0.1 * x + 0.01 * y; });
+  EXPECT_DOUBLE_EQ(field.cell_thickness_mm(4, -2), 1.0 * (0.5 + 0.2 - 0.01));
+  EXPECT_DOUBLE_EQ(field.cell_thickness_mm(-3, 6), 2.0 * (0.5 - 0.15 + 0.03));
+  EXPECT_EQ(field.cell_thickness_mm(0, 0), 0.0);
+}
+
 }  // namespace
 }  // namespace depotwin
