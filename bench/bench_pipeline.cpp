@@ -255,7 +255,7 @@ FinishedRun finished_run() {
   settings.progress = false;
   finished.run = simulate_job(finished.job,
                               select_planners(finished.job.scenario, "lspb_mtt").front(), settings);
-  finished.map = field_heightmap(finished.run.process->field());
+  finished.map = field_heightmap(finished.run.deposit->normal_field());
   return finished;
 }
 
@@ -290,8 +290,8 @@ void BM_RenderRunPlots(benchmark::State& state) {
   input.simulated = &run.simulated;
   input.transitions = plots::transition_intervals(run.plan.trajectory);
   if (!finished.map.thickness_um.empty()) input.thickness = &finished.map;
-  input.profiles = centreline_profiles(run.process->field(), finished.job.toolpath);
-  input.target_thickness_um = target_thickness_um(*run.process, finished.job.toolpath);
+  input.profiles = centreline_profiles(run.deposit->normal_field(), finished.job.toolpath);
+  input.target_thickness_um = target_thickness_um(run.deposit->front(), finished.job.toolpath);
   if (run.report.thickness) input.mean_thickness_um = run.report.thickness->mean_um;
   ScratchDirectory scratch;
   size_t images = 0;

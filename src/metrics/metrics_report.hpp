@@ -50,6 +50,51 @@ struct SimStats {
   double max_constraint_violation_mm = 0.0;
 };
 
+// One layer of a multi-layer (conformal) job: the same metrics as the whole job, over that
+// layer's paths, its own deposit (thickness along the surface normal) and its own material.
+struct LayerReport {
+  int layer = 0;
+  int paths = 0;
+  double print_length_mm = 0.0;
+  double print_s = 0.0;                              // planned depositing time on this layer
+  std::optional<VelocityErrorStats> velocity_error;  // simulated
+  VelocityErrorStats planned_velocity_error;
+  PathErrorStats path_error;  // simulated when simulated, else planned
+  std::optional<ThicknessSummary> thickness;
+  std::optional<WasteStats> waste;
+  std::optional<MaterialStats> material;
+};
+
+// Where a 6-DOF arm stood over the job (metrics.json "arm"): the smallest distances to its
+// joint limits, to singularity and to the part, and what went wrong.
+struct ArmPostureStats {
+  double min_joint_margin_deg = 0.0;        // smallest distance of a joint to its range's end
+  double min_manipulability = 0.0;          // Yoshikawa's sqrt(det(J J^T)), linear rows in m
+  double min_wrist_centre_offset_mm = 0.0;  // wrist centre from the joint-1 axis
+  double min_wrist_alignment = 0.0;         // |sin q5|: 0 when joints 4 and 6 line up
+  double min_clearance_mm = 0.0;            // links and tool body to the part (FCL)
+  std::string nearest_shape;                // which shape came closest
+};
+struct ArmStats {
+  // the simulated run (every recorded step; clearance every clearance_period_s)
+  ArmPostureStats run;
+  int collisions = 0;      // contact events: tool or links against the part (clearance <= 0),
+                           // the table or each other (MuJoCo contacts)
+  int part_contacts = 0;   // of which against the part
+  int table_contacts = 0;  // of which against the table (or anything not an arm link)
+  int self_contacts = 0;   // of which between the arm's own links
+  int branch_changes = 0;  // changes of the IK branch along the run
+  int branch = 0;          // the branch the job was printed on
+  double clearance_period_s = 0.0;
+  // the roll about the nozzle axis: as chosen, and the best fixed roll, at the toolpath's
+  // points (planned); the gain is what the chosen rolls add
+  std::string roll_strategy;  // optimized | fixed
+  double fixed_roll_deg = 0.0;
+  ArmPostureStats chosen_roll, fixed_roll;
+  bool fixed_roll_feasible = true;
+  std::string fixed_roll_problem;  // why the fixed roll fails, when it does
+};
+
 struct MetricsReport {
   std::string scenario, machine, planner, sequencer = "as_given";
   std::string label;  // the run's name (PlannerSpec::run_label): the planner's, or its label
@@ -65,6 +110,8 @@ struct MetricsReport {
   std::optional<OrderStats> order;
   std::vector<std::string> warnings;
   std::optional<SimStats> sim;
+  std::vector<LayerReport> layers;  // multi-layer and conformal jobs
+  std::optional<ArmStats> arm;      // the 6-DOF arm
 };
 
 }  // namespace depotwin

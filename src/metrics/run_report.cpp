@@ -99,6 +99,60 @@ SimStats sim_stats(const RecordedRun& record) {
 
 }  // namespace
 
+MotionSamples only_layer(const MotionSamples& samples, const Toolpath& toolpath, int layer) {
+  MotionSamples kept = samples;
+  for (size_t k = 0; k < kept.size(); ++k) {
+    const int path = kept.path_index[k];
+    if (path < 0 || toolpath.paths[static_cast<size_t>(path)].layer != layer)
+      kept.depositing[k] = 0;
+  }
+  return kept;
+}
+
+std::vector<LayerReport> layer_reports(const Toolpath& toolpath, const MotionSamples& planned,
+                                       const MotionSamples& simulated,
+                                       const LayeredDeposit& deposit) {
+  std::vector<LayerReport> reports;
+  const double period_s = planned.size() > 1 ? planned.t_s[1] - planned.t_s[0] : 0.0;
+  for (int layer = 0; layer < toolpath.layer_count(); ++layer) {
+    LayerReport r;
+    r.layer = layer;
+    // the layer's own paths, joined where they touch (as for the whole job)
+    Toolpath paths;
+    for (const PrintPath& path : toolpath.paths) {
+      if (path.layer != layer) continue;
+      ++r.paths;
+      r.print_length_mm += path.length_mm();
+      paths.paths.push_back(path);
+    }
+    // motion: the samples printing this layer
+    const MotionSamples planned_here = only_layer(planned, toolpath, layer);
+    for (size_t k = 0; k + 1 < planned_here.size(); ++k)
+      if (planned_here.depositing[k]) r.print_s += period_s;
+    r.planned_velocity_error = velocity_error(planned_here);
+    r.path_error = path_error(planned_here, toolpath);
+    if (!simulated.t_s.empty()) {
+      const MotionSamples simulated_here = only_layer(simulated, toolpath, layer);
+      r.velocity_error = velocity_error(simulated_here);
+      r.path_error = path_error(simulated_here, toolpath);
+      // the layer's deposit: thickness along the normal, volumes from its own process
+      if (!paths.paths.empty()) {
+        const Toolpath merged = merge_joined_paths(paths);
+        const ThicknessField& vertical = deposit.layer(layer).field();
+        const TargetRegion region(merged, deposit.line_width_mm(), vertical.cell_mm());
+        r.thickness =
+            thickness_summary(thickness_stats(deposit.layer_normal_field(layer), region, merged));
+        MetricsReport split;
+        material_and_waste(split_material(vertical, region, deposit.layer(layer).account()), split);
+        r.waste = split.waste;
+        r.material = split.material;
+      }
+    }
+    reports.push_back(std::move(r));
+  }
+  return reports;
+}
+
 void add_simulated_metrics(MetricsReport& r, const RecordedRun& record,
                            const MotionSamples& simulated, const Toolpath& toolpath,
                            const DepositionMetrics& deposited) {

@@ -9,6 +9,7 @@
 #include "core/toolpath.hpp"
 #include "core/trajectory.hpp"
 #include "deposition/deposition_metrics.hpp"
+#include "deposition/layered_deposit.hpp"
 #include "metrics/metrics_report.hpp"
 #include "metrics/motion_metrics.hpp"
 
@@ -31,5 +32,16 @@ ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointL
 void add_simulated_metrics(MetricsReport& report, const RecordedRun& record,
                            const MotionSamples& simulated, const Toolpath& toolpath,
                            const DepositionMetrics& deposited);
+
+// The samples with material off wherever another layer's path is printed (path_index names a
+// path of `toolpath`)
+MotionSamples only_layer(const MotionSamples& samples, const Toolpath& toolpath, int layer);
+
+// Every layer's metrics: its paths, the planned and simulated velocity and path error over the
+// samples printing it, its own deposit's thickness (along the normal) and material. `planned`
+// is the plan's samples; `simulated` may be empty (a plan only: no deposit either).
+std::vector<LayerReport> layer_reports(const Toolpath& toolpath, const MotionSamples& planned,
+                                       const MotionSamples& simulated,
+                                       const LayeredDeposit& deposit);
 
 }  // namespace depotwin

@@ -17,6 +17,7 @@
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
 #include "report/trajectory_csv.hpp"
+#include "toolpath/surface_projection.hpp"
 
 namespace depotwin {
 
@@ -138,20 +139,34 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
                                                 sim_settings(scenario), job.model_text);
   const DepositionSettings deposition = deposition_settings(scenario);
   deposition.validate();
-  run.process = make_process(deposition, scenario.sim.cell_mm);
+  // one process per layer; on a part, the surface's slope under each cell (n_z) turns the
+  // vertical thickness into thickness along the normal
+  LayeredDeposit::NormalZ normal_z;
+  if (job.part) {
+    auto projector = std::make_shared<const SurfaceProjector>(*job.part);
+    normal_z = [projector](double x_mm, double y_mm) {
+      const std::optional<SurfaceHit> hit = projector->project_down(x_mm, y_mm);
+      return hit && hit->faces_up() ? hit->normal.z() : 1.0;
+    };
+  }
+  run.deposit = std::make_unique<LayeredDeposit>(deposition, scenario.sim.cell_mm,
+                                                 job.toolpath.layer_count(), normal_z);
 
   // loads carried through closed chains (a delta's platform) by the machine's own model
   if (job.machine->has_closures())
     run.simulation->set_feedforward_hook(
         closure_feedforward_hook(*job.machine, trajectory, sim_settings(scenario)));
 
-  // every step of the job deposits along the simulated nozzle's chord; the aerosol stream
-  // runs from job start to job end (the end of the trajectory), not through the settling
-  Process& process = *run.process;
+  // every step of the job deposits along the simulated nozzle's chord, into the layer of the
+  // path being printed (a transition's into the last one's); the aerosol stream runs from job
+  // start to job end (the end of the trajectory), not through the settling
+  LayeredDeposit& deposit = *run.deposit;
   const double job_end_s = trajectory.duration_s();
+  int layer = 0;
   auto on_step = [&](const StepState& before, const StepState& after) {
+    if (before.path_index >= 0) layer = job.toolpath.paths[before.path_index].layer;
     DepositionStep step;
-    if (deposition_step(before, after, job_end_s, step)) process.advance(step);
+    if (deposition_step(before, after, job_end_s, step)) deposit.advance(step, layer);
   };
   ProgressLine progress(scenario.name + "/" + spec.run_label() + ": simulating", settings.progress);
   run.record =
@@ -161,17 +176,23 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
 
   // extrusion: what still flows when the job ends lands where the nozzle stopped
   if (!run.record.nozzle_mm.empty())
-    deposit_remaining_flow(process, run.record.nozzle_mm.back(), job_end_s);
-  process.flush();  // the last batched deposition steps, before anything reads the field
+    deposit_remaining_flow(deposit.layer(layer), run.record.nozzle_mm.back(), job_end_s);
+  deposit.finish();  // the last batched steps put down, the layers stacked
 
-  // scores from the recorded run only: joints inside a continuous print are not path ends
+  // scores from the recorded run only: joints inside a continuous print are not path ends;
+  // thickness along the surface normal, volumes from the vertical deposit
   run.simulated = recorded_motion(run.record);
   run.planned_at_steps = trajectory_motion_at(trajectory, run.record.t_s);
   run.report = run.plan.report;
-  const DepositionMetrics deposited =
-      evaluate_deposition(process.field(), merge_joined_paths(job.toolpath),
-                          process.line_width_mm(), process.account());
+  const Toolpath merged = merge_joined_paths(job.toolpath);
+  const TargetRegion region(merged, deposit.line_width_mm(), deposit.field().cell_mm());
+  DepositionMetrics deposited;
+  deposited.thickness = thickness_stats(deposit.normal_field(), region, merged);
+  deposited.material = split_material(deposit.field(), region, deposit.account());
   add_simulated_metrics(run.report, run.record, run.simulated, job.toolpath, deposited);
+  // multi-layer and conformal jobs: every metric per layer too
+  if (job.toolpath.layer_count() > 1 || job.part)
+    run.report.layers = layer_reports(job.toolpath, run.plan.planned, run.simulated, deposit);
   run.report.actuators = actuator_stats(run.record, job.machine->joint_limits(),
                                         run.simulation->actuator_force_limits());
   return run;
@@ -195,7 +216,7 @@ HeightMap field_heightmap(const ThicknessField& field, size_t max_cells) {
 void write_run(const PreparedJob& job, const SimulatedRun& run, const std::string& run_directory,
                const RunSettings& settings) {
   StagedDirectory out(run_directory);
-  const ThicknessField& field = run.process->field();
+  const ThicknessField& field = run.deposit->normal_field();
   const HeightMap map = field_heightmap(field, kMaxExportCells);  // at most ~4 M cells
   const std::string directory = out.path();
 
@@ -213,7 +234,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
       input.transitions = plots::transition_intervals(run.plan.trajectory);
       if (!map.thickness_um.empty()) input.thickness = &map;
       input.profiles = centreline_profiles(field, job.toolpath);
-      input.target_thickness_um = target_thickness_um(*run.process, job.toolpath);
+      input.target_thickness_um = target_thickness_um(run.deposit->front(), job.toolpath);
       if (run.report.thickness) input.mean_thickness_um = run.report.thickness->mean_um;
       plots::render_run_plots(input, directory);
     });

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "deposition/job_deposition.hpp"
+#include "deposition/layered_deposit.hpp"
 #include "deposition/process.hpp"
 #include "pipeline/job.hpp"
 #include "plots/plots.hpp"
@@ -30,9 +31,11 @@ struct SimulatedRun {
   PlannedRun plan;
   std::unique_ptr<Simulation> simulation;  // its final state feeds the scene render
   RecordedRun record;
-  std::unique_ptr<Process> process;  // owns the thickness field and the material account
-  MotionSamples simulated;           // the simulated nozzle, one sample per recorded state
-  MotionSamples planned_at_steps;    // the plan at the same times
+  // the deposit, layer by layer (one process per layer, stacked; thickness along the surface
+  // normal on a curved part): owns the thickness fields and the material accounts
+  std::unique_ptr<LayeredDeposit> deposit;
+  MotionSamples simulated;         // the simulated nozzle, one sample per recorded state
+  MotionSamples planned_at_steps;  // the plan at the same times
   MetricsReport report;
 };
 

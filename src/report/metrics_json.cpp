@@ -17,6 +17,75 @@ Json to_json(const PathErrorStats& s) {
   return Json{{"max", s.max_mm}, {"rms", s.rms_mm}};
 }
 
+Json to_json(const ThicknessSummary& t) {
+  return Json{{"mean_um", t.mean_um},
+              {"cv", t.cv},
+              {"line_cv", t.line_cv},
+              {"min_rel", t.min_rel},
+              {"max_rel", t.max_rel}};
+}
+
+Json to_json(const WasteStats& w) {
+  return Json{{"fraction", w.fraction},
+              {"shutter_captured", w.shutter_captured},
+              {"overspray", w.overspray},
+              {"closed_time_s", w.closed_time_s}};
+}
+
+Json to_json(const MaterialStats& m) {
+  return Json{{"emitted", m.emitted},
+              {"on_target", m.on_target},
+              {"overspray", m.overspray},
+              {"captured", m.captured}};
+}
+
+Json to_json(const LayerReport& l) {
+  Json j;
+  j["layer"] = l.layer;
+  j["paths"] = l.paths;
+  j["print_length_mm"] = l.print_length_mm;
+  j["time_s"] = Json{{"print", l.print_s}};
+  if (l.velocity_error) j["velocity_error"] = to_json(*l.velocity_error);
+  j["planned_velocity_error"] = to_json(l.planned_velocity_error);
+  j["path_error_mm"] = to_json(l.path_error);
+  if (l.thickness) j["thickness"] = to_json(*l.thickness);
+  if (l.waste) j["waste"] = to_json(*l.waste);
+  if (l.material) j["material_mm3"] = to_json(*l.material);
+  return j;
+}
+
+Json to_json(const ArmPostureStats& p) {
+  return Json{{"min_joint_margin_deg", p.min_joint_margin_deg},
+              {"min_manipulability", p.min_manipulability},
+              {"min_wrist_centre_offset_mm", p.min_wrist_centre_offset_mm},
+              {"min_wrist_alignment", p.min_wrist_alignment},
+              {"min_clearance_mm", p.min_clearance_mm},
+              {"nearest_shape", p.nearest_shape}};
+}
+
+Json to_json(const ArmStats& a) {
+  // the contract's keys first (the simulated run), then the details
+  Json j{{"min_joint_margin_deg", a.run.min_joint_margin_deg},
+         {"min_manipulability", a.run.min_manipulability},
+         {"min_clearance_mm", a.run.min_clearance_mm},
+         {"collisions", a.collisions},
+         {"branch_changes", a.branch_changes}};
+  j["min_wrist_centre_offset_mm"] = a.run.min_wrist_centre_offset_mm;
+  j["min_wrist_alignment"] = a.run.min_wrist_alignment;
+  j["nearest_shape"] = a.run.nearest_shape;
+  j["contacts"] =
+      Json{{"part", a.part_contacts}, {"table", a.table_contacts}, {"self", a.self_contacts}};
+  j["branch"] = a.branch;
+  j["clearance_period_s"] = a.clearance_period_s;
+  j["roll"] = Json{{"strategy", a.roll_strategy},
+                   {"chosen", to_json(a.chosen_roll)},
+                   {"fixed", to_json(a.fixed_roll)},
+                   {"fixed_roll_deg", a.fixed_roll_deg},
+                   {"fixed_feasible", a.fixed_roll_feasible},
+                   {"fixed_problem", a.fixed_roll_problem}};
+  return j;
+}
+
 }  // namespace
 
 Json to_json(const MetricsReport& r) {
@@ -32,28 +101,9 @@ Json to_json(const MetricsReport& r) {
   j["planned_velocity_error"] = to_json(r.planned_velocity_error);
   j["path_error_mm"] = to_json(r.path_error);
   if (r.planned_path_error) j["planned_path_error_mm"] = to_json(*r.planned_path_error);
-  if (r.thickness) {
-    const ThicknessSummary& t = *r.thickness;
-    j["thickness"] = Json{{"mean_um", t.mean_um},
-                          {"cv", t.cv},
-                          {"line_cv", t.line_cv},
-                          {"min_rel", t.min_rel},
-                          {"max_rel", t.max_rel}};
-  }
-  if (r.waste) {
-    const WasteStats& w = *r.waste;
-    j["waste"] = Json{{"fraction", w.fraction},
-                      {"shutter_captured", w.shutter_captured},
-                      {"overspray", w.overspray},
-                      {"closed_time_s", w.closed_time_s}};
-  }
-  if (r.material) {
-    const MaterialStats& m = *r.material;
-    j["material_mm3"] = Json{{"emitted", m.emitted},
-                             {"on_target", m.on_target},
-                             {"overspray", m.overspray},
-                             {"captured", m.captured}};
-  }
+  if (r.thickness) j["thickness"] = to_json(*r.thickness);
+  if (r.waste) j["waste"] = to_json(*r.waste);
+  if (r.material) j["material_mm3"] = to_json(*r.material);
   if (r.actuators) {
     const ActuatorStats& a = *r.actuators;
     j["actuators"] = Json{{"joints", a.joint_names},
@@ -83,6 +133,12 @@ Json to_json(const MetricsReport& r) {
                     {"wall_s", s.wall_s},
                     {"realtime_factor", s.realtime_factor},
                     {"max_constraint_violation_mm", s.max_constraint_violation_mm}};
+  }
+  if (r.arm) j["arm"] = to_json(*r.arm);
+  if (!r.layers.empty()) {
+    Json layers = Json::array();
+    for (const LayerReport& layer : r.layers) layers.push_back(to_json(layer));
+    j["layers"] = layers;
   }
   return j;
 }

@@ -8,10 +8,14 @@
 #include <fstream>
 #include <sstream>
 
+#include <Eigen/Geometry>
+
 #include "kinematics/machine.hpp"
 #include "scenario/yaml_reader.hpp"
 #include "toolpath/gcode.hpp"
+#include "toolpath/hatching.hpp"
 #include "toolpath/random_segments.hpp"
+#include "toolpath/stl.hpp"
 
 namespace depotwin {
 
@@ -30,6 +34,8 @@ constexpr double kSpeedTolerance = 1e-9;
 constexpr int kMinImageSize = 16;
 constexpr int kMaxImageSize = 2048;
 constexpr long long kMaxRandomSegments = 100000;
+// a surface toolpath starts and ends this far above the part's highest point (and its layers)
+constexpr double kSurfaceClearance_mm = 20.0;
 
 std::string join(const std::vector<std::string>& names, const std::string& separator = ", ") {
   std::string text;
@@ -92,6 +98,8 @@ class Loader {
   void read_gcode_file(const Field& field, const std::optional<double>& default_speed);
   void read_random_segments(const Field& field, const std::optional<double>& default_speed,
                             bool start_given, bool end_given);
+  void read_surface(const Field& field, const std::optional<double>& default_speed,
+                    bool start_given, bool end_given);
   std::optional<std::vector<Vec3>> read_points(const Field& field, std::vector<int>& lines);
   void check_path(const PrintPath& path, const PathOrigin& origin);
   void read_order(const Field& field);
@@ -374,7 +382,7 @@ void Loader::read_toolpath(const Field* field) {
   if (const Field* f = view.find("end"))
     toolpath.end_mm = read_point(*f, problems_).value_or(toolpath.start_mm);
 
-  // exactly one kind of print paths
+  // exactly one kind of print paths (segments, polylines, gcode, random_segments, surface)
   std::vector<const Field*> kinds;
   for (const std::string& kind : kToolpathKinds)
     if (const Field* f = view.find(kind)) kinds.push_back(f);
@@ -383,14 +391,16 @@ void Loader::read_toolpath(const Field* field) {
   if (kinds.empty()) {
     problems_.add(
         field->key_line, field->key,
-        "no print paths: give exactly one of segments, polylines, gcode, random_segments");
+        "no print paths: give exactly one of segments, polylines, gcode, random_segments, "
+        "surface");
     return;
   }
   for (std::size_t i = 1; i < kinds.size(); ++i)
-    problems_.add(kinds[i]->line, kinds[i]->key,
-                  "a toolpath takes exactly one of segments, polylines, gcode, random_segments; "
-                  "remove this or " +
-                      kinds.front()->key);
+    problems_.add(
+        kinds[i]->line, kinds[i]->key,
+        "a toolpath takes exactly one of segments, polylines, gcode, random_segments, surface; "
+        "remove this or " +
+            kinds.front()->key);
   const Field& kind = *kinds.front();
   const std::string name = kind.key.substr(kind.key.rfind('.') + 1);
   if (name == "segments") {
@@ -402,12 +412,16 @@ void Loader::read_toolpath(const Field* field) {
   } else if (name == "random_segments") {
     read_random_segments(kind, default_speed, view.has("start"), view.has("end"));
   } else {
-    problems_.add(kind.line, kind.key,
-                  "surface toolpaths are not supported yet (use segments, polylines or gcode)");
+    read_surface(kind, default_speed, view.has("start"), view.has("end"));
   }
 
-  // an offset moves everything (e.g. a G-code file or a random bed onto the machine)
-  if (const Field* f = view.find("offset")) {
+  // an offset moves everything (e.g. a G-code file or a random bed onto the machine); a part
+  // is placed by its own surface.offset, which moves the part and its paths together
+  if (const Field* f = view.find("offset"); f && name == "surface") {
+    problems_.add(f->line, f->key,
+                  "a surface toolpath is placed by surface.offset (and surface.rotation), which "
+                  "move the part with its paths");
+  } else if (f) {
     if (const std::optional<Vec3> offset = read_point(*f, problems_)) {
       toolpath.start_mm += *offset;
       toolpath.end_mm += *offset;
@@ -606,6 +620,155 @@ void Loader::read_random_segments(const Field& field, const std::optional<double
                                 std::vector<int>(path.points.size(), field.key_line), true});
     scenario_.toolpath.paths.push_back(std::move(path));
   }
+}
+
+void Loader::read_surface(const Field& field, const std::optional<double>& default_speed,
+                          bool start_given, bool end_given) {
+  const std::size_t problems_before = problems_.size();
+  const MapView view(field,
+                     {"file", "units", "offset", "rotation", "hatch_mm", "angles", "layers",
+                      "layer_height_mm", "alpha", "layer_offset", "speed"},
+                     problems_);
+  if (!view.is_map()) return;
+  auto surface = std::make_shared<SurfaceToolpath>();
+  surface->line = field.key_line;
+
+  // the part: its STL file, units and placement
+  std::string given_file;
+  if (const Field* f = view.find("file")) {
+    if (const std::optional<std::string> file = read_string(*f, problems_)) {
+      given_file = *file;
+      const fs::path resolved = resolve(*file);
+      std::error_code error;
+      if (!fs::is_regular_file(resolved, error))
+        problems_.add(f->line, f->key,
+                      "STL file '" + *file + "' not found (looked for " + resolved.string() + ")");
+      else
+        surface->file = resolved.string();
+    }
+  } else {
+    problems_.add(field.key_line, field.key, "missing file: the STL of the part's top surface");
+  }
+  if (const Field* f = view.find("units")) {
+    const std::optional<std::string> units = read_string(*f, problems_);
+    if (units && *units == "mm")
+      surface->mm_per_unit = 1.0;
+    else if (units && (*units == "inch" || *units == "in"))
+      surface->mm_per_unit = 25.4;
+    else if (units)
+      problems_.add(f->line, f->key, "unknown units '" + *units + "' (expected mm or inch)");
+  }
+  if (const Field* f = view.find("offset"))
+    surface->offset_mm = read_point(*f, problems_).value_or(Vec3::Zero());
+  if (const Field* f = view.find("rotation")) {
+    if (f->node.IsScalar()) {
+      surface->rotation_deg.z() = read_number(*f, problems_).value_or(0.0);
+    } else if (const auto angles = read_numbers(*f, problems_, 3, Range{})) {
+      surface->rotation_deg = Vec3((*angles)[0], (*angles)[1], (*angles)[2]);
+    }
+  }
+
+  // the hatch (Algorithm 1)
+  if (const Field* f = view.find("hatch_mm"))
+    surface->hatch_mm =
+        read_number(*f, problems_, Range{0.01, true, 100.0, true}).value_or(surface->hatch_mm);
+  if (const Field* f = view.find("angles")) {
+    if (expect_list(*f, problems_, "a list of hatch angles in degrees, e.g. [0, 90]")) {
+      if (f->node.size() == 0) problems_.add(f->line, f->key, "is empty: give at least one angle");
+      std::vector<double> angles;
+      for (std::size_t i = 0; i < f->node.size(); ++i)
+        if (const std::optional<double> angle = read_number(f->item(i), problems_))
+          angles.push_back(*angle);
+      if (!angles.empty()) surface->angles_deg = angles;
+    }
+  }
+  if (const Field* f = view.find("layers"))
+    surface->layers = static_cast<int>(read_integer(*f, problems_, 1, 1000).value_or(1));
+  if (const Field* f = view.find("layer_height_mm"))
+    surface->layer_height_mm =
+        read_number(*f, problems_, Range::positive()).value_or(surface->layer_height_mm);
+  if (const Field* f = view.find("alpha"))
+    surface->alpha = read_number(*f, problems_, Range{0.0, true, 1.0, true}).value_or(0.5);
+  if (const Field* f = view.find("layer_offset")) {
+    const std::optional<std::string> mode = read_string(*f, problems_);
+    if (mode && (*mode == "normal" || *mode == "z"))
+      surface->layer_offset = *mode;
+    else if (mode)
+      problems_.add(f->line, f->key,
+                    "unknown layer offset '" + *mode +
+                        "' (expected normal: along the surface normal, or z: vertical, as in "
+                        "the paper)");
+  }
+  std::optional<double> speed = default_speed;
+  if (const Field* f = view.find("speed")) speed = read_number(*f, problems_, Range::positive());
+  if (!speed && !speed_missing_ && !view.has("speed")) {
+    problems_.add(field.key_line, field.key, "no print speed: give toolpath.speed or speed: here");
+    speed_missing_ = true;
+  }
+  if (problems_.size() != problems_before || surface->file.empty() || !speed) return;
+
+  // read and place the part; hatch it
+  TriangleMesh part;
+  SurfaceHatch hatch;
+  try {
+    part = read_stl(surface->file, surface->mm_per_unit, field.key + ".file");
+    const Eigen::Matrix3d rotation =
+        (Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.z()), Vec3::UnitZ()) *
+         Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.y()), Vec3::UnitY()) *
+         Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.x()), Vec3::UnitX()))
+            .toRotationMatrix();
+    part.transform(rotation, surface->offset_mm);
+    SurfaceHatchSpec spec;
+    spec.hatch_mm = surface->hatch_mm;
+    spec.angles_deg = surface->angles_deg;
+    spec.layers = surface->layers;
+    spec.layer_height_mm = surface->layer_height_mm;
+    spec.alpha = surface->alpha;
+    spec.offset = surface->layer_offset == "z" ? SurfaceHatchSpec::Offset::z
+                                               : SurfaceHatchSpec::Offset::normal;
+    spec.speed_mm_s = *speed;
+    hatch = hatch_surface(part, spec);
+  } catch (const InputError& e) {
+    // the reader's and the hatch's problems name this file and line
+    for (Problem p : e.problems()) {
+      if (p.file.empty() || p.file == surface->file) {
+        p.message = (p.file.empty() ? std::string() : "'" + given_file + "': ") + p.message;
+        p.file = problems_.file();
+        p.line = field.key_line;
+      }
+      problems_.add_problem(p);
+    }
+    return;
+  }
+  if (hatch.toolpath.paths.empty()) {
+    problems_.add(field.key_line, field.key,
+                  "the hatch found no printable surface on '" + given_file +
+                      "' (seen from above; check units, offset and rotation)");
+    return;
+  }
+
+  // the paths, where each came from, and a start and end above the part by default
+  Toolpath& toolpath = scenario_.toolpath;
+  for (std::size_t i = 0; i < hatch.toolpath.paths.size(); ++i) {
+    PrintPath path = hatch.toolpath.paths[i];
+    path.source_index = static_cast<int>(i);
+    check_path(path, PathOrigin{problems_.file(), field.key,
+                                std::vector<int>(path.points.size(), field.key_line), false});
+    toolpath.paths.push_back(std::move(path));
+    SurfaceToolpath::PathOrigin origin;
+    origin.layer = hatch.info[i].layer;
+    origin.line = hatch.info[i].line;
+    origin.point_index = hatch.info[i].point_index;
+    surface->origins.push_back(std::move(origin));
+  }
+  Vec3 lo, hi;
+  part.bounds(lo, hi);
+  const Vec3 above((lo.x() + hi.x()) / 2, (lo.y() + hi.y()) / 2,
+                   hi.z() + kSurfaceClearance_mm + surface->layers * surface->layer_height_mm);
+  if (!start_given) toolpath.start_mm = above;
+  if (!end_given) toolpath.end_mm = start_given ? toolpath.start_mm : above;
+  scenario_.surface = std::move(surface);
+  scenario_.part = std::make_shared<const TriangleMesh>(std::move(part));
 }
 
 void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
@@ -884,6 +1047,17 @@ void Loader::read_outputs(const Field& field) {
 }
 
 }  // namespace
+
+std::string SurfaceToolpath::describe_point(int source_index, size_t point, size_t point_count,
+                                            bool reversed) const {
+  if (source_index < 0 || static_cast<size_t>(source_index) >= origins.size())
+    return "path " + std::to_string(source_index) + ", point " + std::to_string(point);
+  const PathOrigin& origin = origins[static_cast<size_t>(source_index)];
+  const size_t i = reversed ? point_count - 1 - point : point;
+  const int along = i < origin.point_index.size() ? origin.point_index[i] : static_cast<int>(i);
+  return "layer " + std::to_string(origin.layer) + ", line " + std::to_string(origin.line) +
+         ", point " + std::to_string(along);
+}
 
 Scenario load_scenario(const std::string& path) {
   return Loader(path).load();

@@ -4,12 +4,14 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/error.hpp"
 #include "core/limits.hpp"
 #include "core/toolpath.hpp"
+#include "core/triangle_mesh.hpp"
 #include "planners/ordering/sequencer.hpp"
 #include "planners/planner.hpp"
 
@@ -46,6 +48,34 @@ struct OutputSpec {
   int image_height = 480;
 };
 
+// `toolpath: {surface: ...}` — conformal hatching on a part's top surface (Shembekar et al.,
+// Algorithm 1): where the part came from, how it was placed and hatched (toolpath/hatching.hpp).
+struct SurfaceToolpath {
+  std::string file;          // the STL file, resolved against the scenario's directory
+  double mm_per_unit = 1.0;  // units: mm (1) or inch (25.4)
+  Vec3 offset_mm = Vec3::Zero();
+  Vec3 rotation_deg = Vec3::Zero();  // about x, then y, then z (fixed axes), before the offset
+  double hatch_mm = 0.5;
+  std::vector<double> angles_deg{0.0, 90.0};
+  int layers = 1;
+  double layer_height_mm = 0.5;
+  double alpha = 0.5;
+  std::string layer_offset = "normal";  // normal | z
+  int line = 0;                         // the `surface:` key's line, for messages
+  // per print path (in the scenario's order, PrintPath::source_index): its layer, its grid
+  // line and each point's index along that line, for messages naming a point
+  struct PathOrigin {
+    int layer = 0, line = 0;
+    std::vector<int> point_index;
+  };
+  std::vector<PathOrigin> origins;
+
+  // "layer 3, line 12, point 40" for point `point` of the path with this source index, given
+  // the path's first point as printed (a sequencer may have reversed it)
+  std::string describe_point(int source_index, size_t point, size_t point_count,
+                             bool reversed) const;
+};
+
 struct Scenario {
   std::string file;       // the scenario file as given
   std::string directory;  // its directory: relative paths resolve against it
@@ -62,6 +92,10 @@ struct Scenario {
   int joint_limits_line = 0;  // where `limits.joint` was given, for messages
   ProcessSpec process;
   Toolpath toolpath;
+  // conformal work: the surface toolpath's settings and the part, placed in the work frame
+  // (mm); null / empty for planar toolpaths
+  std::shared_ptr<const SurfaceToolpath> surface;
+  std::shared_ptr<const TriangleMesh> part;
   OrderSpec order;
   std::vector<PlannerSpec> planners;
   SimSpec sim;

@@ -432,8 +432,8 @@ struct LineProfile {
 };
 
 LineProfile line_profile(const DeltaRun& line) {
-  const ThicknessField& field = line.run.process->field();
-  const double sigma_mm = line.run.process->footprint_sigma_mm();
+  const ThicknessField& field = line.run.deposit->field();
+  const double sigma_mm = line.run.deposit->footprint_sigma_mm();
   LineProfile profile;
   std::vector<double> central;
   for (double s = 2.0; s <= 28.0 + 1e-9; s += field.cell_mm())

@@ -60,7 +60,7 @@ TEST(XyPipeline, StraightLineAtConstantSpeed) {
   // the centreline peak of a steady Gaussian line: Q / (v sigma sqrt(2 pi))
   const DepositionSettings settings = deposition_settings(job.scenario);
   const double expected_mm = settings.aerosol_flow_mm3_s() / (3.0 * 0.1 * std::sqrt(2.0 * kPi));
-  const ThicknessField& field = run.process->field();
+  const ThicknessField& field = run.deposit->field();
   for (double x : {5.0, 10.0, 15.0})
     EXPECT_NEAR(field.thickness_mm_at(x, 0.0), expected_mm, 0.01 * expected_mm) << "x " << x;
 
@@ -130,7 +130,7 @@ TEST(XyPipeline, WritesEveryOutputAndImagesShowTheDeposit) {
 
   // the same end state with the shutter never opened (no deposit) looks different on the
   // substrate: count pixels that differ
-  const HeightMap deposit = field_heightmap(run.process->field());
+  const HeightMap deposit = field_heightmap(run.deposit->field());
   const auto with = render_scene_rgb(*run.simulation, deposit);
   const auto without = render_scene_rgb(*run.simulation, HeightMap{});
   ASSERT_EQ(with.size(), without.size());
