@@ -123,8 +123,8 @@ TriangleMesh read_stl(const std::string& path, double mm_per_unit, const std::st
   // assimp decides binary vs ASCII by the same size rule, so the hint is unambiguous here
   Assimp::Importer importer;
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS);
-  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(),
-                                                     aiProcess_RemoveComponent, "stl");
+  const aiScene* scene =
+      importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_RemoveComponent, "stl");
   if (scene == nullptr) {
     throw InputError(path, 0, key,
                      std::string(binary ? "binary" : "ASCII") +
@@ -144,8 +144,8 @@ TriangleMesh read_stl(const std::string& path, double mm_per_unit, const std::st
   }
   scene = importer.ApplyPostProcessing(aiProcess_JoinIdenticalVertices);
   if (scene == nullptr)
-    throw InputError(path, 0, key, std::string("STL that cannot be read: ") +
-                                       importer.GetErrorString());
+    throw InputError(path, 0, key,
+                     std::string("STL that cannot be read: ") + importer.GetErrorString());
 
   TriangleMesh result;
   std::unordered_map<std::array<uint32_t, 3>, int, FloatTripleHash> index_of;

@@ -1,0 +1,200 @@
+#include "toolpath/hatching.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "core/error.hpp"
+#include "core/pose.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr const char* kKey = "toolpath.surface";
+constexpr double kMaxGridPoints = 2e7;  // per layer
+
+void validate(const SurfaceHatchSpec& spec) {
+  std::vector<Problem> problems;
+  auto check = [&](bool ok, const std::string& field, const std::string& message) {
+    if (!ok) problems.push_back(Problem{"", 0, std::string(kKey) + "." + field, message});
+  };
+  check(std::isfinite(spec.hatch_mm) && spec.hatch_mm > 0.0, "hatch_mm",
+        "the hatch spacing must be positive");
+  check(!spec.angles_deg.empty(), "angles_deg", "at least one hatch angle is needed");
+  for (double a : spec.angles_deg) check(std::isfinite(a), "angles_deg", "angles must be finite");
+  check(spec.layers >= 1, "layers", "at least one layer");
+  check(std::isfinite(spec.layer_height_mm) && spec.layer_height_mm >= 0.0, "layer_height_mm",
+        "the layer height must be finite and not negative");
+  check(std::isfinite(spec.alpha) && spec.alpha >= 0.0 && spec.alpha <= 1.0, "alpha",
+        "alpha must be in [0, 1]");
+  check(std::isfinite(spec.speed_mm_s) && spec.speed_mm_s > 0.0, "speed_mm_s",
+        "the print speed must be positive");
+  check(std::isfinite(spec.min_normal_z) && spec.min_normal_z >= 0.0 && spec.min_normal_z < 1.0,
+        "min_normal_z", "the least normal z must be in [0, 1)");
+  check(std::isfinite(spec.max_jump_ratio) && spec.max_jump_ratio >= 1.0, "max_jump_ratio",
+        "the jump ratio must be at least 1");
+  if (!problems.empty()) throw InputError(std::move(problems));
+}
+
+// one piece of a grid line on the surface: consecutive grid points
+struct Piece {
+  std::vector<int> index;  // along the line
+  std::vector<Vec3> points;
+  std::vector<Vec3> normals;  // smooth
+};
+
+// the grid of one hatch angle projected onto the surface, broken into pieces per line
+struct AngleGrid {
+  int lines = 0;
+  int points_per_line = 0;
+  std::vector<std::vector<Piece>> pieces;  // per line
+};
+
+// n points spaced h, centred on [lo, hi]: the i-th at centre + (i - (n - 1) / 2) h
+struct Axis {
+  int n = 1;
+  double first = 0.0;  // the first point
+  Axis(double lo, double hi, double h) {
+    n = static_cast<int>(std::floor((hi - lo) / h + 1e-9)) + 1;
+    first = 0.5 * (lo + hi) - 0.5 * (n - 1) * h;
+  }
+};
+
+AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
+                       const SurfaceHatchSpec& spec) {
+  const double theta = deg_to_rad(angle_deg);
+  const Vec2 d(std::cos(theta), std::sin(theta));  // along the lines
+  const Vec2 e(-d.y(), d.x());                     // across them
+  const TriangleMesh& mesh = projector.mesh();
+  double u_lo = INFINITY, u_hi = -INFINITY, v_lo = INFINITY, v_hi = -INFINITY;
+  for (const Vec3& p : mesh.vertices) {
+    const Vec2 xy = p.head<2>();
+    u_lo = std::min(u_lo, xy.dot(d));
+    u_hi = std::max(u_hi, xy.dot(d));
+    v_lo = std::min(v_lo, xy.dot(e));
+    v_hi = std::max(v_hi, xy.dot(e));
+  }
+  const double h = spec.hatch_mm;
+  const Axis along(u_lo, u_hi, h);
+  const Axis across(v_lo, v_hi, h);
+  if (static_cast<double>(along.n) * across.n > kMaxGridPoints) {
+    throw InputError(std::string(kKey) + ".hatch_mm",
+                     "the hatch grid over the part would have " +
+                         std::to_string(static_cast<double>(along.n) * across.n) +
+                         " points per layer (at most 2e7): the spacing is too fine");
+  }
+
+  AngleGrid grid;
+  grid.lines = across.n;
+  grid.points_per_line = along.n;
+  grid.pieces.resize(static_cast<std::size_t>(across.n));
+  const double max_jump = spec.max_jump_ratio * h;
+  std::vector<Vec2> xy(static_cast<std::size_t>(along.n));
+  std::vector<std::optional<SurfaceHit>> hits;
+  for (int j = 0; j < across.n; ++j) {
+    const double v = across.first + j * h;
+    for (int i = 0; i < along.n; ++i)
+      xy[static_cast<std::size_t>(i)] = (along.first + i * h) * d + v * e;
+    projector.project_down(xy, hits);  // one line per batch: memory stays one line
+    std::vector<Piece>& line = grid.pieces[static_cast<std::size_t>(j)];
+    Piece piece;
+    auto close = [&] {
+      if (piece.points.size() >= 2) line.push_back(std::move(piece));
+      piece = Piece{};
+    };
+    for (int i = 0; i < along.n; ++i) {
+      const std::optional<SurfaceHit>& hit = hits[static_cast<std::size_t>(i)];
+      if (!hit || !hit->faces_up(spec.min_normal_z)) {
+        close();
+        continue;
+      }
+      if (!piece.points.empty() && (hit->point_mm - piece.points.back()).norm() > max_jump) close();
+      piece.index.push_back(i);
+      piece.points.push_back(hit->point_mm);
+      piece.normals.push_back(hit->normal);
+    }
+    close();
+  }
+  return grid;
+}
+
+}  // namespace
+
+std::string SurfaceHatch::describe(std::size_t path, std::size_t point) const {
+  if (path >= info.size()) return "path " + std::to_string(path);
+  const HatchPathInfo& i = info[path];
+  std::string text = "layer " + std::to_string(i.layer) + ", line " + std::to_string(i.line);
+  if (point < i.point_index.size()) text += ", point " + std::to_string(i.point_index[point]);
+  return text;
+}
+
+SurfaceHatch hatch_surface(const TriangleMesh& placed_part_mm, const SurfaceHatchSpec& spec) {
+  validate(spec);
+  return hatch_surface(SurfaceProjector(placed_part_mm), spec);
+}
+
+SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatchSpec& spec) {
+  validate(spec);
+  SurfaceHatch result;
+  if (projector.mesh().empty()) return result;
+
+  std::map<double, AngleGrid> grids;  // per distinct angle, projected once
+  const Vec3 up = vertical_tool_axis();
+  for (int layer = 0; layer < spec.layers; ++layer) {
+    const double angle = spec.angles_deg[static_cast<std::size_t>(layer) % spec.angles_deg.size()];
+    auto found = grids.find(angle);
+    if (found == grids.end())
+      found = grids.emplace(angle, project_grid(projector, angle, spec)).first;
+    const AngleGrid& grid = found->second;
+    result.lines_per_layer.push_back(grid.lines);
+    result.points_per_line.push_back(grid.points_per_line);
+    const double offset = layer * spec.layer_height_mm;
+
+    int printed_lines = 0;
+    for (int j = 0; j < grid.lines; ++j) {
+      const std::vector<Piece>& pieces = grid.pieces[static_cast<std::size_t>(j)];
+      if (pieces.empty()) continue;
+      const bool reversed = printed_lines++ % 2 == 1;
+      for (std::size_t k = 0; k < pieces.size(); ++k) {
+        const Piece& piece = pieces[reversed ? pieces.size() - 1 - k : k];
+        PrintPath path;
+        HatchPathInfo info;
+        info.layer = layer;
+        info.line = j;
+        info.reversed = reversed;
+        const std::size_t n = piece.points.size();
+        for (std::size_t m = 0; m < n; ++m) {
+          const std::size_t at = reversed ? n - 1 - m : m;
+          const Vec3& p = piece.points[at];
+          const Vec3& normal = piece.normals[at];
+          const Vec3 point =
+              p + offset * (spec.offset == SurfaceHatchSpec::Offset::normal ? normal : up);
+          if (!point.allFinite()) throw InternalError("hatch_surface: a non-finite point");
+          if (!path.points.empty() && (point - path.points.back()).norm() <= kJoinTolerance_mm)
+            continue;  // consecutive points must differ
+          path.points.push_back(point);
+          path.normals.push_back(slerp_axis(up, normal, spec.alpha));
+          info.point_index.push_back(piece.index[at]);
+          info.surface_points_mm.push_back(p);
+          info.surface_normals.push_back(normal);
+        }
+        if (path.points.size() < 2) continue;
+        path.speed_mm_s = spec.speed_mm_s;
+        path.layer = layer;
+        path.source_index = static_cast<int>(result.toolpath.paths.size());
+        result.toolpath.paths.push_back(std::move(path));
+        result.info.push_back(std::move(info));
+      }
+    }
+  }
+  return result;
+}
+
+double gap_ratio(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1, double d) {
+  const double gap = (p1 - p0).norm();
+  if (gap == 0.0) return 1.0;
+  return ((p1 + d * n1) - (p0 + d * n0)).norm() / gap;
+}
+
+}  // namespace depotwin

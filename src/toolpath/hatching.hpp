@@ -1,0 +1,90 @@
+// Conformal zig-zag hatching on a part's top surface: Shembekar et al. 2018, Algorithm 1
+// (sec. 3.2-3.4), with the projection done by ray casting (surface_projection.hpp).
+//
+// Per layer k (0-based) with hatch angle theta = angles_deg[k % size] (from +x about +z):
+//  - the grid: in the hatch frame (d = (cos theta, sin theta) along the lines, e = (-sin,
+//    cos) across), lines at spacing hatch_mm across and points every hatch_mm along each
+//    line, over the extent of the part's vertices in that frame, centred on it (so the grid
+//    is symmetric over the part and does not depend on where the part's bounds begin);
+//  - each grid point is projected straight down onto the top surface;
+//  - a line is broken where the surface is absent (no hit: a hole or beyond an edge; or a
+//    normal with n_z <= min_normal_z: a wall) and where consecutive surface points are more
+//    than max_jump_ratio * hatch_mm apart in 3-D (a step); every piece of at least two
+//    points is a PrintPath (the planner joins pieces by travels);
+//  - lines go in order across the part (increasing e), every other printed line reversed
+//    (zig-zag; the alternation counts lines that have a piece, so a line lost entirely to a
+//    hole does not break it); a reversed line's pieces come in reverse order, each reversed;
+//  - points are offset from the surface by k * layer_height_mm along the smooth surface
+//    normal (Offset::normal: parallel layers of equal thickness) or along +z (Offset::z, as
+//    in the paper);
+//  - the tool axis is the smooth surface normal tilted back toward vertical by alpha: the
+//    slerp from +z (alpha = 0) to the normal (alpha = 1). The paper scales its rotation angles
+//    R_x = -atan(n_y / n_z), R_y = atan(n_x / n_z) by alpha; the slerp scales the single
+//    tilt angle instead: the same for a normal tilted about x or about y alone, and free of
+//    the order in which two Euler rotations are applied otherwise.
+// Both the offset and the tool axis use the smooth (vertex-interpolated) normal, not the
+// facet normal: facet normals jump at every triangle edge, which would turn the tool in
+// steps at each edge and, for offset layers, tear the offset points apart at convex edges
+// and fold them over at concave ones.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/toolpath.hpp"
+#include "core/triangle_mesh.hpp"
+#include "toolpath/surface_projection.hpp"
+
+namespace depotwin {
+
+struct SurfaceHatchSpec {
+  double hatch_mm = 0.5;                     // line spacing and point spacing along lines
+  std::vector<double> angles_deg = {0, 90};  // layer k hatches at angles_deg[k % size]
+  int layers = 1;
+  double layer_height_mm = 0.5;
+  double alpha = 0.5;  // tool axis: 0 vertical, 1 along the surface normal
+  enum class Offset { normal, z };
+  Offset offset = Offset::normal;
+  double speed_mm_s = 10.0;
+  double min_normal_z = 0.1;    // a surface whose normal has n_z <= this is no surface
+  double max_jump_ratio = 3.0;  // consecutive points farther apart than this * hatch_mm: a break
+};
+
+// Where each path came from and what the surface is like under it.
+struct HatchPathInfo {
+  int layer = 0;
+  int line = 0;                         // the grid line's index in its layer (0 at the -e side)
+  bool reversed = false;                // printed against the line's direction d
+  std::vector<int> point_index;         // per point: its index along the grid line
+  std::vector<Vec3> surface_points_mm;  // per point: the projected point on the surface
+  std::vector<Vec3> surface_normals;    // per point: the smooth surface normal (the deposit's
+                                        // normal; the tool axis is PrintPath::normals)
+};
+
+struct SurfaceHatch {
+  // print paths in print order: layer by layer, line by line; source_index = the path's
+  // position, layer = its layer, normals = tool axes; start and end left at the origin
+  Toolpath toolpath;
+  std::vector<HatchPathInfo> info;  // one per path
+  // grid lines per layer (printed or not) and grid points per line, for reports
+  std::vector<int> lines_per_layer;
+  std::vector<int> points_per_line;
+
+  // "layer 3, line 12, point 40" for point i of path p
+  std::string describe(std::size_t path, std::size_t point) const;
+};
+
+// The hatch of the part (a mesh placed in the work frame, mm). InputError (key
+// "toolpath.surface.<field>") for a bad spec: hatch_mm not positive, no angles, a non-finite
+// angle, layers < 1, a negative layer height, alpha outside [0, 1], speed not positive, a
+// grid of more than 2e7 points per layer.
+SurfaceHatch hatch_surface(const TriangleMesh& placed_part_mm, const SurfaceHatchSpec& spec);
+// the same with a projector built once (several hatches of one part)
+SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatchSpec& spec);
+
+// The paper's offset-point gap test (sec. 4.1) for consecutive points p0, p1 with unit
+// normals n0, n1 and offset distance d: |(p1 + d n1) - (p0 + d n0)| / |p1 - p0|. Above 1 the
+// surface is convex between them, below 1 concave, 1 flat. 1 for coincident points.
+double gap_ratio(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1, double d);
+
+}  // namespace depotwin

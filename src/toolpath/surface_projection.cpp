@@ -1,0 +1,221 @@
+#include "toolpath/surface_projection.hpp"
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr int kPacket = 16;
+
+void check_device(RTCDevice device, const char* what) {
+  const RTCError error = rtcGetDeviceError(device);
+  if (error != RTC_ERROR_NONE)
+    throw InternalError(std::string("Embree: ") + what + " failed (error " +
+                        std::to_string(static_cast<int>(error)) + ")");
+}
+
+}  // namespace
+
+struct SurfaceProjector::Impl {
+  TriangleMesh mesh;
+  std::vector<std::array<Vec3, 3>> corner_normals;
+  Vec3 lo = Vec3::Zero();
+  Vec3 hi = Vec3::Zero();
+  Vec3 center = Vec3::Zero();  // Embree works in float about this point
+  float ray_z = 1.0f;          // ray origins' z (centred frame), above the mesh
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+
+  Impl(TriangleMesh m, const SurfaceProjectorOptions& options) : mesh(std::move(m)) {
+    for (const Vec3& v : mesh.vertices)
+      if (!v.allFinite()) throw InternalError("SurfaceProjector: a mesh vertex is not finite");
+    mesh.bounds(lo, hi);
+    center = 0.5 * (lo + hi);
+    const double extent = (hi - lo).maxCoeff();
+    ray_z = static_cast<float>(hi.z() - center.z() + 1.0 + 1e-3 * extent);
+    corner_normals = mesh.corner_normals(deg_to_rad(options.crease_angle_deg));
+
+    // one thread: the build is deterministic and leaves the shared cores alone
+    device = rtcNewDevice("threads=1,verbose=0");
+    if (device == nullptr) throw InternalError("Embree: rtcNewDevice failed");
+    scene = rtcNewScene(device);
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    if (!mesh.empty()) {
+      RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_HIGH);
+      auto* vertices = static_cast<float*>(
+          rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                  3 * sizeof(float), mesh.vertices.size()));
+      auto* indices = static_cast<unsigned*>(
+          rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                  3 * sizeof(unsigned), mesh.triangles.size()));
+      check_device(device, "buffer allocation");
+      for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+        for (int i = 0; i < 3; ++i)
+          vertices[3 * v + static_cast<std::size_t>(i)] =
+              static_cast<float>(mesh.vertices[v][i] - center[i]);
+      for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+        for (int i = 0; i < 3; ++i)
+          indices[3 * t + static_cast<std::size_t>(i)] =
+              static_cast<unsigned>(mesh.triangles[t][static_cast<std::size_t>(i)]);
+      rtcCommitGeometry(geometry);
+      rtcAttachGeometry(scene, geometry);
+      rtcReleaseGeometry(geometry);
+    }
+    rtcCommitScene(scene);
+    check_device(device, "building the BVH");
+  }
+
+  ~Impl() {
+    if (scene != nullptr) rtcReleaseScene(scene);
+    if (device != nullptr) rtcReleaseDevice(device);
+  }
+
+  Vec3 smooth_normal(int t, const Vec3& b) const {
+    const std::array<Vec3, 3>& n = corner_normals[static_cast<std::size_t>(t)];
+    const Vec3 sum = b[0] * n[0] + b[1] * n[1] + b[2] * n[2];
+    const double length = sum.norm();
+    return length > 0.0 ? Vec3(sum / length) : mesh.facet_normal(static_cast<std::size_t>(t));
+  }
+
+  // the exact hit at (x, y) on triangle t; embree_z: Embree's hit height (centred frame),
+  // used only for a vertical triangle, whose plane gives no z
+  SurfaceHit exact_hit(double x, double y, int t, double embree_z, float u, float v) const {
+    const std::array<int, 3>& f = mesh.triangles[static_cast<std::size_t>(t)];
+    const Vec3& a = mesh.vertices[f[0]];
+    const Vec3& b = mesh.vertices[f[1]];
+    const Vec3& c = mesh.vertices[f[2]];
+    const Vec3 n = (b - a).cross(c - a);
+    const double length = n.norm();
+    SurfaceHit hit;
+    hit.triangle = t;
+    hit.facet_normal = length > 0.0 ? Vec3(n / length) : Vec3::Zero();
+    if (length > 0.0 && std::abs(n.z()) > 1e-12 * length) {
+      // on the plane: n . (p - a) = 0 with p = (x, y, z)
+      const double z = a.z() - (n.x() * (x - a.x()) + n.y() * (y - a.y())) / n.z();
+      hit.point_mm = Vec3(x, y, z);
+      // barycentric coordinates from the (x, y) projection (n.z is twice its signed area)
+      const double wa = ((b.x() - x) * (c.y() - y) - (b.y() - y) * (c.x() - x)) / n.z();
+      const double wb = ((c.x() - x) * (a.y() - y) - (c.y() - y) * (a.x() - x)) / n.z();
+      hit.barycentric = Vec3(wa, wb, 1.0 - wa - wb);
+    } else {
+      hit.point_mm = Vec3(x, y, embree_z + center.z());
+      hit.barycentric = Vec3(1.0 - static_cast<double>(u) - static_cast<double>(v), u, v);
+    }
+    // a point Embree placed in t by a float decision may be a rounding outside it
+    hit.barycentric = hit.barycentric.cwiseMax(0.0);
+    const double sum = hit.barycentric.sum();
+    hit.barycentric = sum > 0.0 ? Vec3(hit.barycentric / sum) : Vec3::Constant(1.0 / 3.0);
+    hit.normal = smooth_normal(t, hit.barycentric);
+    return hit;
+  }
+};
+
+SurfaceProjector::SurfaceProjector(TriangleMesh mesh, const SurfaceProjectorOptions& options)
+    : impl_(std::make_unique<Impl>(std::move(mesh), options)) {}
+SurfaceProjector::~SurfaceProjector() = default;
+SurfaceProjector::SurfaceProjector(SurfaceProjector&&) noexcept = default;
+SurfaceProjector& SurfaceProjector::operator=(SurfaceProjector&&) noexcept = default;
+
+std::optional<SurfaceHit> SurfaceProjector::project_down(double x_mm, double y_mm) const {
+  const Impl& im = *impl_;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rayhit;
+  rayhit.ray.org_x = static_cast<float>(x_mm - im.center.x());
+  rayhit.ray.org_y = static_cast<float>(y_mm - im.center.y());
+  rayhit.ray.org_z = im.ray_z;
+  rayhit.ray.dir_x = 0.0f;
+  rayhit.ray.dir_y = 0.0f;
+  rayhit.ray.dir_z = -1.0f;
+  rayhit.ray.tnear = 0.0f;
+  rayhit.ray.tfar = std::numeric_limits<float>::infinity();
+  rayhit.ray.mask = ~0u;
+  rayhit.ray.flags = 0;
+  rayhit.ray.time = 0.0f;
+  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(im.scene, &context, &rayhit);
+  if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  return im.exact_hit(x_mm, y_mm, static_cast<int>(rayhit.hit.primID),
+                      static_cast<double>(im.ray_z - rayhit.ray.tfar), rayhit.hit.u, rayhit.hit.v);
+}
+
+void SurfaceProjector::project_down(const std::vector<Vec2>& xy,
+                                    std::vector<std::optional<SurfaceHit>>& hits) const {
+  const Impl& im = *impl_;
+  hits.resize(xy.size());
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // parallel rays side by side
+  alignas(64) RTCRayHit16 packet;
+  alignas(64) int valid[kPacket];
+  for (std::size_t start = 0; start < xy.size(); start += kPacket) {
+    const int count = static_cast<int>(std::min<std::size_t>(kPacket, xy.size() - start));
+    for (int k = 0; k < kPacket; ++k) {
+      const Vec2& p = xy[start + static_cast<std::size_t>(std::min(k, count - 1))];
+      valid[k] = k < count ? -1 : 0;
+      packet.ray.org_x[k] = static_cast<float>(p.x() - im.center.x());
+      packet.ray.org_y[k] = static_cast<float>(p.y() - im.center.y());
+      packet.ray.org_z[k] = im.ray_z;
+      packet.ray.dir_x[k] = 0.0f;
+      packet.ray.dir_y[k] = 0.0f;
+      packet.ray.dir_z[k] = -1.0f;
+      packet.ray.tnear[k] = 0.0f;
+      packet.ray.tfar[k] = std::numeric_limits<float>::infinity();
+      packet.ray.mask[k] = ~0u;
+      packet.ray.flags[k] = 0;
+      packet.ray.time[k] = 0.0f;
+      packet.ray.id[k] = static_cast<unsigned>(k);
+      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, im.scene, &context, &packet);
+    for (int k = 0; k < count; ++k) {
+      std::optional<SurfaceHit>& out = hits[start + static_cast<std::size_t>(k)];
+      if (packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
+        out.reset();
+        continue;
+      }
+      const Vec2& p = xy[start + static_cast<std::size_t>(k)];
+      out = im.exact_hit(p.x(), p.y(), static_cast<int>(packet.hit.primID[k]),
+                         static_cast<double>(im.ray_z - packet.ray.tfar[k]), packet.hit.u[k],
+                         packet.hit.v[k]);
+    }
+  }
+}
+
+std::optional<double> SurfaceProjector::height_at(double x_mm, double y_mm) const {
+  const std::optional<SurfaceHit> hit = project_down(x_mm, y_mm);
+  if (!hit) return std::nullopt;
+  return hit->point_mm.z();
+}
+
+const TriangleMesh& SurfaceProjector::mesh() const {
+  return impl_->mesh;
+}
+
+Vec3 SurfaceProjector::smooth_normal(int triangle, const Vec3& barycentric) const {
+  return impl_->smooth_normal(triangle, barycentric);
+}
+
+const Vec3& SurfaceProjector::lower_bound() const {
+  return impl_->lo;
+}
+
+const Vec3& SurfaceProjector::upper_bound() const {
+  return impl_->hi;
+}
+
+}  // namespace depotwin

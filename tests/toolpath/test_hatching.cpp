@@ -1,0 +1,347 @@
+// Surface hatching (Shembekar et al., Algorithm 1): grid spacing across and along the lines,
+// zig-zag, angles alternating per layer, layer offsets along the normal or z, the tool axis as
+// slerp(z, n, alpha), breaks at holes and steps, determinism, the gap ratio.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "core/error.hpp"
+#include "core/pose.hpp"
+#include "toolpath/analytic_surfaces.hpp"
+#include "toolpath/hatching.hpp"
+
+namespace depotwin {
+namespace {
+
+// z = height over [0, size_x] x [0, size_y]
+HeightField plane(double size_x, double size_y, double height) {
+  HeightField field;
+  field.z = [height](double, double) { return height; };
+  field.gradient = [](double, double) { return Eigen::Vector2d(0, 0); };
+  field.hessian = [](double, double) { return Eigen::Matrix2d::Zero().eval(); };
+  field.x_max = size_x;
+  field.y_max = size_y;
+  return field;
+}
+
+TriangleMesh plate(double size_x, double size_y, double height,
+                   const std::vector<SurfaceHole>& holes = {}) {
+  TessellationOptions options;
+  options.holes = holes;
+  return tessellate(plane(size_x, size_y, height), options);
+}
+
+// every path: at least two points, consecutive points distinct, finite, unit tool axes, its
+// info the same length
+void expect_well_formed(const SurfaceHatch& hatch) {
+  ASSERT_EQ(hatch.info.size(), hatch.toolpath.paths.size());
+  for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p) {
+    const PrintPath& path = hatch.toolpath.paths[p];
+    const HatchPathInfo& info = hatch.info[p];
+    ASSERT_GE(path.points.size(), 2u);
+    ASSERT_EQ(path.normals.size(), path.points.size());
+    ASSERT_EQ(info.point_index.size(), path.points.size());
+    ASSERT_EQ(info.surface_points_mm.size(), path.points.size());
+    ASSERT_EQ(info.surface_normals.size(), path.points.size());
+    EXPECT_EQ(path.layer, info.layer);
+    EXPECT_EQ(path.source_index, static_cast<int>(p));
+    for (std::size_t i = 0; i < path.points.size(); ++i) {
+      ASSERT_TRUE(path.points[i].allFinite());
+      ASSERT_NEAR(path.normals[i].norm(), 1.0, 1e-12);
+      ASSERT_NEAR(info.surface_normals[i].norm(), 1.0, 1e-12);
+      if (i > 0) {
+        ASSERT_GT((path.points[i] - path.points[i - 1]).norm(), kJoinTolerance_mm);
+      }
+    }
+  }
+}
+
+TEST(Hatching, FlatPlateGridAndZigZag) {
+  // 10.2 x 6.2 mm: 21 points per line (0.1 .. 10.1), 13 lines (y = 0.1 .. 6.1), centred
+  SurfaceHatchSpec spec;
+  spec.angles_deg = {0};
+  spec.speed_mm_s = 12.0;
+  const SurfaceHatch hatch = hatch_surface(plate(10.2, 6.2, 2.0), spec);
+  expect_well_formed(hatch);
+  ASSERT_EQ(hatch.toolpath.paths.size(), 13u);
+  EXPECT_EQ(hatch.lines_per_layer, std::vector<int>{13});
+  EXPECT_EQ(hatch.points_per_line, std::vector<int>{21});
+  for (int j = 0; j < 13; ++j) {
+    const PrintPath& path = hatch.toolpath.paths[static_cast<std::size_t>(j)];
+    const HatchPathInfo& info = hatch.info[static_cast<std::size_t>(j)];
+    ASSERT_EQ(path.points.size(), 21u);
+    EXPECT_EQ(info.line, j);
+    EXPECT_EQ(info.reversed, j % 2 == 1);
+    EXPECT_EQ(path.speed_mm_s, 12.0);
+    EXPECT_EQ(path.layer, 0);
+    for (int i = 0; i < 21; ++i) {
+      const int along = j % 2 == 0 ? i : 20 - i;  // every other line reversed
+      EXPECT_EQ(info.point_index[static_cast<std::size_t>(i)], along);
+      const Vec3 expected(0.1 + 0.5 * along, 0.1 + 0.5 * j, 2.0);
+      EXPECT_LT((path.points[static_cast<std::size_t>(i)] - expected).norm(), 1e-12);
+      EXPECT_LT((path.normals[static_cast<std::size_t>(i)] - Vec3::UnitZ()).norm(), 1e-12);
+    }
+  }
+  EXPECT_EQ(hatch.describe(1, 0), "layer 0, line 1, point 20");
+}
+
+TEST(Hatching, AnglesAlternatePerLayerAndLayersStack) {
+  SurfaceHatchSpec spec;
+  spec.angles_deg = {0, 90};
+  spec.layers = 4;
+  spec.layer_height_mm = 0.4;
+  for (SurfaceHatchSpec::Offset offset :
+       {SurfaceHatchSpec::Offset::normal, SurfaceHatchSpec::Offset::z}) {
+    spec.offset = offset;
+    const SurfaceHatch hatch = hatch_surface(plate(10.2, 6.2, 2.0), spec);
+    expect_well_formed(hatch);
+    EXPECT_EQ(hatch.toolpath.layer_count(), 4);
+    EXPECT_EQ(hatch.lines_per_layer, (std::vector<int>{13, 21, 13, 21}));
+    std::map<int, int> paths_per_layer;
+    for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p) {
+      const PrintPath& path = hatch.toolpath.paths[p];
+      ++paths_per_layer[path.layer];
+      const Vec3 step = path.points[1] - path.points[0];
+      if (path.layer % 2 == 0)
+        EXPECT_NEAR(std::abs(step.x()), 0.5, 1e-12);  // along x
+      else
+        EXPECT_NEAR(std::abs(step.y()), 0.5, 1e-12);  // along y
+      for (const Vec3& point : path.points) EXPECT_NEAR(point.z(), 2.0 + 0.4 * path.layer, 1e-12);
+    }
+    EXPECT_EQ(paths_per_layer, (std::map<int, int>{{0, 13}, {1, 21}, {2, 13}, {3, 21}}));
+    // layers are printed in order and each layer's zig-zag starts afresh
+    for (std::size_t p = 1; p < hatch.toolpath.paths.size(); ++p)
+      EXPECT_LE(hatch.toolpath.paths[p - 1].layer, hatch.toolpath.paths[p].layer);
+    for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p)
+      if (p == 0 || hatch.info[p].layer != hatch.info[p - 1].layer) {
+        EXPECT_FALSE(hatch.info[p].reversed);
+      }
+  }
+}
+
+TEST(Hatching, AnyAngleSpacingAcrossAndAlong) {
+  const TriangleMesh mesh = plate(20.0, 15.0, 1.0);
+  for (double angle : {45.0, 135.0, 30.0, -20.0}) {
+    SCOPED_TRACE(angle);
+    SurfaceHatchSpec spec;
+    spec.angles_deg = {angle};
+    spec.hatch_mm = 0.7;
+    const SurfaceHatch hatch = hatch_surface(mesh, spec);
+    expect_well_formed(hatch);
+    const double theta = deg_to_rad(angle);
+    const Vec3 d(std::cos(theta), std::sin(theta), 0.0);
+    const Vec3 e(-d.y(), d.x(), 0.0);
+    ASSERT_GT(hatch.toolpath.paths.size(), 20u);
+    for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p) {
+      const PrintPath& path = hatch.toolpath.paths[p];
+      const HatchPathInfo& info = hatch.info[p];
+      const double sign = info.reversed ? -1.0 : 1.0;
+      for (std::size_t i = 0; i + 1 < path.points.size(); ++i)  // 0.7 apart along d
+        EXPECT_LT((path.points[i + 1] - path.points[i] - sign * 0.7 * d).norm(), 1e-12);
+      // on its line: e . p is the same for every point ...
+      for (const Vec3& point : path.points) EXPECT_NEAR(point.dot(e), path.points[0].dot(e), 1e-12);
+      // ... and lines j, j + 1 are 0.7 apart across
+      if (p > 0 && hatch.info[p - 1].line + 1 == info.line) {
+        EXPECT_NEAR(path.points[0].dot(e) - hatch.toolpath.paths[p - 1].points[0].dot(e), 0.7,
+                    1e-12);
+      }
+      if (p > 0) {
+        EXPECT_NE(info.reversed, hatch.info[p - 1].reversed);  // zig-zag (no holes)
+      }
+    }
+  }
+}
+
+TEST(Hatching, ToolAxisIsSlerpOfVerticalAndNormal) {
+  SphereCapParams cap;  // R 40 mm: normals tilt up to 45 deg
+  const HeightField field = sphere_cap_field(cap);
+  const TriangleMesh mesh = sphere_cap(cap);
+  for (double alpha : {0.0, 0.25, 0.5, 1.0}) {
+    SurfaceHatchSpec spec;
+    spec.alpha = alpha;
+    spec.angles_deg = {45};
+    const SurfaceHatch hatch = hatch_surface(mesh, spec);
+    expect_well_formed(hatch);
+    int checked = 0;
+    for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p) {
+      const PrintPath& path = hatch.toolpath.paths[p];
+      for (std::size_t i = 0; i < path.points.size(); ++i) {
+        const Vec3& n = hatch.info[p].surface_normals[i];
+        const Vec3& axis = path.normals[i];
+        EXPECT_LT((axis - slerp_axis(Vec3::UnitZ(), n, alpha)).norm(), 1e-12);
+        // tilted alpha of the way, in the plane of z and n
+        EXPECT_NEAR(axis_angle_rad(Vec3::UnitZ(), axis), alpha * axis_angle_rad(Vec3::UnitZ(), n),
+                    1e-12);
+        EXPECT_NEAR(axis.dot(Vec3::UnitZ().cross(n)), 0.0, 1e-12);
+        if (alpha == 0.0) {
+          EXPECT_EQ(axis, Vec3::UnitZ());
+        }
+        if (alpha == 1.0) {
+          EXPECT_LT((axis - n).norm(), 1e-12);
+        }
+        // the surface normal is the sphere's within the tessellation bound (kappa delta)
+        const Vec3& s = hatch.info[p].surface_points_mm[i];
+        EXPECT_LT(axis_angle_rad(n, field.normal(s.x(), s.y())), 0.05);
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 5000);
+  }
+}
+
+TEST(Hatching, LayerOffsetsAlongNormalOrZOnACurvedSurface) {
+  CylinderParams params;
+  const TriangleMesh mesh = cylinder(params);
+  for (SurfaceHatchSpec::Offset offset :
+       {SurfaceHatchSpec::Offset::normal, SurfaceHatchSpec::Offset::z}) {
+    SurfaceHatchSpec spec;
+    spec.layers = 3;
+    spec.layer_height_mm = 0.6;
+    spec.offset = offset;
+    const SurfaceHatch hatch = hatch_surface(mesh, spec);
+    expect_well_formed(hatch);
+    for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p) {
+      const PrintPath& path = hatch.toolpath.paths[p];
+      const HatchPathInfo& info = hatch.info[p];
+      for (std::size_t i = 0; i < path.points.size(); ++i) {
+        const Vec3 direction = offset == SurfaceHatchSpec::Offset::normal ? info.surface_normals[i]
+                                                                          : Vec3::UnitZ().eval();
+        EXPECT_LT(
+            (path.points[i] - info.surface_points_mm[i] - 0.6 * path.layer * direction).norm(),
+            1e-12);
+        if (path.layer == 0 && i > 0) {  // on the surface, hatch_mm apart in (x, y)
+          EXPECT_NEAR((path.points[i] - path.points[i - 1]).head<2>().norm(), 0.5, 1e-12);
+        }
+      }
+    }
+  }
+}
+
+TEST(Hatching, HoleSplitsALineIntoTwoPaths) {
+  // a 6 mm hole in the middle of a 20.2 x 10.2 plate; lines at y = 0.1 .. 10.1
+  const TriangleMesh mesh =
+      plate(20.2, 10.2, 2.0, {SurfaceHole::circle(Eigen::Vector2d(10.1, 5.1), 3.0)});
+  SurfaceHatchSpec spec;
+  spec.angles_deg = {0};
+  const SurfaceHatch hatch = hatch_surface(mesh, spec);
+  expect_well_formed(hatch);
+  std::map<int, int> pieces;  // per line
+  for (const HatchPathInfo& info : hatch.info) ++pieces[info.line];
+  EXPECT_EQ(pieces.size(), 21u);
+  EXPECT_EQ(pieces[10], 2);  // y = 5.1 through the hole's centre
+  EXPECT_EQ(pieces[0], 1);
+  EXPECT_EQ(pieces[20], 1);
+  for (std::size_t p = 0; p < hatch.info.size(); ++p)
+    for (const Vec3& point : hatch.toolpath.paths[p].points)
+      EXPECT_GE((point.head<2>() - Eigen::Vector2d(10.1, 5.1)).norm(), 2.5);
+  // the reversed line's pieces come in reverse order: printing goes on in one direction
+  for (std::size_t p = 1; p < hatch.info.size(); ++p)
+    if (hatch.info[p].line == hatch.info[p - 1].line) {
+      const double gap_start = hatch.toolpath.paths[p - 1].back().x();
+      const double gap_end = hatch.toolpath.paths[p].front().x();
+      EXPECT_EQ(gap_end > gap_start, !hatch.info[p].reversed);
+    }
+}
+
+TEST(Hatching, StepSplitsALine) {
+  // z = 0 up to x = 10, a ramp up to 10 mm at x = 11, flat after: the grid points
+  // x = 10.1 (z 1), 10.6 (z 6), 11.1 (z 10) are 5.0 and 4.0 mm apart, over 3 x 0.5 mm
+  HeightField field = plane(20.2, 4.2, 0.0);
+  field.z = [](double x, double) { return std::clamp(10.0 * (x - 10.0), 0.0, 10.0); };
+  field.x_breaks = {10.0, 11.0};
+  TessellationOptions options;
+  const TriangleMesh mesh = tessellate(field, options);
+  SurfaceHatchSpec spec;
+  spec.angles_deg = {0};
+  spec.min_normal_z = 0.0;  // the ramp (n_z 0.0995) counts as surface: the jump breaks
+  const SurfaceHatch hatch = hatch_surface(mesh, spec);
+  expect_well_formed(hatch);
+  EXPECT_EQ(hatch.toolpath.paths.size(), 2u * 9u);  // 9 lines, each in two
+  for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p) {
+    const PrintPath& path = hatch.toolpath.paths[p];
+    const bool low = std::min(path.front().x(), path.back().x()) < 10.0;
+    EXPECT_NEAR(std::max(path.front().x(), path.back().x()), low ? 10.1 : 20.1, 1e-9);
+    EXPECT_NEAR(std::min(path.front().x(), path.back().x()), low ? 0.1 : 11.1, 1e-9);
+  }
+  // with the default least normal z (0.1) the ramp is a wall: the same breaks
+  spec.min_normal_z = 0.1;
+  const SurfaceHatch walls = hatch_surface(mesh, spec);
+  EXPECT_EQ(walls.toolpath.paths.size(), 2u * 9u);
+}
+
+TEST(Hatching, Deterministic) {
+  SurfaceHatchSpec spec;
+  spec.layers = 3;
+  spec.angles_deg = {45, 135};
+  const TriangleMesh mesh = car_bonnet(CarBonnetParams{});
+  const SurfaceHatch a = hatch_surface(mesh, spec);
+  const SurfaceHatch b = hatch_surface(mesh, spec);
+  ASSERT_EQ(a.toolpath.paths.size(), b.toolpath.paths.size());
+  for (std::size_t p = 0; p < a.toolpath.paths.size(); ++p) {
+    ASSERT_EQ(a.toolpath.paths[p].points, b.toolpath.paths[p].points);
+    ASSERT_EQ(a.toolpath.paths[p].normals, b.toolpath.paths[p].normals);
+    ASSERT_EQ(a.info[p].point_index, b.info[p].point_index);
+  }
+  expect_well_formed(a);
+}
+
+TEST(Hatching, GapRatio) {
+  // points on a circle of radius R, normals outward (convex) or inward (concave): the offset
+  // points lie on a circle of radius R + d or R - d
+  const double r = 30.0, d = 2.0, phi = 0.02;
+  const Vec3 p0(-r * std::sin(phi), 0, r * std::cos(phi));
+  const Vec3 p1(r * std::sin(phi), 0, r * std::cos(phi));
+  EXPECT_NEAR(gap_ratio(p0, p0 / r, p1, p1 / r, d), (r + d) / r, 1e-12);
+  EXPECT_NEAR(gap_ratio(p0, -p0 / r, p1, -p1 / r, d), (r - d) / r, 1e-12);
+  EXPECT_NEAR(gap_ratio(p0, Vec3::UnitZ(), p1, Vec3::UnitZ(), d), 1.0, 1e-15);
+  EXPECT_EQ(gap_ratio(p0, Vec3::UnitZ(), p0, Vec3::UnitX(), d), 1.0);
+
+  // along hatch lines across the convex / concave cylinder
+  for (bool concave : {false, true}) {
+    CylinderParams params;
+    params.concave = concave;
+    SurfaceHatchSpec spec;
+    spec.angles_deg = {0};
+    const SurfaceHatch hatch = hatch_surface(cylinder(params), spec);
+    const HatchPathInfo& info = hatch.info[5];
+    for (std::size_t i = 10; i + 10 < info.surface_points_mm.size(); ++i) {
+      const double ratio = gap_ratio(info.surface_points_mm[i], info.surface_normals[i],
+                                     info.surface_points_mm[i + 1], info.surface_normals[i + 1], d);
+      const double expected = concave ? (30.0 - d) / 30.0 : (30.0 + d) / 30.0;
+      EXPECT_NEAR(ratio, expected, 0.01);
+    }
+  }
+}
+
+TEST(Hatching, BadSpecsAreInputErrors) {
+  const TriangleMesh mesh = plate(5.0, 5.0, 0.0);
+  auto problem_key = [&](const SurfaceHatchSpec& spec) -> std::string {
+    try {
+      hatch_surface(mesh, spec);
+    } catch (const InputError& e) {
+      return e.problems().front().key;
+    }
+    return "no error";
+  };
+  SurfaceHatchSpec spec;
+  spec.hatch_mm = 0.0;
+  EXPECT_EQ(problem_key(spec), "toolpath.surface.hatch_mm");
+  spec = SurfaceHatchSpec{};
+  spec.angles_deg = {};
+  EXPECT_EQ(problem_key(spec), "toolpath.surface.angles_deg");
+  spec = SurfaceHatchSpec{};
+  spec.alpha = 1.5;
+  EXPECT_EQ(problem_key(spec), "toolpath.surface.alpha");
+  spec = SurfaceHatchSpec{};
+  spec.layers = 0;
+  EXPECT_EQ(problem_key(spec), "toolpath.surface.layers");
+  spec = SurfaceHatchSpec{};
+  spec.hatch_mm = 1e-4;  // 2.5e9 grid points
+  EXPECT_EQ(problem_key(spec), "toolpath.surface.hatch_mm");
+}
+
+}  // namespace
+}  // namespace depotwin

@@ -1,0 +1,230 @@
+// Projection straight down onto a surface (Embree BVH, exact double recompute): points on the
+// hit triangle's plane, on the analytic surface at mesh vertices, within the chordal bound
+// elsewhere; smooth normals within the tessellation bound; holes and edges give no hit; the
+// first hit on a closed solid is its top; undersides are reported as not facing up.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "core/pose.hpp"
+#include "toolpath/analytic_surfaces.hpp"
+#include "toolpath/surface_projection.hpp"
+
+namespace depotwin {
+namespace {
+
+// the distance of p from the plane of triangle t
+double plane_distance(const TriangleMesh& mesh, int t, const Vec3& p) {
+  const std::array<int, 3>& f = mesh.triangles[static_cast<std::size_t>(t)];
+  return std::abs(mesh.facet_normal(static_cast<std::size_t>(t)).dot(p - mesh.vertices[f[0]]));
+}
+
+// the longest edge of the surface's triangles (those facing up), 3-D
+double longest_top_edge(const TriangleMesh& mesh) {
+  double longest = 0.0;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    if (mesh.facet_normal(t).z() <= 0.0) continue;
+    for (int c = 0; c < 3; ++c)
+      longest = std::max(longest, (mesh.vertices[mesh.triangles[t][c]] -
+                                   mesh.vertices[mesh.triangles[t][(c + 1) % 3]])
+                                      .norm());
+  }
+  return longest;
+}
+
+struct Measured {
+  int hits = 0;
+  int at_vertices = 0;
+  double plane = 0.0;          // largest distance from the hit triangle's plane
+  double vertex_error = 0.0;   // largest |z - f| at mesh vertices
+  double chordal = 0.0;        // largest |z - f|
+  double normal_all = 0.0;     // largest angle to the analytic normal (rad)
+  double normal_inside = 0.0;  // ... two cells or more inside the footprint
+};
+
+// project a grid at half the mesh's cell (every other point on a vertex) and compare
+Measured measure(const HeightField& field, const TriangleMesh& mesh, double cell) {
+  const SurfaceProjector projector(mesh);
+  Measured m;
+  const double step = 0.5 * cell;
+  const int nx = static_cast<int>(std::lround((field.x_max - field.x_min) / step));
+  const int ny = static_cast<int>(std::lround((field.y_max - field.y_min) / step));
+  std::vector<Vec2> xy;
+  for (int j = 1; j < ny; ++j)  // inside the footprint: its very edge is ambiguous
+    for (int i = 1; i < nx; ++i) xy.emplace_back(field.x_min + i * step, field.y_min + j * step);
+  std::vector<std::optional<SurfaceHit>> hits;
+  projector.project_down(xy, hits);
+  for (std::size_t k = 0; k < xy.size(); ++k) {
+    const double x = xy[k].x(), y = xy[k].y();
+    const std::optional<SurfaceHit>& hit = hits[k];
+    if (!hit) continue;
+    ++m.hits;
+    EXPECT_EQ(hit->point_mm.x(), x);
+    EXPECT_EQ(hit->point_mm.y(), y);
+    m.plane = std::max(m.plane, plane_distance(mesh, hit->triangle, hit->point_mm));
+    const double dz = std::abs(hit->point_mm.z() - field.z(x, y));
+    m.chordal = std::max(m.chordal, dz);
+    const int i = static_cast<int>(k % static_cast<std::size_t>(nx - 1)) + 1;
+    const int j = static_cast<int>(k / static_cast<std::size_t>(nx - 1)) + 1;
+    if (i % 2 == 0 && j % 2 == 0) {
+      ++m.at_vertices;
+      m.vertex_error = std::max(m.vertex_error, dz);
+    }
+    const double angle = axis_angle_rad(hit->normal, field.normal(x, y));
+    m.normal_all = std::max(m.normal_all, angle);
+    const double margin = 2.0 * cell;
+    if (x > field.x_min + margin && x < field.x_max - margin && y > field.y_min + margin &&
+        y < field.y_max - margin)
+      m.normal_inside = std::max(m.normal_inside, angle);
+  }
+  return m;
+}
+
+// Tessellation bounds for the smooth normal (kappa: the largest principal curvature, delta:
+// the longest 3-D edge). Each facet of a triangle whose corners lie on the surface is
+// parallel to the surface normal somewhere within it, and the normal turns at most kappa per
+// mm, so facet normals within one edge of a point differ from its normal by about kappa
+// delta; angle-weighted averages and barycentric interpolation of unit vectors stay within
+// that: angle <= kappa delta (first order; what the boundary's one-sided vertex fans reach).
+// Inside, each vertex's fan on this grid is point-symmetric, the first-order terms cancel,
+// and the error is second order: angle <= (kappa delta)^2.
+void expect_normals_within_bounds(const Measured& m, double kappa, double delta) {
+  EXPECT_LE(m.normal_all, kappa * delta);
+  EXPECT_LE(m.normal_inside, (kappa * delta) * (kappa * delta));
+}
+
+TEST(SurfaceProjection, SphereCap) {
+  SphereCapParams params;  // R 40 mm, 40 x 40 mm footprint, 1 mm cells
+  for (bool solid : {false, true}) {
+    params.mesh.solid = solid;
+    const HeightField field = sphere_cap_field(params);
+    const TriangleMesh mesh = sphere_cap(params);
+    const Measured m = measure(field, mesh, params.mesh.cell_mm);
+    EXPECT_EQ(m.hits, 79 * 79);  // every point inside the footprint hits
+    EXPECT_EQ(m.at_vertices, 39 * 39);
+    EXPECT_LE(m.plane, 1e-9);
+    EXPECT_LE(m.vertex_error, 1e-9);
+    const double chordal_bound = chordal_error_bound_mm(field, params.mesh);
+    EXPECT_LE(chordal_bound, 0.018);  // as documented for the defaults
+    EXPECT_LE(m.chordal, chordal_bound);
+    EXPECT_GT(m.chordal, 0.5 * chordal_bound);  // the bound is not loose
+    // kappa = 1 / 40; delta = 2.0 mm (the diagonal at a corner, slope 45 deg):
+    // bounds 0.05 rad everywhere, 0.0025 rad inside (measured 0.024 and 0.00046)
+    const double delta = longest_top_edge(mesh);
+    EXPECT_NEAR(delta, 2.0, 0.1);
+    expect_normals_within_bounds(m, 1.0 / params.radius_mm, delta);
+  }
+}
+
+TEST(SurfaceProjection, ConvexAndConcaveCylinder) {
+  CylinderParams params;  // R 30 mm along y, |x| <= 20, 1 mm cells
+  for (bool concave : {false, true}) {
+    params.concave = concave;
+    const HeightField field = cylinder_field(params);
+    const TriangleMesh mesh = cylinder(params);
+    const Measured m = measure(field, mesh, params.mesh.cell_mm);
+    EXPECT_EQ(m.hits, 79 * 79);
+    EXPECT_LE(m.plane, 1e-9);
+    EXPECT_LE(m.vertex_error, 1e-9);
+    EXPECT_LE(m.chordal, chordal_error_bound_mm(field, params.mesh));
+    // kappa = 1 / 30, delta = 1.67 mm: bounds 0.056 rad and 0.0031 rad (measured 0.022,
+    // 0.00046)
+    expect_normals_within_bounds(m, 1.0 / params.radius_mm, longest_top_edge(mesh));
+  }
+}
+
+TEST(SurfaceProjection, HolesAndOutsideGiveNoHit) {
+  SphereCapParams params;
+  params.mesh.holes = {SurfaceHole::circle(Vec2(5, 5), 4.0),
+                       SurfaceHole::rectangle(Vec2(-10, 0), Vec2(3, 6))};
+  for (bool solid : {false, true}) {
+    params.mesh.solid = solid;
+    const SurfaceProjector projector(sphere_cap(params));
+    EXPECT_FALSE(projector.project_down(5.0, 5.0));
+    EXPECT_FALSE(projector.project_down(7.5, 5.0));
+    EXPECT_FALSE(projector.project_down(-10.0, 0.0));
+    EXPECT_FALSE(projector.project_down(-12.5, 5.5));
+    EXPECT_FALSE(projector.project_down(25.0, 0.0));  // beyond the edge
+    EXPECT_FALSE(projector.project_down(0.0, -20.5));
+    EXPECT_FALSE(projector.height_at(5.0, 5.0));
+    // beside the holes the surface is there
+    EXPECT_TRUE(projector.project_down(5.0, 10.5));
+    EXPECT_TRUE(projector.project_down(-10.0, 6.5));
+    EXPECT_TRUE(projector.project_down(0.0, 0.0));
+  }
+}
+
+TEST(SurfaceProjection, FirstHitOnAClosedSolidIsTheTop) {
+  CurvedBeamParams params;  // a 4 mm shell: the ray crosses the top, then the bottom
+  const HeightField field = curved_beam_field(params);
+  const SurfaceProjector projector(curved_beam(params));
+  for (double x : {-30.1, -10.3, 0.2, 17.7, 32.0}) {
+    const std::optional<SurfaceHit> hit = projector.project_down(x, 1.3);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->point_mm.z(), field.z(x, 1.3), chordal_error_bound_mm(field, params.mesh));
+    EXPECT_TRUE(hit->faces_up());
+    EXPECT_GT(hit->facet_normal.z(), 0.9);
+    EXPECT_NEAR(*projector.height_at(x, 1.3), hit->point_mm.z(), 1e-12);
+  }
+}
+
+TEST(SurfaceProjection, SmoothNormalsStopAtTheRim) {
+  // the top corner normals on a solid's rim ignore the wall (a crease); on the sphere cap's
+  // edge cell the normal stays within the surface bound instead of leaning out by ~25 deg
+  SphereCapParams params;
+  const HeightField field = sphere_cap_field(params);
+  const SurfaceProjector projector(sphere_cap(params));
+  const std::optional<SurfaceHit> hit = projector.project_down(19.75, 0.25);
+  ASSERT_TRUE(hit);
+  EXPECT_LT(axis_angle_rad(hit->normal, field.normal(19.75, 0.25)), 0.03);
+}
+
+TEST(SurfaceProjection, BatchEqualsSingleRays) {
+  CylinderParams params;
+  params.mesh.holes = {SurfaceHole::circle(Vec2(0, 0), 5.0)};
+  const SurfaceProjector projector(cylinder(params));
+  std::vector<Vec2> xy;
+  for (int k = 0; k < 1000; ++k)  // scattered, some outside or in the hole
+    xy.emplace_back(-25.0 + std::fmod(k * 0.618034 * 50.0, 50.0),
+                    -25.0 + std::fmod(k * 0.754878 * 50.0, 50.0));
+  std::vector<std::optional<SurfaceHit>> hits;
+  projector.project_down(xy, hits);
+  ASSERT_EQ(hits.size(), xy.size());
+  int found = 0;
+  for (std::size_t k = 0; k < xy.size(); ++k) {
+    const std::optional<SurfaceHit> single = projector.project_down(xy[k].x(), xy[k].y());
+    ASSERT_EQ(single.has_value(), hits[k].has_value()) << k;
+    if (!single) continue;
+    ++found;
+    EXPECT_EQ(single->triangle, hits[k]->triangle);
+    EXPECT_EQ(single->point_mm, hits[k]->point_mm);
+    EXPECT_EQ(single->normal, hits[k]->normal);
+  }
+  EXPECT_GT(found, 500);
+  EXPECT_LT(found, 1000);
+}
+
+TEST(SurfaceProjection, InvertedMeshDoesNotFaceUp) {
+  SphereCapParams params;
+  params.mesh.solid = false;
+  TriangleMesh mesh = sphere_cap(params);
+  for (std::array<int, 3>& f : mesh.triangles) std::swap(f[1], f[2]);
+  const SurfaceProjector projector(std::move(mesh));
+  const std::optional<SurfaceHit> hit = projector.project_down(1.0, 2.0);
+  ASSERT_TRUE(hit);  // the surface is there ...
+  EXPECT_LT(hit->facet_normal.z(), 0.0);
+  EXPECT_LT(hit->normal.z(), 0.0);
+  EXPECT_FALSE(hit->faces_up());  // ... but it is an underside
+}
+
+TEST(SurfaceProjection, EmptyMeshIsNeverHit) {
+  const SurfaceProjector projector{TriangleMesh{}};
+  EXPECT_FALSE(projector.project_down(0.0, 0.0));
+  std::vector<std::optional<SurfaceHit>> hits;
+  projector.project_down({Vec2(0, 0), Vec2(1, 1)}, hits);
+  EXPECT_FALSE(hits[0] || hits[1]);
+}
+
+}  // namespace
+}  // namespace depotwin
