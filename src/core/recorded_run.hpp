@@ -22,6 +22,15 @@ struct StepState {
   int path_index = -1;              // the trajectory piece's print path (-1: transition)
 };
 
+// MuJoCo contacts over a run: between the machine's own parts (self: both geoms on bodies
+// of the tree that carries the nozzle) and with anything else (the table, the world). An
+// event is a pair of geoms starting to touch; steps count the states with any such contact.
+struct ContactLog {
+  int self_events = 0, other_events = 0;
+  long self_steps = 0, other_steps = 0;
+  std::string first;  // "t = 1.234 s: link3 / table" for the first event, "" without any
+};
+
 // A whole run as a struct of arrays: entry k is the state at t = k * timestep_s,
 // k = 0 .. steps (the initial state plus one entry per step).
 struct RecordedRun {
@@ -45,6 +54,7 @@ struct RecordedRun {
   double wall_s = 0.0;                       // wall-clock time of run()
   long steps = 0;                            // physics steps taken (entries - 1)
   double max_constraint_violation_mm = 0.0;  // largest equality-constraint residual; 0 without
+  ContactLog contacts;
 
   size_t size() const { return t_s.size(); }
   double joint(const std::vector<double>& values, size_t entry, int joint_index) const {

@@ -22,6 +22,8 @@ namespace {
 
 constexpr double kMinTimestep_s = 1e-5;
 constexpr double kMaxTimestep_s = 0.01;
+// contacts followed per step for the contact log (more are counted, not followed as pairs)
+constexpr size_t kMaxLoggedContacts = 256;
 // how often run() looks at the clock for progress reports
 constexpr long kProgressCheckSteps = 256;
 // how many steps' states run() buffers before handing them to on_step
@@ -66,11 +68,16 @@ struct Simulation::Impl {
   std::vector<mjtNum> acceleration_reference;  // nv
   std::vector<mjtNum> inertia_force;           // nv
   std::vector<double> hook_force;              // joints
+  // the contacting geom pairs of this step and the previous one (reserved: no allocation)
+  std::vector<std::pair<int, int>> contact_pairs, previous_contact_pairs;
+  int machine_root = -1;  // the body tree that carries the nozzle
 
   // a reset state exactly on the first reference, closed chains assembled around it
   void start_on(const JointReferences& refs);
   // the recorded state at step k (the plan's flags are already in `run`)
   void record_state(long k, RecordedRun& run, StepState& state) const;
+  // the contacts MuJoCo found at this state, as events and steps
+  void log_contacts(double t, ContactLog& log);
   // the servos' controls for update u at time t, held until the next update
   void update_controls(const JointReferences& refs, long u, double t,
                        FlushSubnormalsScope& flush_subnormals);
@@ -87,6 +94,10 @@ Simulation::Simulation(const std::string& model_path, const Machine& machine,
   s.acceleration_reference.assign(nv, 0.0);
   s.inertia_force.assign(nv, 0.0);
   s.hook_force.assign(s.bound.joints.size(), 0.0);
+  s.contact_pairs.reserve(kMaxLoggedContacts);
+  s.previous_contact_pairs.reserve(kMaxLoggedContacts);
+  const mjModel& m = *s.bound.model;
+  s.machine_root = m.body_rootid[m.site_bodyid[s.bound.nozzle_site]];
 }
 
 Simulation::~Simulation() = default;
@@ -166,6 +177,46 @@ void Simulation::Impl::record_state(long k, RecordedRun& run, StepState& state) 
     run.joint_position[k * joint_count + j] = d->qpos[servo.qpos_adr] / servo.user_to_si;
     run.joint_velocity[k * joint_count + j] = d->qvel[servo.dof_adr] / servo.user_to_si;
   }
+}
+
+void Simulation::Impl::log_contacts(double t, ContactLog& log) {
+  const mjModel& m = *bound.model;
+  const mjData& d = *bound.data;
+  previous_contact_pairs.swap(contact_pairs);
+  contact_pairs.clear();
+  bool self = false, other = false;
+  const auto on_machine = [&](int geom) {
+    const int body = m.geom_bodyid[geom];
+    return body != 0 && m.body_rootid[body] == machine_root;
+  };
+  for (int c = 0; c < d.ncon; ++c) {
+    const int g1 = std::min(d.contact[c].geom1, d.contact[c].geom2);
+    const int g2 = std::max(d.contact[c].geom1, d.contact[c].geom2);
+    const bool is_self = on_machine(g1) && on_machine(g2);
+    self = self || is_self;
+    other = other || !is_self;
+    if (contact_pairs.size() == contact_pairs.capacity()) continue;
+    const std::pair<int, int> pair(g1, g2);
+    if (std::find(contact_pairs.begin(), contact_pairs.end(), pair) != contact_pairs.end())
+      continue;
+    contact_pairs.push_back(pair);
+    // a pair that did not touch at the previous state: a new event
+    if (std::find(previous_contact_pairs.begin(), previous_contact_pairs.end(), pair) !=
+        previous_contact_pairs.end())
+      continue;
+    ++(is_self ? log.self_events : log.other_events);
+    if (log.first.empty()) {
+      const char* name1 = mj_id2name(&m, mjOBJ_GEOM, g1);
+      const char* name2 = mj_id2name(&m, mjOBJ_GEOM, g2);
+      char text[256];
+      std::snprintf(text, sizeof text, "t = %.4g s: %s / %s", t,
+                    name1 ? name1 : ("geom " + std::to_string(g1)).c_str(),
+                    name2 ? name2 : ("geom " + std::to_string(g2)).c_str());
+      log.first = text;
+    }
+  }
+  log.self_steps += self ? 1 : 0;
+  log.other_steps += other ? 1 : 0;
 }
 
 void Simulation::Impl::update_controls(const JointReferences& refs, long u, double t,
@@ -271,6 +322,7 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
     d->time = t;
     mj_step1(m, d);
     s.record_state(k, run, after);
+    if (d->ncon > 0 || !s.contact_pairs.empty()) s.log_contacts(t, run.contacts);
     if (m->neq > 0)  // only equality constraints have rows to measure
       max_violation_mm = std::max(max_violation_mm, constraint_violation_mm(*d));
     if (on_step) {
