@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "kinematics/arm6.hpp"
 #include "kinematics/linear_delta.hpp"
 #include "kinematics/machine.hpp"
 #include "kinematics/xy_stage.hpp"
@@ -16,6 +17,7 @@ const std::vector<MachineInfo>& machine_registry() {
       {"linear_delta",
        "Giberti et al.'s linear delta: three vertical carriages carry the substrate platform",
        &make_linear_delta},
+      {"arm6", "6-DOF arm (ABB IRB 120) carrying a tilted-nozzle head over a table", &make_arm6},
   };
   return registry;
 }

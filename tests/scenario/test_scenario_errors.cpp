@@ -428,7 +428,7 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(unknown.size(), 1u) << dump(unknown);
   expect_problem(unknown, scenario_path(), "machine", 1,
-                 "unknown machine 'scara' (expected xy_stage, linear_delta, or {model:");
+                 "unknown machine 'scara' (expected xy_stage, linear_delta, arm6, or {model:");
   const auto missing = problems_of(R"(
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 machine: {model: models/none.xml, kinematics: xy_stage}
@@ -447,16 +447,17 @@ machine: models/mine.xml
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(bare.size(), 1u) << dump(bare);
-  expect_problem(bare, scenario_path(), "machine", 1,
-                 "must name its kinematics family, which is never guessed: machine: {model: "
-                 "models/mine.xml, kinematics: NAME} with NAME one of xy_stage, linear_delta");
+  expect_problem(
+      bare, scenario_path(), "machine", 1,
+      "must name its kinematics family, which is never guessed: machine: {model: "
+      "models/mine.xml, kinematics: NAME} with NAME one of xy_stage, linear_delta, arm6");
   const auto unknown_family = problems_of(R"(
 machine: {model: models/mine.xml, kinematics: scara}
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(unknown_family.size(), 1u) << dump(unknown_family);
   expect_problem(unknown_family, scenario_path(), "machine.kinematics", 1,
-                 "unknown kinematics family 'scara' (expected xy_stage, linear_delta)");
+                 "unknown kinematics family 'scara' (expected xy_stage, linear_delta, arm6)");
   const auto missing_family = problems_of(R"(
 machine: {model: models/mine.xml}
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
@@ -499,15 +500,54 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
   expect_problem(problems, scenario_path(), "limits", 1, "expected a map, got nothing");
 }
 
-TEST_F(ScenarioErrors, SurfaceIsNotSupportedYet) {
+// every problem of a surface toolpath in one run, each at its key
+TEST_F(ScenarioErrors, SurfaceProblemsAreListedTogether) {
   const auto problems = problems_of(R"(
 toolpath:
   speed: 3
-  surface: {mesh: part.stl}
+  surface:
+    mesh: part.stl
+    units: furlong
+    alpha: 2
+    angles: []
+    layers: 0
+    layer_offset: sideways
 )");
-  ASSERT_EQ(problems.size(), 1u) << dump(problems);
-  expect_problem(problems, scenario_path(), "toolpath.surface", 3,
-                 "surface toolpaths are not supported yet");
+  ASSERT_EQ(problems.size(), 7u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.surface", 4, "missing file");
+  expect_problem(problems, scenario_path(), "toolpath.surface", 5, "unknown key 'mesh'");
+  expect_problem(problems, scenario_path(), "toolpath.surface.units", 6, "unknown units 'furlong'");
+  expect_problem(problems, scenario_path(), "toolpath.surface.alpha", 7, "");
+  expect_problem(problems, scenario_path(), "toolpath.surface.angles", 8, "is empty");
+  expect_problem(problems, scenario_path(), "toolpath.surface.layers", 9, "");
+  expect_problem(problems, scenario_path(), "toolpath.surface.layer_offset", 10,
+                 "unknown layer offset 'sideways'");
+}
+
+// a missing STL names the path looked for; an offset outside surface: is refused
+TEST_F(ScenarioErrors, SurfaceFileMustExist) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  offset: [1, 2]
+  surface: {file: nowhere.stl}
+)");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.offset", 4, "surface.offset");
+  expect_problem(problems, scenario_path(), "toolpath.surface.file", 5,
+                 "STL file 'nowhere.stl' not found");
+}
+
+// `arm:` belongs to the arm
+TEST_F(ScenarioErrors, ArmSettingsNeedTheArm) {
+  const auto problems = problems_of(R"(
+machine: xy_stage
+arm: {roll: sideways}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  expect_problem(problems, scenario_path(), "arm", 3, "applies to machine arm6");
+  expect_problem(problems, scenario_path(), "arm.roll", 3, "unknown roll strategy 'sideways'");
 }
 
 TEST_F(ScenarioErrors, BadRandomSegments) {
