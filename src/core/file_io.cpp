@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <system_error>
 
 #include "core/error.hpp"
@@ -30,6 +31,14 @@ void write_file_atomically(const std::string& path, const std::string& content) 
     fs::remove(temporary, error);
     throw InternalError("cannot move " + temporary + " to " + path);
   }
+}
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in && !in.eof()) throw InputError(path, 0, "", "cannot read the file");
+  if (!fs::is_regular_file(path)) throw InputError(path, 0, "", "no such file");
+  return content;
 }
 
 }  // namespace depotwin

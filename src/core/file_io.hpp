@@ -10,4 +10,7 @@ namespace depotwin {
 // Throws InternalError on I/O failure (the target is then untouched).
 void write_file_atomically(const std::string& path, const std::string& content);
 
+// The whole file's bytes; InputError naming the path when it cannot be read.
+std::string read_text_file(const std::string& path);
+
 }  // namespace depotwin

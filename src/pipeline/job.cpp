@@ -6,9 +6,12 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/file_io.hpp"
+#include "kinematics/arm6.hpp"
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
 #include "report/trajectory_csv.hpp"
+#include "sim/part_model.hpp"
 
 namespace depotwin {
 
@@ -59,6 +62,42 @@ std::vector<Problem> unreachable_poses(const Scenario& scenario, const Machine& 
   return problems;
 }
 
+// Problems of the arm's posture (no file, key "toolpath") placed at the scenario's toolpath
+std::vector<Problem> at_toolpath(const Scenario& scenario, std::vector<Problem> problems) {
+  for (Problem& p : problems) {
+    if (!p.file.empty()) continue;
+    p.file = scenario.file;
+    p.line = scenario.surface ? scenario.surface->line : 0;
+    p.key = scenario.surface ? "toolpath.surface" : "toolpath";
+  }
+  return problems;
+}
+
+// A 6-DOF arm: the roll about the nozzle axis at every point and the branch of the job (the
+// ladder graph of posture/), checked against the part
+void choose_posture(const Scenario& scenario, Arm6& arm, PreparedJob& job) {
+  if (job.part) job.clearance = std::make_shared<const PartClearance>(*job.part);
+  // a point named by its layer, line and index for a surface toolpath
+  const auto name = [&](size_t path, size_t point) {
+    const PrintPath& printed = job.toolpath.paths[path];
+    if (!scenario.surface)
+      return "toolpath path " + std::to_string(printed.source_index) + ", point " +
+             std::to_string(point);
+    const PrintPath& given = scenario.toolpath.paths[static_cast<size_t>(printed.source_index)];
+    const bool reversed = (given.front() - printed.front()).norm() > kJoinTolerance_mm;
+    return scenario.surface->describe_point(printed.source_index, point, printed.points.size(),
+                                            reversed);
+  };
+  try {
+    job.posture = choose_arm_posture(arm, job.clearance.get(), job.toolpath,
+                                     scenario.arm.value_or(ArmPostureSettings{}), name);
+  } catch (const InputError& e) {
+    throw InputError(at_toolpath(scenario, e.problems()));
+  }
+  arm.set_branch(job.posture->branch);
+  job.toolpath = job.posture->toolpath;
+}
+
 }  // namespace
 
 PreparedJob prepare_job(const Scenario& scenario) {
@@ -71,9 +110,19 @@ PreparedJob prepare_job(const Scenario& scenario) {
       throw InputError(scenario.file, scenario.joint_limits_line, "limits.joint", problem);
   }
 
-  // every pose of the toolpath must be reachable by the machine
-  const std::vector<Problem> problems = unreachable_poses(scenario, *job.machine);
-  if (!problems.empty()) throw InputError(problems);
+  // the part, in the machine's model too (shown in the scene, carried by the substrate)
+  Arm6* arm = dynamic_cast<Arm6*>(job.machine.get());
+  if (scenario.part) {
+    job.part = scenario.part;
+    job.model_text = mjcf_with_part(read_text_file(job.model_path), job.model_path, *job.part);
+  }
+
+  // every pose of the toolpath must be reachable by the machine (an arm: for some roll, on
+  // its posture's branch, below)
+  if (!arm) {
+    const std::vector<Problem> problems = unreachable_poses(scenario, *job.machine);
+    if (!problems.empty()) throw InputError(problems);
+  }
 
   // the TCP limits: the user's, refined per move by the machine (Klipper's check_move)
   job.limits = job.machine->tcp_limits(scenario.limits);
@@ -81,6 +130,9 @@ PreparedJob prepare_job(const Scenario& scenario) {
   // print order (Ganganath et al.), before every planner
   job.order = sequence(scenario.toolpath, job.limits, scenario.order);
   job.toolpath = apply_order(scenario.toolpath, job.order);
+
+  // an arm: its roll at every point and its branch, away from limits, singularities and the part
+  if (arm) choose_posture(scenario, *arm, job);
   return job;
 }
 

@@ -3,14 +3,17 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "collision/part_clearance.hpp"
 #include "core/triangle_mesh.hpp"
 #include "kinematics/machine.hpp"
 #include "metrics/metrics_report.hpp"
 #include "planners/ordering/sequencer.hpp"
 #include "planners/planner.hpp"
+#include "posture/arm_posture.hpp"
 #include "scenario/scenario.hpp"
 
 namespace depotwin {
@@ -26,6 +29,10 @@ struct PreparedJob {
   std::string model_text;
   // the part printed on (conformal work), placed in the work frame; null for planar work
   std::shared_ptr<const TriangleMesh> part;
+  // a 6-DOF arm: the exact distance to the part, and the roll and branch chosen along the
+  // toolpath (the toolpath above carries the rolls)
+  std::shared_ptr<const PartClearance> clearance;
+  std::optional<ArmPosture> posture;
   TcpLimits limits;  // what every planner must respect (refers to *machine)
   OrderResult order;
   Toolpath toolpath;  // in print order

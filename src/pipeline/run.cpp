@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "deposition/deposition_metrics.hpp"
 #include "deposition/field_io.hpp"
+#include "kinematics/arm6.hpp"
 #include "metrics/run_report.hpp"
 #include "plots/plots.hpp"
 #include "render/scene.hpp"
@@ -22,6 +23,9 @@
 namespace depotwin {
 
 namespace fs = std::filesystem;
+
+// the arm's clearance to the part is measured this often over a run (and at every step near it)
+constexpr double kArmClearancePeriod_s = 0.02;
 
 DepositionSettings deposition_settings(const Scenario& scenario) {
   const ProcessSpec& p = scenario.process;
@@ -195,6 +199,10 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
     run.report.layers = layer_reports(job.toolpath, run.plan.planned, run.simulated, deposit);
   run.report.actuators = actuator_stats(run.record, job.machine->joint_limits(),
                                         run.simulation->actuator_force_limits());
+  // an arm: its posture over the run (limits, singularities, the part, contacts, branch)
+  if (const auto* arm = dynamic_cast<const Arm6*>(job.machine.get()); arm && job.posture)
+    run.report.arm =
+        arm_run_stats(*arm, job.clearance.get(), run.record, *job.posture, kArmClearancePeriod_s);
   return run;
 }
 

@@ -102,6 +102,7 @@ class Loader {
                     bool start_given, bool end_given);
   std::optional<std::vector<Vec3>> read_points(const Field& field, std::vector<int>& lines);
   void check_path(const PrintPath& path, const PathOrigin& origin);
+  void read_arm(const Field& field);
   void read_order(const Field& field);
   bool read_order_name(const Field& field, OrderSpec& order);
   void read_planners(const Field& field);
@@ -124,21 +125,26 @@ Scenario Loader::load() {
   if (!read_document(root)) throw InputError(problems_.problems());
 
   // the top level: every key optional except the toolpath
-  const MapView top(
-      Field{root, "", 1, 1},
-      {"name", "machine", "limits", "process", "toolpath", "order", "planners", "sim", "outputs"},
-      problems_);
+  const MapView top(Field{root, "", 1, 1},
+                    {"name", "machine", "limits", "process", "toolpath", "arm", "order", "planners",
+                     "sim", "outputs"},
+                    problems_);
   if (top.is_map()) {
     if (const Field* f = top.find("name")) read_name(*f);
     if (const Field* f = top.find("machine")) read_machine(*f);
     if (const Field* f = top.find("limits")) read_limits(*f);
     if (const Field* f = top.find("process")) read_process(*f);
     read_toolpath(top.find("toolpath"));
+    if (const Field* f = top.find("arm")) read_arm(*f);
     if (const Field* f = top.find("order")) read_order(*f);
     if (const Field* f = top.find("planners")) read_planners(*f);
     if (const Field* f = top.find("sim")) read_sim(*f);
     if (const Field* f = top.find("outputs")) read_outputs(*f);
   }
+  // `arm:` belongs to an arm
+  if (scenario_.arm && scenario_.machine != "arm6")
+    problems_.add(scenario_.arm_line, "arm",
+                  "applies to machine arm6 (a 6-DOF arm), not to " + scenario_.machine);
   if (problems_.empty()) return scenario_;
 
   // scenario-file problems in line order, then those of imported files
@@ -813,6 +819,48 @@ void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
       return;  // one problem per path is enough
     }
   }
+}
+
+void Loader::read_arm(const Field& field) {
+  scenario_.arm_line = field.key_line;
+  const MapView view(field,
+                     {"roll", "fixed_roll_deg", "branch", "roll_step_deg", "sample_spacing_mm",
+                      "min_joint_margin_deg", "min_wrist_alignment", "min_wrist_offset_mm",
+                      "min_manipulability", "min_clearance_mm", "max_joint_step_deg"},
+                     problems_);
+  if (!view.is_map()) return;
+  ArmPostureSettings arm;
+  if (const Field* f = view.find("roll")) {
+    const std::optional<std::string> roll = read_string(*f, problems_);
+    if (roll && (*roll == "optimized" || *roll == "fixed"))
+      arm.optimize_roll = *roll == "optimized";
+    else if (roll)
+      problems_.add(f->line, f->key,
+                    "unknown roll strategy '" + *roll +
+                        "' (expected optimized: chosen point by point, or fixed: one roll)");
+  }
+  if (const Field* f = view.find("fixed_roll_deg")) {
+    arm.fixed_roll_deg = read_number(*f, problems_, Range{-360.0, true, 360.0, true});
+    if (arm.optimize_roll && arm.fixed_roll_deg)
+      problems_.add(f->line, f->key, "applies to roll: fixed only");
+  }
+  if (const Field* f = view.find("branch"))
+    arm.branch = static_cast<int>(read_integer(*f, problems_, -1, 7).value_or(-1));
+  const auto read = [&](const char* key, const Range& range, double& target) {
+    if (const Field* f = view.find(key))
+      target = read_number(*f, problems_, range).value_or(target);
+  };
+  read("roll_step_deg", Range{1.0, true, 90.0, true}, arm.roll_step_deg);
+  read("sample_spacing_mm", Range::positive(), arm.sample_spacing_mm);
+  read("min_joint_margin_deg", Range{0.0, true, 90.0, true}, arm.min_joint_margin_deg);
+  read("min_wrist_alignment", Range{0.0, true, 1.0, false}, arm.min_wrist_alignment);
+  read("min_wrist_offset_mm", Range::non_negative(), arm.min_wrist_offset_mm);
+  read("min_manipulability", Range::non_negative(), arm.min_manipulability);
+  read("min_clearance_mm", Range{-100.0, true, 100.0, true}, arm.min_clearance_mm);
+  read("max_joint_step_deg", Range{0.0, false, 180.0, true}, arm.max_joint_step_deg);
+  const std::string problem = arm.validate();
+  if (!problem.empty()) problems_.add(field.key_line, field.key, problem);
+  scenario_.arm = arm;
 }
 
 bool Loader::read_order_name(const Field& field, OrderSpec& order) {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "core/triangle_mesh.hpp"
 #include "planners/ordering/sequencer.hpp"
 #include "planners/planner.hpp"
+#include "posture/arm_posture.hpp"
 
 namespace depotwin {
 
@@ -96,6 +98,9 @@ struct Scenario {
   // (mm); null / empty for planar toolpaths
   std::shared_ptr<const SurfaceToolpath> surface;
   std::shared_ptr<const TriangleMesh> part;
+  // `arm:` — how a 6-DOF arm chooses its roll and branch along the toolpath (arm6 only)
+  std::optional<ArmPostureSettings> arm;
+  int arm_line = 0;
   OrderSpec order;
   std::vector<PlannerSpec> planners;
   SimSpec sim;

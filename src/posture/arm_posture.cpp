@@ -1,0 +1,690 @@
+#include "posture/arm_posture.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr int kBranches = 8;
+// reference values of the rung cost: a posture this far from each limit costs 1 per measure
+constexpr double kMarginReference_deg = 30.0;
+constexpr double kAlignmentReference = 0.5;  // |sin q5| at 30 deg
+constexpr double kOffsetReference_mm = 150.0;
+constexpr double kManipulabilityReference = 0.01;
+constexpr double kClearanceReference_mm = 10.0;
+// edge costs: joint motion between stations, in units of these steps, squared
+constexpr double kPrintJointStep_deg = 2.0;
+constexpr double kTravelJointStep_deg = 30.0;
+// closer to the part than this, the run's clearance is measured at every state
+constexpr double kNearPart_mm = 3.0;
+// at most this many points are named in an error
+constexpr size_t kMaxNamedPoints = 20;
+
+// why a rung is not valid, most fundamental first
+enum class Reason : uint8_t { ok, unreachable, joint_limit, singular, collides };
+
+const char* reason_text(Reason reason) {
+  switch (reason) {
+    case Reason::unreachable:
+      return "out of the arm's reach";
+    case Reason::joint_limit:
+      return "beyond a joint's range";
+    case Reason::singular:
+      return "at a singularity";
+    case Reason::collides:
+      return "too close to the part";
+    default:
+      return "reachable";
+  }
+}
+
+std::string format(const char* pattern, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, pattern, value);
+  return text;
+}
+
+std::string point_text(const Vec3& p) {
+  char text[96];
+  std::snprintf(text, sizeof text, "(%.3f, %.3f, %.3f) mm", p.x(), p.y(), p.z());
+  return text;
+}
+
+// one station of the ladder
+struct Station {
+  Pose pose;                 // roll 0
+  int path = -1;             // -1: the job's start or end
+  size_t point = 0;          // index in the path
+  bool after_travel = true;  // the edge from the previous station is a travel
+};
+
+// the job's start, points along every path about `spacing` apart (ends always), the job's end
+std::vector<Station> make_stations(const Toolpath& toolpath, double spacing_mm) {
+  std::vector<Station> stations;
+  stations.push_back(Station{Pose(toolpath.start_mm), -1, 0, true});
+  for (size_t p = 0; p < toolpath.paths.size(); ++p) {
+    const PrintPath& path = toolpath.paths[p];
+    double since = 0.0;
+    for (size_t i = 0; i < path.points.size(); ++i) {
+      if (i > 0) since += (path.points[i] - path.points[i - 1]).norm();
+      const bool last = i + 1 == path.points.size();
+      if (i > 0 && !last && since < spacing_mm) continue;
+      stations.push_back(
+          Station{Pose(path.points[i], path.tool_axis(i)), static_cast<int>(p), i, i == 0});
+      since = 0.0;
+    }
+  }
+  stations.push_back(Station{Pose(toolpath.end_mm), -1, 0, true});
+  return stations;
+}
+
+Arm6Joints to_array(const JointVector& q) {
+  Arm6Joints a{};
+  for (size_t j = 0; j < 6; ++j) a[j] = q[j];
+  return a;
+}
+
+JointVector to_vector(const Arm6Joints& q) {
+  return JointVector(q.begin(), q.end());
+}
+
+// the smallest distance of joints 1-5 to their range's ends (rad): joint 6 turns +-400 deg,
+// so one of its turns is always well inside
+double margin_1_to_5(const Arm6& arm, const Arm6Joints& q) {
+  double margin = kInfinity;
+  const std::vector<JointLimit>& limits = arm.joint_limits();
+  for (size_t j = 0; j < 5; ++j)
+    margin = std::min({margin, q[j] - limits[j].min, limits[j].max - q[j]});
+  return margin;
+}
+
+// the angle difference a - b wrapped into (-pi, pi] (joint 6's turns are equivalent here)
+double wrapped(double a, double b) {
+  return std::remainder(a - b, 2.0 * kPi);
+}
+
+// squared joint motion between two postures in units of `step`
+double motion_cost(const Arm6Joints& a, const Arm6Joints& b, double step_rad) {
+  double sum = 0.0;
+  for (size_t j = 0; j < 6; ++j) {
+    const double d = (j == 5 ? wrapped(a[j], b[j]) : a[j] - b[j]) / step_rad;
+    sum += d * d;
+  }
+  return sum;
+}
+
+double largest_step(const Arm6Joints& a, const Arm6Joints& b) {
+  double largest = 0.0;
+  for (size_t j = 0; j < 6; ++j)
+    largest = std::max(largest, std::abs(j == 5 ? wrapped(a[j], b[j]) : a[j] - b[j]));
+  return largest;
+}
+
+// A rung's validity and cost without the part: reach, joint ranges, singularity
+struct RungCheck {
+  Reason reason = Reason::ok;
+  double cost = kInfinity;
+};
+
+RungCheck check_rung(const Arm6& arm, const Arm6Joints& q, const ArmPostureSettings& s) {
+  RungCheck check;
+  const double margin = margin_1_to_5(arm, q);
+  if (margin < deg_to_rad(s.min_joint_margin_deg)) {
+    check.reason = Reason::joint_limit;
+    return check;
+  }
+  const JointVector joints = to_vector(q);
+  const double alignment = arm.wrist_alignment(joints);
+  const double offset = arm.wrist_centre_offset_mm(joints);
+  const double manipulability = arm.manipulability(joints);
+  if (alignment < s.min_wrist_alignment || offset < s.min_wrist_offset_mm ||
+      manipulability < s.min_manipulability) {
+    check.reason = Reason::singular;
+    return check;
+  }
+  const auto square = [](double x) { return x * x; };
+  check.cost = square(deg_to_rad(kMarginReference_deg) / margin) +
+               square(kAlignmentReference / alignment) + square(kOffsetReference_mm / offset) +
+               square(kManipulabilityReference / manipulability);
+  return check;
+}
+
+// the pose of a station at roll index k
+Pose rolled(const Station& station, double roll_rad) {
+  Pose pose = station.pose;
+  pose.roll_rad = roll_rad;
+  return pose;
+}
+
+// The ladder of one branch: per station and roll, the posture, its cost (infinite: invalid)
+// and why, and the clearance once measured.
+struct Ladder {
+  int rolls = 0;
+  std::vector<Arm6Joints> q;  // station-major
+  std::vector<double> cost;
+  std::vector<Reason> reason;
+  std::vector<double> clearance;  // NaN until measured
+  size_t index(size_t station, int roll) const { return station * rolls + roll; }
+};
+
+// The shortest path through a ladder: one roll index per station, or empty when none exists.
+// Along a print path the roll moves at most one step between stations and no joint more than
+// max_step; between paths any roll.
+std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>& stations,
+                               double max_step_rad, bool joint_costs) {
+  const int K = ladder.rolls;
+  const size_t n = stations.size();
+  std::vector<double> total(K, kInfinity), next(K);
+  std::vector<int16_t> back(n * K, -1);
+  for (int k = 0; k < K; ++k) total[k] = ladder.cost[ladder.index(0, k)];
+  const double print_step = deg_to_rad(kPrintJointStep_deg);
+  const double travel_step = deg_to_rad(kTravelJointStep_deg);
+  for (size_t s = 1; s < n; ++s) {
+    const bool travel = stations[s].after_travel;
+    for (int k = 0; k < K; ++k) {
+      next[k] = kInfinity;
+      const double here = ladder.cost[ladder.index(s, k)];
+      if (!std::isfinite(here)) continue;
+      const Arm6Joints& q = ladder.q[ladder.index(s, k)];
+      // the previous station's rungs this one may follow
+      const int reach = travel ? K / 2 : 1;
+      for (int d = -reach; d <= reach; ++d) {
+        if (travel && d == reach && K % 2 == 0 && reach != 0) continue;  // each roll once
+        const int from = ((k + d) % K + K) % K;
+        const double before = total[from];
+        if (!std::isfinite(before)) continue;
+        const Arm6Joints& p = ladder.q[ladder.index(s - 1, from)];
+        double edge = 0.0;
+        if (travel) {
+          edge = joint_costs ? motion_cost(p, q, travel_step) : 0.0;
+        } else {
+          if (joint_costs && largest_step(p, q) > max_step_rad) continue;
+          edge = joint_costs ? motion_cost(p, q, print_step) : static_cast<double>(d * d);
+        }
+        const double candidate = before + edge + here;
+        if (candidate < next[k]) {
+          next[k] = candidate;
+          back[s * K + k] = static_cast<int16_t>(from);
+        }
+      }
+    }
+    total.swap(next);
+  }
+  int best = -1;
+  for (int k = 0; k < K; ++k)
+    if (std::isfinite(total[k]) && (best < 0 || total[k] < total[best])) best = k;
+  if (best < 0) return {};
+  std::vector<int> path(n);
+  path[n - 1] = best;
+  for (size_t s = n - 1; s > 0; --s) path[s - 1] = back[s * K + path[s]];
+  return path;
+}
+
+double path_cost(const Ladder& ladder, const std::vector<int>& path) {
+  double sum = 0.0;
+  for (size_t s = 0; s < path.size(); ++s) sum += ladder.cost[ladder.index(s, path[s])];
+  return sum;
+}
+
+}  // namespace
+
+std::string ArmPostureSettings::validate() const {
+  if (!(roll_step_deg >= 1.0 && roll_step_deg <= 90.0 && std::fmod(360.0, roll_step_deg) < 1e-9))
+    return "roll_step_deg must divide 360 and lie in [1, 90]";
+  if (!(sample_spacing_mm > 0.0) || !std::isfinite(sample_spacing_mm))
+    return "sample_spacing_mm must be > 0";
+  if (!(min_joint_margin_deg >= 0.0) || !std::isfinite(min_joint_margin_deg))
+    return "min_joint_margin_deg must be >= 0";
+  if (!(min_wrist_alignment >= 0.0 && min_wrist_alignment < 1.0))
+    return "min_wrist_alignment must lie in [0, 1)";
+  if (!(min_wrist_offset_mm >= 0.0) || !std::isfinite(min_wrist_offset_mm))
+    return "min_wrist_offset_mm must be >= 0";
+  if (!(min_manipulability >= 0.0) || !std::isfinite(min_manipulability))
+    return "min_manipulability must be >= 0";
+  if (!std::isfinite(min_clearance_mm)) return "min_clearance_mm must be finite";
+  if (!(max_joint_step_deg > 0.0) || !std::isfinite(max_joint_step_deg))
+    return "max_joint_step_deg must be > 0";
+  if (branch < -1 || branch > 7) return "branch must be -1 (the best) or 0..7";
+  if (fixed_roll_deg && !std::isfinite(*fixed_roll_deg)) return "fixed_roll_deg must be finite";
+  return "";
+}
+
+ArmPostureStats best_possible_posture() {
+  ArmPostureStats stats;
+  stats.min_joint_margin_deg = kInfinity;
+  stats.min_manipulability = kInfinity;
+  stats.min_wrist_centre_offset_mm = kInfinity;
+  stats.min_wrist_alignment = kInfinity;
+  stats.min_clearance_mm = kInfinity;
+  return stats;
+}
+
+void keep_worst(ArmPostureStats& worst, const ArmPostureStats& next) {
+  worst.min_joint_margin_deg = std::min(worst.min_joint_margin_deg, next.min_joint_margin_deg);
+  worst.min_manipulability = std::min(worst.min_manipulability, next.min_manipulability);
+  worst.min_wrist_centre_offset_mm =
+      std::min(worst.min_wrist_centre_offset_mm, next.min_wrist_centre_offset_mm);
+  worst.min_wrist_alignment = std::min(worst.min_wrist_alignment, next.min_wrist_alignment);
+  if (next.min_clearance_mm < worst.min_clearance_mm) {
+    worst.min_clearance_mm = next.min_clearance_mm;
+    worst.nearest_shape = next.nearest_shape;
+  }
+}
+
+ArmStats arm_run_stats(const Arm6& arm, const PartClearance* part, const RecordedRun& record,
+                       const ArmPosture& posture, double clearance_period_s) {
+  ArmStats stats;
+  stats.run = best_possible_posture();
+  stats.branch = posture.branch;
+  stats.clearance_period_s = clearance_period_s;
+  stats.roll_strategy = posture.roll_optimized ? "optimized" : "fixed";
+  stats.fixed_roll_deg =
+      posture.roll_optimized ? posture.best_fixed_roll_deg : posture.fixed_roll_deg;
+  stats.chosen_roll = posture.chosen;
+  stats.fixed_roll = posture.fixed;
+  stats.fixed_roll_feasible = posture.fixed_feasible;
+  stats.fixed_roll_problem = posture.fixed_problem;
+  if (record.joint_count != 6 || record.size() == 0) return stats;
+
+  // every state's joints (rad); the measures that need the Jacobian or the part at a period
+  const long stride =
+      std::max(1L, std::lround(clearance_period_s / std::max(record.timestep_s, 1e-9)));
+  JointVector q(6);
+  int previous_branch = -1;
+  bool in_contact = false;
+  double last_clearance = kInfinity;
+  for (size_t k = 0; k < record.size(); ++k) {
+    for (int j = 0; j < 6; ++j) q[j] = record.joint(record.joint_position, k, j);
+    stats.run.min_joint_margin_deg =
+        std::min(stats.run.min_joint_margin_deg, rad_to_deg(arm.joint_margin_rad(q)));
+    stats.run.min_wrist_alignment = std::min(stats.run.min_wrist_alignment, arm.wrist_alignment(q));
+    // a branch change: the shoulder, elbow or wrist crossing its singular boundary
+    const int branch = arm.branch_of(q);
+    if (previous_branch >= 0 && branch != previous_branch) ++stats.branch_changes;
+    previous_branch = branch;
+    const bool periodic = k % static_cast<size_t>(stride) == 0 || k + 1 == record.size();
+    const bool near_part = last_clearance < kNearPart_mm;
+    if (!periodic && !near_part) continue;
+    stats.run.min_manipulability = std::min(stats.run.min_manipulability, arm.manipulability(q));
+    stats.run.min_wrist_centre_offset_mm =
+        std::min(stats.run.min_wrist_centre_offset_mm, arm.wrist_centre_offset_mm(q));
+    if (!part) continue;
+    const PartClearance::Result nearest =
+        part->clearance(arm.collision_shapes(), arm.link_frames(q));
+    last_clearance = nearest.distance_mm;
+    if (nearest.distance_mm < stats.run.min_clearance_mm) {
+      stats.run.min_clearance_mm = nearest.distance_mm;
+      if (nearest.shape >= 0) stats.run.nearest_shape = arm.collision_shapes()[nearest.shape].name;
+    }
+    // a contact with the part starts
+    const bool touching = nearest.distance_mm <= 0.0;
+    if (touching && !in_contact) ++stats.part_contacts;
+    in_contact = touching;
+  }
+  stats.self_contacts = record.contacts.self_events;
+  stats.table_contacts = record.contacts.other_events;
+  stats.collisions = stats.part_contacts + stats.self_contacts + stats.table_contacts;
+  return stats;
+}
+
+ArmPostureStats posture_at(const Arm6& arm, const PartClearance* part, const JointVector& joints) {
+  ArmPostureStats stats;
+  stats.min_joint_margin_deg = rad_to_deg(arm.joint_margin_rad(joints));
+  stats.min_manipulability = arm.manipulability(joints);
+  stats.min_wrist_centre_offset_mm = arm.wrist_centre_offset_mm(joints);
+  stats.min_wrist_alignment = arm.wrist_alignment(joints);
+  stats.min_clearance_mm = kInfinity;
+  if (part) {
+    const PartClearance::Result nearest =
+        part->clearance(arm.collision_shapes(), arm.link_frames(joints));
+    stats.min_clearance_mm = nearest.distance_mm;
+    if (nearest.shape >= 0) stats.nearest_shape = arm.collision_shapes()[nearest.shape].name;
+  }
+  return stats;
+}
+
+ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const Toolpath& toolpath,
+                              const ArmPostureSettings& settings, const PointNamer& name) {
+  const std::string problem = settings.validate();
+  if (!problem.empty()) throw InputError("arm", problem);
+  const int K = static_cast<int>(std::lround(360.0 / settings.roll_step_deg));
+  const double step_rad = deg_to_rad(settings.roll_step_deg);
+  const std::vector<Station> stations = make_stations(toolpath, settings.sample_spacing_mm);
+  const size_t n = stations.size();
+  const auto station_name = [&](size_t s) {
+    const Station& st = stations[s];
+    const std::string where = st.path < 0
+                                  ? (s == 0 ? std::string("the start") : std::string("the end"))
+                                  : name(static_cast<size_t>(st.path), st.point);
+    return where + " " + point_text(st.pose.position_mm);
+  };
+
+  // pass 1, every branch: rung validity and cost from the kinematics alone
+  std::vector<double> cost(static_cast<size_t>(kBranches) * n * K, kInfinity);
+  std::vector<Reason> reason(cost.size(), Reason::unreachable);
+  const auto at = [&](int b, size_t s, int k) { return (static_cast<size_t>(b) * n + s) * K + k; };
+  Arm6Branches solved;
+  for (size_t s = 0; s < n; ++s) {
+    for (int k = 0; k < K; ++k) {
+      if (!arm.branch_solutions(rolled(stations[s], k * step_rad), solved)) continue;
+      for (int b = 0; b < kBranches; ++b) {
+        const RungCheck check = check_rung(arm, solved[b], settings);
+        cost[at(b, s, k)] = check.cost;
+        reason[at(b, s, k)] = check.reason;
+      }
+    }
+  }
+
+  // stations no branch and no roll can take: the job cannot be printed; say where and why
+  std::vector<Problem> problems;
+  for (size_t s = 0; s < n; ++s) {
+    Reason best = Reason::unreachable;
+    bool any = false;
+    for (int b = 0; b < kBranches && !any; ++b)
+      for (int k = 0; k < K; ++k) {
+        const size_t i = at(b, s, k);
+        if (std::isfinite(cost[i])) {
+          any = true;
+          break;
+        }
+        best = std::max(best, reason[i]);
+      }
+    if (any) continue;
+    if (problems.size() < kMaxNamedPoints)
+      problems.push_back(Problem{"", 0, "toolpath",
+                                 station_name(s) + " is " + reason_text(best) +
+                                     " for every roll and branch of " + arm.name()});
+  }
+  if (!problems.empty()) throw InputError(problems);
+
+  // the fixed roll: for each branch and roll, is every station valid, and at what cost
+  ArmPosture result;
+  result.stations = n;
+  result.roll_optimized = settings.optimize_roll;
+  int fixed_branch = -1, fixed_roll = 0, fewest_invalid_branch = 0, fewest_invalid_roll = 0;
+  size_t fewest_invalid = n + 1;
+  double fixed_cost = kInfinity;
+  const int requested_roll =
+      settings.fixed_roll_deg
+          ? static_cast<int>(
+                ((std::lround(*settings.fixed_roll_deg / settings.roll_step_deg) % K) + K) % K)
+          : -1;
+  for (int b = 0; b < kBranches; ++b) {
+    if (settings.branch >= 0 && b != settings.branch) continue;
+    for (int k = 0; k < K; ++k) {
+      if (requested_roll >= 0 && !settings.optimize_roll && k != requested_roll) continue;
+      double sum = 0.0;
+      size_t invalid = 0;
+      for (size_t s = 0; s < n; ++s) {
+        const double c = cost[at(b, s, k)];
+        if (std::isfinite(c))
+          sum += c;
+        else
+          ++invalid;
+      }
+      if (invalid < fewest_invalid) {
+        fewest_invalid = invalid;
+        fewest_invalid_branch = b;
+        fewest_invalid_roll = k;
+      }
+      if (invalid == 0 && sum < fixed_cost) {
+        fixed_cost = sum;
+        fixed_branch = b;
+        fixed_roll = k;
+      }
+    }
+  }
+  result.fixed_feasible = fixed_branch >= 0;
+  if (!result.fixed_feasible) {
+    fixed_branch = fewest_invalid_branch;
+    fixed_roll = fewest_invalid_roll;
+    for (size_t s = 0; s < n; ++s) {
+      const size_t i = at(fixed_branch, s, fixed_roll);
+      if (std::isfinite(cost[i])) continue;
+      result.fixed_problem = "at roll " + format("%.0f", fixed_roll * settings.roll_step_deg) +
+                             " deg (branch " + std::to_string(fixed_branch) + ", the fewest " +
+                             "failures: " + std::to_string(fewest_invalid) + " of " +
+                             std::to_string(n) + " stations), " + station_name(s) + " is " +
+                             reason_text(reason[i]);
+      break;
+    }
+  }
+  result.best_fixed_roll_deg = fixed_roll * settings.roll_step_deg;
+
+  // the branch: the cheapest whose ladder (roll moving one step at a time along paths) has a
+  // path; a forced one as given
+  std::vector<int> branches;
+  if (settings.branch >= 0) {
+    branches.push_back(settings.branch);
+  } else {
+    std::vector<std::pair<double, int>> ranked;
+    for (int b = 0; b < kBranches; ++b) {
+      Ladder ladder;
+      ladder.rolls = K;
+      ladder.cost.assign(cost.begin() + at(b, 0, 0), cost.begin() + at(b, 0, 0) + n * K);
+      ladder.q.assign(n * K, Arm6Joints{});
+      const std::vector<int> path = shortest_path(ladder, stations, kInfinity, false);
+      if (!path.empty()) ranked.emplace_back(path_cost(ladder, path), b);
+    }
+    std::sort(ranked.begin(), ranked.end());
+    for (const auto& [c, b] : ranked) branches.push_back(b);
+  }
+
+  // pass 2 on the best branches in turn: postures stored, joint-motion edges, clearance checked
+  // where the path goes (a colliding station's every roll measured, then search again)
+  std::vector<int> chosen;
+  int branch = -1;
+  std::string last_failure;
+  for (int b : branches) {
+    Ladder ladder;
+    ladder.rolls = K;
+    ladder.q.assign(n * K, Arm6Joints{});
+    ladder.cost.assign(cost.begin() + at(b, 0, 0), cost.begin() + at(b, 0, 0) + n * K);
+    ladder.reason.assign(reason.begin() + at(b, 0, 0), reason.begin() + at(b, 0, 0) + n * K);
+    ladder.clearance.assign(n * K, std::numeric_limits<double>::quiet_NaN());
+    if (!settings.optimize_roll) {
+      // one roll for the whole job: every other rung removed
+      const int keep = requested_roll >= 0 ? requested_roll : fixed_roll;
+      for (size_t s = 0; s < n; ++s)
+        for (int k = 0; k < K; ++k)
+          if (k != keep) ladder.cost[ladder.index(s, k)] = kInfinity;
+    }
+    for (size_t s = 0; s < n; ++s)
+      for (int k = 0; k < K; ++k) {
+        if (!std::isfinite(ladder.cost[ladder.index(s, k)])) continue;
+        arm.branch_solutions(rolled(stations[s], k * step_rad), solved);
+        ladder.q[ladder.index(s, k)] = solved[b];
+      }
+    const auto measure = [&](size_t s, int k) {
+      const size_t i = ladder.index(s, k);
+      if (!part || !std::isnan(ladder.clearance[i])) return;
+      const double distance =
+          part->clearance(arm.collision_shapes(), arm.link_frames(to_vector(ladder.q[i])),
+                          settings.min_clearance_mm)
+              .distance_mm;
+      ladder.clearance[i] = distance;
+      if (distance < settings.min_clearance_mm) {
+        ladder.cost[i] = kInfinity;
+        ladder.reason[i] = Reason::collides;
+      } else {
+        ladder.cost[i] += std::pow(kClearanceReference_mm / std::max(distance, 1e-3), 2);
+      }
+    };
+    const double max_step = deg_to_rad(settings.max_joint_step_deg);
+    std::vector<int> path;
+    for (int round = 0; round < 64; ++round) {
+      path = shortest_path(ladder, stations, max_step, true);
+      if (path.empty() || !part) break;
+      // measure along the path; where it is too close, every roll of that station
+      bool clear = true;
+      for (size_t s = 0; s < n; ++s) {
+        measure(s, path[s]);
+        if (std::isfinite(ladder.cost[ladder.index(s, path[s])])) continue;
+        clear = false;
+        for (int k = 0; k < K; ++k)
+          if (std::isfinite(ladder.cost[ladder.index(s, k)])) measure(s, k);
+      }
+      if (clear) {
+        // the clearance costs changed the path's cost: one more search settles it
+        const std::vector<int> again = shortest_path(ladder, stations, max_step, true);
+        bool same = again == path;
+        if (!same) {
+          for (size_t s = 0; s < n; ++s) measure(s, again[s]);
+          same = true;
+          for (size_t s = 0; s < n && same; ++s)
+            same = std::isfinite(ladder.cost[ladder.index(s, again[s])]);
+          if (same) path = again;
+        }
+        break;
+      }
+    }
+    if (!path.empty()) {
+      bool valid = true;
+      for (size_t s = 0; s < n && valid; ++s)
+        valid = std::isfinite(ladder.cost[ladder.index(s, path[s])]);
+      if (valid) {
+        chosen = path;
+        branch = b;
+        break;
+      }
+    }
+    // name the station where this branch fails: the first with no valid rung, else a gap
+    last_failure = "branch " + std::to_string(b) + ": ";
+    bool named = false;
+    for (size_t s = 0; s < n && !named; ++s) {
+      Reason why = Reason::ok;
+      bool any = false;
+      for (int k = 0; k < K; ++k) {
+        any = any || std::isfinite(ladder.cost[ladder.index(s, k)]);
+        why = std::max(why, ladder.reason[ladder.index(s, k)]);
+      }
+      if (any) continue;
+      last_failure += station_name(s) + " is " + reason_text(why) + " for every roll";
+      named = true;
+    }
+    if (!named)
+      last_failure += "no roll sequence keeps every joint within " +
+                      format("%.3g", settings.max_joint_step_deg) +
+                      " deg between neighbouring points along the paths";
+  }
+  if (branch < 0)
+    throw InputError("toolpath", "no posture of " + arm.name() + " prints the whole job on one " +
+                                     "branch without a joint limit, a singularity or the part (" +
+                                     last_failure + ")");
+  result.branch = branch;
+  result.fixed_roll_deg =
+      settings.fixed_roll_deg ? *settings.fixed_roll_deg : result.best_fixed_roll_deg;
+
+  // the rolls: unwrapped along each path (one step at a time), the shortest way round between
+  // paths, then interpolated by arc length between stations
+  std::vector<double> station_roll(n);
+  for (size_t s = 0; s < n; ++s) {
+    double roll = chosen[s] * step_rad;
+    if (s > 0) roll = station_roll[s - 1] + wrapped(roll, station_roll[s - 1]);
+    station_roll[s] = roll;
+  }
+  result.toolpath = toolpath;
+  Toolpath& out = result.toolpath;
+  out.start_roll_rad = station_roll.front();
+  out.end_roll_rad = station_roll.back();
+  size_t s = 1;
+  for (size_t p = 0; p < out.paths.size(); ++p) {
+    PrintPath& path = out.paths[p];
+    path.rolls.assign(path.points.size(), 0.0);
+    // the stations of this path, in order
+    size_t first = s;
+    while (s < n && stations[s].path == static_cast<int>(p)) ++s;
+    std::vector<double> arc(path.points.size(), 0.0);
+    for (size_t i = 1; i < path.points.size(); ++i)
+      arc[i] = arc[i - 1] + (path.points[i] - path.points[i - 1]).norm();
+    for (size_t t = first; t + 1 < s; ++t) {
+      const size_t i0 = stations[t].point, i1 = stations[t + 1].point;
+      for (size_t i = i0; i <= i1; ++i) {
+        const double f = arc[i1] > arc[i0] ? (arc[i] - arc[i0]) / (arc[i1] - arc[i0]) : 0.0;
+        path.rolls[i] = station_roll[t] + f * (station_roll[t + 1] - station_roll[t]);
+      }
+    }
+    if (s == first + 1) path.rolls.assign(path.points.size(), station_roll[first]);
+  }
+
+  // every point solved on the branch, each from its neighbour; posture measures at the stations
+  // for the chosen and the best fixed roll
+  JointVector seed, joints;
+  Arm6Solutions all;
+  const auto solve_on_branch = [&](const Pose& pose, JointVector& q) {
+    const int count = arm.solutions(pose, all);
+    double best = kInfinity;
+    for (int i = 0; i < count; ++i) {
+      if (all[i].branch != branch) continue;
+      double distance = 0.0;
+      for (size_t j = 0; j < 6; ++j)
+        distance += seed.empty() ? (j == 5 ? all[i].q[j] * all[i].q[j] : 0.0)
+                                 : std::pow(all[i].q[j] - seed[j], 2);
+      if (distance < best) {
+        best = distance;
+        q = to_vector(all[i].q);
+      }
+    }
+    return std::isfinite(best);
+  };
+  const double max_dense_step = deg_to_rad(settings.max_joint_step_deg);
+  std::vector<Problem> dense_problems;
+  // `travel`: reached by a travel from the previous point (any joint motion allowed)
+  const auto visit = [&](const Pose& pose, const std::string& where, bool travel) {
+    if (!solve_on_branch(pose, joints)) {
+      if (dense_problems.size() < kMaxNamedPoints)
+        dense_problems.push_back(Problem{"", 0, "toolpath",
+                                         where + " " + point_text(pose.position_mm) +
+                                             " is beyond a joint's range on branch " +
+                                             std::to_string(branch) + " at the chosen roll " +
+                                             format("%.1f", rad_to_deg(pose.roll_rad)) + " deg"});
+      return;
+    }
+    if (!travel && !seed.empty() &&
+        largest_step(to_array(seed), to_array(joints)) > max_dense_step &&
+        dense_problems.size() < kMaxNamedPoints)
+      dense_problems.push_back(Problem{
+          "", 0, "toolpath",
+          where + " " + point_text(pose.position_mm) + ": a joint would jump by more than " +
+              format("%.3g", settings.max_joint_step_deg) + " deg from the previous point"});
+    seed = joints;
+  };
+  visit(Pose(out.start_mm, vertical_tool_axis(), out.start_roll_rad), "the start", true);
+  for (size_t p = 0; p < out.paths.size(); ++p) {
+    const PrintPath& path = out.paths[p];
+    for (size_t i = 0; i < path.points.size(); ++i)
+      visit(Pose(path.points[i], path.tool_axis(i), path.rolls[i]), name(p, i), i == 0);
+    if (!dense_problems.empty()) break;
+  }
+  visit(Pose(out.end_mm, vertical_tool_axis(), out.end_roll_rad), "the end", true);
+  if (!dense_problems.empty()) throw InputError(dense_problems);
+
+  // the posture measures at the stations: chosen rolls, and the best fixed roll
+  result.chosen = best_possible_posture();
+  result.fixed = best_possible_posture();
+  for (size_t t = 0; t < n; ++t) {
+    if (arm.branch_solutions(rolled(stations[t], chosen[t] * step_rad), solved))
+      keep_worst(result.chosen, posture_at(arm, part, to_vector(solved[branch])));
+    if (arm.branch_solutions(rolled(stations[t], fixed_roll * step_rad), solved))
+      keep_worst(result.fixed, posture_at(arm, part, to_vector(solved[fixed_branch])));
+  }
+  if (result.fixed_feasible && result.fixed.min_clearance_mm < settings.min_clearance_mm) {
+    result.fixed_feasible = false;
+    result.fixed_problem = "at roll " + format("%.0f", result.best_fixed_roll_deg) +
+                           " deg (branch " + std::to_string(fixed_branch) + ") the " +
+                           result.fixed.nearest_shape + " comes within " +
+                           format("%.3g", result.fixed.min_clearance_mm) + " mm of the part";
+  }
+  return result;
+}
+
+}  // namespace depotwin
