@@ -7,6 +7,9 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <set>
+#include <utility>
 
 namespace depotwin::plots {
 
@@ -79,6 +82,24 @@ void Curve::add_break() {
 }
 
 size_t Curve::point_count() const {
+  return static_cast<size_t>(
+      std::count_if(x.begin(), x.end(), [](double v) { return !std::isnan(v); }));
+}
+
+void Curve3::add(const Vec3& p) {
+  x.push_back(p.x());
+  y.push_back(p.y());
+  z.push_back(p.z());
+}
+
+void Curve3::add_break() {
+  if (x.empty() || std::isnan(x.back())) return;
+  x.push_back(kNaN);
+  y.push_back(kNaN);
+  z.push_back(kNaN);
+}
+
+size_t Curve3::point_count() const {
   return static_cast<size_t>(
       std::count_if(x.begin(), x.end(), [](double v) { return !std::isnan(v); }));
 }
@@ -200,6 +221,170 @@ Curve xy_path_curve(const MotionSamples& samples, PathPart part, size_t max_poin
   return curve;
 }
 
+namespace {
+
+// the runs of samples in `part` as index ranges [first, last) (a transition run widened by one
+// sample on each side, so that it meets the print samples)
+std::vector<std::pair<size_t, size_t>> part_runs(const MotionSamples& samples, PathPart part) {
+  std::vector<std::pair<size_t, size_t>> runs;
+  const size_t n = samples.size();
+  size_t k = 0;
+  while (k < n) {
+    if (!in_part(samples, k, part)) {
+      ++k;
+      continue;
+    }
+    size_t first = k;
+    while (k < n && in_part(samples, k, part)) ++k;
+    size_t last = k;
+    if (part == PathPart::transition) {
+      if (first > 0) --first;
+      if (last < n) ++last;
+    }
+    runs.push_back({first, last});
+  }
+  return runs;
+}
+
+// one thinning pass over polylines given as point accessors
+template <typename Lines>
+Curve3 thin_3d(const Lines& lines, size_t count, double spacing_mm) {
+  Curve3 curve;
+  for (size_t line = 0; line < count; ++line) {
+    const auto [begin, end] = lines.range(line);
+    if (end <= begin) continue;
+    Vec3 previous = lines.point(begin);
+    curve.add(previous);
+    for (size_t j = begin + 1; j + 1 < end; ++j) {
+      const Vec3 p = lines.point(j);
+      if ((p - previous).norm() < spacing_mm) continue;
+      curve.add(p);
+      previous = p;
+    }
+    if (end - 1 > begin) curve.add(lines.point(end - 1));
+    curve.add_break();
+  }
+  return curve;
+}
+
+// spacing from extent / 1500 upwards until at most max_points remain
+template <typename Lines>
+Curve3 thin_to_budget(const Lines& lines, size_t count, size_t max_points) {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (size_t line = 0; line < count; ++line) {
+    const auto [begin, end] = lines.range(line);
+    for (size_t j = begin; j < end; ++j) {
+      lo = lo.cwiseMin(lines.point(j));
+      hi = hi.cwiseMax(lines.point(j));
+    }
+  }
+  if (!(hi.x() >= lo.x())) return {};
+  double spacing_mm = std::max((hi - lo).maxCoeff(), 1e-6) / 1500.0;
+  Curve3 curve = thin_3d(lines, count, spacing_mm);
+  for (int attempt = 0; attempt < 30 && curve.point_count() > max_points; ++attempt) {
+    spacing_mm *= 1.5;
+    curve = thin_3d(lines, count, spacing_mm);
+  }
+  return curve;
+}
+
+}  // namespace
+
+Curve3 path_curve_3d(const MotionSamples& samples, PathPart part, size_t max_points) {
+  struct Runs {
+    const MotionSamples& samples;
+    std::vector<std::pair<size_t, size_t>> runs;
+    std::pair<size_t, size_t> range(size_t i) const { return runs[i]; }
+    Vec3 point(size_t j) const { return samples.position_mm[j]; }
+  } lines{samples, part_runs(samples, part)};
+  return thin_to_budget(lines, lines.runs.size(), max_points);
+}
+
+Curve3 polylines_3d(const std::vector<const std::vector<Vec3>*>& polylines, size_t max_points) {
+  // the points of all lines in one array, each line a range of it
+  struct Lines {
+    std::vector<Vec3> points;
+    std::vector<std::pair<size_t, size_t>> ranges;
+    std::pair<size_t, size_t> range(size_t i) const { return ranges[i]; }
+    Vec3 point(size_t j) const { return points[j]; }
+  } lines;
+  for (const std::vector<Vec3>* line : polylines) {
+    const size_t begin = lines.points.size();
+    lines.points.insert(lines.points.end(), line->begin(), line->end());
+    lines.ranges.push_back({begin, lines.points.size()});
+  }
+  return thin_to_budget(lines, lines.ranges.size(), max_points);
+}
+
+TriangleMesh display_surface(const TriangleMesh& mesh, size_t max_triangles) {
+  // the upward-facing triangles and the vertices they use
+  std::vector<std::array<int, 3>> up;
+  for (size_t t = 0; t < mesh.triangle_count(); ++t)
+    if (mesh.facet_normal(t).z() > 0.05) up.push_back(mesh.triangles[t]);
+  TriangleMesh out;
+  if (up.empty()) return out;
+  Eigen::Vector2d lo = mesh.vertices[up[0][0]].head<2>(), hi = lo;
+  for (const auto& triangle : up)
+    for (int v : triangle) {
+      lo = lo.cwiseMin(mesh.vertices[v].head<2>());
+      hi = hi.cwiseMax(mesh.vertices[v].head<2>());
+    }
+  // the triangles with the vertices they use, renumbered in order of first use
+  auto compact = [&](const std::vector<std::array<int, 3>>& triangles) {
+    std::map<int, int> renumbered;
+    for (const auto& triangle : triangles) {
+      std::array<int, 3> t{};
+      for (int c = 0; c < 3; ++c) {
+        const auto [it, added] =
+            renumbered.emplace(triangle[c], static_cast<int>(out.vertices.size()));
+        if (added) out.vertices.push_back(mesh.vertices[triangle[c]]);
+        t[c] = it->second;
+      }
+      out.triangles.push_back(t);
+    }
+    return out;
+  };
+  if (up.size() <= max_triangles) return compact(up);
+  // vertex clustering on an x-y grid: start where the grid has about max_triangles / 2 cells
+  // (two triangles per cell of a regular tessellation) and coarsen until the result fits
+  const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-9);
+  double cell_mm = std::sqrt(extent.x() * extent.y() / std::max<size_t>(max_triangles / 2, 1));
+  for (int attempt = 0; attempt < 40; ++attempt, cell_mm *= 1.15) {
+    // each vertex's cell, and each cell's representative: its vertex nearest the cell centre
+    auto cell_of = [&](const Vec3& p) {
+      return std::make_pair(static_cast<long>(std::floor((p.x() - lo.x()) / cell_mm)),
+                            static_cast<long>(std::floor((p.y() - lo.y()) / cell_mm)));
+    };
+    std::map<std::pair<long, long>, int> representative;  // cell -> vertex index in `mesh`
+    for (const auto& triangle : up)
+      for (int v : triangle) {
+        const Vec3& p = mesh.vertices[v];
+        const auto cell = cell_of(p);
+        const Eigen::Vector2d centre =
+            lo + cell_mm * Eigen::Vector2d(cell.first + 0.5, cell.second + 0.5);
+        auto [it, added] = representative.emplace(cell, v);
+        if (!added && v != it->second) {
+          const double d = (p.head<2>() - centre).squaredNorm();
+          const double best = (mesh.vertices[it->second].head<2>() - centre).squaredNorm();
+          if (d < best || (d == best && v < it->second)) it->second = v;
+        }
+      }
+    std::set<std::array<int, 3>> seen;
+    std::vector<std::array<int, 3>> kept;
+    for (const auto& triangle : up) {
+      std::array<int, 3> t{};
+      for (int c = 0; c < 3; ++c) t[c] = representative.at(cell_of(mesh.vertices[triangle[c]]));
+      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+      std::array<int, 3> key = t;
+      std::sort(key.begin(), key.end());
+      if (!seen.insert(key).second) continue;
+      kept.push_back(t);
+    }
+    if (kept.size() <= max_triangles) return compact(kept);
+  }
+  return out;  // a grid 270 times coarser still too fine: not for any real mesh; nothing drawn
+}
+
 double feature_size_mm(const Toolpath& toolpath) {
   Vec3 lo, hi;
   bool any = false;
@@ -277,6 +462,42 @@ std::string format_curve(const Curve& curve) {
     append_number(out, curve.x[k]);
     out += ' ';
     append_number(out, curve.y[k]);
+    out += '\n';
+  }
+  return out;
+}
+
+std::string format_curve3(const Curve3& curve) {
+  std::string out;
+  out.reserve(curve.size() * 36);
+  for (size_t k = 0; k < curve.size(); ++k) {
+    if (std::isnan(curve.x[k])) {
+      out += "\n\n";
+      continue;
+    }
+    append_number(out, curve.x[k]);
+    out += ' ';
+    append_number(out, curve.y[k]);
+    out += ' ';
+    append_number(out, curve.z[k]);
+    out += '\n';
+  }
+  return out;
+}
+
+std::string format_triangles(const TriangleMesh& mesh) {
+  std::string out;
+  out.reserve(mesh.triangle_count() * 110);
+  for (const auto& triangle : mesh.triangles) {
+    for (int v : triangle) {
+      const Vec3& p = mesh.vertices[v];
+      append_number(out, p.x());
+      out += ' ';
+      append_number(out, p.y());
+      out += ' ';
+      append_number(out, p.z());
+      out += '\n';
+    }
     out += '\n';
   }
   return out;

@@ -10,6 +10,7 @@
 #include "core/heightmap.hpp"
 #include "core/toolpath.hpp"
 #include "core/trajectory.hpp"
+#include "core/triangle_mesh.hpp"
 #include "metrics/motion_metrics.hpp"
 
 namespace depotwin::plots {
@@ -40,6 +41,16 @@ struct Curve {
   size_t point_count() const;
 };
 
+// A curve in 3-D (splot): points in order, a NaN in x marks a break in the line.
+struct Curve3 {
+  std::vector<double> x, y, z;
+
+  size_t size() const { return x.size(); }
+  void add(const Vec3& p);
+  void add_break();
+  size_t point_count() const;
+};
+
 // Min/max-preserving decimation of values[begin, end): the range is cut into buckets of
 // equal sample count and each bucket keeps its smallest and its largest sample (in index
 // order); the first and the last sample are always kept. At most max_points indices
@@ -60,6 +71,20 @@ enum class PathPart { printing, transition, all };
 // most max_points points
 Curve xy_path_curve(const MotionSamples& samples, PathPart part, size_t max_points);
 
+// the same in 3-D: the samples in `part` (a transition run reaching the print samples on
+// both sides), thinned to points a minimum 3-D spacing apart (run ends kept), at most about
+// max_points points
+Curve3 path_curve_3d(const MotionSamples& samples, PathPart part, size_t max_points);
+// polylines (one line each) thinned the same way: each keeps its ends and the points at least
+// the spacing from the last kept one; the spacing grows until at most max_points remain
+Curve3 polylines_3d(const std::vector<const std::vector<Vec3>*>& lines, size_t max_points);
+
+// The part's surface for display: the triangles that face up (facet normal z > 0.05),
+// decimated by vertex clustering on an x-y grid (each grid cell's vertices merged into the
+// one nearest the cell's centre, so every vertex stays on the surface; triangles that collapse
+// or repeat dropped), the grid coarsened until at most max_triangles remain.
+TriangleMesh display_surface(const TriangleMesh& mesh, size_t max_triangles);
+
 // the size the relative path error is divided by: the largest extent of the print paths'
 // bounding box (Thompson & Yoon's 10-mm feature); falls back to Toolpath::bounds when no
 // print path is given and to 1 mm for a degenerate toolpath
@@ -79,6 +104,10 @@ HeightMap downsample_for_display(const HeightMap& map, int max_cells_per_side);
 
 // the text gnuplot reads: "x y" per line in fixed %.9g format, a blank line per break
 std::string format_curve(const Curve& curve);
+// "x y z" per line, two blank lines per break (one would make splot join the lines into a grid)
+std::string format_curve3(const Curve3& curve);
+// each triangle as a closed polygon: its three corners ("x y z"), a blank line after each
+std::string format_triangles(const TriangleMesh& mesh);
 // float32 cells in row-major order (x fastest), host byte order, for `binary array=(nx,ny)`
 std::string format_binary_map(const HeightMap& map);
 

@@ -4,6 +4,24 @@
 
 namespace depotwin::plots {
 
+std::string plot_command(const std::vector<std::string>& elements, const char* verb) {
+  std::string command;
+  for (const std::string& e : elements) {
+    if (e.empty()) continue;
+    command += command.empty() ? std::string(verb) + " " : ", \\\n     ";
+    command += e;
+  }
+  return command.empty() ? "" : command + "\n";
+}
+
+std::string line_style(const char* colour, double width, int dash) {
+  return format("with lines lw %.2f dt %d lc rgb \"%s\"", width, dash, colour);
+}
+
+void require(bool condition, const char* what) {
+  if (!condition) throw InternalError(std::string("plots: ") + what);
+}
+
 PlotJob::PlotJob(const std::string& output_directory, const PlotOptions& options)
     : gnuplot_(find_gnuplot(options.gnuplot)), temporary_(output_directory) {}
 

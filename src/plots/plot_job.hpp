@@ -3,6 +3,9 @@
 // and the PNGs are renamed into place only when it succeeded.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,6 +37,56 @@ class PlotJob {
   std::string script_;
   std::vector<std::pair<std::string, std::string>> pngs_;  // (temporary, final)
 };
+
+// running [lo, hi] of the finite values of curves
+struct Range {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+
+  void add(double v) {
+    if (!std::isfinite(v)) return;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  void add_y(const Curve& c) {
+    for (double v : c.y) add(v);
+  }
+  void add_x(const Curve& c) {
+    for (double v : c.x) add(v);
+  }
+  bool empty() const { return !(hi >= lo); }
+  // [lo, hi] padded by a fraction of its width (at least min_half_width either side of a single
+  // value)
+  std::string gnuplot(double pad_fraction, double min_half_width) const {
+    double a = empty() ? 0.0 : lo, b = empty() ? 1.0 : hi;
+    if (b - a < 2 * min_half_width) {
+      const double mid = 0.5 * (a + b);
+      a = mid - min_half_width;
+      b = mid + min_half_width;
+    }
+    const double pad = pad_fraction * (b - a);
+    return format("[%.9g:%.9g]", a - pad, b + pad);
+  }
+};
+
+// "plot a, b, c" from the non-empty elements (`verb`: "plot" or "splot")
+std::string plot_command(const std::vector<std::string>& elements, const char* verb = "plot");
+// "with lines lw .. dt .. lc rgb .."
+std::string line_style(const char* colour, double width, int dash = 1);
+// InternalError("plots: what") unless the condition holds
+void require(bool condition, const char* what);
+
+// The conformal plots (conformal_plots.cpp): their data, filled into `data` by
+// prepare_run_plot_data, and their drawing.
+void prepare_joint_panels(const JointSeries& joints, const PlotOptions& options, RunPlotData& data);
+void prepare_layer_panels(const RunPlotInput& input, const PlotOptions& options, RunPlotData& data);
+void prepare_paths3d(const RunPlotInput& input, const PlotOptions& options, RunPlotData& data);
+void joints_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
+                 const std::string& png);
+void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
+                 const std::string& png);
+void paths3d_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
+                  const std::string& png);
 
 // the thickness map as an image (colours by the current cbrange) with the print paths
 // overlaid as dashed lines: a plot command; shared by thickness.png and the comparison sheet

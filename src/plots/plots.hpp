@@ -11,7 +11,10 @@
 #include <vector>
 
 #include "core/heightmap.hpp"
+#include "core/limits.hpp"
+#include "core/recorded_run.hpp"
 #include "core/toolpath.hpp"
+#include "core/triangle_mesh.hpp"
 #include "metrics/motion_metrics.hpp"
 #include "plots/gnuplot.hpp"
 #include "plots/plot_data.hpp"
@@ -23,6 +26,23 @@ struct LineProfile {
   int path_index = 0;  // index into Toolpath::paths
   std::vector<double> arc_length_mm, thickness_um;
 };
+
+// The machine's joint positions over a run (joints.png), every joint on one clock.
+struct JointSeries {
+  std::vector<std::string> names;  // per joint, e.g. "j1"
+  // per joint, the unit of its values: "rad" (a revolute joint, drawn in degrees), "deg", or
+  // "mm" (a prismatic joint); any other is drawn as given
+  std::vector<std::string> units;
+  std::vector<double> t_s;
+  std::vector<std::vector<double>> position;  // per joint, one value per t_s
+  // per joint, its range in its unit; a joint with !(min < max) (or non-finite) has none
+  std::vector<double> min, max;
+};
+// The joints of a recorded run (RecordedRun::joint_position, its own units: rad for hinges,
+// mm for slides) with the machine's ranges; `revolute` per joint (true: "rad", false: "mm").
+// InternalError when the counts differ.
+JointSeries joint_series(const RecordedRun& run, const std::vector<JointLimit>& limits,
+                         const std::vector<bool>& revolute);
 
 // Everything the run plots show. Pointers are borrowed for the call; the struct owns nothing.
 struct RunPlotInput {
@@ -39,19 +59,57 @@ struct RunPlotInput {
   double target_thickness_um = 0.0;  // <= 0: no target line
   double mean_thickness_um = 0.0;    // <= 0: no mean line
   double feature_size_mm = 0.0;      // <= 0: feature_size_mm(*toolpath)
+  // joints.png (optional): the joints against time, with their ranges
+  const JointSeries* joints = nullptr;
+  // layers.png (optional): each layer's thickness map (index = PrintPath::layer, 0-based as in
+  // metrics.json); null or empty: nothing deposited on that layer
+  std::vector<const HeightMap*> layer_maps;
+  // per layer, its hatch angle (deg); missing or NaN: unknown (the panel says "layer k" only)
+  std::vector<double> layer_angles_deg;
+  // paths3d.png: the part's surface under the paths (optional; work frame, mm)
+  const TriangleMesh* part = nullptr;
 };
 
-enum class RunPlot { path, axes, errors, thickness_profile, thickness };
-// "path.png", "axes.png", "errors.png", "thickness_profile.png", "thickness.png"
+enum class RunPlot { path, axes, errors, thickness_profile, thickness, joints, layers, paths3d };
+// "path.png", "axes.png", "errors.png", "thickness_profile.png", "thickness.png",
+// "joints.png", "layers.png", "paths3d.png"
 const char* file_name(RunPlot plot);
 // the plots the input has data for: path, axes, errors always; the thickness plots when
-// a non-empty map / at least one profile is given
+// a non-empty map / at least one profile is given; joints.png with a JointSeries of at least
+// one joint; layers.png when some layer map is non-empty; paths3d.png for a conformal job (a
+// part is given, or the toolpath has tool axes or several layers)
 std::vector<RunPlot> available_plots(const RunPlotInput& input);
 
 struct PlotOptions {
   std::string gnuplot = "gnuplot";  // program name (PATH) or path
   size_t max_points_per_curve = 1200;
   int max_map_cells_per_side = 400;  // thickness maps are block-averaged down to this
+  int max_layer_panels = 8;          // layers.png: more layers are shown evenly chosen
+  size_t max_part_triangles = 3000;  // paths3d.png: the part's surface is decimated to this
+  size_t max_tool_axes = 120;        // paths3d.png: at most this many tool-axis segments
+};
+
+// One joint's panel of joints.png, in display units.
+struct JointPanel {
+  std::string name;
+  std::string unit;  // as drawn: "deg" for a revolute joint, "mm" for a prismatic one
+  Curve position;    // decimated, against time
+  bool limited = false;
+  double min = 0.0, max = 0.0;  // the range (limited only)
+  // the panel's y range; limited: y_lo < min < max < y_hi, and the forbidden bands shaded
+  // are [y_lo, min] and [max, y_hi]
+  double y_lo = 0.0, y_hi = 0.0;
+  // the smallest distance of any sample from the nearer limit (negative: beyond it); NaN
+  // without limits or samples
+  double closest_to_limit = 0.0;
+};
+
+// One panel of layers.png.
+struct LayerPanel {
+  int layer = 0;      // index into RunPlotInput::layer_maps
+  std::string title;  // "layer k (θ°)" or "layer k"
+  HeightMap map;      // at display resolution; empty: nothing deposited on it
+  Curve paths;        // the layer's print paths, x-y
 };
 
 struct PlotResult {
@@ -77,6 +135,23 @@ struct RunPlotData {
   std::vector<Curve> profiles;
   // thickness.png: the map at display resolution
   HeightMap display_map;
+  // joints.png
+  std::vector<JointPanel> joint_panels;
+  // layers.png: the shown layers, the layer count, the shared colour range [0, max] (um) and
+  // the x-y extent every panel shows
+  std::vector<LayerPanel> layer_panels;
+  int layer_count = 0;
+  double layer_max_um = 0.0;
+  double layers_x_lo = 0.0, layers_x_hi = 0.0, layers_y_lo = 0.0, layers_y_hi = 0.0;
+  // paths3d.png: print paths per layer (index = layer; the toolpath's points, thinned),
+  // travels (the planned samples where not depositing), tool-axis segments (two points each:
+  // a print path's point and that point + tool_axis_length_mm * its tool axis), the part's
+  // upward-facing surface decimated
+  std::vector<Curve3> layer_paths;
+  Curve3 travels;
+  Curve3 tool_axes;
+  double tool_axis_length_mm = 0.0;
+  TriangleMesh part_surface;
 };
 // InternalError when a required input is missing
 RunPlotData prepare_run_plot_data(const RunPlotInput& input, const PlotOptions& options = {});

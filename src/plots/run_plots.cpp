@@ -1,5 +1,6 @@
-// The five plots of one run: path.png (Fig. 8), axes.png (Fig. 9), errors.png (Figs. 10, 12),
-// thickness_profile.png and thickness.png.
+// The plots of one run: path.png (Fig. 8), axes.png (Fig. 9), errors.png (Figs. 10, 12),
+// thickness_profile.png and thickness.png here; joints.png, layers.png and paths3d.png (the
+// conformal ones) in conformal_plots.cpp.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -14,37 +15,6 @@ namespace {
 
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
-// running [lo, hi] of the finite values of curves
-struct Range {
-  double lo = std::numeric_limits<double>::infinity();
-  double hi = -std::numeric_limits<double>::infinity();
-
-  void add(double v) {
-    if (!std::isfinite(v)) return;
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  }
-  void add_y(const Curve& c) {
-    for (double v : c.y) add(v);
-  }
-  void add_x(const Curve& c) {
-    for (double v : c.x) add(v);
-  }
-  bool empty() const { return !(hi >= lo); }
-  // [lo, hi] padded by a fraction of its width (at least min_half_width either side of a single
-  // value)
-  std::string gnuplot(double pad_fraction, double min_half_width) const {
-    double a = empty() ? 0.0 : lo, b = empty() ? 1.0 : hi;
-    if (b - a < 2 * min_half_width) {
-      const double mid = 0.5 * (a + b);
-      a = mid - min_half_width;
-      b = mid + min_half_width;
-    }
-    const double pad = pad_fraction * (b - a);
-    return format("[%.9g:%.9g]", a - pad, b + pad);
-  }
-};
-
 // [0, 1.08 * max] for quantities that start at zero (errors, thickness)
 std::string zero_based_range(double max_value) {
   return format("[0:%.9g]", max_value > 0.0 ? 1.08 * max_value : 1.0);
@@ -55,25 +25,6 @@ bool moves(const Curve& position) {
   Range r;
   r.add_y(position);
   return !r.empty() && r.hi - r.lo > 1e-3;
-}
-
-// "plot a, b, c" from the non-empty elements
-std::string plot_command(const std::vector<std::string>& elements) {
-  std::string command;
-  for (const std::string& e : elements) {
-    if (e.empty()) continue;
-    command += command.empty() ? "plot " : ", \\\n     ";
-    command += e;
-  }
-  return command.empty() ? "" : command + "\n";
-}
-
-std::string line_style(const char* colour, double width, int dash = 1) {
-  return format("with lines lw %.2f dt %d lc rgb \"%s\"", width, dash, colour);
-}
-
-void require(bool condition, const char* what) {
-  if (!condition) throw InternalError(std::string("plots: ") + what);
 }
 
 }  // namespace
@@ -90,6 +41,12 @@ const char* file_name(RunPlot plot) {
       return "thickness_profile.png";
     case RunPlot::thickness:
       return "thickness.png";
+    case RunPlot::joints:
+      return "joints.png";
+    case RunPlot::layers:
+      return "layers.png";
+    case RunPlot::paths3d:
+      return "paths3d.png";
   }
   return "plot.png";
 }
@@ -99,6 +56,19 @@ std::vector<RunPlot> available_plots(const RunPlotInput& input) {
   if (!input.profiles.empty()) plots.push_back(RunPlot::thickness_profile);
   if (input.thickness != nullptr && input.thickness->nx > 0 && input.thickness->ny > 0)
     plots.push_back(RunPlot::thickness);
+  if (input.joints != nullptr && !input.joints->names.empty()) plots.push_back(RunPlot::joints);
+  if (std::any_of(input.layer_maps.begin(), input.layer_maps.end(), [](const HeightMap* map) {
+        return map != nullptr && map->nx > 0 && map->ny > 0;
+      }))
+    plots.push_back(RunPlot::layers);
+  if (input.toolpath != nullptr) {
+    const auto& paths = input.toolpath->paths;
+    const bool conformal = (input.part != nullptr && !input.part->empty()) ||
+                           input.toolpath->layer_count() > 1 ||
+                           std::any_of(paths.begin(), paths.end(),
+                                       [](const PrintPath& path) { return !path.normals.empty(); });
+    if (conformal) plots.push_back(RunPlot::paths3d);
+  }
   return plots;
 }
 
@@ -170,6 +140,11 @@ RunPlotData prepare_run_plot_data(const RunPlotInput& input, const PlotOptions& 
             "the height map's size does not match nx * ny");
     data.display_map = downsample_for_display(*input.thickness, options.max_map_cells_per_side);
   }
+
+  // the conformal plots
+  if (input.joints != nullptr) prepare_joint_panels(*input.joints, options, data);
+  prepare_layer_panels(input, options, data);
+  prepare_paths3d(input, options, data);
   return data;
 }
 
@@ -494,6 +469,17 @@ PlotResult render_run_plots(const RunPlotInput& input, const std::string& direct
         require(data.display_map.nx > 0 && data.display_map.ny > 0,
                 "thickness.png needs a thickness map");
         thickness_plot(job, input, data, png);
+        break;
+      case RunPlot::joints:
+        require(!data.joint_panels.empty(), "joints.png needs joint positions");
+        joints_plot(job, input, data, png);
+        break;
+      case RunPlot::layers:
+        require(!data.layer_panels.empty(), "layers.png needs layer thickness maps");
+        layers_plot(job, input, data, png);
+        break;
+      case RunPlot::paths3d:
+        paths3d_plot(job, input, data, png);
         break;
     }
   }

@@ -38,6 +38,15 @@ constexpr const char* kAxisColours[3] = {"#1f77b4", "#ff7f0e", "#2ca02c"};  // x
 // the same, lightened (40 % of the colour on white): the wide band of the simulated axis,
 // under the planned line, so that both show where they coincide
 constexpr const char* kAxisBandColours[3] = {"#a5c9e1", "#ffcb9f", "#abd9ab"};
+// joints.png: the forbidden band beyond a joint's range (red, 65 % transparent, so a transition
+// band under it still shows) and the range's limit lines
+constexpr const char* kLimitBandColour = "#a6d62728";
+constexpr const char* kLimitLineColour = "#d62728";
+// paths3d.png: travels, tool axes, the part's surface
+constexpr const char* kTravelColour = "#a0a0a0";
+constexpr const char* kToolAxisColour = "#303030";
+constexpr const char* kPartColour = "#d0d3d8";
+constexpr const char* kPartEdgeColour = "#b4b8be";
 // colours cycled over print lines and planners
 constexpr const char* kSeriesColours[8] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728",
                                            "#9467bd", "#8c564b", "#e377c2", "#17becf"};
