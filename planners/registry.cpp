@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "planners/motion/bezier/bezier.hpp"
+#include "planners/motion/conformal.hpp"
 #include "planners/motion/lspb_mtt.hpp"
 #include "planners/motion/stop_and_go.hpp"
 #include "planners/planner.hpp"
@@ -34,6 +35,11 @@ const std::vector<PlannerInfo>& planner_registry() {
        true},
       {"bezier", "Giberti et al. 2017: lines with Bezier corner blends at constant speed",
        bezier_parameters(), [](const PlannerSpec& spec) { return make_bezier_planner(spec); },
+       false},
+      {"conformal",
+       "Shembekar et al. 2018: conformal paths flown by with zone blends, time-optimal under TCP "
+       "and joint limits (TOPP-RA), speed and flow control",
+       conformal_parameters(), [](const PlannerSpec& spec) { return make_conformal_planner(spec); },
        false},
   };
   return registry;

@@ -41,6 +41,7 @@ struct JointLimit {
   double v_max = 0.0;
   double a_max = 0.0;
   double j_max = 0.0;  // 0: no jerk limit
+  bool revolute = false;  // a hinge (rad) rather than a slide (mm)
 };
 
 using JointVector = std::vector<double>;  // mm for prismatic joints, rad for revolute ones

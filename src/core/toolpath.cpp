@@ -70,6 +70,12 @@ ToolOrientation PrintPath::orientation_near(const Vec3& p, size_t& edge_hint) co
   return near;
 }
 
+double gap_ratio(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1, double d) {
+  const double gap = (p1 - p0).norm();
+  if (gap == 0.0) return 1.0;
+  return ((p1 + d * n1) - (p0 + d * n0)).norm() / gap;
+}
+
 double Toolpath::print_length_mm() const {
   double length = 0.0;
   for (const PrintPath& path : paths) length += path.length_mm();

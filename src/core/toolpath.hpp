@@ -61,6 +61,12 @@ struct Toolpath {
   void bounds(Vec3& lo, Vec3& hi) const;
 };
 
+// Shembekar et al.'s offset-point gap test (sec. 4.1) for consecutive points p0, p1 with unit
+// normals n0, n1 and offset distance d: |(p1 + d n1) - (p0 + d n0)| / |p1 - p0|. Above 1 the
+// surface is convex between them, below 1 concave, 1 flat (1 for coincident points). For
+// points on a curve of normal curvature k it is 1 + d k (exactly, on a circle).
+double gap_ratio(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1, double d);
+
 // Two path ends closer than this (mm) are one point: printing continues through them.
 constexpr double kJoinTolerance_mm = 1e-6;
 

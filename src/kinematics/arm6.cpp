@@ -113,6 +113,7 @@ Arm6::Arm6(const Arm6Geometry& geometry) : geometry_(geometry) {
     joint_limits_.push_back(JointLimit{spec.name, deg_to_rad(spec.min_deg),
                                        deg_to_rad(spec.max_deg), v_max,
                                        kAccelerationPerSpeed_per_s * v_max});
+    joint_limits_.back().revolute = true;
   }
   const Arm6Geometry& g = geometry_;
   forearm_mm_ = std::hypot(g.c3_mm, g.a2_mm);

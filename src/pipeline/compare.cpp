@@ -109,7 +109,8 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
   write_file_atomically((fs::path(directory) / "comparison.md").string(),
                         comparison_markdown(scenario.name, rows, settings.render));
   if (settings.render) {
-    for (const SimulatedRun& run : runs) maps.push_back(field_heightmap(run.deposit->normal_field()));
+    for (const SimulatedRun& run : runs)
+      maps.push_back(field_heightmap(run.deposit->normal_field()));
     plots::ComparisonInput input;
     input.title = scenario.name;
     input.toolpath = &jobs.front().toolpath;

@@ -15,6 +15,7 @@
 #include "planners/planner.hpp"
 #include "posture/arm_posture.hpp"
 #include "scenario/scenario.hpp"
+#include "toolpath/surface_projection.hpp"
 
 namespace depotwin {
 
@@ -29,6 +30,8 @@ struct PreparedJob {
   std::string model_text;
   // the part printed on (conformal work), placed in the work frame; null for planar work
   std::shared_ptr<const TriangleMesh> part;
+  // ray casting onto it (heights and normals under a point; thread-safe)
+  std::shared_ptr<const SurfaceProjector> surface;
   // a 6-DOF arm: the exact distance to the part, and the roll and branch chosen along the
   // toolpath (the toolpath above carries the rolls)
   std::shared_ptr<const PartClearance> clearance;

@@ -24,6 +24,8 @@ namespace depotwin {
 
 namespace fs = std::filesystem;
 
+// each layer's map for layers.png: the plot shows at most 400 cells a side
+constexpr size_t kLayerMapCells = 800 * 800;
 // the arm's clearance to the part is measured this often over a run (and at every step near it)
 constexpr double kArmClearancePeriod_s = 0.02;
 
@@ -146,8 +148,8 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   // one process per layer; on a part, the surface's slope under each cell (n_z) turns the
   // vertical thickness into thickness along the normal
   LayeredDeposit::NormalZ normal_z;
-  if (job.part) {
-    auto projector = std::make_shared<const SurfaceProjector>(*job.part);
+  if (job.surface) {
+    std::shared_ptr<const SurfaceProjector> projector = job.surface;
     normal_z = [projector](double x_mm, double y_mm) {
       const std::optional<SurfaceHit> hit = projector->project_down(x_mm, y_mm);
       return hit && hit->faces_up() ? hit->normal.z() : 1.0;
@@ -235,7 +237,8 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
   if (settings.render) {
     plots_done = std::async(std::launch::async, [&job, &run, &field, &map, &directory] {
       plots::RunPlotInput input;
-      input.title = job.scenario.name + " / " + run.report.planner;
+      input.title = job.scenario.name + " / " +
+                    (run.report.label.empty() ? run.report.planner : run.report.label);
       input.toolpath = &job.toolpath;
       input.planned = &run.planned_at_steps;
       input.simulated = &run.simulated;
@@ -244,6 +247,26 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
       input.profiles = centreline_profiles(field, job.toolpath);
       input.target_thickness_um = target_thickness_um(run.deposit->front(), job.toolpath);
       if (run.report.thickness) input.mean_thickness_um = run.report.thickness->mean_um;
+      // every machine's joints against their limits
+      std::vector<bool> revolute;
+      for (const JointLimit& limit : job.machine->joint_limits())
+        revolute.push_back(limit.revolute);
+      const plots::JointSeries joints =
+          plots::joint_series(run.record, job.machine->joint_limits(), revolute);
+      input.joints = &joints;
+      // several layers or a part: each layer's deposit, and the paths in 3-D over the part
+      std::vector<HeightMap> layer_maps;
+      if (run.deposit->layer_count() > 1 || job.part) {
+        for (int k = 0; k < run.deposit->layer_count(); ++k)
+          layer_maps.push_back(field_heightmap(run.deposit->layer_normal_field(k), kLayerMapCells));
+        for (const HeightMap& layer_map : layer_maps) input.layer_maps.push_back(&layer_map);
+        if (job.scenario.surface)
+          for (int k = 0; k < run.deposit->layer_count(); ++k) {
+            const std::vector<double>& angles = job.scenario.surface->angles_deg;
+            input.layer_angles_deg.push_back(angles[static_cast<size_t>(k) % angles.size()]);
+          }
+      }
+      input.part = job.part.get();
       plots::render_run_plots(input, directory);
     });
   }
@@ -263,7 +286,14 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
 
     // the MuJoCo scene through OSMesa
     if (settings.render) {
-      const SceneRenderOptions scene = scene_render_options(job.scenario);
+      SceneRenderOptions scene = scene_render_options(job.scenario);
+      // on a part, the deposit lies on its surface
+      if (job.surface) {
+        std::shared_ptr<const SurfaceProjector> surface = job.surface;
+        scene.surface_height_mm = [surface](double x_mm, double y_mm) {
+          return surface->height_at(x_mm, y_mm);
+        };
+      }
       SceneRenderer own_renderer;  // used only without a shared one
       SceneRenderer& renderer = settings.scene_renderer ? *settings.scene_renderer : own_renderer;
       renderer.render_png(*run.simulation, map, out.file("scene.png"), scene);

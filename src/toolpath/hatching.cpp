@@ -191,10 +191,4 @@ SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatch
   return result;
 }
 
-double gap_ratio(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1, double d) {
-  const double gap = (p1 - p0).norm();
-  if (gap == 0.0) return 1.0;
-  return ((p1 + d * n1) - (p0 + d * n0)).norm() / gap;
-}
-
 }  // namespace depotwin

@@ -82,9 +82,4 @@ SurfaceHatch hatch_surface(const TriangleMesh& placed_part_mm, const SurfaceHatc
 // the same with a projector built once (several hatches of one part)
 SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatchSpec& spec);
 
-// The paper's offset-point gap test (sec. 4.1) for consecutive points p0, p1 with unit
-// normals n0, n1 and offset distance d: |(p1 + d n1) - (p0 + d n0)| / |p1 - p0|. Above 1 the
-// surface is convex between them, below 1 concave, 1 flat. 1 for coincident points.
-double gap_ratio(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1, double d);
-
 }  // namespace depotwin

@@ -514,13 +514,13 @@ toolpath:
     layer_offset: sideways
 )");
   ASSERT_EQ(problems.size(), 7u) << dump(problems);
-  expect_problem(problems, scenario_path(), "toolpath.surface", 4, "missing file");
-  expect_problem(problems, scenario_path(), "toolpath.surface", 5, "unknown key 'mesh'");
-  expect_problem(problems, scenario_path(), "toolpath.surface.units", 6, "unknown units 'furlong'");
-  expect_problem(problems, scenario_path(), "toolpath.surface.alpha", 7, "");
-  expect_problem(problems, scenario_path(), "toolpath.surface.angles", 8, "is empty");
-  expect_problem(problems, scenario_path(), "toolpath.surface.layers", 9, "");
-  expect_problem(problems, scenario_path(), "toolpath.surface.layer_offset", 10,
+  expect_problem(problems, scenario_path(), "toolpath.surface", 3, "missing file");
+  expect_problem(problems, scenario_path(), "toolpath.surface.mesh", 4, "unknown key");
+  expect_problem(problems, scenario_path(), "toolpath.surface.units", 5, "unknown units 'furlong'");
+  expect_problem(problems, scenario_path(), "toolpath.surface.alpha", 6, "must be in [0, 1]");
+  expect_problem(problems, scenario_path(), "toolpath.surface.angles", 7, "is empty");
+  expect_problem(problems, scenario_path(), "toolpath.surface.layers", 8, "whole number");
+  expect_problem(problems, scenario_path(), "toolpath.surface.layer_offset", 9,
                  "unknown layer offset 'sideways'");
 }
 
@@ -533,8 +533,8 @@ toolpath:
   surface: {file: nowhere.stl}
 )");
   ASSERT_EQ(problems.size(), 2u) << dump(problems);
-  expect_problem(problems, scenario_path(), "toolpath.offset", 4, "surface.offset");
-  expect_problem(problems, scenario_path(), "toolpath.surface.file", 5,
+  expect_problem(problems, scenario_path(), "toolpath.offset", 3, "surface.offset");
+  expect_problem(problems, scenario_path(), "toolpath.surface.file", 4,
                  "STL file 'nowhere.stl' not found");
 }
 
@@ -546,8 +546,8 @@ arm: {roll: sideways}
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(problems.size(), 2u) << dump(problems);
-  expect_problem(problems, scenario_path(), "arm", 3, "applies to machine arm6");
-  expect_problem(problems, scenario_path(), "arm.roll", 3, "unknown roll strategy 'sideways'");
+  expect_problem(problems, scenario_path(), "arm", 2, "applies to machine arm6");
+  expect_problem(problems, scenario_path(), "arm.roll", 2, "unknown roll strategy 'sideways'");
 }
 
 TEST_F(ScenarioErrors, BadRandomSegments) {
