@@ -88,6 +88,8 @@ Toolpath apply_order(const Toolpath& toolpath, const OrderResult& result) {
   Toolpath out;
   out.start_mm = toolpath.start_mm;
   out.end_mm = toolpath.end_mm;
+  out.start_roll_rad = toolpath.start_roll_rad;
+  out.end_roll_rad = toolpath.end_roll_rad;
   for (size_t k = 0; k < result.order.size(); ++k) {
     const PrintPath& path = toolpath.paths.at(result.order[k]);
     out.paths.push_back(result.reversed[k] ? path.reversed() : path);

@@ -32,8 +32,11 @@ int main(int argc, char** argv) {
           "DepoTwin make_parts: curved beam 65 x 14 mm, sag 6 mm, 4 mm thick (mm)");
     write(car_bonnet(CarBonnetParams{}), "shembekar_bonnet.stl",
           "DepoTwin make_parts: bonnet 150 x 130 mm, rolled front edge (mm)");
-    write(fillet_step(FilletStepParams{}), "shembekar_fillet.stl",
-          "DepoTwin make_parts: step with 2 mm fillets, 40 deg slope (mm)");
+    // the fillet step 12 mm wide: two dozen hatch lines are enough to see the blob
+    FilletStepParams fillet;
+    fillet.width_mm = 12.0;
+    write(fillet_step(fillet), "shembekar_fillet.stl",
+          "DepoTwin make_parts: step 12 mm wide, 2 mm fillets, 40 deg slope (mm)");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "make_parts: %s\n", e.what());
     return 1;

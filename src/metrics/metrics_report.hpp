@@ -75,6 +75,18 @@ struct ArmPostureStats {
   double min_clearance_mm = 0.0;            // links and tool body to the part (FCL)
   std::string nearest_shape;                // which shape came closest
 };
+// One roll for the whole job, as the arm's chosen rolls are compared with (planned, at the
+// toolpath's stations, on the branch best for that roll)
+struct FixedRollComparison {
+  double roll_deg = 0.0;
+  int branch = 0;
+  bool feasible = true;  // every station reachable off limits, singularities and the part
+  std::string problem;   // why not, when not
+  ArmPostureStats stats;
+  double mean_cost = 0.0;  // the posture's rung cost per station (infinite when not feasible)
+  double joint_travel_deg = 0.0;  // how far the joints turn along the paths (summed)
+};
+
 struct ArmStats {
   // the simulated run (every recorded step; clearance every clearance_period_s)
   ArmPostureStats run;
@@ -86,13 +98,14 @@ struct ArmStats {
   int branch_changes = 0;  // changes of the IK branch along the run
   int branch = 0;          // the branch the job was printed on
   double clearance_period_s = 0.0;
-  // the roll about the nozzle axis: as chosen, and the best fixed roll, at the toolpath's
-  // points (planned); the gain is what the chosen rolls add
-  std::string roll_strategy;  // optimized | fixed
-  double fixed_roll_deg = 0.0;
-  ArmPostureStats chosen_roll, fixed_roll;
-  bool fixed_roll_feasible = true;
-  std::string fixed_roll_problem;  // why the fixed roll fails, when it does
+  // the roll about the nozzle axis: as chosen, against roll 0 and the best fixed roll, at the
+  // toolpath's stations (planned); the gain is what the chosen rolls add
+  std::string roll_strategy;    // optimized | fixed
+  double fixed_roll_deg = 0.0;  // the roll used under `fixed`
+  ArmPostureStats chosen_roll;
+  double chosen_mean_cost = 0.0;
+  double chosen_joint_travel_deg = 0.0;
+  FixedRollComparison roll_zero, best_fixed;
 };
 
 struct MetricsReport {

@@ -129,7 +129,11 @@ PreparedJob prepare_job(const Scenario& scenario) {
   job.limits = job.machine->tcp_limits(scenario.limits);
 
   // print order (Ganganath et al.), before every planner
-  job.order = sequence(scenario.toolpath, job.limits, scenario.order);
+  // (the lower bound, every pair of path ends, only where an order is searched for: the given
+  // order's job never needs it, and a hatched part has hundreds of paths)
+  SequencerOptions sequencing;
+  sequencing.lower_bound = scenario.order.method != "as_given";
+  job.order = sequence(scenario.toolpath, job.limits, scenario.order, sequencing);
   job.toolpath = apply_order(scenario.toolpath, job.order);
 
   // an arm: its roll at every point and its branch, away from limits, singularities and the part

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <unordered_map>
 
 #include "core/error.hpp"
 
@@ -15,17 +16,30 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kBranches = 8;
-// reference values of the rung cost: a posture this far from each limit costs 1 per measure
+// reference values of the rung cost: a posture this far from each limit costs 1 per measure,
+// and the cost grows with the fourth power of how much closer it is (nearly flat where the arm
+// is comfortable, steep near a limit: the worst station weighs more than many good ones)
 constexpr double kMarginReference_deg = 30.0;
-constexpr double kAlignmentReference = 0.5;  // |sin q5| at 30 deg
-constexpr double kOffsetReference_mm = 150.0;
-constexpr double kManipulabilityReference = 0.01;
-constexpr double kClearanceReference_mm = 10.0;
+constexpr double kAlignmentReference = 0.3;  // |sin q5| at 17.5 deg
+constexpr double kOffsetReference_mm = 100.0;
+constexpr double kManipulabilityReference = 0.005;
+constexpr double kClearanceReference_mm = 5.0;
 // edge costs: joint motion between stations, in units of these steps, squared
-constexpr double kPrintJointStep_deg = 2.0;
-constexpr double kTravelJointStep_deg = 30.0;
+constexpr double kPrintJointStep_deg = 20.0;
+constexpr double kTravelJointStep_deg = 60.0;
 // closer to the part than this, the run's clearance is measured at every state
 constexpr double kNearPart_mm = 3.0;
+// pass 2 runs on at most this many branches (the most promising by pass 1) once one works
+constexpr int kBranchesCompared = 3;
+// a station also where the tool axis has turned this much since the last one
+constexpr double kStationTurn_deg = 5.0;
+// a joint step along a path is a jump (a branch or a wrap flipping) above max_joint_step_deg plus
+// this many times the tool's own turn (axis and roll) between the two points
+constexpr double kJointStepPerToolTurn = 4.0;
+// a travel between two rolls is checked at intermediate poses at most this far apart in tool
+// turn (deg) and in distance (mm)
+constexpr double kTravelCheckTurn_deg = 5.0;
+constexpr double kTravelCheckDistance_mm = 10.0;
 // at most this many points are named in an error
 constexpr size_t kMaxNamedPoints = 20;
 
@@ -67,20 +81,24 @@ struct Station {
   bool after_travel = true;  // the edge from the previous station is a travel
 };
 
-// the job's start, points along every path about `spacing` apart (ends always), the job's end
+// the job's start, points along every path about `spacing` apart or where the tool axis has
+// turned by kStationTurn_deg (a fillet), ends always, the job's end
 std::vector<Station> make_stations(const Toolpath& toolpath, double spacing_mm) {
   std::vector<Station> stations;
   stations.push_back(Station{Pose(toolpath.start_mm), -1, 0, true});
   for (size_t p = 0; p < toolpath.paths.size(); ++p) {
     const PrintPath& path = toolpath.paths[p];
     double since = 0.0;
+    Vec3 axis = path.tool_axis(0);
     for (size_t i = 0; i < path.points.size(); ++i) {
       if (i > 0) since += (path.points[i] - path.points[i - 1]).norm();
       const bool last = i + 1 == path.points.size();
-      if (i > 0 && !last && since < spacing_mm) continue;
+      const bool turned = axis_angle_rad(axis, path.tool_axis(i)) >= deg_to_rad(kStationTurn_deg);
+      if (i > 0 && !last && since < spacing_mm && !turned) continue;
       stations.push_back(
           Station{Pose(path.points[i], path.tool_axis(i)), static_cast<int>(p), i, i == 0});
       since = 0.0;
+      axis = path.tool_axis(i);
     }
   }
   stations.push_back(Station{Pose(toolpath.end_mm), -1, 0, true});
@@ -122,6 +140,14 @@ double motion_cost(const Arm6Joints& a, const Arm6Joints& b, double step_rad) {
   return sum;
 }
 
+// the largest joint step allowed between two poses along a path (rad): the fixed allowance
+// plus what the tool's own turn may take
+double allowed_step(const Pose& a, const Pose& b, double max_step_rad) {
+  const double turn =
+      axis_angle_rad(a.tool_axis, b.tool_axis) + std::abs(wrapped(a.roll_rad, b.roll_rad));
+  return max_step_rad + kJointStepPerToolTurn * turn;
+}
+
 double largest_step(const Arm6Joints& a, const Arm6Joints& b) {
   double largest = 0.0;
   for (size_t j = 0; j < 6; ++j)
@@ -151,10 +177,10 @@ RungCheck check_rung(const Arm6& arm, const Arm6Joints& q, const ArmPostureSetti
     check.reason = Reason::singular;
     return check;
   }
-  const auto square = [](double x) { return x * x; };
-  check.cost = square(deg_to_rad(kMarginReference_deg) / margin) +
-               square(kAlignmentReference / alignment) + square(kOffsetReference_mm / offset) +
-               square(kManipulabilityReference / manipulability);
+  const auto fourth = [](double x) { return x * x * x * x; };
+  check.cost = fourth(deg_to_rad(kMarginReference_deg) / margin) +
+               fourth(kAlignmentReference / alignment) + fourth(kOffsetReference_mm / offset) +
+               fourth(kManipulabilityReference / manipulability);
   return check;
 }
 
@@ -169,6 +195,7 @@ Pose rolled(const Station& station, double roll_rad) {
 // and why, and the clearance once measured.
 struct Ladder {
   int rolls = 0;
+  double step_rad = 0.0;      // between rolls
   std::vector<Arm6Joints> q;  // station-major
   std::vector<double> cost;
   std::vector<Reason> reason;
@@ -176,11 +203,16 @@ struct Ladder {
   size_t index(size_t station, int roll) const { return station * rolls + roll; }
 };
 
+// whether the travel into station s from roll `from` (at s - 1) to roll k can be made: null
+// accepts every travel
+using TravelCheck = std::function<bool(size_t s, int from, int k)>;
+
 // The shortest path through a ladder: one roll index per station, or empty when none exists.
 // Along a print path the roll moves at most one step between stations and no joint more than
-// max_step; between paths any roll.
+// max_step; between paths any roll the travel check accepts.
 std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>& stations,
-                               double max_step_rad, bool joint_costs) {
+                               double max_step_rad, bool joint_costs,
+                               const TravelCheck& travel_ok = nullptr) {
   const int K = ladder.rolls;
   const size_t n = stations.size();
   std::vector<double> total(K, kInfinity), next(K);
@@ -205,9 +237,14 @@ std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>&
         const Arm6Joints& p = ladder.q[ladder.index(s - 1, from)];
         double edge = 0.0;
         if (travel) {
+          if (travel_ok && !travel_ok(s, from, k)) continue;
           edge = joint_costs ? motion_cost(p, q, travel_step) : 0.0;
         } else {
-          if (joint_costs && largest_step(p, q) > max_step_rad) continue;
+          if (joint_costs &&
+              largest_step(p, q) > allowed_step(rolled(stations[s - 1], from * ladder.step_rad),
+                                                rolled(stations[s], k * ladder.step_rad),
+                                                max_step_rad))
+            continue;
           edge = joint_costs ? motion_cost(p, q, print_step) : static_cast<double>(d * d);
         }
         const double candidate = before + edge + here;
@@ -287,12 +324,12 @@ ArmStats arm_run_stats(const Arm6& arm, const PartClearance* part, const Recorde
   stats.branch = posture.branch;
   stats.clearance_period_s = clearance_period_s;
   stats.roll_strategy = posture.roll_optimized ? "optimized" : "fixed";
-  stats.fixed_roll_deg =
-      posture.roll_optimized ? posture.best_fixed_roll_deg : posture.fixed_roll_deg;
+  stats.fixed_roll_deg = posture.fixed_roll_deg;
+  stats.chosen_mean_cost = posture.chosen_mean_cost;
+  stats.chosen_joint_travel_deg = posture.chosen_joint_travel_deg;
+  stats.roll_zero = posture.roll_zero;
+  stats.best_fixed = posture.best_fixed;
   stats.chosen_roll = posture.chosen;
-  stats.fixed_roll = posture.fixed;
-  stats.fixed_roll_feasible = posture.fixed_feasible;
-  stats.fixed_roll_problem = posture.fixed_problem;
   if (record.joint_count != 6 || record.size() == 0) return stats;
 
   // every state's joints (rad); the measures that need the Jacobian or the part at a period
@@ -406,59 +443,71 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   }
   if (!problems.empty()) throw InputError(problems);
 
-  // the fixed roll: for each branch and roll, is every station valid, and at what cost
   ArmPosture result;
   result.stations = n;
   result.roll_optimized = settings.optimize_roll;
-  int fixed_branch = -1, fixed_roll = 0, fewest_invalid_branch = 0, fewest_invalid_roll = 0;
-  size_t fewest_invalid = n + 1;
-  double fixed_cost = kInfinity;
   const int requested_roll =
       settings.fixed_roll_deg
           ? static_cast<int>(
                 ((std::lround(*settings.fixed_roll_deg / settings.roll_step_deg) % K) + K) % K)
           : -1;
-  for (int b = 0; b < kBranches; ++b) {
-    if (settings.branch >= 0 && b != settings.branch) continue;
-    for (int k = 0; k < K; ++k) {
-      if (requested_roll >= 0 && !settings.optimize_roll && k != requested_roll) continue;
-      double sum = 0.0;
-      size_t invalid = 0;
+
+  // One roll for the whole job, for comparison (or as the user asks): `only_roll` >= 0 that roll,
+  // else the best; the branch whose stations are all valid at the lowest cost, else the one with
+  // the fewest failures (and the first of them named)
+  const auto fixed_roll_on_best_branch = [&](int only_roll) {
+    FixedRollComparison fixed;
+    int best_branch = -1, best_roll = 0, fewest_branch = 0, fewest_roll = 0;
+    size_t fewest_invalid = n + 1;
+    double best_sum = kInfinity;
+    for (int b = 0; b < kBranches; ++b) {
+      if (settings.branch >= 0 && b != settings.branch) continue;
+      for (int k = 0; k < K; ++k) {
+        if (only_roll >= 0 && k != only_roll) continue;
+        double sum = 0.0;
+        size_t invalid = 0;
+        for (size_t s = 0; s < n; ++s) {
+          const double c = cost[at(b, s, k)];
+          if (std::isfinite(c))
+            sum += c;
+          else
+            ++invalid;
+        }
+        if (invalid < fewest_invalid) {
+          fewest_invalid = invalid;
+          fewest_branch = b;
+          fewest_roll = k;
+        }
+        if (invalid == 0 && sum < best_sum) {
+          best_sum = sum;
+          best_branch = b;
+          best_roll = k;
+        }
+      }
+    }
+    fixed.feasible = best_branch >= 0;
+    fixed.branch = fixed.feasible ? best_branch : fewest_branch;
+    const int roll = fixed.feasible ? best_roll : fewest_roll;
+    fixed.roll_deg = roll * settings.roll_step_deg;
+    fixed.mean_cost = fixed.feasible ? best_sum / static_cast<double>(n) : kInfinity;
+    if (!fixed.feasible) {
       for (size_t s = 0; s < n; ++s) {
-        const double c = cost[at(b, s, k)];
-        if (std::isfinite(c))
-          sum += c;
-        else
-          ++invalid;
-      }
-      if (invalid < fewest_invalid) {
-        fewest_invalid = invalid;
-        fewest_invalid_branch = b;
-        fewest_invalid_roll = k;
-      }
-      if (invalid == 0 && sum < fixed_cost) {
-        fixed_cost = sum;
-        fixed_branch = b;
-        fixed_roll = k;
+        const size_t i = at(fixed.branch, s, roll);
+        if (std::isfinite(cost[i])) continue;
+        fixed.problem = std::to_string(fewest_invalid) + " of " + std::to_string(n) +
+                        " stations fail on the best branch (" + std::to_string(fixed.branch) +
+                        "), the first " + station_name(s) + ": " + reason_text(reason[i]);
+        break;
       }
     }
-  }
-  result.fixed_feasible = fixed_branch >= 0;
-  if (!result.fixed_feasible) {
-    fixed_branch = fewest_invalid_branch;
-    fixed_roll = fewest_invalid_roll;
-    for (size_t s = 0; s < n; ++s) {
-      const size_t i = at(fixed_branch, s, fixed_roll);
-      if (std::isfinite(cost[i])) continue;
-      result.fixed_problem = "at roll " + format("%.0f", fixed_roll * settings.roll_step_deg) +
-                             " deg (branch " + std::to_string(fixed_branch) + ", the fewest " +
-                             "failures: " + std::to_string(fewest_invalid) + " of " +
-                             std::to_string(n) + " stations), " + station_name(s) + " is " +
-                             reason_text(reason[i]);
-      break;
-    }
-  }
-  result.best_fixed_roll_deg = fixed_roll * settings.roll_step_deg;
+    return fixed;
+  };
+  result.roll_zero = fixed_roll_on_best_branch(0);
+  result.best_fixed = fixed_roll_on_best_branch(-1);
+  const FixedRollComparison used_fixed =
+      requested_roll >= 0 ? fixed_roll_on_best_branch(requested_roll) : result.best_fixed;
+  const int fixed_roll =
+      static_cast<int>(std::lround(used_fixed.roll_deg / settings.roll_step_deg));
 
   // the branch: the cheapest whose ladder (roll moving one step at a time along paths) has a
   // path; a forced one as given
@@ -470,6 +519,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     for (int b = 0; b < kBranches; ++b) {
       Ladder ladder;
       ladder.rolls = K;
+      ladder.step_rad = step_rad;
       ladder.cost.assign(cost.begin() + at(b, 0, 0), cost.begin() + at(b, 0, 0) + n * K);
       ladder.q.assign(n * K, Arm6Joints{});
       const std::vector<int> path = shortest_path(ladder, stations, kInfinity, false);
@@ -479,14 +529,20 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     for (const auto& [c, b] : ranked) branches.push_back(b);
   }
 
-  // pass 2 on the best branches in turn: postures stored, joint-motion edges, clearance checked
-  // where the path goes (a colliding station's every roll measured, then search again)
+  // pass 2 on the most promising branches: postures stored, joint-motion edges, clearance
+  // checked where the path goes (a colliding station's every roll measured, then search again);
+  // of those that print the job, the one whose postures cost least
   std::vector<int> chosen;
   int branch = -1;
+  double chosen_sum = kInfinity;
+  int tried = 0;
   std::string last_failure;
   for (int b : branches) {
+    if (branch >= 0 && tried >= kBranchesCompared) break;
+    ++tried;
     Ladder ladder;
     ladder.rolls = K;
+    ladder.step_rad = step_rad;
     ladder.q.assign(n * K, Arm6Joints{});
     ladder.cost.assign(cost.begin() + at(b, 0, 0), cost.begin() + at(b, 0, 0) + n * K);
     ladder.reason.assign(reason.begin() + at(b, 0, 0), reason.begin() + at(b, 0, 0) + n * K);
@@ -516,13 +572,51 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
         ladder.cost[i] = kInfinity;
         ladder.reason[i] = Reason::collides;
       } else {
-        ladder.cost[i] += std::pow(kClearanceReference_mm / std::max(distance, 1e-3), 2);
+        ladder.cost[i] += std::pow(kClearanceReference_mm / std::max(distance, 1e-3), 4);
       }
     };
     const double max_step = deg_to_rad(settings.max_joint_step_deg);
+    // a travel's intermediate poses (position straight, axis and roll turning evenly, as the
+    // planners move) must stay on the branch, off the limits and singularities, continuously
+    std::unordered_map<uint64_t, bool> travel_memo;
+    const TravelCheck travel_ok = [&](size_t s, int from, int k) {
+      const uint64_t key = (static_cast<uint64_t>(s) * K + from) * K + k;
+      const auto known = travel_memo.find(key);
+      if (known != travel_memo.end()) return known->second;
+      const Pose a = rolled(stations[s - 1], from * step_rad);
+      const Pose end = rolled(stations[s], k * step_rad);
+      const double turn = rad_to_deg(axis_angle_rad(a.tool_axis, end.tool_axis) +
+                                     std::abs(wrapped(end.roll_rad, a.roll_rad)));
+      const double distance = (end.position_mm - a.position_mm).norm();
+      const int checks = 1 + static_cast<int>(std::ceil(turn / kTravelCheckTurn_deg)) +
+                         static_cast<int>(std::ceil(distance / kTravelCheckDistance_mm));
+      Arm6Joints previous = ladder.q[ladder.index(s - 1, from)];
+      Pose previous_pose = a;
+      bool ok = true;
+      Arm6Branches mid_solved;
+      for (int i = 1; i <= checks + 1 && ok; ++i) {
+        const double f = static_cast<double>(i) / (checks + 1);
+        Pose mid = end;
+        Arm6Joints q = ladder.q[ladder.index(s, k)];
+        if (i <= checks) {
+          mid = Pose(a.position_mm + f * (end.position_mm - a.position_mm),
+                     slerp_axis(a.tool_axis, end.tool_axis, f),
+                     a.roll_rad + f * wrapped(end.roll_rad, a.roll_rad));
+          ok = arm.branch_solutions(mid, mid_solved) &&
+               check_rung(arm, mid_solved[b], settings).reason == Reason::ok;
+          if (!ok) break;
+          q = mid_solved[b];
+        }
+        ok = largest_step(previous, q) <= allowed_step(previous_pose, mid, max_step);
+        previous = q;
+        previous_pose = mid;
+      }
+      travel_memo.emplace(key, ok);
+      return ok;
+    };
     std::vector<int> path;
     for (int round = 0; round < 64; ++round) {
-      path = shortest_path(ladder, stations, max_step, true);
+      path = shortest_path(ladder, stations, max_step, true, travel_ok);
       if (path.empty() || !part) break;
       // measure along the path; where it is too close, every roll of that station
       bool clear = true;
@@ -535,7 +629,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       }
       if (clear) {
         // the clearance costs changed the path's cost: one more search settles it
-        const std::vector<int> again = shortest_path(ladder, stations, max_step, true);
+        const std::vector<int> again = shortest_path(ladder, stations, max_step, true, travel_ok);
         bool same = again == path;
         if (!same) {
           for (size_t s = 0; s < n; ++s) measure(s, again[s]);
@@ -552,9 +646,13 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       for (size_t s = 0; s < n && valid; ++s)
         valid = std::isfinite(ladder.cost[ladder.index(s, path[s])]);
       if (valid) {
-        chosen = path;
-        branch = b;
-        break;
+        const double sum = path_cost(ladder, path);
+        if (sum < chosen_sum) {
+          chosen_sum = sum;
+          chosen = path;
+          branch = b;
+        }
+        continue;
       }
     }
     // name the station where this branch fails: the first with no valid rung, else a gap
@@ -581,8 +679,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
                                      "branch without a joint limit, a singularity or the part (" +
                                      last_failure + ")");
   result.branch = branch;
-  result.fixed_roll_deg =
-      settings.fixed_roll_deg ? *settings.fixed_roll_deg : result.best_fixed_roll_deg;
+  result.fixed_roll_deg = settings.optimize_roll ? 0.0 : used_fixed.roll_deg;
 
   // the rolls: unwrapped along each path (one step at a time), the shortest way round between
   // paths, then interpolated by arc length between stations
@@ -637,6 +734,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     return std::isfinite(best);
   };
   const double max_dense_step = deg_to_rad(settings.max_joint_step_deg);
+  Pose previous_pose;
   std::vector<Problem> dense_problems;
   // `travel`: reached by a travel from the previous point (any joint motion allowed)
   const auto visit = [&](const Pose& pose, const std::string& where, bool travel) {
@@ -649,9 +747,11 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
                                              format("%.1f", rad_to_deg(pose.roll_rad)) + " deg"});
       return;
     }
-    if (!travel && !seed.empty() &&
-        largest_step(to_array(seed), to_array(joints)) > max_dense_step &&
-        dense_problems.size() < kMaxNamedPoints)
+    const bool jump = !travel && !seed.empty() &&
+                      largest_step(to_array(seed), to_array(joints)) >
+                          allowed_step(previous_pose, pose, max_dense_step);
+    previous_pose = pose;
+    if (jump && dense_problems.size() < kMaxNamedPoints)
       dense_problems.push_back(Problem{
           "", 0, "toolpath",
           where + " " + point_text(pose.position_mm) + ": a joint would jump by more than " +
@@ -668,21 +768,41 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   visit(Pose(out.end_mm, vertical_tool_axis(), out.end_roll_rad), "the end", true);
   if (!dense_problems.empty()) throw InputError(dense_problems);
 
-  // the posture measures at the stations: chosen rolls, and the best fixed roll
+  // the posture measures at the stations: the chosen rolls against roll 0 and the best fixed
+  // roll (each on its own best branch), what the choice gains
+  // (and how far the joints turn while printing: the price of a roll that keeps them comfortable)
+  const auto joint_turn_deg = [](const Arm6Joints& a, const Arm6Joints& b) {
+    double sum = 0.0;
+    for (size_t j = 0; j < 6; ++j) sum += std::abs(j == 5 ? wrapped(a[j], b[j]) : a[j] - b[j]);
+    return rad_to_deg(sum);
+  };
   result.chosen = best_possible_posture();
-  result.fixed = best_possible_posture();
+  double chosen_cost = 0.0;
+  Arm6Joints last{};
   for (size_t t = 0; t < n; ++t) {
-    if (arm.branch_solutions(rolled(stations[t], chosen[t] * step_rad), solved))
-      keep_worst(result.chosen, posture_at(arm, part, to_vector(solved[branch])));
-    if (arm.branch_solutions(rolled(stations[t], fixed_roll * step_rad), solved))
-      keep_worst(result.fixed, posture_at(arm, part, to_vector(solved[fixed_branch])));
+    chosen_cost += cost[at(branch, t, chosen[t])];
+    if (!arm.branch_solutions(rolled(stations[t], chosen[t] * step_rad), solved)) continue;
+    keep_worst(result.chosen, posture_at(arm, part, to_vector(solved[branch])));
+    if (t > 0 && !stations[t].after_travel)
+      result.chosen_joint_travel_deg += joint_turn_deg(last, solved[branch]);
+    last = solved[branch];
   }
-  if (result.fixed_feasible && result.fixed.min_clearance_mm < settings.min_clearance_mm) {
-    result.fixed_feasible = false;
-    result.fixed_problem = "at roll " + format("%.0f", result.best_fixed_roll_deg) +
-                           " deg (branch " + std::to_string(fixed_branch) + ") the " +
-                           result.fixed.nearest_shape + " comes within " +
-                           format("%.3g", result.fixed.min_clearance_mm) + " mm of the part";
+  result.chosen_mean_cost = chosen_cost / static_cast<double>(n);
+  for (FixedRollComparison* fixed : {&result.roll_zero, &result.best_fixed}) {
+    fixed->stats = best_possible_posture();
+    const int k = static_cast<int>(std::lround(fixed->roll_deg / settings.roll_step_deg)) % K;
+    for (size_t t = 0; t < n; ++t) {
+      if (!arm.branch_solutions(rolled(stations[t], k * step_rad), solved)) continue;
+      keep_worst(fixed->stats, posture_at(arm, part, to_vector(solved[fixed->branch])));
+      if (t > 0 && !stations[t].after_travel)
+        fixed->joint_travel_deg += joint_turn_deg(last, solved[fixed->branch]);
+      last = solved[fixed->branch];
+    }
+    if (fixed->feasible && fixed->stats.min_clearance_mm < settings.min_clearance_mm) {
+      fixed->feasible = false;
+      fixed->problem = "the " + fixed->stats.nearest_shape + " comes within " +
+                       format("%.3g", fixed->stats.min_clearance_mm) + " mm of the part";
+    }
   }
   return result;
 }

@@ -65,12 +65,12 @@ struct ArmPosture {
   int branch = 0;
   bool roll_optimized = true;
   double fixed_roll_deg = 0.0;  // the roll used when not optimized
-  // at every station: the chosen rolls, and the best single roll over the whole job
+  // at every station: the chosen rolls (their mean rung cost: lower is farther from trouble),
+  // against one roll for the whole job: roll 0, and the best single roll
   ArmPostureStats chosen;
-  ArmPostureStats fixed;
-  double best_fixed_roll_deg = 0.0;
-  bool fixed_feasible = true;
-  std::string fixed_problem;
+  double chosen_mean_cost = 0.0;
+  double chosen_joint_travel_deg = 0.0;  // the joints' turn summed along the paths
+  FixedRollComparison roll_zero, best_fixed;
   size_t stations = 0;
 };
 

@@ -77,12 +77,24 @@ Json to_json(const ArmStats& a) {
       Json{{"part", a.part_contacts}, {"table", a.table_contacts}, {"self", a.self_contacts}};
   j["branch"] = a.branch;
   j["clearance_period_s"] = a.clearance_period_s;
+  const auto fixed = [](const FixedRollComparison& f) {
+    Json j = to_json(f.stats);
+    j["roll_deg"] = f.roll_deg;
+    j["branch"] = f.branch;
+    j["feasible"] = f.feasible;
+    j["problem"] = f.problem;
+    j["mean_cost"] = f.feasible ? Json(f.mean_cost) : Json(nullptr);
+    j["joint_travel_deg"] = f.joint_travel_deg;
+    return j;
+  };
+  Json chosen = to_json(a.chosen_roll);
+  chosen["mean_cost"] = a.chosen_mean_cost;
+  chosen["joint_travel_deg"] = a.chosen_joint_travel_deg;
   j["roll"] = Json{{"strategy", a.roll_strategy},
-                   {"chosen", to_json(a.chosen_roll)},
-                   {"fixed", to_json(a.fixed_roll)},
                    {"fixed_roll_deg", a.fixed_roll_deg},
-                   {"fixed_feasible", a.fixed_roll_feasible},
-                   {"fixed_problem", a.fixed_roll_problem}};
+                   {"chosen", chosen},
+                   {"roll_zero", fixed(a.roll_zero)},
+                   {"best_fixed", fixed(a.best_fixed)}};
   return j;
 }
 

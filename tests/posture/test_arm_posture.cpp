@@ -56,7 +56,10 @@ TEST(ArmPosture, BeamEveryPointSolvedOnOneBranchContinuously) {
   // every point: a solution on the branch within the ranges, forward kinematics gives the pose,
   // neighbours close in joint space
   Arm6Solutions all;
+  // the chain starts where the job does (joint 6 nearest 0), as the posture's own
   JointVector previous;
+  ASSERT_TRUE(arm.inverse(Pose(out.start_mm, vertical_tool_axis(), out.start_roll_rad), previous));
+  ASSERT_EQ(arm.branch_of(previous), posture.branch);
   for (const PrintPath& path : out.paths) {
     ASSERT_EQ(path.rolls.size(), path.points.size());
     for (size_t i = 0; i < path.points.size(); ++i) {
@@ -174,12 +177,14 @@ TEST(ArmPosture, OptimisedRollsReachWhereOneFixedRollCannot) {
   const auto [lo, hi] = std::minmax_element(rolls.begin(), rolls.end());
   EXPECT_GT(*hi - *lo, deg_to_rad(30.0));
   // and at least as far from trouble as the best single roll
-  EXPECT_GE(posture.chosen.min_wrist_alignment, posture.fixed.min_wrist_alignment - 1e-9);
+  EXPECT_GE(posture.chosen.min_wrist_alignment,
+            posture.best_fixed.stats.min_wrist_alignment - 1e-9);
   // no single roll keeps the wrist clear of its singularity all round (the best fails at a
   // point and says so)
-  EXPECT_FALSE(posture.fixed_feasible);
-  EXPECT_NE(posture.fixed_problem.find("at a singularity"), std::string::npos)
-      << posture.fixed_problem;
+  EXPECT_FALSE(posture.best_fixed.feasible);
+  EXPECT_FALSE(posture.roll_zero.feasible);
+  EXPECT_NE(posture.best_fixed.problem.find("at a singularity"), std::string::npos)
+      << posture.best_fixed.problem;
 }
 
 }  // namespace
