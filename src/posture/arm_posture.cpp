@@ -27,10 +27,15 @@ constexpr double kClearanceReference_mm = 5.0;
 // edge costs: joint motion between stations, in units of these steps, squared
 constexpr double kPrintJointStep_deg = 20.0;
 constexpr double kTravelJointStep_deg = 60.0;
+// a roll step between stations along a print path costs this much (a rung at the reference
+// distances from every limit costs 4)
+constexpr double kRollStepCost = 5.0;
+// a travel this long pays half of that per roll step, longer ones less
+constexpr double kLongTravel_mm = 10.0;
 // closer to the part than this, the run's clearance is measured at every state
 constexpr double kNearPart_mm = 3.0;
-// pass 2 runs on at most this many branches (the most promising by pass 1) once one works
-constexpr int kBranchesCompared = 3;
+// pass 2 ranks at most this many branches (the most promising by pass 1) once one works
+constexpr int kBranchesCompared = 2;
 // a station also where the tool axis has turned this much since the last one
 constexpr double kStationTurn_deg = 5.0;
 // a joint step along a path is a jump (a branch or a wrap flipping) above max_joint_step_deg plus
@@ -237,15 +242,23 @@ std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>&
         const Arm6Joints& p = ladder.q[ladder.index(s - 1, from)];
         double edge = 0.0;
         if (travel) {
+          // a short travel (the next hatch line) turns the roll in a short move too
+          const double distance =
+              (stations[s].pose.position_mm - stations[s - 1].pose.position_mm).norm();
+          edge = (joint_costs ? motion_cost(p, q, travel_step) : 0.0) +
+                 kRollStepCost * d * d / (1.0 + distance / kLongTravel_mm);
+          // the travel's own check (inverse kinematics along it) only where it would win
+          if (!(before + edge + here < next[k])) continue;
           if (travel_ok && !travel_ok(s, from, k)) continue;
-          edge = joint_costs ? motion_cost(p, q, travel_step) : 0.0;
         } else {
           if (joint_costs &&
               largest_step(p, q) > allowed_step(rolled(stations[s - 1], from * ladder.step_rad),
                                                 rolled(stations[s], k * ladder.step_rad),
                                                 max_step_rad))
             continue;
-          edge = joint_costs ? motion_cost(p, q, print_step) : static_cast<double>(d * d);
+          // a roll change while printing costs the time law too (the joints turn for it): it
+          // is made only where it buys a clearly better posture
+          edge = (joint_costs ? motion_cost(p, q, print_step) : 0.0) + kRollStepCost * d * d;
         }
         const double candidate = before + edge + here;
         if (candidate < next[k]) {
@@ -532,14 +545,12 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   // pass 2 on the most promising branches: postures stored, joint-motion edges, clearance
   // checked where the path goes (a colliding station's every roll measured, then search again);
   // of those that print the job, the one whose postures cost least
-  std::vector<int> chosen;
-  int branch = -1;
-  double chosen_sum = kInfinity;
-  int tried = 0;
+  // one branch's ladder solved, with the part's clearance or (to rank branches) without:
+  // the path and its posture cost, or nothing (last_failure says why)
   std::string last_failure;
-  for (int b : branches) {
-    if (branch >= 0 && tried >= kBranchesCompared) break;
-    ++tried;
+  const auto solve_branch =
+      [&](int b, bool with_clearance) -> std::optional<std::pair<double, std::vector<int>>> {
+    const PartClearance* check_part = with_clearance ? part : nullptr;
     Ladder ladder;
     ladder.rolls = K;
     ladder.step_rad = step_rad;
@@ -562,9 +573,10 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       }
     const auto measure = [&](size_t s, int k) {
       const size_t i = ladder.index(s, k);
-      if (!part || !std::isnan(ladder.clearance[i])) return;
+      if (!check_part || !std::isnan(ladder.clearance[i])) return;
       const double distance =
-          part->clearance(arm.collision_shapes(), arm.link_frames(to_vector(ladder.q[i])),
+          check_part
+              ->clearance(arm.collision_shapes(), arm.link_frames(to_vector(ladder.q[i])),
                           settings.min_clearance_mm)
               .distance_mm;
       ladder.clearance[i] = distance;
@@ -617,7 +629,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     std::vector<int> path;
     for (int round = 0; round < 64; ++round) {
       path = shortest_path(ladder, stations, max_step, true, travel_ok);
-      if (path.empty() || !part) break;
+      if (path.empty() || !check_part) break;
       // measure along the path; where it is too close, every roll of that station
       bool clear = true;
       for (size_t s = 0; s < n; ++s) {
@@ -645,15 +657,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       bool valid = true;
       for (size_t s = 0; s < n && valid; ++s)
         valid = std::isfinite(ladder.cost[ladder.index(s, path[s])]);
-      if (valid) {
-        const double sum = path_cost(ladder, path);
-        if (sum < chosen_sum) {
-          chosen_sum = sum;
-          chosen = path;
-          branch = b;
-        }
-        continue;
-      }
+      if (valid) return std::make_pair(path_cost(ladder, path), path);
     }
     // name the station where this branch fails: the first with no valid rung, else a gap
     last_failure = "branch " + std::to_string(b) + ": ";
@@ -673,6 +677,25 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       last_failure += "no roll sequence keeps every joint within " +
                       format("%.3g", settings.max_joint_step_deg) +
                       " deg between neighbouring points along the paths";
+    return std::nullopt;
+  };
+  // rank the most promising branches without the part (cheap), then check the part's clearance
+  // on the best first: the first that passes is the job's
+  std::vector<std::pair<double, int>> by_cost;
+  for (int b : branches) {
+    if (!by_cost.empty() && static_cast<int>(by_cost.size()) >= kBranchesCompared) break;
+    if (const auto solved_branch = solve_branch(b, false))
+      by_cost.emplace_back(solved_branch->first, b);
+  }
+  std::sort(by_cost.begin(), by_cost.end());
+  std::vector<int> chosen;
+  int branch = -1;
+  for (const auto& [ranked_cost, b] : by_cost) {
+    const auto solved_branch = part ? solve_branch(b, true) : solve_branch(b, false);
+    if (!solved_branch) continue;
+    chosen = solved_branch->second;
+    branch = b;
+    break;
   }
   if (branch < 0)
     throw InputError("toolpath", "no posture of " + arm.name() + " prints the whole job on one " +
@@ -682,7 +705,9 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   result.fixed_roll_deg = settings.optimize_roll ? 0.0 : used_fixed.roll_deg;
 
   // the rolls: unwrapped along each path (one step at a time), the shortest way round between
-  // paths, then interpolated by arc length between stations
+  // paths, then interpolated by arc length between stations with a C1 cubic (tangents from the
+  // neighbouring stations, zero at a path's ends): a piecewise-linear roll would kink at every
+  // station, and the kinks' joint accelerations would slow the time law
   std::vector<double> station_roll(n);
   for (size_t s = 0; s < n; ++s) {
     double roll = chosen[s] * step_rad;
@@ -703,11 +728,21 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     std::vector<double> arc(path.points.size(), 0.0);
     for (size_t i = 1; i < path.points.size(); ++i)
       arc[i] = arc[i - 1] + (path.points[i] - path.points[i - 1]).norm();
+    // the roll's slope at station t (rad/mm): central difference, 0 at the path's ends
+    const auto slope = [&](size_t t) {
+      if (t == first || t + 1 == s) return 0.0;
+      const double span = arc[stations[t + 1].point] - arc[stations[t - 1].point];
+      return span > 0.0 ? (station_roll[t + 1] - station_roll[t - 1]) / span : 0.0;
+    };
     for (size_t t = first; t + 1 < s; ++t) {
       const size_t i0 = stations[t].point, i1 = stations[t + 1].point;
+      const double h = arc[i1] - arc[i0];
+      const double m0 = slope(t) * h, m1 = slope(t + 1) * h;
       for (size_t i = i0; i <= i1; ++i) {
-        const double f = arc[i1] > arc[i0] ? (arc[i] - arc[i0]) / (arc[i1] - arc[i0]) : 0.0;
-        path.rolls[i] = station_roll[t] + f * (station_roll[t + 1] - station_roll[t]);
+        const double f = h > 0.0 ? (arc[i] - arc[i0]) / h : 0.0;
+        const double f2 = f * f, f3 = f2 * f;
+        path.rolls[i] = (2 * f3 - 3 * f2 + 1) * station_roll[t] + (f3 - 2 * f2 + f) * m0 +
+                        (-2 * f3 + 3 * f2) * station_roll[t + 1] + (f3 - f2) * m1;
       }
     }
     if (s == first + 1) path.rolls.assign(path.points.size(), station_roll[first]);

@@ -45,7 +45,7 @@ struct ArmPostureSettings {
   std::optional<double> fixed_roll_deg;  // with optimize_roll false: this roll, else the best one
   int branch = -1;                       // -1: the best branch; 0..7: this one (Arm6 bits)
   double roll_step_deg = 15.0;
-  double sample_spacing_mm = 2.0;
+  double sample_spacing_mm = 5.0;
   double min_joint_margin_deg = 2.0;
   double min_wrist_alignment = 0.1;   // |sin q5| (5.7 deg)
   double min_wrist_offset_mm = 20.0;  // wrist centre from the joint-1 axis
