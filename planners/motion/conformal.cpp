@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -431,21 +432,79 @@ PathGeometry print_geometry(const PrintPath& path, const ConformalSettings& sett
 // ---------------------------------------------------------------------------------------
 // transitions
 
+// The toolpath's highest point per square cell of (x, y): the paths lie on the part's surface,
+// so a travel that would pass lower than them over its corridor must rise above them first (a
+// straight move between two points of a convex part cuts through it).
+class PathHeights {
+ public:
+  static constexpr double kCell_mm = 2.0;
+
+  explicit PathHeights(const Toolpath& toolpath) {
+    for (const PrintPath& path : toolpath.paths)
+      for (const Vec3& p : path.points) {
+        const auto key = cell_of(p.x(), p.y());
+        auto [it, inserted] = highest_.emplace(key, p.z());
+        if (!inserted) it->second = std::max(it->second, p.z());
+      }
+  }
+  // the highest path point within `radius` (in x, y, cells rounded outwards) of the segment
+  // a -> b; -infinity where there is none
+  double highest_along(const Vec3& a, const Vec3& b, double radius) const {
+    double top = -kInf;
+    const double length = (b - a).head<2>().norm();
+    const int steps = 1 + static_cast<int>(std::ceil(length / (0.5 * kCell_mm)));
+    const int reach = 1 + static_cast<int>(std::ceil(radius / kCell_mm));
+    for (int k = 0; k <= steps; ++k) {
+      const Vec3 p = a + (b - a) * (static_cast<double>(k) / steps);
+      const auto [cx, cy] = cell_of(p.x(), p.y());
+      for (int dx = -reach; dx <= reach; ++dx)
+        for (int dy = -reach; dy <= reach; ++dy) {
+          const auto it = highest_.find({cx + dx, cy + dy});
+          if (it != highest_.end()) top = std::max(top, it->second);
+        }
+    }
+    return top;
+  }
+
+ private:
+  static std::pair<long, long> cell_of(double x, double y) {
+    return {static_cast<long>(std::floor(x / kCell_mm)),
+            static_cast<long>(std::floor(y / kCell_mm))};
+  }
+  std::map<std::pair<long, long>, double> highest_;
+};
+
+// a travel keeps the nozzle this far around it (mm, in x and y) clear of the paths' heights
+constexpr double kTravelCorridor_mm = 5.0;
+
 // The lift-move-lower polyline from (p0, o0) to (p1, o1) and its grid; the orientation turns
 // with a smoothstep in arc length between the end of the lift and the start of the lowering.
 // Empty when there is nothing to do.
 PathGrid transition_grid(const Vec3& p0, const ToolOrientation& o0, const Vec3& p1,
                          const ToolOrientation& o1, double lift_mm, double ds,
-                         const std::string& name) {
+                         const std::string& name, const PathHeights* heights = nullptr) {
   const bool same_orientation = o0.axis == o1.axis && o0.roll_rad == o1.roll_rad;
   if ((p1 - p0).norm() <= kSamePoint && same_orientation) return {};
   if ((p1 - p0).norm() <= kSamePoint && lift_mm <= 0.0) lift_mm = kTurnInPlaceLiftMm;
   Polyline line;
-  const Vec3 candidates[4] = {p0, p0 + lift_mm * o0.axis, p1 + lift_mm * o1.axis, p1};
-  std::vector<int> kept;  // which of the four candidates remain
-  for (int k = 0; k < 4; ++k) {
+  // lift, then, where the paths between stand higher, rise above them; across and lower
+  const Vec3 up0 = p0 + lift_mm * o0.axis, up1 = p1 + lift_mm * o1.axis;
+  Vec3 over0 = up0, over1 = up1;
+  if (heights && lift_mm > 0.0) {
+    // (half the lift above them: the lifted ends themselves stand that high over their own
+    // points for tool axes up to 60 deg from vertical)
+    const double clear_z = heights->highest_along(up0, up1, kTravelCorridor_mm) + 0.5 * lift_mm;
+    if (clear_z > std::min(up0.z(), up1.z())) {
+      over0.z() = std::max(over0.z(), clear_z);
+      over1.z() = std::max(over1.z(), clear_z);
+    }
+  }
+  std::vector<Vec3> candidates{p0, up0, over0, over1, up1, p1};
+  std::vector<int> kept;  // which of the candidates remain
+  const int count = static_cast<int>(candidates.size());
+  for (int k = 0; k < count; ++k) {
     if (!line.points.empty() && (candidates[k] - line.points.back()).norm() <= kSamePoint) {
-      if (k == 3) line.points.back() = p1;  // end exactly at p1
+      if (k == count - 1) line.points.back() = p1;  // end exactly at p1
       continue;
     }
     line.points.push_back(candidates[k]);
@@ -463,9 +522,10 @@ PathGrid transition_grid(const Vec3& p0, const ToolOrientation& o0, const Vec3& 
   // the turn: from where the lift leg's straight part ends to where the lowering's begins
   const double total = grid.length_mm();
   double s1 = 0.0, s2 = total;
-  if (n == 4 && kept[1] == 1 && kept[2] == 2) {
+  if (n >= 4 && (line.points[1] - up0).norm() <= kSamePoint &&
+      (line.points[n - 2] - up1).norm() <= kSamePoint) {
     s1 = (line.points[1] - line.points[0]).norm() - line.delta[1];
-    s2 = total - ((line.points[3] - line.points[2]).norm() - line.delta[2]);
+    s2 = total - ((line.points[n - 1] - line.points[n - 2]).norm() - line.delta[n - 2]);
   }
   if (!(s2 > s1 + 1e-9)) {
     s1 = 0.0;
@@ -580,13 +640,16 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
   };
   double t = 0.0;
 
+  // the paths' heights, which travels clear
+  const PathHeights heights(toolpath);
   // transitions lift; where the machine cannot reach the lifted poses (a machine without a z
   // axis) they go straight instead, and one warning says how often
   int unlifted = 0;
   std::string unlifted_first;
   const auto add_transition = [&](const Vec3& p0, const ToolOrientation& o0, const Vec3& p1,
                                   const ToolOrientation& o1, const std::string& name) {
-    PathGrid grid = transition_grid(p0, o0, p1, o1, settings.lift_mm, settings.ds_mm, name);
+    PathGrid grid =
+        transition_grid(p0, o0, p1, o1, settings.lift_mm, settings.ds_mm, name, &heights);
     if (grid.points.empty()) return;
     if (joints) {
       try {

@@ -33,7 +33,7 @@ constexpr double kRollStepCost = 5.0;
 // a travel this long pays half of that per roll step, longer ones less
 constexpr double kLongTravel_mm = 10.0;
 // closer to the part than this, the run's clearance is measured at every state
-constexpr double kNearPart_mm = 3.0;
+constexpr double kNearPart_mm = 0.5;
 // pass 2 ranks at most this many branches (the most promising by pass 1) once one works
 constexpr int kBranchesCompared = 2;
 // a station also where the tool axis has turned this much since the last one

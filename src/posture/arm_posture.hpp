@@ -82,7 +82,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
 
 // What the arm did over a simulated run (the recorded joints, not the plan): the posture
 // measures at every recorded state (clearance to the part every clearance_period_s, and at
-// every state while it is below 3 mm), contact events with the part (clearance
+// every state while it is below 0.5 mm), contact events with the part (clearance
 // <= 0 starting) and MuJoCo's contacts (the run's ContactLog), and how often the branch
 // changed. `posture` fills the roll comparison and the branch.
 ArmStats arm_run_stats(const Arm6& arm, const PartClearance* part, const RecordedRun& record,

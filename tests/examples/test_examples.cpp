@@ -77,7 +77,7 @@ TEST_P(EveryScenario, ProducesEveryPlot) {
   const std::string path = scenario_path(stem + ".yaml");
   const Scenario scenario = load_scenario(path);
   ASSERT_FALSE(scenario.planners.empty()) << path;
-  const std::string planner = scenario.planners.front().name;
+  const std::string planner = scenario.planners.front().run_label();
   const std::string out = fresh_directory("examples_" + stem);
   const Result run = depotwin("run " + quoted(path) + " --planner " + planner + " --out " +
                               quoted(out) + " --quiet");
