@@ -9,6 +9,7 @@
 # usage: scripts/render-examples.sh [OUTDIR]      (default: <repo>/renders)
 # env:   DEPOTWIN_BUILD_DIR (default <repo>/build; built with scripts/build.sh when the
 #        depotwin binary is missing)
+#        DEPOTWIN_RENDER_SCENARIOS: scenario names to render (space-separated; default: all)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out_dir="${1:-$root/renders}"
@@ -22,7 +23,8 @@ if [[ ! -x "$depotwin" ]]; then
 fi
 
 # the images copied per run
-run_images=(scene.png thickness.png path.png axes.png errors.png thickness_profile.png)
+run_images=(scene.png thickness.png path.png axes.png errors.png thickness_profile.png joints.png
+  layers.png paths3d.png)
 # images that show only the deposit, which is the same for every print order
 deposit_images=(scene.png thickness.png thickness_profile.png)
 
@@ -36,6 +38,9 @@ scenario_files=("$root"/scenarios/*.yaml)
 
 for scenario_file in "${scenario_files[@]}"; do
   name="$(basename "$scenario_file" .yaml)"
+  if [[ -n "${DEPOTWIN_RENDER_SCENARIOS:-}" && " $DEPOTWIN_RENDER_SCENARIOS " != *" $name "* ]]; then
+    continue
+  fi
   # per-scenario compare flags; an order comparison keeps the deposit images of one order
   # only (the orders print the same lines), which keeps renders/ under about 5 MB
   compare_flags=()

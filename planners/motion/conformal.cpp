@@ -500,7 +500,6 @@ PathGrid transition_grid(const Vec3& p0, const ToolOrientation& o0, const Vec3& 
     }
   }
   std::vector<Vec3> candidates{p0, up0, over0, over1, up1, p1};
-  std::vector<int> kept;  // which of the candidates remain
   const int count = static_cast<int>(candidates.size());
   for (int k = 0; k < count; ++k) {
     if (!line.points.empty() && (candidates[k] - line.points.back()).norm() <= kSamePoint) {
@@ -508,7 +507,6 @@ PathGrid transition_grid(const Vec3& p0, const ToolOrientation& o0, const Vec3& 
       continue;
     }
     line.points.push_back(candidates[k]);
-    kept.push_back(k);
   }
   const size_t n = line.points.size();
   line.orientations.assign(n, o0);
