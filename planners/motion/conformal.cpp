@@ -430,6 +430,18 @@ PathGeometry print_geometry(const PrintPath& path, const ConformalSettings& sett
 }
 
 // ---------------------------------------------------------------------------------------
+// joints
+
+// the machine's joints along the grid, their limits with the headroom above
+void attach_joints_with_headroom(PathGrid& grid, const JointMap& joints) {
+  attach_joints(grid, joints);
+  for (JointLimit& limit : grid.joint_limits) {
+    limit.v_max *= kJointLimitHeadroom;
+    limit.a_max *= kJointLimitHeadroom;
+  }
+}
+
+// ---------------------------------------------------------------------------------------
 // transitions
 
 // The toolpath's highest point per square cell of (x, y): the paths lie on the part's surface,
@@ -651,11 +663,11 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     if (grid.points.empty()) return;
     if (joints) {
       try {
-        attach_joints(grid, *joints);
+        attach_joints_with_headroom(grid, *joints);
       } catch (const InputError& error) {
         if (settings.lift_mm <= 0.0) throw;
         PathGrid straight = transition_grid(p0, o0, p1, o1, 0.0, settings.ds_mm, name);
-        attach_joints(straight, *joints);
+        attach_joints_with_headroom(straight, *joints);
         grid = std::move(straight);
         if (unlifted++ == 0) unlifted_first = error.what();
       }
@@ -701,7 +713,7 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
         polyline_grid(fly_by_pieces(geometry.polyline), settings.ds_mm, path.speed_mm_s, name);
     grid.points.front().tool_axis = path.tool_axis(0);
     grid.points.back().tool_axis = path.tool_axis(path.points.size() - 1);
-    if (joints) attach_joints(grid, *joints);
+    if (joints) attach_joints_with_headroom(grid, *joints);
     const std::vector<MachineLimits> interval_limits = interval_tcp_limits(grid, limits, kChunkMm);
 
     // the time law; `speed` and `both` cruise at the largest constant speed no limit slows

@@ -80,10 +80,11 @@ void choose_posture(const Scenario& scenario, Arm6& arm, PreparedJob& job) {
   // a point named by its layer, line and index for a surface toolpath
   const auto name = [&](size_t path, size_t point) {
     const PrintPath& printed = job.toolpath.paths[path];
-    if (!scenario.surface)
-      return "toolpath path " + std::to_string(printed.source_index) + ", point " +
-             std::to_string(point);
-    const PrintPath& given = scenario.toolpath.paths[static_cast<size_t>(printed.source_index)];
+    const int source = printed.source_index;
+    if (!scenario.surface || source < 0 ||
+        static_cast<size_t>(source) >= scenario.toolpath.paths.size())
+      return "toolpath path " + std::to_string(source) + ", point " + std::to_string(point);
+    const PrintPath& given = scenario.toolpath.paths[static_cast<size_t>(source)];
     const bool reversed = (given.front() - printed.front()).norm() > kJoinTolerance_mm;
     return scenario.surface->describe_point(printed.source_index, point, printed.points.size(),
                                             reversed);

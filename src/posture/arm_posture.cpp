@@ -772,11 +772,17 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   Pose previous_pose;
   std::vector<Problem> dense_problems;
   // `travel`: reached by a travel from the previous point (any joint motion allowed)
-  const auto visit = [&](const Pose& pose, const std::string& where, bool travel) {
+  // point `point` of path `path` (-1: the start, -2: the end), named only when it fails
+  const auto where = [&](long path, size_t point) {
+    if (path == -1) return std::string("the start");
+    if (path == -2) return std::string("the end");
+    return name(static_cast<size_t>(path), point);
+  };
+  const auto visit = [&](const Pose& pose, long path, size_t point, bool travel) {
     if (!solve_on_branch(pose, joints)) {
       if (dense_problems.size() < kMaxNamedPoints)
         dense_problems.push_back(Problem{"", 0, "toolpath",
-                                         where + " " + point_text(pose.position_mm) +
+                                         where(path, point) + " " + point_text(pose.position_mm) +
                                              " is beyond a joint's range on branch " +
                                              std::to_string(branch) + " at the chosen roll " +
                                              format("%.1f", rad_to_deg(pose.roll_rad)) + " deg"});
@@ -787,20 +793,22 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
                           allowed_step(previous_pose, pose, max_dense_step);
     previous_pose = pose;
     if (jump && dense_problems.size() < kMaxNamedPoints)
-      dense_problems.push_back(Problem{
-          "", 0, "toolpath",
-          where + " " + point_text(pose.position_mm) + ": a joint would jump by more than " +
-              format("%.3g", settings.max_joint_step_deg) + " deg from the previous point"});
+      dense_problems.push_back(Problem{"", 0, "toolpath",
+                                       where(path, point) + " " + point_text(pose.position_mm) +
+                                           ": a joint would jump by more than " +
+                                           format("%.3g", settings.max_joint_step_deg) +
+                                           " deg from the previous point"});
     seed = joints;
   };
-  visit(Pose(out.start_mm, vertical_tool_axis(), out.start_roll_rad), "the start", true);
+  visit(Pose(out.start_mm, vertical_tool_axis(), out.start_roll_rad), -1, 0, true);
   for (size_t p = 0; p < out.paths.size(); ++p) {
     const PrintPath& path = out.paths[p];
     for (size_t i = 0; i < path.points.size(); ++i)
-      visit(Pose(path.points[i], path.tool_axis(i), path.rolls[i]), name(p, i), i == 0);
+      visit(Pose(path.points[i], path.tool_axis(i), path.rolls[i]), static_cast<long>(p), i,
+            i == 0);
     if (!dense_problems.empty()) break;
   }
-  visit(Pose(out.end_mm, vertical_tool_axis(), out.end_roll_rad), "the end", true);
+  visit(Pose(out.end_mm, vertical_tool_axis(), out.end_roll_rad), -2, 0, true);
   if (!dense_problems.empty()) throw InputError(dense_problems);
 
   // the posture measures at the stations: the chosen rolls against roll 0 and the best fixed

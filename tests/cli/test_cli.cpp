@@ -153,5 +153,85 @@ TEST(Cli, RunAndCompareWriteResults) {
   EXPECT_GE(reordered["cost_s"].get<double>(), reordered["lower_bound_s"].get<double>());
 }
 
+// ---------------------------------------------------------------------------------------
+// the 6-DOF arm: a toolpath it cannot print is refused with file:line: key and the point
+
+// scenarios/shembekar_beam.stl (the 65 x 14 mm arch centred on the origin) placed at `offset`
+// and hatched every 4 mm along x: line k at y = -6 + 4 k, point i at x = -32 + 4 i (before the
+// offset). The `surface:` key is on line 7.
+std::string arm_beam_scenario(const std::string& offset, const std::string& extra = "") {
+  return "name: arm_bad\n"
+         "machine: arm6\n"
+         "limits: {v_max: 200, a_max: 2000}\n"
+         "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5, tau_s: 0.02}\n"
+         "toolpath:\n"
+         "  speed: 30\n"
+         "  surface:\n"
+         "    file: " +
+         scenario_path("shembekar_beam.stl") +
+         "\n"
+         "    offset: " +
+         offset +
+         "\n"
+         "    hatch_mm: 4\n"
+         "    angles: [0]\n"
+         "planners: [conformal]\n" +
+         extra;
+}
+
+// 600 mm beyond the work origin: 960 mm in front of the robot's base, far out of its reach
+TEST(Cli, ArmPointOutOfReachIsNamed) {
+  const std::string dir = fresh_directory("cli_arm_reach");
+  const std::string path = write_text(dir, "reach.yaml", arm_beam_scenario("[600, 0, 0]"));
+  const Result r = depotwin("validate " + path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  const std::string where = path + ":7: toolpath.surface: ";
+  // the job's start above the part, and the points of the hatch by layer, line and point
+  EXPECT_NE(r.output.find(where + "the start (600.000, 0.000, "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(where + "layer 0, line 0, point 0 (568.000, -6.000, "), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(where + "layer 0, line 1, point 16 (632.000, -2.000, "),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(") mm is out of the arm's reach for every roll and branch of arm6"),
+            std::string::npos)
+      << r.output;
+  // `run` refuses it the same way and leaves nothing behind
+  expect_bad_run("arm_out_of_reach", arm_beam_scenario("[600, 0, 0]"), "is out of the arm's reach");
+}
+
+// every posture's wrist centre is closer than 1000 mm to the joint-1 axis: all singular
+TEST(Cli, ArmSingularPointIsNamed) {
+  const std::string dir = fresh_directory("cli_arm_singular");
+  const std::string path = write_text(
+      dir, "singular.yaml", arm_beam_scenario("[0, 0, 0]", "arm: {min_wrist_offset_mm: 1000}\n"));
+  const Result r = depotwin("validate " + path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(
+      r.output.find(path + ":7: toolpath.surface: layer 0, line 0, point 0 (-32.000, -6.000, "),
+      std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(") mm is at a singularity for every roll and branch of arm6"),
+            std::string::npos)
+      << r.output;
+  // the same scenario without the demand is fine
+  const std::string fine = write_text(dir, "fine.yaml", arm_beam_scenario("[0, 0, 0]"));
+  const Result ok = depotwin("validate " + fine);
+  EXPECT_EQ(ok.status, 0) << ok.output;
+  EXPECT_NE(ok.output.find("machine arm6, 4 print paths"), std::string::npos) << ok.output;
+}
+
+// `arm:` on a machine without a wrist
+TEST(Cli, ArmSettingsOnAPlanarMachineAreRefused) {
+  const std::string dir = fresh_directory("cli_arm_planar");
+  const std::string path =
+      write_text(dir, "planar.yaml", scenario_with_machine("xy_stage") + "arm: {roll: fixed}\n");
+  const Result r = depotwin("validate " + path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(path + ":8: arm: applies to machine arm6 (a 6-DOF arm), not to xy_stage"),
+            std::string::npos)
+      << r.output;
+}
+
 }  // namespace
 }  // namespace depotwin
