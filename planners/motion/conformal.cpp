@@ -486,8 +486,9 @@ class PathHeights {
   std::map<std::pair<long, long>, double> highest_;
 };
 
-// a travel keeps the nozzle this far around it (mm, in x and y) clear of the paths' heights
-constexpr double kTravelCorridor_mm = 5.0;
+// a travel keeps the nozzle tip this far around it (mm, in x and y: its thin end is 1.5 mm
+// wide) clear of the paths' heights
+constexpr double kTravelCorridor_mm = 2.0;
 
 // The lift-move-lower polyline from (p0, o0) to (p1, o1) and its grid; the orientation turns
 // with a smoothstep in arc length between the end of the lift and the start of the lowering.

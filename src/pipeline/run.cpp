@@ -237,8 +237,10 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
   if (settings.render) {
     plots_done = std::async(std::launch::async, [&job, &run, &field, &map, &directory] {
       plots::RunPlotInput input;
-      input.title = job.scenario.name + " / " +
-                    (run.report.label.empty() ? run.report.planner : run.report.label);
+      // the planner, and the run's label where it has its own (an order, a setting)
+      const MetricsReport& r = run.report;
+      input.title = job.scenario.name + " / " + r.planner +
+                    (r.label.empty() || r.label == r.planner ? "" : " (" + r.label + ")");
       input.toolpath = &job.toolpath;
       input.planned = &run.planned_at_steps;
       input.simulated = &run.simulated;
