@@ -20,6 +20,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr double kSamplePeriod_s = 0.001;  // trajectory.csv and planned metrics
+// at most this many unreachable points are listed (the rest counted)
+constexpr size_t kMaxNamedPoints = 20;
 // the longest job planned, sampled and simulated (at 1 ms, about 14 M samples)
 constexpr double kMaxJobDuration_s = 4.0 * 3600.0;
 
@@ -42,23 +44,44 @@ std::unique_ptr<Machine> machine_for(const Scenario& scenario, std::string& mode
 // "" when every toolpath pose is reachable; else one problem per unreachable pose
 std::vector<Problem> unreachable_poses(const Scenario& scenario, const Machine& machine) {
   std::vector<Problem> problems;
+  size_t unnamed = 0;  // beyond kMaxNamedPoints: counted, not listed
   JointVector joints;
-  auto check_reachable = [&](const Pose& pose, const std::string& key) {
+  const int surface_line = scenario.surface ? scenario.surface->line : 0;
+  auto check_reachable = [&](const Pose& pose, const std::string& key, int line,
+                             const std::string& where) {
     std::string why;
     if (machine.inverse(pose, joints, &why)) return;
+    if (problems.size() >= kMaxNamedPoints) {
+      ++unnamed;
+      return;
+    }
     const Vec3& p = pose.position_mm;
     std::ostringstream msg;
-    msg << "point (" << p.x() << ", " << p.y() << ", " << p.z() << ") mm is not reachable by "
-        << machine.name() << ": " << why;
-    problems.push_back(Problem{scenario.file, 0, key, msg.str()});
+    msg << where << "point (" << p.x() << ", " << p.y() << ", " << p.z()
+        << ") mm is not reachable by " << machine.name() << ": " << why;
+    problems.push_back(Problem{scenario.file, line, key, msg.str()});
   };
   const Toolpath& toolpath = scenario.toolpath;
-  check_reachable(Pose(toolpath.start_mm), "toolpath.start");
-  check_reachable(Pose(toolpath.end_mm), "toolpath.end");
+  check_reachable(Pose(toolpath.start_mm), "toolpath.start", 0, "");
+  check_reachable(Pose(toolpath.end_mm), "toolpath.end", 0, "");
   for (const PrintPath& path : toolpath.paths)
-    for (size_t i = 0; i < path.points.size(); ++i)
+    for (size_t i = 0; i < path.points.size(); ++i) {
+      // a surface's points by their layer, line and index (only the ones listed are named)
+      const bool named = scenario.surface && problems.size() < kMaxNamedPoints;
       check_reachable(Pose(path.points[i], path.tool_axis(i)),
-                      "toolpath path " + std::to_string(path.source_index));
+                      scenario.surface ? "toolpath.surface"
+                                       : "toolpath path " + std::to_string(path.source_index),
+                      surface_line,
+                      named ? scenario.surface->describe_point(path.source_index, i,
+                                                               path.points.size(), false) +
+                                  ": "
+                            : "");
+    }
+  if (unnamed > 0)
+    problems.push_back(
+        Problem{scenario.file, surface_line, scenario.surface ? "toolpath.surface" : "toolpath",
+                "... and " + std::to_string(unnamed) + " more unreachable points (the first " +
+                    std::to_string(kMaxNamedPoints) + " are listed)"});
   return problems;
 }
 

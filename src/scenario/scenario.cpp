@@ -34,6 +34,8 @@ constexpr double kSpeedTolerance = 1e-9;
 constexpr int kMinImageSize = 16;
 constexpr int kMaxImageSize = 2048;
 constexpr long long kMaxRandomSegments = 100000;
+// a surface toolpath's path problems listed before the rest are counted
+constexpr std::size_t kMaxSurfacePathProblems = 5;
 // a surface toolpath starts and ends this far above the part's highest point (and its layers)
 constexpr double kSurfaceClearance_mm = 20.0;
 
@@ -753,8 +755,10 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     return;
   }
 
-  // the paths, where each came from, and a start and end above the part by default
+  // the paths, where each came from, and a start and end above the part by default (a
+  // hatch has hundreds of paths: their problems are listed for the first few, then counted)
   Toolpath& toolpath = scenario_.toolpath;
+  const std::size_t problems_before_paths = problems_.size();
   for (std::size_t i = 0; i < hatch.toolpath.paths.size(); ++i) {
     PrintPath path = hatch.toolpath.paths[i];
     path.source_index = static_cast<int>(i);
@@ -766,6 +770,13 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     origin.line = hatch.info[i].line;
     origin.point_index = hatch.info[i].point_index;
     surface->origins.push_back(std::move(origin));
+  }
+  std::vector<Problem>& listed = problems_.problems();
+  if (listed.size() > problems_before_paths + kMaxSurfacePathProblems) {
+    const std::size_t more = listed.size() - problems_before_paths - kMaxSurfacePathProblems;
+    listed.resize(problems_before_paths + kMaxSurfacePathProblems);
+    problems_.add(field.key_line, field.key,
+                  "... and " + std::to_string(more) + " more hatch lines with such a problem");
   }
   Vec3 lo, hi;
   part.bounds(lo, hi);

@@ -1,5 +1,6 @@
 #include "sim/part_model.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <map>
 #include <utility>
@@ -76,12 +77,26 @@ std::string mjcf_with_part(const std::string& mjcf, const std::string& model_pat
   const size_t root_end = root == std::string::npos ? root : mjcf.find('>', root);
   if (root_end == std::string::npos)
     throw InputError(model_path, 0, "model", "no <mujoco> root element to add the part to");
-  // the substrate body's opening tag (either quote style)
-  size_t name = mjcf.find("name=\"substrate\"");
-  if (name == std::string::npos) name = mjcf.find("name='substrate'");
-  const size_t body = name == std::string::npos ? name : mjcf.rfind("<body", name);
-  const size_t tag_end = body == std::string::npos ? body : mjcf.find('>', name);
-  if (tag_end == std::string::npos || mjcf.find('<', body + 1) < name)
+  // the substrate body's opening tag (either quote style; not a material or a geom of that
+  // name, nor anything inside a comment)
+  size_t body = std::string::npos, tag_end = std::string::npos;
+  for (const char* quoted : {"name=\"substrate\"", "name='substrate'"}) {
+    for (size_t name = mjcf.find(quoted); name != std::string::npos && body == std::string::npos;
+         name = mjcf.find(quoted, name + 1)) {
+      const size_t open = mjcf.rfind('<', name);
+      const size_t comment_open = mjcf.rfind("<!--", name);
+      const size_t comment_close =
+          comment_open == std::string::npos ? std::string::npos : mjcf.find("-->", comment_open);
+      const bool in_comment = comment_open != std::string::npos &&
+                              (comment_close == std::string::npos || comment_close > name);
+      if (in_comment || open == std::string::npos || mjcf.compare(open, 5, "<body") != 0 ||
+          !std::isspace(static_cast<unsigned char>(mjcf[open + 5])))
+        continue;
+      body = open;
+      tag_end = mjcf.find('>', name);
+    }
+  }
+  if (tag_end == std::string::npos)
     throw InputError(model_path, 0, "body substrate",
                      "the model has no <body name=\"substrate\"> to carry the part");
   const TriangleMesh mesh = mesh_is_closed(part_mm) ? part_mm : closed_shell(part_mm, shell_mm);

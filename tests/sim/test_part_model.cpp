@@ -112,6 +112,23 @@ TEST(PartModel, ClosedMeshIsAddedAsItIs) {
   EXPECT_LT((hi - Vec3(10, 10, 10)).norm(), 1e-3);
 }
 
+// the body named substrate, not a material or a commented-out body of that name
+TEST(PartModel, TheSubstrateBodyNotAnythingElseOfThatName) {
+  const std::string mjcf = R"(<mujoco>
+  <asset><material name="substrate" rgba="1 1 1 1"/></asset>
+  <!-- <body name="substrate"> was here -->
+  <worldbody>
+    <geom name='substrate' type="plane" size="1 1 0.1"/>
+    <body name="substrate" pos="0.1 0 0"><geom type="sphere" size="0.01"/></body>
+  </worldbody>
+</mujoco>)";
+  const ModelPtr model =
+      load_model_from_string(mjcf_with_part(mjcf, "probe.xml", tetrahedron()), "probe.xml");
+  const int geom = mj_name2id(model.get(), mjOBJ_GEOM, kPartGeomName);
+  ASSERT_GE(geom, 0);
+  EXPECT_EQ(model->geom_bodyid[geom], mj_name2id(model.get(), mjOBJ_BODY, "substrate"));
+}
+
 TEST(PartModel, SelfClosingSubstrateAndErrors) {
   const std::string self_closing =
       "<mujoco><worldbody><body name='substrate' pos='0 0 0'/></worldbody></mujoco>";
