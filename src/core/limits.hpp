@@ -40,7 +40,7 @@ struct JointLimit {
   double max = 0.0;
   double v_max = 0.0;
   double a_max = 0.0;
-  double j_max = 0.0;  // 0: no jerk limit
+  double j_max = 0.0;     // 0: no jerk limit
   bool revolute = false;  // a hinge (rad) rather than a slide (mm)
 };
 
