@@ -104,21 +104,6 @@ std::unique_ptr<BeamJob> beam_job(size_t paths) {
   return beam;
 }
 
-// the job's deposit as simulate_job makes it (one process per layer, n_z on the part)
-std::unique_ptr<LayeredDeposit> job_deposit(const PreparedJob& job) {
-  LayeredDeposit::NormalZ normal_z;
-  if (job.surface) {
-    std::shared_ptr<const SurfaceProjector> projector = job.surface;
-    normal_z = [projector](double x_mm, double y_mm) {
-      const std::optional<SurfaceHit> hit = projector->project_down(x_mm, y_mm);
-      return hit && hit->faces_up() ? hit->normal.z() : 1.0;
-    };
-  }
-  return std::make_unique<LayeredDeposit>(deposition_settings(job.scenario),
-                                          job.scenario.sim.cell_mm, job.toolpath.layer_count(),
-                                          normal_z);
-}
-
 // One run as simulate_job does it, without planning and scoring: with `deposit`, every step
 // into the layer of its path, and the batched steps flushed at the end.
 RecordedRun full_run(Simulation& simulation, const BeamJob& beam, LayeredDeposit* deposit) {

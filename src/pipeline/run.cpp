@@ -133,17 +133,8 @@ Simulation::FeedForwardHook closure_feedforward_hook(const Machine& machine,
   };
 }
 
-SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
-                          const RunSettings& settings) {
-  SimulatedRun run;
-  run.plan = plan_job(job, spec);
-  const Trajectory& trajectory = run.plan.trajectory;
-  const Scenario& scenario = job.scenario;
-
-  // the twin: the machine's MJCF, driven through its actuators
-  run.simulation = std::make_unique<Simulation>(job.model_path, *job.machine,
-                                                sim_settings(scenario), job.model_text);
-  const DepositionSettings deposition = deposition_settings(scenario);
+std::unique_ptr<LayeredDeposit> job_deposit(const PreparedJob& job) {
+  const DepositionSettings deposition = deposition_settings(job.scenario);
   deposition.validate();
   // one process per layer; on a part, the surface's slope under each cell (n_z) turns the
   // vertical thickness into thickness along the normal
@@ -155,8 +146,21 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
       return hit && hit->faces_up() ? hit->normal.z() : 1.0;
     };
   }
-  run.deposit = std::make_unique<LayeredDeposit>(deposition, scenario.sim.cell_mm,
-                                                 job.toolpath.layer_count(), normal_z);
+  return std::make_unique<LayeredDeposit>(deposition, job.scenario.sim.cell_mm,
+                                          job.toolpath.layer_count(), normal_z);
+}
+
+SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
+                          const RunSettings& settings) {
+  SimulatedRun run;
+  run.plan = plan_job(job, spec);
+  const Trajectory& trajectory = run.plan.trajectory;
+  const Scenario& scenario = job.scenario;
+
+  // the twin: the machine's MJCF, driven through its actuators
+  run.simulation = std::make_unique<Simulation>(job.model_path, *job.machine,
+                                                sim_settings(scenario), job.model_text);
+  run.deposit = job_deposit(job);
 
   // loads carried through closed chains (a delta's platform) by the machine's own model
   if (job.machine->has_closures())

@@ -46,6 +46,10 @@ std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
 DepositionSettings deposition_settings(const Scenario& scenario);
 // the scenario's simulation settings
 SimSettings sim_settings(const Scenario& scenario);
+// The job's deposit before its first step: one process per layer and, on a part, the slope of
+// its surface under each cell (n_z) that turns vertical thickness into thickness along the
+// normal. InputError for bad process settings.
+std::unique_ptr<LayeredDeposit> job_deposit(const PreparedJob& job);
 
 // The load feed-forward of a machine with closed chains (Machine::closure_feedforward), at
 // the TCP velocity and acceleration the servo's setpoints give: first and second

@@ -17,30 +17,18 @@
 #include <string>
 
 #include "kinematics/arm6.hpp"
+#include "models/mujoco_test_util.hpp"
 #include "sim/mujoco_access.hpp"
 #include "sim/simulation.hpp"
 
 namespace depotwin {
 namespace {
 
-int& warning_count() {
-  static int count = 0;
-  return count;
-}
-void throw_error(const char* message) {
-  throw std::runtime_error(message);
-}
-void count_warning(const char* message) {
-  ++warning_count();
-  ADD_FAILURE() << "MuJoCo warning: " << message;
-}
-
-struct ModelDeleter {
-  void operator()(mjModel* model) const { mj_deleteModel(model); }
-};
-struct DataDeleter {
-  void operator()(mjData* data) const { mj_deleteData(data); }
-};
+using testing_models::count_warning;
+using testing_models::DataDeleter;
+using testing_models::ModelDeleter;
+using testing_models::throw_error;
+using testing_models::warning_count;
 
 std::string arm6_model_path() {
   return std::string(DEPOTWIN_MODELS_DIR) + "/arm6.xml";

@@ -13,29 +13,16 @@
 #include <string>
 
 #include "kinematics/linear_delta.hpp"
+#include "models/mujoco_test_util.hpp"
 
 namespace depotwin {
 namespace {
 
-// MuJoCo reports through plain function pointers: errors throw, warnings are counted
-int& warning_count() {
-  static int count = 0;
-  return count;
-}
-void throw_error(const char* message) {
-  throw std::runtime_error(message);
-}
-void count_warning(const char* message) {
-  ++warning_count();
-  ADD_FAILURE() << "MuJoCo warning: " << message;
-}
-
-struct ModelDeleter {
-  void operator()(mjModel* model) const { mj_deleteModel(model); }
-};
-struct DataDeleter {
-  void operator()(mjData* data) const { mj_deleteData(data); }
-};
+using testing_models::count_warning;
+using testing_models::DataDeleter;
+using testing_models::ModelDeleter;
+using testing_models::throw_error;
+using testing_models::warning_count;
 
 class DeltaModel : public ::testing::Test {
  protected:
