@@ -486,6 +486,9 @@ class PathHeights {
   std::map<std::pair<long, long>, double> highest_;
 };
 
+// a travel heading more than this far from the tool axis (back towards the surface) does not
+// lift first
+constexpr double kNoLiftAngleRad = 2.0 * kPi / 3.0;
 // a travel keeps the nozzle tip this far around it (mm, in x and y: its thin end is 1.5 mm
 // wide) clear of the paths' heights
 constexpr double kTravelCorridor_mm = 2.0;
@@ -501,7 +504,11 @@ PathGrid transition_grid(const Vec3& p0, const ToolOrientation& o0, const Vec3& 
   if ((p1 - p0).norm() <= kSamePoint && lift_mm <= 0.0) lift_mm = kTurnInPlaceLiftMm;
   Polyline line;
   // lift, then, where the paths between stand higher, rise above them; across and lower
-  const Vec3 up0 = p0 + lift_mm * o0.axis, up1 = p1 + lift_mm * o1.axis;
+  Vec3 up0 = p0 + lift_mm * o0.axis, up1 = p1 + lift_mm * o1.axis;
+  // no lift where the move heads back against it (the job's start high above the paths: a
+  // lift there would only add a hairpin), nor a lowering where it arrives from below
+  if (lift_mm > 0.0 && axis_angle_rad(o0.axis, up1 - p0) > kNoLiftAngleRad) up0 = p0;
+  if (lift_mm > 0.0 && axis_angle_rad(o1.axis, up0 - p1) > kNoLiftAngleRad) up1 = p1;
   Vec3 over0 = up0, over1 = up1;
   if (heights && lift_mm > 0.0) {
     // (half the lift above them: the lifted ends themselves stand that high over their own

@@ -5,7 +5,9 @@
 
 #include "contract/planner_checks.hpp"
 #include "core/error.hpp"
+#include "kinematics/arm6.hpp"
 #include "planners/planner.hpp"
+#include "posture/arm_posture.hpp"
 
 namespace depotwin {
 namespace {
@@ -48,6 +50,67 @@ TEST_P(PlannerContract, ThreeDimensionalPathsWithVaryingToolAxes) {
     testing_support::expect_contract(plan, toolpath, limits);
     testing_support::expect_tool_axis_contract(plan, toolpath);
     if (HasFatalFailure()) return;
+  }
+}
+
+// On the 6-DOF arm: 3-D paths with tilted tool axes, their rolls chosen by the arm's posture, the
+// arm's own TCP limits (with its joint map). Every planner keeps the contract, brings the roll
+// to each path point it reaches and turns it continuously, and the arm follows without a jump
+// (inverse_near along the plan every 1 ms); a planner that plans on the joint map (conformal)
+// keeps every joint within its speed limit.
+TEST_P(PlannerContract, ArmPathsWithRolls) {
+  const Arm6 arm;
+  const auto planner = make_planner(PlannerSpec{GetParam(), {}, 0});
+  const MachineLimits requested = MachineLimits::uniform(30.0, 300.0);
+  const TcpLimits limits = arm.tcp_limits(requested);
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    SCOPED_TRACE(testing::Message() << "seed " << seed);
+    Toolpath toolpath = testing_support::random_toolpath_3d(seed, 10.0);
+    toolpath.start_mm = toolpath.end_mm = Vec3(0, 0, 30);
+    const ArmPosture posture =
+        choose_arm_posture(arm, nullptr, toolpath, {}, [](size_t path, size_t point) {
+          return "path " + std::to_string(path) + ", point " + std::to_string(point);
+        });
+    Arm6 configured;
+    configured.set_branch(posture.branch);
+    const TcpLimits configured_limits = configured.tcp_limits(requested);
+    const Toolpath& rolled = posture.toolpath;
+    const Trajectory plan = planner->plan(rolled, configured_limits);
+    testing_support::expect_contract(plan, rolled, requested);
+    testing_support::expect_tool_axis_contract(plan, rolled);
+    if (HasFatalFailure()) return;
+    // the roll: each path's own where a print piece starts or ends on a path point, and turning
+    // continuously everywhere
+    for (const TrajectoryPiece& piece : plan.pieces()) {
+      if (!piece.depositing) continue;
+      const PrintPath& path = rolled.paths[piece.path_index];
+      const TrajectorySample s = plan.at(piece.t_begin_s);
+      for (size_t i = 0; i < path.points.size(); ++i) {
+        if ((path.points[i] - s.position_mm).norm() < 1e-9) {
+          EXPECT_NEAR(s.roll_rad, path.roll(i), 1e-6) << "path " << piece.path_index;
+        }
+      }
+    }
+    // the arm follows: no joint jumps between 1 ms samples, within speed on the joint map
+    JointVector q, previous;
+    const bool joint_limited = GetParam() == "conformal";
+    const std::vector<JointLimit>& joint_limits = configured.joint_limits();
+    for (double t = 0.0; t <= plan.duration_s(); t += 0.001) {
+      const TrajectorySample s = plan.at(t);
+      const bool solved = previous.empty() ? configured.inverse(s.pose(), q)
+                                           : configured.inverse_near(s.pose(), previous, q);
+      ASSERT_TRUE(solved) << "t " << t;
+      if (!previous.empty()) {
+        for (size_t j = 0; j < q.size(); ++j) {
+          ASSERT_LT(std::abs(q[j] - previous[j]), 0.05) << "joint " << j << " jumps at t " << t;
+          if (joint_limited) {
+            ASSERT_LE(std::abs(q[j] - previous[j]) / 0.001, joint_limits[j].v_max * 1.01)
+                << "joint " << j << " t " << t;
+          }
+        }
+      }
+      previous = q;
+    }
   }
 }
 
