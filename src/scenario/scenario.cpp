@@ -34,6 +34,8 @@ constexpr double kSpeedTolerance = 1e-9;
 constexpr int kMinImageSize = 16;
 constexpr int kMaxImageSize = 2048;
 constexpr long long kMaxRandomSegments = 100000;
+// the most grid points a surface toolpath may project, over all its layers
+constexpr double kMaxSurfaceGridPoints = 2e7;
 // a surface toolpath's path problems listed before the rest are counted
 constexpr std::size_t kMaxSurfacePathProblems = 5;
 // a surface toolpath starts and ends this far above the part's highest point (and its layers)
@@ -726,6 +728,21 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
          Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.x()), Vec3::UnitX()))
             .toRotationMatrix();
     part.transform(rotation, surface->offset_mm);
+    // the grid's size before it is built: every layer's points over the part's (x, y) bounds
+    Vec3 lo, hi;
+    part.bounds(lo, hi);
+    const double grid_points = ((hi.x() - lo.x()) / surface->hatch_mm + 2.0) *
+                               ((hi.y() - lo.y()) / surface->hatch_mm + 2.0) * surface->layers;
+    if (grid_points > kMaxSurfaceGridPoints) {
+      problems_.add(
+          field.key_line, field.key,
+          "the hatch would have about " + format_number(std::round(grid_points)) +
+              " grid points (" + std::to_string(surface->layers) + " layers over the part's " +
+              format_number(hi.x() - lo.x()) + " x " + format_number(hi.y() - lo.y()) + " mm at " +
+              format_number(surface->hatch_mm) + " mm), more than " +
+              format_number(kMaxSurfaceGridPoints) + ": check units, hatch_mm and layers");
+      return;
+    }
     SurfaceHatchSpec spec;
     spec.hatch_mm = surface->hatch_mm;
     spec.angles_deg = surface->angles_deg;
