@@ -435,19 +435,28 @@ std::string Arm6::reach_problem(double distance_mm) const {
          " mm inside the arm's smallest reach of " + format("%.2f", inner) + " mm";
 }
 
+bool Arm6::solve_pose(const Pose& pose, double q1_hint, double q4_hint, Arm6Branches& branches,
+                      std::string* why) const {
+  std::string problem = pose_problem(pose);
+  if (problem.empty()) {
+    Eigen::Matrix3d rotation;
+    Vec3 position;
+    flange_of(pose, rotation, position);
+    double distance_mm = 0.0;
+    if (solve_flange(rotation, position, q1_hint, q4_hint, branches, &distance_mm)) return true;
+    problem = reach_problem(distance_mm);
+  }
+  if (why) *why = problem;
+  return false;
+}
+
 bool Arm6::inverse(const Pose& pose, JointVector& joints, std::string* why) const {
   const auto fail = [why](const std::string& reason) {
     if (why) *why = reason;
     return false;
   };
-  if (const std::string problem = pose_problem(pose); !problem.empty()) return fail(problem);
-  Eigen::Matrix3d rotation;
-  Vec3 position;
-  flange_of(pose, rotation, position);
   Arm6Branches branches;
-  double distance_mm = 0.0;
-  if (!solve_flange(rotation, position, 0.0, 0.0, branches, &distance_mm))
-    return fail(reach_problem(distance_mm));
+  if (!solve_pose(pose, 0.0, 0.0, branches, why)) return false;
   const Arm6Joints& q = branches[branch_];
   if (in_range(q)) {
     joints.assign(q.begin(), q.end());
@@ -479,18 +488,8 @@ bool Arm6::inverse_near(const Pose& pose, const JointVector& seed, JointVector& 
   if (seed.size() != 6 ||
       !std::all_of(seed.begin(), seed.end(), [](double v) { return std::isfinite(v); }))
     return inverse(pose, joints, why);
-  const auto fail = [why](const std::string& reason) {
-    if (why) *why = reason;
-    return false;
-  };
-  if (const std::string problem = pose_problem(pose); !problem.empty()) return fail(problem);
-  Eigen::Matrix3d rotation;
-  Vec3 position;
-  flange_of(pose, rotation, position);
   Arm6Branches branches;
-  double distance_mm = 0.0;
-  if (!solve_flange(rotation, position, seed[0], seed[3], branches, &distance_mm))
-    return fail(reach_problem(distance_mm));
+  if (!solve_pose(pose, seed[0], seed[3], branches, why)) return false;
   const JointLimit& limit6 = joint_limits_[5];
   double best = std::numeric_limits<double>::infinity();
   int best_branch = -1;
@@ -517,7 +516,10 @@ bool Arm6::inverse_near(const Pose& pose, const JointVector& seed, JointVector& 
       }
     }
   }
-  if (best_branch < 0) return fail(every_branch_problem(branches));
+  if (best_branch < 0) {
+    if (why) *why = every_branch_problem(branches);
+    return false;
+  }
   const Arm6Joints& q = branches[best_branch];
   joints.assign(q.begin(), q.end());
   joints[5] = best_q6;

@@ -206,6 +206,10 @@ class Arm6 final : public Machine {
                     double q4_hint, Arm6Branches& out, double* distance_mm) const;
   // base-frame flange of a work-frame pose (the pose must be finite with a unit axis)
   void flange_of(const Pose& pose, Eigen::Matrix3d& rotation, Vec3& position) const;
+  // the eight branches of a work-frame pose (hints as in solve_flange); false, with why
+  // (bad pose or out of reach) when there are none
+  bool solve_pose(const Pose& pose, double q1_hint, double q4_hint, Arm6Branches& branches,
+                  std::string* why) const;
   // "" when the pose is finite with a unit axis, else why not
   std::string pose_problem(const Pose& pose) const;
   std::string reach_problem(double distance_mm) const;
