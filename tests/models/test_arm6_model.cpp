@@ -24,11 +24,8 @@
 namespace depotwin {
 namespace {
 
-using testing_models::count_warning;
 using testing_models::DataDeleter;
 using testing_models::ModelDeleter;
-using testing_models::throw_error;
-using testing_models::warning_count;
 
 std::string arm6_model_path() {
   return std::string(DEPOTWIN_MODELS_DIR) + "/arm6.xml";
@@ -41,13 +38,8 @@ Arm6Joints from_deg(double a, double b, double c, double d, double e, double f) 
 class Arm6Model : public ::testing::Test {
  protected:
   void SetUp() override {
-    mju_user_error = throw_error;
-    mju_user_warning = count_warning;
-    warning_count() = 0;
-    char error[1000] = "";
-    model_.reset(mj_loadXML(arm6_model_path().c_str(), nullptr, error, sizeof(error)));
-    ASSERT_TRUE(model_) << error;
-    EXPECT_STREQ(error, "") << "load warning";
+    model_.reset(testing_models::load_test_model("arm6.xml"));
+    ASSERT_TRUE(model_);
     data_.reset(mj_makeData(model_.get()));
     for (int j = 0; j < 6; ++j) {
       const std::string& name = arm_.joint_limits()[j].name;
@@ -62,13 +54,7 @@ class Arm6Model : public ::testing::Test {
     ASSERT_GE(nozzle_, 0);
   }
 
-  void TearDown() override {
-    if (data_) {
-      for (int kind = 0; kind < mjNWARNING; ++kind)
-        EXPECT_EQ(data_->warning[kind].number, 0) << "MuJoCo warning kind " << kind;
-    }
-    EXPECT_EQ(warning_count(), 0);
-  }
+  void TearDown() override { testing_models::expect_no_warnings(data_.get()); }
 
   void set_joints(const Arm6Joints& q) {
     for (int j = 0; j < 6; ++j) data_->qpos[model_->jnt_qposadr[joint_[j]]] = q[j];

@@ -18,22 +18,14 @@
 namespace depotwin {
 namespace {
 
-using testing_models::count_warning;
 using testing_models::DataDeleter;
 using testing_models::ModelDeleter;
-using testing_models::throw_error;
-using testing_models::warning_count;
 
 class DeltaModel : public ::testing::Test {
  protected:
   void SetUp() override {
-    mju_user_error = throw_error;
-    mju_user_warning = count_warning;
-    warning_count() = 0;
-    char error[1000] = "";
-    const std::string path = std::string(DEPOTWIN_MODELS_DIR) + "/linear_delta.xml";
-    model_.reset(mj_loadXML(path.c_str(), nullptr, error, sizeof(error)));
-    ASSERT_TRUE(model_) << error;
+    model_.reset(testing_models::load_test_model("linear_delta.xml"));
+    ASSERT_TRUE(model_);
     data_.reset(mj_makeData(model_.get()));
     for (int arm = 0; arm < 3; ++arm) {
       const std::string name = delta_.joint_limits()[arm].name;
@@ -48,11 +40,7 @@ class DeltaModel : public ::testing::Test {
     ASSERT_GE(nozzle_, 0);
   }
 
-  void TearDown() override {
-    for (int kind = 0; kind < mjNWARNING; ++kind)
-      EXPECT_EQ(data_->warning[kind].number, 0) << "MuJoCo warning kind " << kind;
-    EXPECT_EQ(warning_count(), 0);
-  }
+  void TearDown() override { testing_models::expect_no_warnings(data_.get()); }
 
   // the nozzle point in the substrate frame (mm)
   Vec3 simulated_tcp_mm() const {
