@@ -34,7 +34,6 @@
 //                         metrics (the scores), of which arm_stats (arm_run_stats: posture
 //                         measures and clearance to the part over the recorded run).
 #include <benchmark/benchmark.h>
-#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -44,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_clock.hpp"
 #include "deposition/deposition_metrics.hpp"
 #include "deposition/job_deposition.hpp"
 #include "deposition/layered_deposit.hpp"
@@ -59,23 +59,15 @@
 namespace depotwin {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::seconds_since;
+using bench::thread_cpu_s;
 
 const char* const kScenario = DEPOTWIN_SCENARIOS_DIR "/shembekar_beam.yaml";
 // hatch lines of the per-step benchmarks (layer 0's first ones, in the scenario's order)
 constexpr size_t kBenchPaths = 4;
 // src/pipeline/run.cpp's period of the arm's clearance checks over a run
 constexpr double kArmClearancePeriod_s = 0.02;
-
-double thread_cpu_s() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-}
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // the beam scenario with its first `paths` print paths (0: all) or its first `layers` layers
 Scenario beam_scenario(size_t paths, int layers = 0) {

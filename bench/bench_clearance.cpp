@@ -18,10 +18,10 @@
 #include <fcl/fcl.h>
 
 #include <cmath>
-#include <ctime>
 #include <random>
 #include <vector>
 
+#include "bench_clock.hpp"
 #include "collision/part_clearance.hpp"
 
 using namespace depotwin;
@@ -250,12 +250,8 @@ void BM_FclDistanceTool(benchmark::State& state) {
 }
 BENCHMARK(BM_FclDistanceTool)->Unit(benchmark::kMicrosecond);
 
-// this thread's CPU seconds (the machine is shared: wall time counts other processes)
-double thread_cpu_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+// CPU time of this thread: the machine is shared, wall time counts other processes
+using bench::thread_cpu_s;
 
 // CPU seconds per call of f over every pose
 template <typename F>

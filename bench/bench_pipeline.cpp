@@ -26,12 +26,12 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <ctime>
 #include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "bench_clock.hpp"
 #include "deposition/process.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/run.hpp"
@@ -45,20 +45,12 @@ namespace depotwin {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::seconds_since;
+using bench::thread_cpu_s;
 
 const char* const kModel = DEPOTWIN_MODELS_DIR "/xy_stage.xml";
 const char* const kScenario = DEPOTWIN_SCENARIOS_DIR "/thompson_fig7.yaml";
-
-double thread_cpu_s() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-}
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // thompson_fig7 prepared and planned by lspb_mtt
 struct PlannedJob {
