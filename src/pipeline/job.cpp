@@ -138,7 +138,8 @@ PreparedJob prepare_job(const Scenario& scenario) {
   Arm6* arm = dynamic_cast<Arm6*>(job.machine.get());
   if (scenario.part) {
     job.part = scenario.part;
-    job.surface = std::make_shared<const SurfaceProjector>(*job.part);
+    job.surface = scenario.part_projector;
+    if (!job.surface) throw InternalError("prepare_job: the scenario's part has no projector");
     job.model_text = mjcf_with_part(read_text_file(job.model_path), job.model_path, *job.part);
   }
 

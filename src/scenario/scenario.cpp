@@ -718,10 +718,10 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
   if (problems_.size() != problems_before || surface->file.empty() || !speed) return;
 
   // read and place the part; hatch it
-  TriangleMesh part;
+  std::shared_ptr<const SurfaceProjector> projector;
   SurfaceHatch hatch;
   try {
-    part = read_stl(surface->file, surface->mm_per_unit, field.key + ".file");
+    TriangleMesh part = read_stl(surface->file, surface->mm_per_unit, field.key + ".file");
     const Eigen::Matrix3d rotation =
         (Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.z()), Vec3::UnitZ()) *
          Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.y()), Vec3::UnitY()) *
@@ -752,7 +752,8 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     spec.offset = surface->layer_offset == "z" ? SurfaceHatchSpec::Offset::z
                                                : SurfaceHatchSpec::Offset::normal;
     spec.speed_mm_s = *speed;
-    hatch = hatch_surface(part, spec);
+    projector = std::make_shared<const SurfaceProjector>(std::move(part));
+    hatch = hatch_surface(*projector, spec);
   } catch (const InputError& e) {
     // the reader's and the hatch's problems name this file and line
     for (Problem p : e.problems()) {
@@ -795,14 +796,15 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     problems_.add(field.key_line, field.key,
                   "... and " + std::to_string(more) + " more hatch lines with such a problem");
   }
-  Vec3 lo, hi;
-  part.bounds(lo, hi);
+  const Vec3& lo = projector->lower_bound();
+  const Vec3& hi = projector->upper_bound();
   const Vec3 above((lo.x() + hi.x()) / 2, (lo.y() + hi.y()) / 2,
                    hi.z() + kSurfaceClearance_mm + surface->layers * surface->layer_height_mm);
   if (!start_given) toolpath.start_mm = above;
   if (!end_given) toolpath.end_mm = start_given ? toolpath.start_mm : above;
   scenario_.surface = std::move(surface);
-  scenario_.part = std::make_shared<const TriangleMesh>(std::move(part));
+  scenario_.part = std::shared_ptr<const TriangleMesh>(projector, &projector->mesh());
+  scenario_.part_projector = std::move(projector);
 }
 
 void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {

@@ -16,6 +16,7 @@
 #include "planners/ordering/sequencer.hpp"
 #include "planners/planner.hpp"
 #include "posture/arm_posture.hpp"
+#include "toolpath/surface_projection.hpp"
 
 namespace depotwin {
 
@@ -98,6 +99,9 @@ struct Scenario {
   // (mm); null / empty for planar toolpaths
   std::shared_ptr<const SurfaceToolpath> surface;
   std::shared_ptr<const TriangleMesh> part;
+  // ray casting onto the part, built once for its hatch and kept for the run (`part` is its
+  // mesh); null with `part`
+  std::shared_ptr<const SurfaceProjector> part_projector;
   // `arm:` — how a 6-DOF arm chooses its roll and branch along the toolpath (arm6 only)
   std::optional<ArmPostureSettings> arm;
   int arm_line = 0;
