@@ -47,6 +47,8 @@ struct PlannerParameter {
   bool list_allowed = false;  // may be given as a list (e.g. one weight per corner)
   // a choice parameter: one of these words (the first is the default); numbers are refused
   std::vector<std::string> choices = {};
+  std::string unit = {};      // mm, s, deg, ...; "" for a pure number or a word
+  bool whole_number = false;  // only whole numbers in the range (e.g. a 0/1 switch)
 };
 
 class Planner {

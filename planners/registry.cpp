@@ -98,6 +98,13 @@ std::string check_planner_spec(const PlannerSpec& spec) {
             << it->max_value << "]";
         return msg.str();
       }
+      // a switch or a count takes whole numbers only
+      if (it->whole_number && std::floor(v) != v) {
+        std::ostringstream msg;
+        msg << "parameter '" << key << "' = " << v << " must be a whole number in ["
+            << it->min_value << ", " << it->max_value << "]";
+        return msg.str();
+      }
     }
   }
   return "";

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "kinematics/machine.hpp"
+#include "scenario/schema.hpp"
 #include "scenario/yaml_reader.hpp"
 #include "toolpath/gcode.hpp"
 #include "toolpath/hatching.hpp"
@@ -27,15 +28,14 @@ namespace fs = std::filesystem;
 const std::vector<std::string> kToolpathKinds{"segments", "polylines", "gcode", "random_segments",
                                               "surface"};
 // the paper's stage (Thompson & Yoon) when `limits:` is absent
-constexpr double kDefaultVMax_mm_s = 4.0;
-constexpr double kDefaultAMax_mm_s2 = 30.0;
+constexpr double kDefaultVMax_mm_s = kDefaultTcpVMax_mm_s;
+constexpr double kDefaultAMax_mm_s2 = kDefaultTcpAMax_mm_s2;
 // a print speed may exceed an axis limit by this relative amount (rounding)
 constexpr double kSpeedTolerance = 1e-9;
-constexpr int kMinImageSize = 16;
-constexpr int kMaxImageSize = 2048;
-constexpr long long kMaxRandomSegments = 100000;
 // the most grid points a surface toolpath may project, over all its layers
 constexpr double kMaxSurfaceGridPoints = 2e7;
+// print segments over speed listed before the rest are counted
+constexpr std::size_t kMaxSpeedProblems = 20;
 // a surface toolpath's path problems listed before the rest are counted
 constexpr std::size_t kMaxSurfacePathProblems = 5;
 // a surface toolpath starts and ends this far above the part's highest point (and its layers)
@@ -62,6 +62,24 @@ std::string format_speed(double value) {
   out.precision(4);
   out << value;
   return out.str();
+}
+
+// the accepted range of a key in the schema's tables (scenario/schema.cpp)
+const ValueRange& range_of(const std::string& section, const std::string& key) {
+  return schema_section(section).key(key).range;
+}
+
+// the keys a section allows, from the same tables
+std::vector<std::string> keys_of(const std::string& section) {
+  return schema_section(section).key_names();
+}
+
+// a whole-number key's bounds
+long long min_of(const std::string& section, const std::string& key) {
+  return static_cast<long long>(range_of(section, key).min);
+}
+long long max_of(const std::string& section, const std::string& key) {
+  return static_cast<long long>(range_of(section, key).max);
 }
 
 // where a print path came from, so its problems name the right file, line and key
@@ -94,7 +112,10 @@ class Loader {
   void read_name(const Field& field);
   void read_machine(const Field& field);
   void read_limits(const Field& field);
-  void read_axis_limits(const MapView& view, AxisLimits& axis);
+  // false when v_max was given but unusable (speed checks on that axis are skipped)
+  bool read_axis_limits(const MapView& view, const std::string& section, AxisLimits& axis);
+  // the machine named, its joint limits applied, and its TCP limits per move
+  void prepare_machine();
   void read_process(const Field& field);
   void read_toolpath(const Field* field);
   void read_segments(const Field& field, const std::optional<double>& default_speed);
@@ -110,6 +131,8 @@ class Loader {
   void read_order(const Field& field);
   bool read_order_name(const Field& field, OrderSpec& order);
   void read_planners(const Field& field);
+  // the TCP limits over the toolpath's box (the machine's joint limits mapped), else the user's
+  MachineLimits limits_in_force() const;
   void read_sim(const Field& field);
   void read_outputs(const Field& field);
   // a path as written, resolved against the scenario file's directory
@@ -120,8 +143,14 @@ class Loader {
   ProblemList problems_;
   Scenario scenario_;
   fs::path relative_dir_;
-  bool limits_ok_ = true;       // speed feasibility is checked only against valid limits
-  bool speed_missing_ = false;  // reported once, not per path
+  // per TCP axis: its v_max is usable, so print speeds are checked against it
+  std::array<bool, 3> axis_v_max_known_{true, true, true};
+  bool joint_limits_bad_ = false;  // `limits.joint` given but unusable
+  // the machine named (when known) and its TCP limits per move, for the speed and reach checks
+  std::unique_ptr<Machine> machine_;
+  std::optional<TcpLimits> tcp_limits_;
+  std::size_t speed_problems_ = 0;  // print segments over speed, listed up to a count
+  bool speed_missing_ = false;      // reported once, not per path
 };
 
 Scenario Loader::load() {
@@ -129,14 +158,12 @@ Scenario Loader::load() {
   if (!read_document(root)) throw InputError(problems_.problems());
 
   // the top level: every key optional except the toolpath
-  const MapView top(Field{root, "", 1, 1},
-                    {"name", "machine", "limits", "process", "toolpath", "arm", "order", "planners",
-                     "sim", "outputs"},
-                    problems_);
+  const MapView top(Field{root, "", 1, 1}, keys_of(""), problems_);
   if (top.is_map()) {
     if (const Field* f = top.find("name")) read_name(*f);
     if (const Field* f = top.find("machine")) read_machine(*f);
     if (const Field* f = top.find("limits")) read_limits(*f);
+    prepare_machine();
     if (const Field* f = top.find("process")) read_process(*f);
     read_toolpath(top.find("toolpath"));
     if (const Field* f = top.find("arm")) read_arm(*f);
@@ -149,6 +176,16 @@ Scenario Loader::load() {
   if (scenario_.arm && scenario_.machine != "arm6")
     problems_.add(scenario_.arm_line, "arm",
                   "applies to machine arm6 (a 6-DOF arm), not to " + scenario_.machine);
+  if (speed_problems_ > kMaxSpeedProblems)
+    problems_.add(scenario_.toolpath_line, "toolpath",
+                  "... and " + std::to_string(speed_problems_ - kMaxSpeedProblems) +
+                      " more print segments above the speed limits (the first " +
+                      std::to_string(kMaxSpeedProblems) + " are listed)");
+  // what the machine makes of the paths that were read: every pose within its travel or
+  // workspace (the arm's reach depends on the roll its posture chooses: prepare_job)
+  if (machine_ && scenario_.machine != "arm6")
+    for (Problem& problem : unreachable_points(scenario_, *machine_))
+      problems_.add_problem(std::move(problem));
   if (problems_.empty()) return scenario_;
 
   // scenario-file problems in line order, then those of imported files
@@ -269,102 +306,128 @@ void Loader::read_machine(const Field& field) {
   }
 }
 
-void Loader::read_axis_limits(const MapView& view, AxisLimits& axis) {
-  if (const Field* f = view.find("v_max"))
-    axis.v_max_mm_s = read_number(*f, problems_, Range::positive()).value_or(axis.v_max_mm_s);
+bool Loader::read_axis_limits(const MapView& view, const std::string& section, AxisLimits& axis) {
+  bool v_max_ok = true;
+  if (const Field* f = view.find("v_max")) {
+    const std::optional<double> v_max = read_number(*f, problems_, range_of(section, "v_max"));
+    v_max_ok = v_max.has_value();
+    axis.v_max_mm_s = v_max.value_or(axis.v_max_mm_s);
+  }
   if (const Field* f = view.find("a_max"))
-    axis.a_max_mm_s2 = read_number(*f, problems_, Range::positive()).value_or(axis.a_max_mm_s2);
+    axis.a_max_mm_s2 =
+        read_number(*f, problems_, range_of(section, "a_max")).value_or(axis.a_max_mm_s2);
   if (const Field* f = view.find("j_max"))
-    axis.j_max_mm_s3 = read_number(*f, problems_, Range::non_negative()).value_or(axis.j_max_mm_s3);
+    axis.j_max_mm_s3 =
+        read_number(*f, problems_, range_of(section, "j_max")).value_or(axis.j_max_mm_s3);
+  return v_max_ok;
 }
 
 void Loader::read_limits(const Field& field) {
-  const std::size_t problems_before = problems_.size();
-  const std::vector<std::string> axis_keys{"v_max", "a_max", "j_max"};
-  const MapView view(field, {"v_max", "a_max", "j_max", "x", "y", "z", "joint"}, problems_);
+  const MapView view(field, keys_of("limits"), problems_);
   if (!view.is_map()) {
-    limits_ok_ = false;
+    axis_v_max_known_.fill(false);
     return;
   }
-  // common values, then per-axis overrides
+  // common values, then per-axis overrides; an axis whose v_max is unusable is left out of
+  // the speed checks, the others are still checked
   AxisLimits common{kDefaultVMax_mm_s, kDefaultAMax_mm_s2, 0.0};
-  read_axis_limits(view, common);
+  const bool common_v_max_ok = read_axis_limits(view, "limits", common);
   static const char* kAxisNames[3] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
     AxisLimits axis = common;
+    bool v_max_ok = common_v_max_ok;
     if (const Field* f = view.find(kAxisNames[i])) {
-      const MapView axis_view(*f, axis_keys, problems_);
-      if (axis_view.is_map()) read_axis_limits(axis_view, axis);
+      const MapView axis_view(*f, keys_of("limits.x"), problems_);
+      if (axis_view.is_map()) {
+        const bool own_v_max = axis_view.has("v_max");
+        const bool read_ok = read_axis_limits(axis_view, "limits.x", axis);
+        v_max_ok = own_v_max ? read_ok : common_v_max_ok;
+      }
     }
     scenario_.limits.axes[i] = axis;
+    axis_v_max_known_[i] = v_max_ok;
   }
   // joint (carriage) limits: no defaults, v_max and a_max are required
   if (const Field* f = view.find("joint")) {
-    const MapView joint_view(*f, axis_keys, problems_);
+    const MapView joint_view(*f, keys_of("limits.joint"), problems_);
     if (joint_view.is_map()) {
+      const std::size_t problems_before = problems_.size();
       AxisLimits joint{0.0, 0.0, 0.0};
       for (const char* required : {"v_max", "a_max"})
         if (!joint_view.has(required))
           problems_.add(
               f->key_line, f->key,
               std::string("missing ") + required + " (joint limits need v_max and a_max)");
-      read_axis_limits(joint_view, joint);
-      scenario_.has_joint_limits = true;
-      scenario_.joint_limits = joint;
+      read_axis_limits(joint_view, "limits.joint", joint);
       scenario_.joint_limits_line = f->key_line;
+      // joint limits that did not read are not applied (the machine's own stay)
+      if (problems_.size() == problems_before) {
+        scenario_.has_joint_limits = true;
+        scenario_.joint_limits = joint;
+      } else {
+        joint_limits_bad_ = true;
+      }
     }
   }
-  limits_ok_ = problems_.size() == problems_before;
   // the same rules the planners apply (MachineLimits::validate)
-  if (limits_ok_) {
-    const std::string problem = scenario_.limits.validate();
-    if (!problem.empty()) {
-      problems_.add(field.key_line, field.key, problem);
-      limits_ok_ = false;
-    }
+  const std::string problem = scenario_.limits.validate();
+  if (!problem.empty()) {
+    problems_.add(field.key_line, field.key, problem);
+    axis_v_max_known_.fill(false);
   }
 }
 
+void Loader::prepare_machine() {
+  machine_ = make_machine(scenario_.machine);
+  if (!machine_) return;
+  // joint limits the machine cannot honour (e.g. a jerk limit on the delta's carriages)
+  if (scenario_.has_joint_limits) {
+    const std::string problem = machine_->set_joint_limits(scenario_.joint_limits);
+    if (!problem.empty()) {
+      problems_.add(scenario_.joint_limits_line, "limits.joint", problem);
+      return;
+    }
+  }
+  // the arm's limits depend on its posture (chosen after loading): the user's TCP limits here
+  if (scenario_.machine == "arm6" || joint_limits_bad_) return;
+  if (!scenario_.limits.validate().empty()) return;
+  tcp_limits_ = machine_->tcp_limits(scenario_.limits);
+}
+
 void Loader::read_process(const Field& field) {
-  const std::vector<std::string> aerosol_only{"flow_mm3_s", "sigma_mm", "shutter_time_s"};
-  const std::vector<std::string> extrusion_only{"bead_width_mm", "layer_height_mm", "tau_s"};
-  const MapView view(field,
-                     {"type", "flow_mm3_s", "sigma_mm", "line_width_mm", "shutter_time_s",
-                      "bead_width_mm", "layer_height_mm", "tau_s"},
-                     problems_);
+  const SchemaSection& section = schema_section("process");
+  const MapView view(field, section.key_names(), problems_);
   if (!view.is_map()) return;
   ProcessSpec& process = scenario_.process;
   bool type_known = true;
   if (const Field* f = view.find("type")) {
+    const std::vector<std::string>& types = section.key("type").choices;
     const std::optional<std::string> type = read_string(*f, problems_);
-    if (type && *type != "aerosol" && *type != "extrusion")
+    type_known = type && contains(types, *type);
+    if (type && !type_known)
       problems_.add(f->line, f->key,
-                    "unknown process type '" + *type + "' (expected aerosol or extrusion)");
-    type_known = type && (*type == "aerosol" || *type == "extrusion");
+                    "unknown process type '" + *type + "' (expected " + join(types, " or ") + ")");
     if (type_known) process.type = *type;
   }
   // a parameter of the other process type is a mistake, not something to ignore
-  const auto read = [&](const std::string& key, const Range& range, double& target) {
+  const auto read = [&](const std::string& key, double& target) {
     const Field* f = view.find(key);
     if (!f) return;
-    const bool wrong_type =
-        type_known && ((process.type == "aerosol" && contains(extrusion_only, key)) ||
-                       (process.type == "extrusion" && contains(aerosol_only, key)));
-    if (wrong_type) {
-      const std::string other = process.type == "aerosol" ? "extrusion" : "aerosol";
+    const SchemaKey& declared = section.key(key);
+    if (type_known && !declared.applies_to.empty() && declared.applies_to != process.type) {
       problems_.add(f->line, f->key,
-                    "applies to " + other + ", not to process type " + process.type);
+                    "applies to " + declared.applies_to + ", not to process type " + process.type);
       return;
     }
-    target = read_number(*f, problems_, range).value_or(target);
+    target = read_number(*f, problems_, declared.range).value_or(target);
   };
-  read("flow_mm3_s", Range::non_negative(), process.flow_mm3_s);
-  read("sigma_mm", Range::positive(), process.sigma_mm);
-  read("line_width_mm", Range::non_negative(), process.line_width_mm);
-  read("shutter_time_s", Range::positive(), process.shutter_time_s);
-  read("bead_width_mm", Range::positive(), process.bead_width_mm);
-  read("layer_height_mm", Range::positive(), process.layer_height_mm);
-  read("tau_s", Range::positive(), process.tau_s);
+  read("flow_mm3_s", process.flow_mm3_s);
+  read("sigma_mm", process.sigma_mm);
+  read("line_width_mm", process.line_width_mm);
+  read("shutter_time_s", process.shutter_time_s);
+  read("bead_width_mm", process.bead_width_mm);
+  read("layer_height_mm", process.layer_height_mm);
+  read("tau_s", process.tau_s);
 }
 
 void Loader::read_toolpath(const Field* field) {
@@ -373,24 +436,26 @@ void Loader::read_toolpath(const Field* field) {
                   "missing: give the print paths, e.g. toolpath: {speed: 3, segments: [...]}");
     return;
   }
-  const MapView view(*field,
-                     {"speed", "start", "end", "offset", "segments", "polylines", "gcode",
-                      "random_segments", "surface"},
-                     problems_);
+  const MapView view(*field, keys_of("toolpath"), problems_);
   if (!view.is_map()) return;
   Toolpath& toolpath = scenario_.toolpath;
+  scenario_.toolpath_line = field->key_line;
 
   // default print speed, start and end (end defaults to start)
   std::optional<double> default_speed;
   if (const Field* f = view.find("speed")) {
-    default_speed = read_number(*f, problems_, Range::positive());
+    default_speed = read_number(*f, problems_, range_of("toolpath", "speed"));
     speed_missing_ = !default_speed;  // already reported: do not repeat per path
   }
-  if (const Field* f = view.find("start"))
+  if (const Field* f = view.find("start")) {
     toolpath.start_mm = read_point(*f, problems_).value_or(Vec3::Zero());
+    scenario_.start_line = f->line;
+  }
   toolpath.end_mm = toolpath.start_mm;
-  if (const Field* f = view.find("end"))
+  if (const Field* f = view.find("end")) {
     toolpath.end_mm = read_point(*f, problems_).value_or(toolpath.start_mm);
+    scenario_.end_line = f->line;
+  }
 
   // exactly one kind of print paths (segments, polylines, gcode, random_segments, surface)
   std::vector<const Field*> kinds;
@@ -490,7 +555,7 @@ void Loader::read_segments(const Field& field, const std::optional<double>& defa
     path.points = *points;
     path.speed_mm_s = default_speed.value_or(0.0);
     path.source_index = static_cast<int>(i);
-    check_path(path, PathOrigin{problems_.file(), item.key, {item.line, item.line}, false});
+    check_path(path, PathOrigin{problems_.file(), item.key, lines, false});
     scenario_.toolpath.paths.push_back(std::move(path));
   }
 }
@@ -508,10 +573,10 @@ void Loader::read_polylines(const Field& field, const std::optional<double>& def
     std::optional<double> speed = default_speed;
     bool speed_bad = false;
     if (item.node.IsMap()) {
-      const MapView view(item, {"points", "speed"}, problems_);
+      const MapView view(item, keys_of("toolpath.polylines[]"), problems_);
       const Field* points = view.find("points");
       if (const Field* f = view.find("speed")) {
-        speed = read_number(*f, problems_, Range::positive());
+        speed = read_number(*f, problems_, range_of("toolpath.polylines[]", "speed"));
         speed_bad = !speed;
       }
       if (!points) {
@@ -572,12 +637,14 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
 void Loader::read_random_segments(const Field& field, const std::optional<double>& default_speed,
                                   bool start_given, bool end_given) {
   const std::size_t problems_before = problems_.size();
-  const MapView view(field, {"n", "bed", "length", "seed", "speed"}, problems_);
+  const std::string section = "toolpath.random_segments";
+  const MapView view(field, keys_of(section), problems_);
   if (!view.is_map()) return;
   RandomSegmentsSpec spec;
   if (const Field* f = view.find("n"))
     spec.count =
-        static_cast<int>(read_integer(*f, problems_, 1, kMaxRandomSegments).value_or(spec.count));
+        static_cast<int>(read_integer(*f, problems_, min_of(section, "n"), max_of(section, "n"))
+                             .value_or(spec.count));
   if (const Field* f = view.find("bed")) {
     if (const auto bed = read_numbers(*f, problems_, 2, Range::positive())) {
       spec.bed_x_mm = (*bed)[0];
@@ -598,7 +665,7 @@ void Loader::read_random_segments(const Field& field, const std::optional<double
   std::optional<double> speed = default_speed;
   bool speed_bad = false;
   if (const Field* f = view.find("speed")) {
-    speed = read_number(*f, problems_, Range::positive());
+    speed = read_number(*f, problems_, range_of(section, "speed"));
     speed_bad = !speed;
   }
   if (!speed && !speed_bad && !speed_missing_)
@@ -635,10 +702,8 @@ void Loader::read_random_segments(const Field& field, const std::optional<double
 void Loader::read_surface(const Field& field, const std::optional<double>& default_speed,
                           bool start_given, bool end_given) {
   const std::size_t problems_before = problems_.size();
-  const MapView view(field,
-                     {"file", "units", "offset", "rotation", "hatch_mm", "angles", "layers",
-                      "layer_height_mm", "alpha", "layer_offset", "speed"},
-                     problems_);
+  const std::string section = "toolpath.surface";
+  const MapView view(field, keys_of(section), problems_);
   if (!view.is_map()) return;
   auto surface = std::make_shared<SurfaceToolpath>();
   surface->line = field.key_line;
@@ -681,7 +746,7 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
   // the hatch (Algorithm 1)
   if (const Field* f = view.find("hatch_mm"))
     surface->hatch_mm =
-        read_number(*f, problems_, Range{0.01, true, 100.0, true}).value_or(surface->hatch_mm);
+        read_number(*f, problems_, range_of(section, "hatch_mm")).value_or(surface->hatch_mm);
   if (const Field* f = view.find("angles")) {
     if (expect_list(*f, problems_, "a list of hatch angles in degrees, e.g. [0, 90]")) {
       if (f->node.size() == 0) problems_.add(f->line, f->key, "is empty: give at least one angle");
@@ -693,12 +758,15 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     }
   }
   if (const Field* f = view.find("layers"))
-    surface->layers = static_cast<int>(read_integer(*f, problems_, 1, 1000).value_or(1));
+    surface->layers = static_cast<int>(
+        read_integer(*f, problems_, min_of(section, "layers"), max_of(section, "layers"))
+            .value_or(surface->layers));
   if (const Field* f = view.find("layer_height_mm"))
-    surface->layer_height_mm =
-        read_number(*f, problems_, Range::positive()).value_or(surface->layer_height_mm);
+    surface->layer_height_mm = read_number(*f, problems_, range_of(section, "layer_height_mm"))
+                                   .value_or(surface->layer_height_mm);
   if (const Field* f = view.find("alpha"))
-    surface->alpha = read_number(*f, problems_, Range{0.0, true, 1.0, true}).value_or(0.5);
+    surface->alpha =
+        read_number(*f, problems_, range_of(section, "alpha")).value_or(surface->alpha);
   if (const Field* f = view.find("layer_offset")) {
     const std::optional<std::string> mode = read_string(*f, problems_);
     if (mode && (*mode == "normal" || *mode == "z"))
@@ -710,7 +778,8 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
                         "the paper)");
   }
   std::optional<double> speed = default_speed;
-  if (const Field* f = view.find("speed")) speed = read_number(*f, problems_, Range::positive());
+  if (const Field* f = view.find("speed"))
+    speed = read_number(*f, problems_, range_of(section, "speed"));
   if (!speed && !speed_missing_ && !view.has("speed")) {
     problems_.add(field.key_line, field.key, "no print speed: give toolpath.speed or speed: here");
     speed_missing_ = true;
@@ -808,6 +877,12 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
 }
 
 void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
+  // remembered for the checks after loading (reach) and for the job's messages
+  if (path.source_index >= 0) {
+    const std::size_t index = static_cast<std::size_t>(path.source_index);
+    if (scenario_.path_sources.size() <= index) scenario_.path_sources.resize(index + 1);
+    scenario_.path_sources[index] = PathSource{origin.file, origin.key, origin.point_lines};
+  }
   for (std::size_t k = 0; k + 1 < path.points.size(); ++k) {
     const std::string segment = origin.name_segments
                                     ? "segment " + std::to_string(k) + " (points " +
@@ -815,49 +890,58 @@ void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
                                     : "segment";
     const Vec3 step = path.points[k + 1] - path.points[k];
     const double length_mm = step.norm();
-    const int line = origin.point_lines.at(k + 1);
+    // a segment's problem at the line of its end point, a whole path's (a `segments` entry, a
+    // hatch line) at its first
+    const int line = origin.point_lines.at(origin.name_segments ? k + 1 : 0);
     // consecutive points must differ
     if (length_mm <= kJoinTolerance_mm) {
       problems_.add_problem(Problem{origin.file, line, origin.key,
                                     segment + " has zero length: both points are " +
                                         format_point(path.points[k]) +
                                         " (consecutive points must differ)"});
-      return;
+      continue;
     }
-    if (!limits_ok_ || path.speed_mm_s <= 0.0) continue;
-    // every axis must reach its share of the print speed
+    if (path.speed_mm_s <= 0.0) continue;
+    // every axis must reach its share of the print speed, under the limits over this segment
+    // (the machine's joint limits mapped to it, as the planners get them)
+    const MachineLimits limits =
+        tcp_limits_ ? tcp_limits_->along(path.points[k], path.points[k + 1]) : scenario_.limits;
     static const char* kAxisNames[3] = {"x", "y", "z"};
     int worst_axis = -1;
     double worst_ratio = 1.0 + kSpeedTolerance;
     for (int axis = 0; axis < 3; ++axis) {
+      if (!axis_v_max_known_[axis]) continue;
       const double needed_mm_s = path.speed_mm_s * std::abs(step[axis]) / length_mm;
-      const double ratio = needed_mm_s / scenario_.limits.axes[axis].v_max_mm_s;
+      const double ratio = needed_mm_s / limits.axes[axis].v_max_mm_s;
       if (ratio > worst_ratio) {
         worst_ratio = ratio;
         worst_axis = axis;
       }
     }
-    if (worst_axis >= 0) {
-      const double needed_mm_s = path.speed_mm_s * std::abs(step[worst_axis]) / length_mm;
-      problems_.add_problem(Problem{origin.file, line, origin.key,
-                                    (origin.name_segments ? segment + ": " : std::string()) +
-                                        "print speed " + format_speed(path.speed_mm_s) +
-                                        " mm/s needs " + format_speed(needed_mm_s) + " mm/s on " +
-                                        kAxisNames[worst_axis] + ", above limits v_max " +
-                                        format_speed(scenario_.limits.axes[worst_axis].v_max_mm_s) +
-                                        " (lower the speed or raise the limit)"});
-      return;  // one problem per path is enough
-    }
+    if (worst_axis < 0) continue;
+    // every segment over speed is reported, up to a count (a G-code file may have thousands)
+    if (++speed_problems_ > kMaxSpeedProblems) continue;
+    const double needed_mm_s = path.speed_mm_s * std::abs(step[worst_axis]) / length_mm;
+    const double requested_mm_s = scenario_.limits.axes[worst_axis].v_max_mm_s;
+    const double mapped_mm_s = limits.axes[worst_axis].v_max_mm_s;
+    const std::string limit_text =
+        mapped_mm_s < requested_mm_s * (1.0 - kSpeedTolerance)
+            ? "above v_max " + format_speed(mapped_mm_s) + " here (" + scenario_.machine +
+                  "'s joint limits mapped over this segment; limits v_max is " +
+                  format_speed(requested_mm_s) + ")"
+            : "above limits v_max " + format_speed(requested_mm_s);
+    problems_.add_problem(Problem{origin.file, line, origin.key,
+                                  (origin.name_segments ? segment + ": " : std::string()) +
+                                      "print speed " + format_speed(path.speed_mm_s) +
+                                      " mm/s needs " + format_speed(needed_mm_s) + " mm/s on " +
+                                      kAxisNames[worst_axis] + ", " + limit_text +
+                                      " (lower the speed or raise the limit)"});
   }
 }
 
 void Loader::read_arm(const Field& field) {
   scenario_.arm_line = field.key_line;
-  const MapView view(field,
-                     {"roll", "fixed_roll_deg", "branch", "roll_step_deg", "sample_spacing_mm",
-                      "min_joint_margin_deg", "min_wrist_alignment", "min_wrist_offset_mm",
-                      "min_manipulability", "min_clearance_mm", "max_joint_step_deg"},
-                     problems_);
+  const MapView view(field, keys_of("arm"), problems_);
   if (!view.is_map()) return;
   ArmPostureSettings arm;
   if (const Field* f = view.find("roll")) {
@@ -870,24 +954,26 @@ void Loader::read_arm(const Field& field) {
                         "' (expected optimized: chosen point by point, or fixed: one roll)");
   }
   if (const Field* f = view.find("fixed_roll_deg")) {
-    arm.fixed_roll_deg = read_number(*f, problems_, Range{-360.0, true, 360.0, true});
+    arm.fixed_roll_deg = read_number(*f, problems_, range_of("arm", "fixed_roll_deg"));
     if (arm.optimize_roll && arm.fixed_roll_deg)
       problems_.add(f->line, f->key, "applies to roll: fixed only");
   }
   if (const Field* f = view.find("branch"))
-    arm.branch = static_cast<int>(read_integer(*f, problems_, -1, 7).value_or(-1));
-  const auto read = [&](const char* key, const Range& range, double& target) {
+    arm.branch = static_cast<int>(
+        read_integer(*f, problems_, min_of("arm", "branch"), max_of("arm", "branch"))
+            .value_or(arm.branch));
+  const auto read = [&](const char* key, double& target) {
     if (const Field* f = view.find(key))
-      target = read_number(*f, problems_, range).value_or(target);
+      target = read_number(*f, problems_, range_of("arm", key)).value_or(target);
   };
-  read("roll_step_deg", Range{1.0, true, 90.0, true}, arm.roll_step_deg);
-  read("sample_spacing_mm", Range::positive(), arm.sample_spacing_mm);
-  read("min_joint_margin_deg", Range{0.0, true, 90.0, true}, arm.min_joint_margin_deg);
-  read("min_wrist_alignment", Range{0.0, true, 1.0, false}, arm.min_wrist_alignment);
-  read("min_wrist_offset_mm", Range::non_negative(), arm.min_wrist_offset_mm);
-  read("min_manipulability", Range::non_negative(), arm.min_manipulability);
-  read("min_clearance_mm", Range{-100.0, true, 100.0, true}, arm.min_clearance_mm);
-  read("max_joint_step_deg", Range{0.0, false, 180.0, true}, arm.max_joint_step_deg);
+  read("roll_step_deg", arm.roll_step_deg);
+  read("sample_spacing_mm", arm.sample_spacing_mm);
+  read("min_joint_margin_deg", arm.min_joint_margin_deg);
+  read("min_wrist_alignment", arm.min_wrist_alignment);
+  read("min_wrist_offset_mm", arm.min_wrist_offset_mm);
+  read("min_manipulability", arm.min_manipulability);
+  read("min_clearance_mm", arm.min_clearance_mm);
+  read("max_joint_step_deg", arm.max_joint_step_deg);
   const std::string problem = arm.validate();
   if (!problem.empty()) problems_.add(field.key_line, field.key, problem);
   scenario_.arm = arm;
@@ -932,7 +1018,7 @@ void Loader::read_order(const Field& field) {
                       describe(field.node));
     return;
   }
-  const MapView view(field, {"method", "refine", "cost_model", "seed"}, problems_);
+  const MapView view(field, keys_of("order"), problems_);
   bool method_refines = false;
   if (const Field* f = view.find("method")) {
     if (read_order_name(*f, order)) method_refines = !order.refine.empty();
@@ -960,6 +1046,13 @@ void Loader::read_order(const Field& field) {
   }
   if (const Field* f = view.find("seed"))
     order.seed = read_seed(*f, problems_).value_or(order.seed);
+}
+
+MachineLimits Loader::limits_in_force() const {
+  if (!tcp_limits_ || scenario_.toolpath.paths.empty()) return scenario_.limits;
+  Vec3 lo, hi;
+  scenario_.toolpath.bounds(lo, hi);
+  return tcp_limits_->over(lo, hi);
 }
 
 void Loader::read_planners(const Field& field) {
@@ -1007,8 +1100,8 @@ void Loader::read_planners(const Field& field) {
       problems_.add(item.line, item.key, name_problem);
       continue;
     }
-    // a jerk limit the planner would ignore
-    const std::string limits_problem = check_planner_limits(spec, scenario_.limits);
+    // a jerk limit the planner would ignore (the user's, or the joints' mapped to the TCP)
+    const std::string limits_problem = check_planner_limits(spec, limits_in_force());
     if (!limits_problem.empty()) problems_.add(item.line, item.key, limits_problem);
     for (const Field* parameter : parameter_fields) {
       const std::string key = parameter->key.substr(parameter->key.rfind('.') + 1);
@@ -1083,45 +1176,45 @@ void Loader::read_planners(const Field& field) {
 }
 
 void Loader::read_sim(const Field& field) {
-  const MapView view(field, {"timestep_s", "control_period_s", "cell_mm", "kp_scale", "settle_s"},
-                     problems_);
+  const MapView view(field, keys_of("sim"), problems_);
   SimSpec& sim = scenario_.sim;
-  if (const Field* f = view.find("timestep_s"))
-    sim.timestep_s =
-        read_number(*f, problems_, Range{0.0, false, 0.01, true}).value_or(sim.timestep_s);
+  const auto read = [&](const char* key, double& target) {
+    if (const Field* f = view.find(key))
+      target = read_number(*f, problems_, range_of("sim", key)).value_or(target);
+  };
+  read("timestep_s", sim.timestep_s);
   // the servo update period: a whole number of physics steps, by default the one nearest
   // to 1 ms
   sim.control_period_s = sim.timestep_s * std::max(1.0, std::round(0.001 / sim.timestep_s));
   if (const Field* f = view.find("control_period_s")) {
-    if (auto period = read_number(*f, problems_, Range{0.0, false, 0.01, true})) {
+    if (auto period = read_number(*f, problems_, range_of("sim", "control_period_s"))) {
       const double steps = *period / sim.timestep_s;
       if (std::abs(steps - std::round(steps)) > 1e-9 * steps || std::round(steps) < 1)
-        problems_.add(f->line, f->key,
-                      "must be a whole multiple of sim.timestep_s (" +
-                          std::to_string(sim.timestep_s) + " s)");
+        problems_.add(
+            f->line, f->key,
+            "must be a whole multiple of sim.timestep_s (" + format_number(sim.timestep_s) + " s)");
       else
         sim.control_period_s = *period;
     }
   }
-  if (const Field* f = view.find("cell_mm"))
-    sim.cell_mm = read_number(*f, problems_, Range::non_negative()).value_or(sim.cell_mm);
-  if (const Field* f = view.find("kp_scale"))
-    sim.kp_scale = read_number(*f, problems_, Range::positive()).value_or(sim.kp_scale);
-  if (const Field* f = view.find("settle_s"))
-    sim.settle_s = read_number(*f, problems_, Range::non_negative()).value_or(sim.settle_s);
+  read("cell_mm", sim.cell_mm);
+  read("kp_scale", sim.kp_scale);
+  read("settle_s", sim.settle_s);
 }
 
 void Loader::read_outputs(const Field& field) {
-  const MapView view(field, {"render", "image_width", "image_height"}, problems_);
+  const MapView view(field, keys_of("outputs"), problems_);
   OutputSpec& outputs = scenario_.outputs;
   if (const Field* f = view.find("render"))
     outputs.render = read_bool(*f, problems_).value_or(outputs.render);
-  if (const Field* f = view.find("image_width"))
-    outputs.image_width = static_cast<int>(
-        read_integer(*f, problems_, kMinImageSize, kMaxImageSize).value_or(outputs.image_width));
-  if (const Field* f = view.find("image_height"))
-    outputs.image_height = static_cast<int>(
-        read_integer(*f, problems_, kMinImageSize, kMaxImageSize).value_or(outputs.image_height));
+  const auto read = [&](const char* key, int& target) {
+    if (const Field* f = view.find(key))
+      target = static_cast<int>(
+          read_integer(*f, problems_, min_of("outputs", key), max_of("outputs", key))
+              .value_or(target));
+  };
+  read("image_width", outputs.image_width);
+  read("image_height", outputs.image_height);
 }
 
 }  // namespace
@@ -1135,6 +1228,76 @@ std::string SurfaceToolpath::describe_point(int source_index, size_t point, size
   const int along = i < origin.point_index.size() ? origin.point_index[i] : static_cast<int>(i);
   return "layer " + std::to_string(origin.layer) + ", line " + std::to_string(origin.line) +
          ", point " + std::to_string(along);
+}
+
+Problem path_point_problem(const Scenario& scenario, int source_index, std::size_t point,
+                           const std::string& message) {
+  // a hatched surface: by layer, line and point, at the `surface:` key
+  if (scenario.surface) {
+    const PrintPath* given = nullptr;
+    for (const PrintPath& path : scenario.toolpath.paths)
+      if (path.source_index == source_index) given = &path;
+    const std::size_t count = given ? given->points.size() : point + 1;
+    return Problem{
+        scenario.file, scenario.surface->line, "toolpath.surface",
+        scenario.surface->describe_point(source_index, point, count, false) + ": " + message};
+  }
+  // a path of the file (or of its G-code): its key and the point's line
+  if (source_index >= 0 && static_cast<std::size_t>(source_index) < scenario.path_sources.size()) {
+    const PathSource& source = scenario.path_sources[static_cast<std::size_t>(source_index)];
+    if (!source.key.empty()) {
+      const int line = point < source.point_lines.size() ? source.point_lines[point] : 0;
+      return Problem{source.file, line, source.key,
+                     "point " + std::to_string(point) + " " + message};
+    }
+  }
+  return Problem{
+      scenario.file, scenario.toolpath_line, "toolpath",
+      "path " + std::to_string(source_index) + ", point " + std::to_string(point) + " " + message};
+}
+
+std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine& machine,
+                                        std::size_t max_listed) {
+  std::vector<Problem> problems;
+  std::size_t unlisted = 0;
+  JointVector joints;
+  // "(x, y, z) mm is not reachable by M: why", or nothing when reachable
+  const auto unreachable = [&](const Pose& pose) -> std::optional<std::string> {
+    std::string why;
+    if (machine.inverse(pose, joints, &why)) return std::nullopt;
+    const Vec3& p = pose.position_mm;
+    return format_point(p) + " mm is not reachable by " + machine.name() + ": " + why;
+  };
+  const auto add = [&](Problem problem) {
+    if (problems.size() < max_listed)
+      problems.push_back(std::move(problem));
+    else
+      ++unlisted;
+  };
+  // start and end, at their keys (or the toolpath's line when they are defaults)
+  const Toolpath& toolpath = scenario.toolpath;
+  const int surface_line = scenario.surface ? scenario.surface->line : 0;
+  const auto end_line = [&](int given) {
+    return given > 0 ? given : surface_line > 0 ? surface_line : scenario.toolpath_line;
+  };
+  if (const auto why = unreachable(Pose(toolpath.start_mm)))
+    add(Problem{scenario.file, end_line(scenario.start_line), "toolpath.start",
+                (scenario.start_line > 0 ? "" : "(the default) ") + *why});
+  if (const auto why = unreachable(Pose(toolpath.end_mm)))
+    add(Problem{scenario.file, end_line(scenario.end_line), "toolpath.end",
+                (scenario.end_line > 0 ? "" : "(the default) ") + *why});
+  // every point of every path, where it was given
+  for (const PrintPath& path : toolpath.paths)
+    for (std::size_t i = 0; i < path.points.size(); ++i)
+      if (const auto why = unreachable(Pose(path.points[i], path.tool_axis(i))))
+        add(path_point_problem(scenario, path.source_index, i, *why));
+  if (unlisted > 0)
+    problems.push_back(
+        Problem{scenario.file, surface_line > 0 ? surface_line : scenario.toolpath_line,
+                scenario.surface ? "toolpath.surface" : "toolpath",
+                "... and " + std::to_string(unlisted) + " more unreachable points (the first " +
+                    std::to_string(max_listed) + " are listed)"});
+  return problems;
 }
 
 Scenario load_scenario(const std::string& path) {

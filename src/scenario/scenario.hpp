@@ -13,6 +13,7 @@
 #include "core/limits.hpp"
 #include "core/toolpath.hpp"
 #include "core/triangle_mesh.hpp"
+#include "kinematics/machine.hpp"
 #include "planners/ordering/sequencer.hpp"
 #include "planners/planner.hpp"
 #include "posture/arm_posture.hpp"
@@ -79,6 +80,15 @@ struct SurfaceToolpath {
                              bool reversed) const;
 };
 
+// Where a print path was given, for messages: the file (the scenario, or an imported G-code
+// file), the dotted key (`toolpath.segments[3]`, `toolpath.polylines[0]`, `toolpath.gcode`) and
+// each point's line in that file.
+struct PathSource {
+  std::string file;
+  std::string key;
+  std::vector<int> point_lines;
+};
+
 struct Scenario {
   std::string file;       // the scenario file as given
   std::string directory;  // its directory: relative paths resolve against it
@@ -95,6 +105,11 @@ struct Scenario {
   int joint_limits_line = 0;  // where `limits.joint` was given, for messages
   ProcessSpec process;
   Toolpath toolpath;
+  // per print path, by its PrintPath::source_index: where it was given
+  std::vector<PathSource> path_sources;
+  int toolpath_line = 0;  // the `toolpath:` key's line
+  int start_line = 0;     // `toolpath.start:` / `end:` lines; 0: not given (defaults)
+  int end_line = 0;
   // conformal work: the surface toolpath's settings and the part, placed in the work frame
   // (mm); null / empty for planar toolpaths
   std::shared_ptr<const SurfaceToolpath> surface;
@@ -111,12 +126,29 @@ struct Scenario {
   OutputSpec outputs;
 };
 
+// The problem `message` about point `point` (0-based, as given in the file) of the print path
+// with this source index, placed at that point's file, line and key (e.g.
+// "scenario.yaml:12: toolpath.segments[3]: point 1 (60, 0, 0) mm ..."); a surface
+// toolpath's points are named by layer, line and point.
+Problem path_point_problem(const Scenario& scenario, int source_index, std::size_t point,
+                           const std::string& message);
+
+// Every toolpath pose (start, end, each point) a machine that holds the nozzle as the paths
+// say cannot reach, as problems at the point's file, line and key; at most `max_listed`
+// listed, then one counting the rest. Not for the arm, whose reach depends on the roll its
+// posture chooses (posture/).
+std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine& machine,
+                                        std::size_t max_listed = 20);
+
 // Load and validate a scenario file. Throws InputError listing every problem
-// found ("file:line: key: what is wrong"), not only the first: problems of the scenario
-// file in line order (file = `path` as given, line 1-based, key a dotted path such as
-// `toolpath.segments[2]` or `limits.x.v_max`), then those of an imported G-code file.
-// Relative paths in the file (machine MJCF, gcode) resolve against its directory.
-// Full schema and defaults: src/scenario/SCHEMA.md.
+// found ("file:line: key: what is wrong"), not only the first: what the file says (types,
+// ranges, names: the tables of scenario/schema.hpp) and, on what could be read, what the
+// machine makes of it (joint limits it cannot honour, points out of its travel or
+// workspace, print speeds above its joint limits mapped to each segment, a planner that
+// ignores a jerk limit in force); problems of the scenario file in line order (file = `path` as
+// given, line 1-based, key a dotted path such as `toolpath.segments[2]` or `limits.x.v_max`), then
+// those of an imported G-code file. Relative paths in the file (machine MJCF, gcode) resolve
+// against its directory. Full schema and defaults: src/scenario/SCHEMA.md.
 Scenario load_scenario(const std::string& path);
 
 // For `depotwin validate`: every problem load_scenario would report, or an empty list

@@ -114,23 +114,6 @@ const Field* MapView::find(const std::string& key) const {
   return nullptr;
 }
 
-bool Range::contains(double value) const {
-  const bool above = min_inclusive ? value >= min : value > min;
-  const bool below = max_inclusive ? value <= max : value < max;
-  return above && below;
-}
-
-std::string Range::text() const {
-  const bool has_min = std::isfinite(min);
-  const bool has_max = std::isfinite(max);
-  if (has_min && has_max)
-    return std::string("in ") + (min_inclusive ? "[" : "(") + format_number(min) + ", " +
-           format_number(max) + (max_inclusive ? "]" : ")");
-  if (has_min) return std::string(min_inclusive ? ">= " : "> ") + format_number(min);
-  if (has_max) return std::string(max_inclusive ? "<= " : "< ") + format_number(max);
-  return "finite";
-}
-
 std::optional<double> read_number(const Field& field, ProblemList& problems, const Range& range) {
   const YAML::Node& node = field.node;
   if (!node.IsScalar()) {
@@ -253,12 +236,6 @@ std::optional<Vec3> read_point(const Field& field, ProblemList& problems) {
   }
   if (!ok) return std::nullopt;
   return point;
-}
-
-std::string format_number(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
 }
 
 }  // namespace depotwin::scenario_detail

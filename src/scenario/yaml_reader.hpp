@@ -13,6 +13,7 @@
 
 #include "core/error.hpp"
 #include "core/types.hpp"
+#include "scenario/schema.hpp"
 
 namespace depotwin::scenario_detail {
 
@@ -70,18 +71,8 @@ class MapView {
   std::vector<std::pair<std::string, Field>> entries_;
 };
 
-// an inclusive or exclusive numeric range, for "must be > 0" style messages
-struct Range {
-  double min = -std::numeric_limits<double>::infinity();
-  bool min_inclusive = true;
-  double max = std::numeric_limits<double>::infinity();
-  bool max_inclusive = true;
-
-  static Range positive() { return {0.0, false}; }
-  static Range non_negative() { return {0.0, true}; }
-  bool contains(double value) const;
-  std::string text() const;  // e.g. "> 0", "in (0, 0.01]"
-};
+// an inclusive or exclusive numeric range (the schema tables' type)
+using Range = ValueRange;
 
 // Typed reads: each reports its problem (wrong type, not finite, out of range) and
 // returns nothing, so the caller keeps its default and carries on.
@@ -100,7 +91,6 @@ std::optional<Vec3> read_point(const Field& field, ProblemList& problems);
 // a list (reports anything else); true when the field holds a list
 bool expect_list(const Field& field, ProblemList& problems, const std::string& what);
 
-// shortest text that prints a number the way a user wrote it (3, 0.25, 1e-05)
-std::string format_number(double value);
+using depotwin::format_number;
 
 }  // namespace depotwin::scenario_detail

@@ -301,6 +301,7 @@ TEST_F(ScenarioLoad, RandomSegmentsKeysAreParsed) {
   const std::string path = write("r.yaml", R"(
 toolpath:
   random_segments: {n: 6, bed: [100, 80], length: [10, 40], seed: 3, speed: 2}
+  offset: [-50, -40]
 limits: {v_max: 4, a_max: 30}
 )");
   try {

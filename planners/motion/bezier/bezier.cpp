@@ -506,15 +506,29 @@ MachineLimits path_limits(const PrintPath& path, const TcpLimits& limits, bool l
 
 std::vector<PlannerParameter> bezier_parameters() {
   return {
-      {"delta", 0.5, 1e-6, 100.0,
-       "fillet distance (mm): the blend starts and ends this far from the corner", false},
+      {"delta",
+       0.5,
+       1e-6,
+       100.0,
+       "fillet distance: the blend starts and ends this far from the corner",
+       false,
+       {},
+       "mm"},
       {"weight", 1.0, 0.01, 100.0,
        "rational weight of each corner (one value, or one per corner of the toolpath in order); "
        "larger pulls the blend towards the corner, 1 is the parabola",
        true},
-      {"period_s", 0.001, 1e-5, 0.1, "sample period T_s of the Taylor update (s)", false},
-      {"lead_in", 0.0, 0.0, 1.0,
-       "1: ramp up and down on extensions of the first and last line with material off", false},
+      {"period_s", 0.001, 1e-5, 0.1, "sample period T_s of the Taylor update of u", false, {}, "s"},
+      {"lead_in",
+       0.0,
+       0.0,
+       1.0,
+       "1: ramp up and down on extensions of the first and last line with material off; 0: on "
+       "the lines",
+       false,
+       {},
+       "",
+       true},
   };
 }
 

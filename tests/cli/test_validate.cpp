@@ -1,0 +1,65 @@
+// `depotwin validate`: every problem in one run, as `file:line: key: message`, exit 2; the arm's
+// posture problems at the dotted key and line of the point they name.
+#include <gtest/gtest.h>
+
+#include "pipeline/pipeline_test_util.hpp"
+
+namespace depotwin {
+namespace {
+
+using testing_support::depotwin;
+using testing_support::fresh_directory;
+using testing_support::write_text;
+
+// a parse error, two over-speed segments and an unreachable point, all in one run
+TEST(ValidateVerb, ListsLoaderAndMachineProblemsInOneRun) {
+  const std::string dir = fresh_directory("validate_all");
+  const std::string path = write_text(dir, "all.yaml", R"(limits: {v_max: 4, a_max: abc}
+toolpath:
+  speed: 5
+  polylines:
+    - - [0, 0]
+      - [10, 0]
+      - [13, 4]
+      - [70, 4]
+)");
+  const auto r = depotwin("validate " + path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  const std::string expected =
+      "error: " + path + ":1: limits.a_max: expected a number, got 'abc'\n" + "error: " + path +
+      ":6: toolpath.polylines[0]: segment 0 (points 0 and 1): print speed 5 mm/s needs 5 mm/s "
+      "on x, above limits v_max 4 (lower the speed or raise the limit)\n" +
+      "error: " + path +
+      ":8: toolpath.polylines[0]: segment 2 (points 2 and 3): print speed 5 mm/s needs 5 mm/s "
+      "on x, above limits v_max 4 (lower the speed or raise the limit)\n" +
+      "error: " + path +
+      ":8: toolpath.polylines[0]: point 3 (70, 4, 0) mm is not reachable by xy_stage: joint x "
+      "at -70 mm is outside its travel [-50, 50] mm (TCP x = 70 mm)\n";
+  EXPECT_EQ(r.output, expected);
+}
+
+// the arm: a segment out of reach for every roll is named by its key, line and point
+TEST(ValidateVerb, ArmPostureProblemsNameTheSegmentAndLine) {
+  const std::string dir = fresh_directory("validate_arm_segment");
+  const std::string path = write_text(dir, "arm.yaml", R"(machine: arm6
+limits: {v_max: 50, a_max: 500}
+process: {type: extrusion}
+toolpath:
+  speed: 5
+  start: [0, 0, 20]
+  segments:
+    - [[0, 0, 0], [10, 0, 0]]
+    - [[0, 10, 0],
+       [900, 10, 0]]
+planners: [conformal]
+)");
+  const auto r = depotwin("validate " + path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(path + ":10: toolpath.segments[1]: point 1 (900.000, 10.000, "),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("toolpath path"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace depotwin
