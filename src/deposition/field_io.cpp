@@ -71,21 +71,31 @@ double write_heightmap_png16(const HeightMap& map, const std::string& path, doub
 void write_heightmap_csv(const HeightMap& map, const std::string& path, double um_per_level) {
   check_map(map);
   std::ostringstream out;
-  out << "# depotwin thickness map, values in um\n"
+  out << "# depotwin thickness map: thickness in um; first column y_mm (the row's y), the "
+         "header's other cells x_mm (each column's x), both at the cell centres\n"
       << "# origin_x_mm=" << format_number(map.origin_x_mm)
       << " origin_y_mm=" << format_number(map.origin_y_mm)
       << " cell_mm=" << format_number(map.cell_mm) << " nx=" << map.nx << " ny=" << map.ny << "\n"
       << "# um_per_level=" << format_number(um_per_level)
       << " (scale of the 16-bit PNG: thickness_um = gray * um_per_level)\n"
       << "# origin = centre of the bottom-left cell; first data row = top row (y = origin_y_mm "
-         "+ (ny - 1) * cell_mm); columns along +x\n";
+         "+ (ny - 1) * cell_mm); columns along +x\n"
+      << "# pandas: pd.read_csv(path, comment='#', index_col='y_mm')\n";
+  // the header: y_mm, then every column's x (mm)
   char value[32];
+  out << "y_mm";
+  for (int ix = 0; ix < map.nx; ++ix) {
+    std::snprintf(value, sizeof(value), "%.9g", map.origin_x_mm + ix * map.cell_mm);
+    out << ',' << value;
+  }
+  out << '\n';
   for (int row = 0; row < map.ny; ++row) {
     const int iy = map.ny - 1 - row;
+    std::snprintf(value, sizeof(value), "%.9g", map.origin_y_mm + iy * map.cell_mm);
+    out << value;
     for (int ix = 0; ix < map.nx; ++ix) {
       std::snprintf(value, sizeof(value), "%.7g", static_cast<double>(map.at(ix, iy)));
-      if (ix > 0) out << ',';
-      out << value;
+      out << ',' << value;
     }
     out << '\n';
   }

@@ -6,7 +6,10 @@
 // PNG: gray = round(thickness_um / um_per_level), 0..65535, big-endian 16-bit samples,
 // zlib-compressed (core/png.hpp). tEXt chunks carry um_per_level,
 // origin_x_mm, origin_y_mm and cell_mm.
-// CSV: '#' comment lines with the same metadata, then ny lines of nx thickness values (um).
+// CSV: '#' comment lines with the same metadata, a header row `y_mm,<x of column 0>,...`
+// (mm, cell centres), then ny rows `<y of the row>,<nx thickness values in um>`: loads as a
+// table indexed by y with one column per x (pandas: read_csv(path, comment='#',
+// index_col='y_mm')).
 // I/O failures throw InternalError naming the file.
 #pragma once
 

@@ -27,9 +27,11 @@ struct MaterialStats {
   double emitted = 0.0, on_target = 0.0, overspray = 0.0, captured = 0.0;
 };
 
-// per joint, in the joint's user units (mm/s, mm/s^2, N), with the limits they are held to
+// per joint, with the limits they are held to: a prismatic joint in mm/s, mm/s^2 and N, a
+// revolute one in deg/s, deg/s^2 and N m
 struct ActuatorStats {
   std::vector<std::string> joint_names;
+  std::vector<bool> revolute;  // per joint: a hinge (deg, N m) rather than a slide (mm, N)
   std::vector<double> peak_vel, peak_acc, peak_force;
   std::vector<double> limit_vel, limit_acc, limit_force;
   // the plan's own peak joint acceleration (what the servo is asked for), and the simulated
@@ -56,10 +58,13 @@ struct LayerReport {
   int layer = 0;
   int paths = 0;
   double print_length_mm = 0.0;
-  double print_s = 0.0;                              // planned depositing time on this layer
-  std::optional<VelocityErrorStats> velocity_error;  // simulated
+  double print_s = 0.0;                                     // planned depositing time on this layer
+  std::optional<VelocityErrorStats> velocity_error;         // simulated
+  std::optional<VelocityErrorStats> velocity_error_steady;  // simulated, outside the ramps
   VelocityErrorStats planned_velocity_error;
-  PathErrorStats path_error;  // simulated when simulated, else planned
+  VelocityErrorStats planned_velocity_error_steady;  // outside the plan's start and end ramps
+  std::optional<PathErrorStats> path_error;          // simulated
+  PathErrorStats planned_path_error;
   std::optional<ThicknessSummary> thickness;
   std::optional<WasteStats> waste;
   std::optional<MaterialStats> material;
@@ -112,10 +117,19 @@ struct MetricsReport {
   std::string scenario, machine, planner, sequencer = "as_given";
   std::string label;  // the run's name (PlannerSpec::run_label): the planner's, or its label
   TimeStats time;
-  std::optional<VelocityErrorStats> velocity_error;  // simulated
+  // Every figure is either planned (from the trajectory alone: planned_*) or simulated (the
+  // contract's keys, present once a simulation ran). The speed error is given over the whole
+  // printed length and, as the papers give it, outside each printed stretch's start and end
+  // ramps (_steady; speed_ramps() defines them).
+  std::optional<VelocityErrorStats> velocity_error;         // simulated
+  std::optional<VelocityErrorStats> velocity_error_steady;  // simulated, outside the ramps
   VelocityErrorStats planned_velocity_error;
-  PathErrorStats path_error;                         // simulated when simulated, else planned
-  std::optional<PathErrorStats> planned_path_error;  // also given when simulated
+  VelocityErrorStats planned_velocity_error_steady;
+  std::optional<PathErrorStats> path_error;  // simulated
+  PathErrorStats planned_path_error;
+  // the plan's start and end ramps (not written as such: their count and total time are);
+  // the simulated steady error excludes the same stretches of time
+  std::vector<TimeSpan> speed_ramps;
   std::optional<ThicknessSummary> thickness;
   std::optional<WasteStats> waste;
   std::optional<MaterialStats> material;

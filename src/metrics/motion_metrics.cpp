@@ -70,12 +70,22 @@ std::vector<double> relative_speed_error(const MotionSamples& samples) {
 }
 
 VelocityErrorStats velocity_error(const MotionSamples& samples) {
+  return velocity_error(samples, {});
+}
+
+VelocityErrorStats velocity_error(const MotionSamples& samples,
+                                  const std::vector<TimeSpan>& excluded) {
   VelocityErrorStats stats;
   const std::vector<double> error = relative_speed_error(samples);
   std::vector<std::pair<double, double>> weighted;  // (error, time weight)
   double total_time = 0.0, sum_sq = 0.0, length = 0.0, length_over = 0.0;
+  // the spans are in time order (speed_ramps): one cursor walks them beside the samples
+  size_t span = 0;
   for (size_t k = 0; k < samples.size(); ++k) {
     if (!depositing_with_target(samples, k)) continue;
+    const double t = samples.t_s[k];
+    while (span < excluded.size() && excluded[span].end_s <= t) ++span;
+    if (span < excluded.size() && excluded[span].begin_s < t) continue;
     const double w = time_weight(samples, k);
     const double ds = samples.velocity_mm_s[k].norm() * w;  // path length of this sample
     stats.max_rel = std::max(stats.max_rel, error[k]);
@@ -99,6 +109,57 @@ VelocityErrorStats velocity_error(const MotionSamples& samples) {
     }
   }
   return stats;
+}
+
+std::vector<TimeSpan> speed_ramps(const MotionSamples& planned) {
+  std::vector<TimeSpan> ramps;
+  const size_t n = planned.size();
+  // a ramp's span reaches half a sample period beyond its outer samples
+  const auto half_gap = [&](size_t a, size_t b) { return 0.5 * (planned.t_s[b] - planned.t_s[a]); };
+  const auto reached = [&](size_t k) {
+    return planned.velocity_mm_s[k].norm() >=
+           (1.0 - kRampTolerance_rel) * planned.desired_speed_mm_s[k];
+  };
+  size_t k = 0;
+  while (k < n) {
+    if (!depositing_with_target(planned, k)) {
+      ++k;
+      continue;
+    }
+    // one printed stretch [first, last]
+    const size_t first = k;
+    while (k + 1 < n && depositing_with_target(planned, k + 1)) ++k;
+    const size_t last = k++;
+    // (at the run's own ends: half the neighbouring period inside it, or a nanosecond)
+    const double inner = last > first ? half_gap(first, first + 1) : 1e-9;
+    const double before = first > 0 ? half_gap(first - 1, first) : inner;
+    const double after = last + 1 < n ? half_gap(last, last + 1) : inner;
+    size_t steady_first = first;
+    while (steady_first <= last && !reached(steady_first)) ++steady_first;
+    if (steady_first > last) {  // never at speed: ramp throughout
+      ramps.push_back({planned.t_s[first] - before, planned.t_s[last] + after});
+      continue;
+    }
+    size_t steady_last = last;
+    while (!reached(steady_last)) --steady_last;
+    // each ramp takes in the first (last) sample at speed: the servo follows a period late
+    if (steady_first > first)
+      ramps.push_back(
+          {planned.t_s[first] - before,
+           planned.t_s[steady_first] +
+               (steady_first < last ? half_gap(steady_first, steady_first + 1) : after)});
+    if (steady_last < last)
+      ramps.push_back({planned.t_s[steady_last] -
+                           (steady_last > first ? half_gap(steady_last - 1, steady_last) : before),
+                       planned.t_s[last] + after});
+  }
+  return ramps;
+}
+
+double total_time_s(const std::vector<TimeSpan>& spans) {
+  double total = 0.0;
+  for (const TimeSpan& span : spans) total += span.end_s - span.begin_s;
+  return total;
 }
 
 double distance_to_polyline(const Vec3& point, const std::vector<Vec3>& polyline) {

@@ -36,24 +36,28 @@ ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointL
       a = std::max(a, std::abs(record.joint(record.joint_acceleration, k, j)));
       f = std::max(f, std::abs(record.joint(record.actuator_force, k, j)));
     }
-    stats.joint_names.push_back(record.joint_names[j]);
-    stats.peak_vel.push_back(v);
-    stats.peak_acc.push_back(a);
-    stats.peak_force.push_back(f);
-    const double v_lim = j < static_cast<int>(limits.size()) ? limits[j].v_max : 0.0;
-    const double a_lim = j < static_cast<int>(limits.size()) ? limits[j].a_max : 0.0;
+    const bool known = j < static_cast<int>(limits.size());
+    const double v_lim = known ? limits[j].v_max : 0.0;
+    const double a_lim = known ? limits[j].a_max : 0.0;
     const double f_lim = j < static_cast<int>(force_limits.size()) ? force_limits[j] : 0.0;
-    stats.limit_vel.push_back(v_lim);
-    stats.limit_acc.push_back(a_lim);
-    stats.limit_force.push_back(f_lim);
     const double plan_a = j < static_cast<int>(record.reference_peak_acceleration.size())
                               ? record.reference_peak_acceleration[j]
                               : 0.0;
-    stats.plan_peak_acc.push_back(plan_a);
-    stats.peak_acc_over_plan.push_back(plan_a > 0.0 ? a / plan_a : 0.0);
+    // the limits are counted in the record's units; a hinge is reported in degrees
     if (v_lim > 0 && v > v_lim) ++stats.limit_violations;
     if (a_lim > 0 && a > a_lim) ++stats.limit_violations;
     if (f_lim > 0 && f > f_lim) ++stats.limit_violations;
+    const double scale = known && limits[j].revolute ? 180.0 / kPi : 1.0;
+    stats.joint_names.push_back(record.joint_names[j]);
+    stats.revolute.push_back(known && limits[j].revolute);
+    stats.peak_vel.push_back(scale * v);
+    stats.peak_acc.push_back(scale * a);
+    stats.peak_force.push_back(f);
+    stats.limit_vel.push_back(scale * v_lim);
+    stats.limit_acc.push_back(scale * a_lim);
+    stats.limit_force.push_back(f_lim);
+    stats.plan_peak_acc.push_back(scale * plan_a);
+    stats.peak_acc_over_plan.push_back(plan_a > 0.0 ? a / plan_a : 0.0);
   }
   return stats;
 }
@@ -129,11 +133,14 @@ std::vector<LayerReport> layer_reports(const Toolpath& toolpath, const MotionSam
     const MotionSamples planned_here = only_layer(planned, toolpath, layer);
     for (size_t k = 0; k + 1 < planned_here.size(); ++k)
       if (planned_here.depositing[k]) r.print_s += period_s;
+    const std::vector<TimeSpan> ramps = speed_ramps(planned_here);
     r.planned_velocity_error = velocity_error(planned_here);
-    r.path_error = path_error(planned_here, toolpath);
+    r.planned_velocity_error_steady = velocity_error(planned_here, ramps);
+    r.planned_path_error = path_error(planned_here, toolpath);
     if (!simulated.t_s.empty()) {
       const MotionSamples simulated_here = only_layer(simulated, toolpath, layer);
       r.velocity_error = velocity_error(simulated_here);
+      r.velocity_error_steady = velocity_error(simulated_here, ramps);
       r.path_error = path_error(simulated_here, toolpath);
       // the layer's deposit: thickness along the normal, volumes from its own process
       if (!paths.paths.empty()) {
@@ -156,8 +163,8 @@ std::vector<LayerReport> layer_reports(const Toolpath& toolpath, const MotionSam
 void add_simulated_metrics(MetricsReport& r, const RecordedRun& record,
                            const MotionSamples& simulated, const Toolpath& toolpath,
                            const DepositionMetrics& deposited) {
-  r.planned_path_error = r.path_error;
   r.velocity_error = velocity_error(simulated);
+  r.velocity_error_steady = velocity_error(simulated, r.speed_ramps);
   r.path_error = path_error(simulated, toolpath);
   r.thickness = thickness_summary(deposited.thickness);
   material_and_waste(deposited.material, r);

@@ -22,13 +22,14 @@ MotionSamples trajectory_motion_at(const Trajectory& trajectory, const std::vect
 
 // Per joint: the peaks of velocity, acceleration and force against the joint's limits and
 // actuator force range (0: none), and the simulated acceleration peak against the plan's own
-// (RecordedRun::reference_peak_acceleration)
+// (RecordedRun::reference_peak_acceleration). Prismatic joints in mm/s, mm/s^2 and N;
+// revolute ones (JointLimit::revolute) in deg/s, deg/s^2 and N m (the record's rad converted).
 ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointLimit>& limits,
                              const std::vector<double>& force_limits);
 
 // Adds to a planned report (plan_job's) what the simulation scored: the simulated velocity
-// and path error (the planned path error kept as planned_path_error), thickness, material and
-// waste from the deposit, and the simulation's own statistics.
+// error (whole and steady: outside the plan's ramps, report.speed_ramps) and path error,
+// thickness, material and waste from the deposit, and the simulation's own statistics.
 void add_simulated_metrics(MetricsReport& report, const RecordedRun& record,
                            const MotionSamples& simulated, const Toolpath& toolpath,
                            const DepositionMetrics& deposited);

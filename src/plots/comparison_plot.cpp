@@ -1,5 +1,6 @@
-// comparison.png: one column per planner with its thickness map (shared colour scale), its
-// speed error against time (shared axes) and its key metrics.
+// comparison.png: one column per run with its thickness map (shared colour scale) and a zoom
+// on the thickest spot, or, comparing print orders, its print paths and travels; its speed
+// error against time (shared axes) and its key metrics.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -17,20 +18,163 @@ bool has_map(const HeightMap* map) {
 }
 
 std::string percent_or_na(const std::optional<double>& fraction) {
-  return fraction ? format("%.2f %%", 100.0 * *fraction) : "n/a";
+  return fraction ? format("%.2f", 100.0 * *fraction) : "n/a";
 }
 
 // the vertical layout of the sheet (screen fractions, bottom = 0)
-constexpr double kColourBarY = 0.905, kColourBarHeight = 0.02;
-constexpr double kMapBottom = 0.46, kMapHeight = 0.40;
-constexpr double kSpeedBottom = 0.225, kSpeedTop = 0.415;
-constexpr double kMetricsTop = 0.135, kMetricsLine = 0.024;
+constexpr double kColourBarY = 0.93, kColourBarHeight = 0.014;
+constexpr double kMapBottom = 0.585, kMapHeight = 0.29;
+constexpr double kZoomBottom = 0.335, kZoomHeight = 0.215;
+constexpr double kSpeedBottom = 0.165, kSpeedTop = 0.295;
+constexpr double kMetricsTop = 0.115, kMetricsLine = 0.017;
+// an orders comparison: the travel panel takes the map's and the zoom's place
+constexpr double kTravelBottom = 0.36, kTravelHeight = 0.55;
+// at most this many points per x-y curve, and this many path numbers
+constexpr size_t kMaxPathPoints = 1200;
+constexpr size_t kMaxPathLabels = 40;
+// the zoom window: this fraction of the largest map extent a side, at least this many cells
+constexpr double kZoomFraction = 0.125;
+constexpr int kZoomMinCells = 24;
+constexpr int kZoomMaxCellsPerSide = 200;
+
+// a round tic spacing (1, 2 or 5 x 10^n) giving at most four intervals over `span`
+double tic_step(double span) {
+  const double rough = span / 4.0;
+  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
+  for (double m : {1.0, 2.0, 5.0})
+    if (m * decade >= rough) return m * decade;
+  return 10.0 * decade;
+}
+
+// the window's outline on a map (object 800), removed by `unset object 800`
+std::string window_outline(const ZoomWindow& w) {
+  return format(
+      "set object 800 rect from %.9g,%.9g to %.9g,%.9g front fillstyle empty border lc rgb "
+      "\"white\" lw 1.5\n",
+      w.x_lo, w.y_lo, w.x_hi, w.y_hi);
+}
+
+// the print paths (dark), the travels (the column's colour) and the path numbers
+std::string travel_elements(PlotJob& job, const ComparisonColumn& column, size_t c) {
+  std::string s;
+  for (size_t i = 0; i < column.path_labels.size(); ++i) {
+    const PathLabel& label = column.path_labels[i];
+    s += format(
+        "set label %zu \"%d\" at %.9g,%.9g offset 0.5,0.5 tc rgb \"#404040\" font \",9\" front\n",
+        1000 + i, label.path, label.x_mm, label.y_mm);
+  }
+  std::vector<std::string> elements;
+  if (column.print_xy.point_count() > 0)
+    elements.push_back(job.data_file(format("prints_%zu.dat", c), format_curve(column.print_xy)) +
+                       " " + line_style("#303030", style::kPathLineWidth) + " notitle");
+  if (column.travel_xy.point_count() > 0)
+    elements.push_back(job.data_file(format("travels_%zu.dat", c), format_curve(column.travel_xy)) +
+                       " " + line_style(style::series_colour(c), style::kThinLineWidth + 0.3) +
+                       " notitle");
+  if (elements.empty()) elements.push_back(style::kEmptyFrame);
+  return s + plot_command(elements);
+}
+
+// the x-y ranges of every column's print and travel curves (shared by the travel panels)
+std::string travel_ranges(const std::vector<ComparisonColumn>& columns) {
+  Range x, y;
+  for (const ComparisonColumn& c : columns) {
+    x.add_x(c.print_xy), y.add_y(c.print_xy);
+    x.add_x(c.travel_xy), y.add_y(c.travel_xy);
+  }
+  return "set xrange " + x.gnuplot(0.03, 0.5) + "\nset yrange " + y.gnuplot(0.03, 0.5) + "\n";
+}
 
 }  // namespace
 
 void set_speed_error(ComparisonColumn& column, const MotionSamples& samples) {
   column.t_s = samples.t_s;
   column.speed_error_rel = speed_error_with_gaps(samples);
+}
+
+void set_travels(ComparisonColumn& column, const MotionSamples& planned) {
+  column.print_xy = xy_path_curve(planned, PathPart::printing, kMaxPathPoints);
+  column.travel_xy = xy_path_curve(planned, PathPart::transition, kMaxPathPoints);
+  column.path_labels.clear();
+  // each printed run's path number at its middle sample
+  size_t k = 0;
+  std::vector<PathLabel> labels;
+  while (k < planned.size()) {
+    const int path = planned.path_index[k];
+    if (!planned.depositing[k] || path < 0) {
+      ++k;
+      continue;
+    }
+    const size_t first = k;
+    while (k < planned.size() && planned.depositing[k] && planned.path_index[k] == path) ++k;
+    const Vec3& middle = planned.position_mm[(first + k - 1) / 2];
+    labels.push_back({middle.x(), middle.y(), path});
+  }
+  if (labels.size() <= kMaxPathLabels) column.path_labels = std::move(labels);
+}
+
+bool is_orders_comparison(const std::vector<ComparisonColumn>& columns) {
+  for (const ComparisonColumn& c : columns)
+    if (c.order != columns.front().order) return true;
+  return false;
+}
+
+ZoomWindow thickest_spot_window(const std::vector<const HeightMap*>& maps) {
+  ZoomWindow w;
+  Range x, y;
+  double cell_mm = 0.0;
+  for (const HeightMap* map : maps) {
+    if (!has_map(map)) continue;
+    x.add(map->origin_x_mm - 0.5 * map->cell_mm);
+    x.add(map->origin_x_mm + (map->nx - 0.5) * map->cell_mm);
+    y.add(map->origin_y_mm - 0.5 * map->cell_mm);
+    y.add(map->origin_y_mm + (map->ny - 0.5) * map->cell_mm);
+    cell_mm = std::max(cell_mm, map->cell_mm);
+    // the first thickest cell, row by row
+    for (int iy = 0; iy < map->ny; ++iy)
+      for (int ix = 0; ix < map->nx; ++ix)
+        if (map->at(ix, iy) > w.peak_um) {
+          w.peak_um = map->at(ix, iy);
+          w.centre_x_mm = map->origin_x_mm + ix * map->cell_mm;
+          w.centre_y_mm = map->origin_y_mm + iy * map->cell_mm;
+          w.found = true;
+        }
+  }
+  if (!w.found) return w;
+  // a square an eighth of the extent a side (at least kZoomMinCells cells), kept inside it
+  const double side = std::min(
+      std::max(kZoomFraction * std::max(x.hi - x.lo, y.hi - y.lo), kZoomMinCells * cell_mm),
+      std::min(x.hi - x.lo, y.hi - y.lo));
+  const auto place = [&](double centre, double lo, double hi, double& a, double& b) {
+    a = std::clamp(centre - 0.5 * side, lo, std::max(lo, hi - side));
+    b = a + side;
+  };
+  place(w.centre_x_mm, x.lo, x.hi, w.x_lo, w.x_hi);
+  place(w.centre_y_mm, y.lo, y.hi, w.y_lo, w.y_hi);
+  return w;
+}
+
+HeightMap crop_map(const HeightMap& map, const ZoomWindow& window) {
+  HeightMap out;
+  if (!has_map(&map)) return out;
+  // the cells whose centres lie inside [lo, hi] on each axis
+  const auto cells = [&](double origin, int n, double lo, double hi, int& first, int& count) {
+    first = std::max(0, static_cast<int>(std::ceil((lo - origin) / map.cell_mm - 1e-9)));
+    const int last =
+        std::min(n - 1, static_cast<int>(std::floor((hi - origin) / map.cell_mm + 1e-9)));
+    count = std::max(0, last - first + 1);
+  };
+  int x0 = 0, y0 = 0;
+  cells(map.origin_x_mm, map.nx, window.x_lo, window.x_hi, x0, out.nx);
+  cells(map.origin_y_mm, map.ny, window.y_lo, window.y_hi, y0, out.ny);
+  if (out.nx == 0 || out.ny == 0) return HeightMap{};
+  out.cell_mm = map.cell_mm;
+  out.origin_x_mm = map.origin_x_mm + x0 * map.cell_mm;
+  out.origin_y_mm = map.origin_y_mm + y0 * map.cell_mm;
+  out.thickness_um.reserve(static_cast<size_t>(out.nx) * out.ny);
+  for (int iy = 0; iy < out.ny; ++iy)
+    for (int ix = 0; ix < out.nx; ++ix) out.thickness_um.push_back(map.at(x0 + ix, y0 + iy));
+  return out;
 }
 
 double shared_thickness_max_um(const ComparisonInput& input) {
@@ -51,10 +195,11 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   const int width_px = static_cast<int>(columns) * style::kComparisonColumnWidth_px;
   job.begin_png(png_path, width_px, style::kComparisonHeight_px);
   std::string& s = job.script();
+  const bool orders = is_orders_comparison(input.columns);
 
-  // shared scales: colour range, map extent, time and error axes
-  std::vector<HeightMap> display_maps(columns);
-  std::vector<const HeightMap*> maps;
+  // shared scales: colour range, map extent, zoom window, time and error axes
+  std::vector<HeightMap> display_maps(columns), zoom_maps(columns);
+  std::vector<const HeightMap*> maps, full_maps;
   double duration_s = 0.0, error_max_pct = 0.0;
   std::vector<Curve> speed_curves(columns);
   for (size_t c = 0; c < columns; ++c) {
@@ -64,6 +209,7 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
     if (has_map(column.thickness)) {
       display_maps[c] = downsample_for_display(*column.thickness, options.max_map_cells_per_side);
       maps.push_back(&display_maps[c]);
+      full_maps.push_back(column.thickness);
     }
     std::vector<double> percent = column.speed_error_rel;
     for (double& e : percent) e *= 100.0;
@@ -74,40 +220,81 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
     if (column.total_time_s) duration_s = std::max(duration_s, *column.total_time_s);
   }
   const double cb_max_um = shared_thickness_max_um(input);
+  const ZoomWindow zoom = orders ? ZoomWindow{} : thickest_spot_window(full_maps);
+  if (zoom.found)
+    for (size_t c = 0; c < columns; ++c)
+      if (has_map(input.columns[c].thickness))
+        zoom_maps[c] = downsample_for_display(crop_map(*input.columns[c].thickness, zoom),
+                                              kZoomMaxCellsPerSide);
 
-  s += "set multiplot title " + style::quoted(input.title + ": planner comparison") + " font \"" +
-       style::title_font() + "\"\n";
+  s += "set multiplot title " +
+       style::quoted(input.title + (orders ? ": print order comparison" : ": planner comparison")) +
+       " font \"" + style::title_font() + "\"\n";
   s += style::thickness_palette();
   s += format("set cbrange [0:%.9g]\n", cb_max_um);
   s += "set cblabel " +
-       style::quoted(style::axis_label("thickness, one colour scale for all planners", "µm")) +
+       style::quoted(style::axis_label("thickness, one colour scale for all runs", "µm")) +
        " offset 0,0.4\n";
   s += format("set colorbox horizontal user origin screen 0.2,%.4f size screen 0.6,%.4f\n",
               kColourBarY, kColourBarHeight);
   s += format(
-      "set label 900 'grey bands: transitions (nothing deposited)' at screen 0.5,%.4f "
-      "center tc rgb \"#606060\"\n",
-      0.018);
+      "set label 900 %s at screen 0.5,%.4f center tc rgb \"#606060\"\n",
+      style::quoted(orders ? "top: print paths (dark, numbered in print order from 0) and "
+                             "travels; grey bands: transitions"
+                           : "grey bands: transitions (nothing deposited); white box: the zoom "
+                             "below each map, on the thickest spot of all runs")
+          .c_str(),
+      0.012);
   const std::string shared_map_ranges = maps.empty() ? "" : map_ranges(maps, input.toolpath);
+  const std::string shared_travel_ranges = orders ? travel_ranges(input.columns) : "";
   bool colour_bar_drawn = false;
 
   for (size_t c = 0; c < columns; ++c) {
     const ComparisonColumn& column = input.columns[c];
     const double left = static_cast<double>(c) / columns, width = 1.0 / columns;
+    const std::string title =
+        "set title " + style::quoted(column.planner) + " font \"" + style::title_font() + "\"\n";
+    const std::string xy_labels = "set xlabel " + style::quoted(style::axis_label("x", "mm")) +
+                                  "\nset ylabel " + style::quoted(style::axis_label("y", "mm")) +
+                                  "\n";
 
-    // thickness map, the colour bar drawn once with the first map
-    if (has_map(column.thickness)) {
+    if (orders) {
+      // the print paths numbered in print order, and the travels between them
+      s += "set margins -1,-1,-1,-1\nset origin " + format("%.4f,%.4f\n", left, kTravelBottom);
+      s += format("set size ratio -1 %.4f,%.4f\n", width, kTravelHeight);
+      s += "unset colorbox\nset grid\nunset key\n" + shared_travel_ranges + title + xy_labels;
+      s += travel_elements(job, column, c);
+      s += "unset title\nunset label\n";
+    } else if (has_map(column.thickness)) {
+      // thickness map, the colour bar drawn once with the first map, the zoom window outlined
       s += "set margins -1,-1,-1,-1\nset origin " + format("%.4f,%.4f\n", left, kMapBottom);
       s += format("set size ratio -1 %.4f,%.4f\n", width, kMapHeight);
-      s += "unset grid\nset tics front\nunset key\n" + shared_map_ranges;
-      s += "set title " + style::quoted(column.planner) + " font \"" + style::title_font() + "\"\n";
-      s += "set xlabel " + style::quoted(style::axis_label("x", "mm")) + "\n";
-      s += "set ylabel " + style::quoted(style::axis_label("y", "mm")) + "\n";
+      s += "unset grid\nset tics front\nunset key\n" + shared_map_ranges + title + xy_labels;
       s += colour_bar_drawn ? "unset colorbox\n" : "";
+      if (zoom.found) s += window_outline(zoom);
       s +=
           thickness_map_elements(job, display_maps[c], input.toolpath, format("map_%zu", c), false);
       colour_bar_drawn = true;
-      s += "unset title\nunset label 900\n";
+      s += "unset title\nunset label 900\nunset object 800\nunset colorbox\n";
+      // the zoom: the same window in every column, at full resolution
+      if (zoom.found && has_map(&zoom_maps[c])) {
+        s += "set origin " + format("%.4f,%.4f\n", left, kZoomBottom);
+        s += format("set size ratio -1 %.4f,%.4f\n", width, kZoomHeight);
+        s += format("set xrange [%.9g:%.9g]\nset yrange [%.9g:%.9g]\n", zoom.x_lo, zoom.x_hi,
+                    zoom.y_lo, zoom.y_hi);
+        // the window is centred on the thickest spot of all runs; the title gives this run's
+        // own peak inside it
+        const double column_peak_um = zoom_maps[c].max_value();
+        s += "set title " +
+             style::quoted(format("zoom at (%.2f, %.2f) mm: peak %.3g µm", zoom.centre_x_mm,
+                                  zoom.centre_y_mm, column_peak_um)) +
+             "\n" + xy_labels;
+        const double tic_mm = tic_step(zoom.x_hi - zoom.x_lo);
+        s += format("set xtics %.9g\nset ytics %.9g\n", tic_mm, tic_mm);
+        s +=
+            thickness_map_elements(job, zoom_maps[c], input.toolpath, format("zoom_%zu", c), false);
+        s += "unset title\nset xtics autofreq\nset ytics autofreq\n";
+      }
     } else {
       // named over the empty map area, drawn with the speed panel below
       s += format("set label 901 %s at screen %.4f,%.4f center font \"%s\"\n",
@@ -129,17 +316,19 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
     s += "set ylabel " + style::quoted(style::axis_label("speed error", "%")) + "\n";
     s += style::transition_shading(column.transitions);
 
-    // key metrics under the panel
-    const std::string lines[5] = {
-        "max speed error  " + percent_or_na(column.max_speed_error_rel),
-        "RMS speed error  " + percent_or_na(column.rms_speed_error_rel),
-        "thickness CV     " + (column.thickness_cv ? format("%.4f", *column.thickness_cv) : "n/a"),
-        "waste fraction   " + percent_or_na(column.waste_fraction),
-        "total time       " +
-            (column.total_time_s ? format("%.2f s", *column.total_time_s) : "n/a")};
-    for (int i = 0; i < 5; ++i)
+    // key metrics under the panel, named as in the summary tables (comparison.csv)
+    const std::string lines[6] = {
+        "sim_vel_err_max_pct         " + percent_or_na(column.max_speed_error_rel),
+        "sim_vel_err_steady_max_pct  " + percent_or_na(column.steady_speed_error_rel),
+        "sim_vel_err_rms_pct         " + percent_or_na(column.rms_speed_error_rel),
+        "thickness_cv                " +
+            (column.thickness_cv ? format("%.4f", *column.thickness_cv) : "n/a"),
+        "waste_pct                   " + percent_or_na(column.waste_fraction),
+        "time_s                      " +
+            (column.total_time_s ? format("%.3f", *column.total_time_s) : "n/a")};
+    for (int i = 0; i < 6; ++i)
       s += format("set label %d %s at screen %.4f,%.4f left font \"%s\"\n", 910 + i,
-                  style::quoted(lines[i]).c_str(), left + 0.16 * width,
+                  style::quoted(lines[i]).c_str(), left + 0.10 * width,
                   kMetricsTop - i * kMetricsLine, style::mono_font().c_str());
 
     const Curve& curve = speed_curves[c];

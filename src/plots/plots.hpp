@@ -57,8 +57,14 @@ struct RunPlotInput {
   const HeightMap* thickness = nullptr;
   std::vector<LineProfile> profiles;
   double target_thickness_um = 0.0;  // <= 0: no target line
-  double mean_thickness_um = 0.0;    // <= 0: no mean line
-  double feature_size_mm = 0.0;      // <= 0: feature_size_mm(*toolpath)
+  // where the target comes from, printed under thickness_profile.png (target_thickness_note);
+  // empty: the general rule
+  std::string target_note;
+  // metrics.json's thickness.mean_um: the mean over the lines' whole width (the target region),
+  // named in a note under thickness_profile.png (<= 0: none); the plot's mean line is the
+  // centreline mean, computed from the profiles
+  double mean_thickness_um = 0.0;
+  double feature_size_mm = 0.0;  // <= 0: feature_size_mm(*toolpath)
   // joints.png (optional): the joints against time, with their ranges
   const JointSeries* joints = nullptr;
   // layers.png (optional): each layer's thickness map (index = PrintPath::layer, 0-based as in
@@ -69,6 +75,14 @@ struct RunPlotInput {
   // paths3d.png: the part's surface under the paths (optional; work frame, mm)
   const TriangleMesh* part = nullptr;
 };
+
+// thickness_profile.png's note on the target: the centreline peak of a straight line at
+// its print speed, with the numbers of the process (aerosol: Q / (v sigma sqrt(2 pi));
+// extrusion: the bead's w x h cross-section as a Gaussian, w h / (sigma sqrt(2 pi)), sigma =
+// w / 4: 1.60 h)
+std::string target_thickness_note(bool extrusion, double target_um, double speed_mm_s,
+                                  double sigma_mm, double flow_mm3_s, double bead_width_mm,
+                                  double layer_height_mm);
 
 enum class RunPlot { path, axes, errors, thickness_profile, thickness, joints, layers, paths3d };
 // "path.png", "axes.png", "errors.png", "thickness_profile.png", "thickness.png",
@@ -162,6 +176,12 @@ PlotResult render_run_plots(const RunPlotInput& input, const std::string& direct
                             const std::vector<RunPlot>& plots = {},
                             const PlotOptions& options = {});
 
+// A print path's number (0-based, in print order) at a point of it.
+struct PathLabel {
+  double x_mm = 0.0, y_mm = 0.0;
+  int path = 0;
+};
+
 // One planner's column of the comparison sheet.
 struct ComparisonColumn {
   std::string planner;
@@ -169,12 +189,36 @@ struct ComparisonColumn {
   // relative speed error against time; NaN = not depositing (speed_error_with_gaps)
   std::vector<double> t_s, speed_error_rel;
   std::vector<TimeInterval> transitions;  // shaded under the speed error
+  // the print order (MetricsReport::sequencer); columns of different orders make an orders
+  // comparison, which shows each column's travels instead of its (identical) thickness map
+  std::string order;
+  // the plan's x-y path: printing and travelling (set_travels), and each path's number
+  Curve print_xy, travel_xy;
+  std::vector<PathLabel> path_labels;
   // key metrics; nullopt prints "n/a"
-  std::optional<double> max_speed_error_rel, rms_speed_error_rel, thickness_cv, waste_fraction,
-      total_time_s;
+  std::optional<double> max_speed_error_rel, steady_speed_error_rel, rms_speed_error_rel,
+      thickness_cv, waste_fraction, total_time_s;
 };
 // fill t_s and speed_error_rel from samples (the simulated ones when there are)
 void set_speed_error(ComparisonColumn& column, const MotionSamples& samples);
+// fill print_xy, travel_xy and path_labels from the plan's samples: each printed run is
+// labelled with its path index (0-based print order) at its middle sample; at most 40 labels
+void set_travels(ComparisonColumn& column, const MotionSamples& planned);
+
+// The comparison sheet's zoom: a square window around the thickest cell of all the maps (the
+// largest deviation above the target), the same window in every column.
+struct ZoomWindow {
+  bool found = false;  // false: every map is empty or zero
+  double centre_x_mm = 0.0, centre_y_mm = 0.0, peak_um = 0.0;
+  double x_lo = 0.0, x_hi = 0.0, y_lo = 0.0, y_hi = 0.0;  // mm
+};
+// the window: an eighth of the largest map extent a side, at least 24 cells, centred on the
+// first thickest cell (maps in order, cells row by row), inside the maps' joint extent
+ZoomWindow thickest_spot_window(const std::vector<const HeightMap*>& maps);
+// the cells of `map` whose centres lie inside the window (an empty map when none)
+HeightMap crop_map(const HeightMap& map, const ZoomWindow& window);
+// true when the columns' orders differ (an orders comparison)
+bool is_orders_comparison(const std::vector<ComparisonColumn>& columns);
 
 struct ComparisonInput {
   std::string title;                   // e.g. the scenario name
@@ -185,8 +229,10 @@ struct ComparisonInput {
 // the colour range every map shares: [0, max over all maps] (1 um when all are empty)
 double shared_thickness_max_um(const ComparisonInput& input);
 
-// comparison.png at png_path: one column per planner (thickness map on a shared colour scale,
-// speed error against time on shared axes, key metrics). One gnuplot process.
+// comparison.png at png_path: one column per run: its thickness map on a shared colour scale
+// with, below it, a zoom on the thickest spot (or, in an orders comparison, its print paths
+// numbered in print order and its travels), its speed error against time on shared axes and
+// its key metrics under the summary tables' names. One gnuplot process.
 PlotResult render_comparison(const ComparisonInput& input, const std::string& png_path,
                              const PlotOptions& options = {});
 

@@ -29,6 +29,20 @@ bool moves(const Curve& position) {
 
 }  // namespace
 
+std::string target_thickness_note(bool extrusion, double target_um, double speed_mm_s,
+                                  double sigma_mm, double flow_mm3_s, double bead_width_mm,
+                                  double layer_height_mm) {
+  if (extrusion && !(flow_mm3_s > 0.0))
+    return format(
+        "target %.3g µm: the bead's w × h = %.3g × %.3g mm cross-section as a Gaussian of "
+        "σ = w/4 = %.3g mm: w h / (σ √(2π)) = 1.60 h",
+        target_um, bead_width_mm, layer_height_mm, sigma_mm);
+  return format(
+      "target %.3g µm: a straight line's centreline peak Q / (v σ √(2π)), Q = %.3g mm³/s, "
+      "v = %.3g mm/s, σ = %.3g mm",
+      target_um, flow_mm3_s, speed_mm_s, sigma_mm);
+}
+
 const char* file_name(RunPlot plot) {
   switch (plot) {
     case RunPlot::path:
@@ -173,7 +187,8 @@ void path_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
   x.add(toolpath.end_mm.x()), y.add(toolpath.end_mm.y());
   s += "set xrange " + x.gnuplot(0.05, 0.5) + "\nset yrange " + y.gnuplot(0.05, 0.5) + "\n";
 
-  // print paths numbered in print order at their middle (as in the paper's Fig. 7)
+  // print paths numbered in print order at their middle (as in the paper's Fig. 7), 0-based
+  // as in trajectory.csv and metrics.json
   if (toolpath.paths.size() <= 40) {
     for (size_t i = 0; i < toolpath.paths.size(); ++i) {
       const auto& points = toolpath.paths[i].points;
@@ -190,7 +205,7 @@ void path_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
       }
       s += format(
           "set label %zu \"%zu\" at %.9g,%.9g offset 0.7,0.7 tc rgb \"#404040\" boxed front\n",
-          i + 1, i + 1, middle.x(), middle.y());
+          i + 1, i, middle.x(), middle.y());
     }
   }
 
@@ -333,7 +348,21 @@ void errors_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
   job.end_png();
 }
 
-// thickness_profile.png: thickness along each print line's centreline, target and mean
+// the mean of the centreline profiles, each sample weighted by the arc length it stands for
+double centreline_mean_um(const std::vector<LineProfile>& profiles) {
+  double sum = 0.0, length = 0.0;
+  for (const LineProfile& p : profiles)
+    for (size_t k = 0; k + 1 < p.arc_length_mm.size(); ++k) {
+      const double ds = p.arc_length_mm[k + 1] - p.arc_length_mm[k];
+      sum += 0.5 * (p.thickness_um[k] + p.thickness_um[k + 1]) * ds;
+      length += ds;
+    }
+  return length > 0.0 ? sum / length : 0.0;
+}
+
+// thickness_profile.png: thickness along each print line's centreline, the target and the
+// centreline mean; the key and the notes (where the target comes from, what
+// thickness.mean_um is) under the plot, clear of the data
 void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
                   const std::string& png) {
   job.begin_png(png, style::kRunPlotWidth_px, style::kRunPlotHeight_px);
@@ -341,14 +370,32 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
   s += "set title " + style::quoted(input.title + ": thickness along the print lines") +
        " font \"" + style::title_font() + "\"\n";
   s += "set xlabel " + style::quoted(style::axis_label("arc length along the line", "mm")) + "\n";
-  s += "set ylabel " + style::quoted(style::axis_label("thickness", "µm")) + "\n";
-  s += "set key outside right top vertical\n";
-  s += "set lmargin at screen 0.095\nset rmargin at screen 0.79\n";
+  s += "set ylabel " + style::quoted(style::axis_label("centreline thickness", "µm")) + "\n";
+  s += "set lmargin at screen 0.095\nset rmargin at screen 0.97\n";
+  s += "set tmargin at screen 0.90\nset bmargin at screen 0.36\n";
+  s += "set key at screen 0.5,0.235 center top horizontal maxrows 3 width 1 samplen 3\n";
+  const double centreline_um = centreline_mean_um(input.profiles);
   Range x, y;
   for (const Curve& c : data.profiles) x.add_x(c), y.add_y(c);
-  y.add(input.target_thickness_um), y.add(input.mean_thickness_um);
+  y.add(input.target_thickness_um), y.add(centreline_um);
   s += format("set xrange [0:%.9g]\n", x.empty() || x.hi <= 0.0 ? 1.0 : x.hi);
   s += "set yrange " + zero_based_range(y.empty() ? 0.0 : y.hi) + "\n";
+
+  // the notes: where the target comes from, and the other mean metrics.json gives
+  std::vector<std::string> notes;
+  if (input.target_thickness_um > 0.0)
+    notes.push_back(!input.target_note.empty()
+                        ? input.target_note
+                        : "target: the centreline peak of a straight line at its print speed "
+                          "(Gaussian cross-section)");
+  if (input.mean_thickness_um > 0.0)
+    notes.push_back(
+        format("metrics.json thickness.mean_um = %.3g µm is the mean over the lines' "
+               "whole width, not the centreline",
+               input.mean_thickness_um));
+  for (size_t i = 0; i < notes.size(); ++i)
+    s += format("set label %zu %s at screen 0.5,%.4f center font \",10\" tc rgb \"#404040\"\n",
+                950 + i, style::quoted(notes[i]).c_str(), 0.075 - 0.04 * i);
 
   // one colour and key entry per line when few; one shared colour and entry when many
   const bool few = data.profiles.size() <= 8;
@@ -358,15 +405,15 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
     elements.push_back(format("%.9g with lines lw 2 dt 2 lc rgb \"%s\" title 'target %.3g µm'",
                               input.target_thickness_um, style::kTargetColour,
                               input.target_thickness_um));
-  if (input.mean_thickness_um > 0.0)
-    elements.push_back(format("%.9g with lines lw 2 dt 3 lc rgb \"%s\" title 'mean %.3g µm'",
-                              input.mean_thickness_um, style::kMeanColour,
-                              input.mean_thickness_um));
+  if (centreline_um > 0.0)
+    elements.push_back(
+        format("%.9g with lines lw 2 dt 3 lc rgb \"%s\" title 'centreline mean %.3g µm'",
+               centreline_um, style::kMeanColour, centreline_um));
   for (size_t i = 0; i < data.profiles.size(); ++i) {
     if (data.profiles[i].point_count() == 0) continue;
     const int path = input.profiles[i].path_index;
-    std::string title = few ? format("title 'path %d'", path + 1)
-                            : (i == 0 ? format("title 'paths 1-%zu'", data.profiles.size())
+    std::string title = few ? format("title 'path %d'", path)
+                            : (i == 0 ? format("title 'paths 0-%zu'", data.profiles.size() - 1)
                                       : std::string("notitle"));
     elements.push_back(
         job.data_file(format("profile_%zu.dat", i), format_curve(data.profiles[i])) + " " +
@@ -374,6 +421,7 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
   }
   if (elements.empty()) elements.push_back(style::kEmptyFrame);
   s += plot_command(elements);
+  s += "unset label\n";
   job.end_png();
 }
 

@@ -14,7 +14,7 @@ namespace depotwin::plots::style {
 constexpr int kRunPlotWidth_px = 800;
 constexpr int kRunPlotHeight_px = 500;
 constexpr int kComparisonColumnWidth_px = 460;
-constexpr int kComparisonHeight_px = 1000;
+constexpr int kComparisonHeight_px = 1300;
 
 // fonts (DejaVu: fonts-dejavu-core, installed with gnuplot-nox by scripts/setup.sh)
 constexpr const char* kFont = "DejaVu Sans";

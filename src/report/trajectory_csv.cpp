@@ -22,7 +22,7 @@ void append_planned(std::string& out, const MotionSamples& s, size_t k) {
 }  // namespace
 
 std::string planned_trajectory_csv(const MotionSamples& planned) {
-  std::string out = "t,x,y,z,vx,vy,vz,speed,depositing,segment,desired_speed\n";
+  std::string out = std::string(kPlannedColumns) + "\n";
   out.reserve(planned.size() * 110);
   for (size_t k = 0; k < planned.size(); ++k) {
     append_planned(out, planned, k);
@@ -31,12 +31,11 @@ std::string planned_trajectory_csv(const MotionSamples& planned) {
   return out;
 }
 
-std::string planned_and_simulated_csv(const MotionSamples& planned, const MotionSamples& simulated) {
+std::string planned_and_simulated_csv(const MotionSamples& planned,
+                                      const MotionSamples& simulated) {
   if (planned.size() != simulated.size())
     throw InternalError("trajectory.csv: planned and simulated samples differ in count");
-  std::string out =
-      "t,x,y,z,vx,vy,vz,speed,depositing,segment,desired_speed,"
-      "sim_x,sim_y,sim_z,sim_vx,sim_vy,sim_vz,sim_speed\n";
+  std::string out = std::string(kPlannedColumns) + "," + kSimulatedColumns + "\n";
   out.reserve(planned.size() * 200);
   for (size_t k = 0; k < planned.size(); ++k) {
     append_planned(out, planned, k);

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "deposition/field_io.hpp"
@@ -65,6 +66,7 @@ TEST(FieldIo, Png16RoundTripsThroughStbImage) {
   EXPECT_NE(bytes.find(std::string("tEXtum_per_level\0", 17)), std::string::npos);
 }
 
+// a header row of x_mm (cell centres) under `y_mm`, then per row its y and its values (um)
 TEST(FieldIo, CsvCarriesOriginCellScaleAndValues) {
   const HeightMap map = ramp_map();
   const fs::path file = scratch_dir("csv") / "thickness.csv";
@@ -72,6 +74,7 @@ TEST(FieldIo, CsvCarriesOriginCellScaleAndValues) {
   std::ifstream in(file);
   std::string line;
   std::string header;
+  std::vector<std::string> column_names;
   int row = 0;
   while (std::getline(in, line)) {
     if (line.rfind("#", 0) == 0) {
@@ -80,15 +83,25 @@ TEST(FieldIo, CsvCarriesOriginCellScaleAndValues) {
     }
     std::stringstream cells(line);
     std::string cell;
-    int ix = 0;
-    while (std::getline(cells, cell, ',')) {
-      EXPECT_NEAR(std::stod(cell), map.at(ix, map.ny - 1 - row), 1e-6);
-      ++ix;
+    std::vector<std::string> fields;
+    while (std::getline(cells, cell, ',')) fields.push_back(cell);
+    ASSERT_EQ(fields.size(), static_cast<size_t>(map.nx) + 1) << line;
+    // the header row: y_mm, then x of every column
+    if (column_names.empty()) {
+      column_names = fields;
+      EXPECT_EQ(fields[0], "y_mm");
+      for (int ix = 0; ix < map.nx; ++ix)
+        EXPECT_NEAR(std::stod(fields[ix + 1]), -1.25 + 0.05 * ix, 1e-9);
+      continue;
     }
-    EXPECT_EQ(ix, map.nx);
+    const int iy = map.ny - 1 - row;
+    EXPECT_NEAR(std::stod(fields[0]), 2.5 + 0.05 * iy, 1e-9);
+    for (int ix = 0; ix < map.nx; ++ix)
+      EXPECT_NEAR(std::stod(fields[ix + 1]), map.at(ix, iy), 1e-6);
     ++row;
   }
   EXPECT_EQ(row, map.ny);
+  EXPECT_NE(header.find("thickness in um"), std::string::npos) << header;
   EXPECT_NE(header.find("origin_x_mm=-1.25 "), std::string::npos) << header;
   EXPECT_NE(header.find("origin_y_mm=2.5 "), std::string::npos);
   EXPECT_NE(header.find("cell_mm=0.050000000000000003"), std::string::npos);

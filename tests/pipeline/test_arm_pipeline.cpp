@@ -181,7 +181,7 @@ TEST(ArmPipeline, CurvedBeamTwoLayersWithSpeedAndFlowControl) {
   ASSERT_EQ(toolpath.layer_count(), 2);
 
   // the simulated nozzle stays on the toolpath (the 0.1 mm)
-  EXPECT_LE(r.path_error.max_mm, 0.1);
+  EXPECT_LE(r.path_error->max_mm, 0.1);
   // no joint beyond its range or its speed limit over the run
   expect_joints_within_limits(arm, "beam");
 
@@ -218,7 +218,7 @@ TEST(ArmPipeline, CurvedBeamTwoLayersWithSpeedAndFlowControl) {
     // lag only delays it): the layer's emitted volume is w h times its print length
     EXPECT_LE(relative(layer.material->emitted, kBeadWidth_mm * kLayerHeight_mm * length_mm), 1e-4)
         << "layer " << k << ": " << layer.material->emitted << " mm^3 for " << length_mm << " mm";
-    EXPECT_LE(layer.path_error.max_mm, 0.1) << "layer " << k;
+    EXPECT_LE(layer.path_error->max_mm, 0.1) << "layer " << k;
     emitted_mm3 += layer.material->emitted;
   }
   EXPECT_LE(relative(emitted_mm3, r.material->emitted), 1e-9);
@@ -242,7 +242,7 @@ TEST(ArmPipeline, CurvedBeamTwoLayersWithSpeedAndFlowControl) {
       "[ beam ] path error %.4f mm, joint margin %.1f deg, clearance %.3f mm, "
       "manipulability %.4f, emitted %.3f + %.3f mm^3, stacked mean %.4f mm (%.4f um "
       "reported)\n",
-      r.path_error.max_mm, r.arm->run.min_joint_margin_deg, r.arm->run.min_clearance_mm,
+      r.path_error->max_mm, r.arm->run.min_joint_margin_deg, r.arm->run.min_clearance_mm,
       r.arm->run.min_manipulability, r.layers[0].material->emitted, r.layers[1].material->emitted,
       stacked_mm, r.thickness->mean_um);
   EXPECT_NEAR(stacked_mm, 2 * kLayerHeight_mm, 0.01 * 2 * kLayerHeight_mm);
@@ -380,7 +380,7 @@ TEST(ArmPipeline, AerosolOnTheArmLandsOnTarget) {
   const ArmRun arm = simulate(beam_lines(fresh_directory("arm_aerosol"), s));
   const MetricsReport& r = arm.run.report;
   ASSERT_TRUE(r.material && r.waste && r.arm);
-  EXPECT_LE(r.path_error.max_mm, 0.1);
+  EXPECT_LE(r.path_error->max_mm, 0.1);
   EXPECT_EQ(r.arm->collisions, 0);
   expect_balanced(*r.material, "aerosol");
   ASSERT_EQ(r.layers.size(), 1u);
@@ -437,9 +437,9 @@ TEST(ArmPipeline, PapersPlannersRunOnTheArm) {
       const ArmRun arm = simulate(scenario);
       const MetricsReport& r = arm.run.report;
       std::printf("[ planners ] %-24s %.2f s, path error %.4f mm (planned %.4f)\n", where.c_str(),
-                  r.time.total_s, r.path_error.max_mm, r.planned_path_error->max_mm);
+                  r.time.total_s, r.path_error->max_mm, r.planned_path_error.max_mm);
       // it completed: the whole plan simulated, material laid
-      ASSERT_TRUE(r.sim && r.material && r.planned_path_error) << where;
+      ASSERT_TRUE(r.sim && r.material && r.path_error) << where;
       EXPECT_GE(static_cast<double>(r.sim->steps) * r.sim->timestep_s, r.time.total_s - 1e-9)
           << where;
       EXPECT_GT(r.material->on_target, 0.0) << where;
@@ -451,13 +451,13 @@ TEST(ArmPipeline, PapersPlannersRunOnTheArm) {
       EXPECT_GT(r.arm->run.min_joint_margin_deg, 0.0) << where;
       expect_joints_within_limits(arm, where);
       if (on_table) {
-        EXPECT_LE(r.path_error.max_mm, r.planned_path_error->max_mm + 0.05) << where;
-        EXPECT_LE(r.path_error.max_mm, 0.15) << where;
+        EXPECT_LE(r.path_error->max_mm, r.planned_path_error.max_mm + 0.05) << where;
+        EXPECT_LE(r.path_error->max_mm, 0.15) << where;
         if (std::string(planner) == "bezier") {
-          EXPECT_NEAR(r.planned_path_error->max_mm, 0.5 / 4, 0.003) << where;
+          EXPECT_NEAR(r.planned_path_error.max_mm, 0.5 / 4, 0.003) << where;
         }
       } else {
-        EXPECT_LE(r.path_error.max_mm, 0.02) << where;
+        EXPECT_LE(r.path_error->max_mm, 0.02) << where;
       }
     }
   }

@@ -1,0 +1,87 @@
+// The comparison sheet's data: the zoom window on the thickest spot and its crop, the print
+// order's travels and 0-based path numbers, orders comparisons told apart; the target note.
+#include <gtest/gtest.h>
+
+#include "plots/plots.hpp"
+
+namespace depotwin {
+namespace {
+
+// a 40 x 20 map of 0.5 mm cells from (-10, 0), zero but for a spot at cell (30, 15)
+HeightMap spotted_map(float spot_um) {
+  HeightMap map;
+  map.origin_x_mm = -10.0;
+  map.origin_y_mm = 0.0;
+  map.cell_mm = 0.5;
+  map.nx = 40;
+  map.ny = 20;
+  map.thickness_um.assign(800, 1.0f);
+  map.thickness_um[15 * 40 + 30] = spot_um;
+  return map;
+}
+
+TEST(ComparisonZoom, WindowCentresOnTheThickestCellOfAllMaps) {
+  const HeightMap a = spotted_map(3.0f), b = spotted_map(5.0f);
+  const plots::ZoomWindow w = plots::thickest_spot_window({&a, &b});
+  ASSERT_TRUE(w.found);
+  EXPECT_FLOAT_EQ(static_cast<float>(w.peak_um), 5.0f);
+  EXPECT_DOUBLE_EQ(w.centre_x_mm, -10.0 + 30 * 0.5);
+  EXPECT_DOUBLE_EQ(w.centre_y_mm, 15 * 0.5);
+  // a side of max(extent / 8, 24 cells) = max(20 / 8, 12) mm, at most the shorter extent
+  // (10 mm: the map spans x -10.25 .. 9.75, y -0.25 .. 9.75), kept inside the maps
+  EXPECT_DOUBLE_EQ(w.x_hi - w.x_lo, 10.0);
+  EXPECT_DOUBLE_EQ(w.x_lo, -0.25);
+  EXPECT_DOUBLE_EQ(w.y_lo, -0.25);
+  EXPECT_DOUBLE_EQ(w.y_hi, 9.75);
+  // the crop: the cells whose centres lie inside, at full resolution
+  const HeightMap crop = plots::crop_map(b, w);
+  EXPECT_EQ(crop.nx, 20);  // centres x = 0 .. 9.5 mm: cells 20 .. 39
+  EXPECT_EQ(crop.nx * crop.ny, static_cast<int>(crop.thickness_um.size()));
+  EXPECT_DOUBLE_EQ(crop.origin_x_mm, 0.0);
+  EXPECT_FLOAT_EQ(crop.max_value(), 5.0f);
+  // nothing deposited: no window
+  HeightMap empty = spotted_map(0.0f);
+  for (float& v : empty.thickness_um) v = 0.0f;
+  EXPECT_FALSE(plots::thickest_spot_window({&empty}).found);
+}
+
+TEST(ComparisonTravels, PathsNumberedFromZeroInPrintOrder) {
+  // print path 1 along y = 0, travel, print path 0 along y = 2 (printed second)
+  MotionSamples s;
+  for (int k = 0; k <= 10; ++k) s.push_back(0.1 * k, Vec3(k, 0, 0), Vec3(10, 0, 0), true, 1, 10);
+  for (int k = 1; k < 5; ++k)
+    s.push_back(1.0 + 0.1 * k, Vec3(10, 0.5 * k, 0), Vec3(0, 5, 0), false, -1, 0);
+  for (int k = 0; k <= 10; ++k)
+    s.push_back(1.5 + 0.1 * k, Vec3(10 - k, 2, 0), Vec3(-10, 0, 0), true, 0, 10);
+  plots::ComparisonColumn column;
+  plots::set_travels(column, s);
+  ASSERT_EQ(column.path_labels.size(), 2u);
+  EXPECT_EQ(column.path_labels[0].path, 1);
+  EXPECT_DOUBLE_EQ(column.path_labels[0].x_mm, 5.0);
+  EXPECT_EQ(column.path_labels[1].path, 0);
+  EXPECT_DOUBLE_EQ(column.path_labels[1].y_mm, 2.0);
+  EXPECT_GT(column.travel_xy.point_count(), 0u);
+  EXPECT_GT(column.print_xy.point_count(), 0u);
+
+  std::vector<plots::ComparisonColumn> columns(2);
+  columns[0].order = columns[1].order = "as_given";
+  EXPECT_FALSE(plots::is_orders_comparison(columns));
+  columns[1].order = "nearest_neighbor";
+  EXPECT_TRUE(plots::is_orders_comparison(columns));
+}
+
+// extrusion's 0.2 mm layer and 0.45 mm bead: 0.45 x 0.2 / (0.1125 sqrt(2 pi)) = 319 um
+TEST(ThicknessProfile, TargetNoteSaysWhereTheTargetComesFrom) {
+  const std::string extrusion =
+      plots::target_thickness_note(true, 319.15, 10.0, 0.1125, 0.0, 0.45, 0.2);
+  EXPECT_EQ(extrusion,
+            "target 319 µm: the bead's w × h = 0.45 × 0.2 mm cross-section as a Gaussian of "
+            "σ = w/4 = 0.113 mm: w h / (σ √(2π)) = 1.60 h");
+  const std::string aerosol = plots::target_thickness_note(false, 2.0, 3.0, 0.1, 1.504, 0, 0);
+  EXPECT_EQ(aerosol,
+            "target 2 µm: a straight line's centreline peak Q / (v σ √(2π)), Q = 1.5 mm³/s, "
+            "v = 3 mm/s, σ = 0.1 mm");
+}
+
+}  // namespace
+}  // namespace depotwin
