@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "core/error.hpp"
@@ -22,35 +23,48 @@ namespace {
 
 constexpr const char* kCameraName = "render_cam";
 constexpr const char* kSubstrateBody = "substrate";
-// margin around the framed region, and the smallest region framed (mm)
-constexpr double kFrameMargin = 1.25;
-constexpr double kMinFrameRadius_mm = 3.0;
+constexpr const char* kNozzleSite = "nozzle";
+// the framed bounds fill this fraction of a panel's half-width and half-height
+constexpr double kFill = 0.92;
+// the close-up shows at least this far around the deposit's centre (mm), and looks down at
+// least this steeply (deg)
+constexpr double kMinCloseupHalf_mm = 3.0;
+constexpr double kCloseupElevation_deg = 55.0;
+// on a part the machine view looks down at least this steeply (deg)
+constexpr double kPartElevation_deg = 40.0;
+// in the close-up, geoms above the substrate outside its body tree (the print head) are drawn
+// with this opacity, so that they hide nothing
+constexpr float kGhostAlpha = 0.2f;
 // framed renders: the key light comes from above, tilted this much towards the view
 // direction, from this far away
 constexpr double kShoulderLight = 0.35;
 constexpr double kLightDistance_m = 0.6;
-// the nozzle counts as apart from the deposit beyond this fraction of the deposit's radius
-constexpr double kNozzleApartFraction = 0.2;
-// the bodies carrying the nozzle are framed while the region's radius stays within this
-// multiple of the deposit-and-nozzle radius (frame_camera)
-constexpr double kChainFrameFactor = 3.5;
-// ... seen broadside when its deposit region is this much longer than wide, the view turned
-// this much towards the machine (deg) (machine_side_azimuth)
+// a machine that carries the nozzle on a chain of bodies is seen broadside when its deposit
+// region is this much longer than wide, the view turned this much towards the machine (deg)
+// (machine_side_azimuth); the tool leans across the long side when this fraction of its lean is
 constexpr double kElongated = 1.5;
 constexpr double kChainTurn_deg = 25.0;
-// the tool leans across the long side when this fraction of its lean is (machine_side_azimuth)
 constexpr double kToolLean = 0.3;
-// on a part the view looks down at least this steeply (deg)
-constexpr double kPartElevation_deg = 40.0;
-// deposit boxes float this far above the plate so they never z-fight with it (mm); on a part
-// (a mesh seen from farther away, an arm's scale) this fraction of the relief, if more
+// the deposit mesh floats this far above a flat plate (mm); on a part (a mesh seen from farther
+// away) this fraction of the relief, if more
 constexpr double kLift_mm = 0.005;
 constexpr double kSurfaceLiftFraction = 0.02;
-// the floor drawn under the machine: colour, half-width and drop below the lowest geom (in
-// model extents)
-constexpr float kBackdropColour[4] = {0.78f, 0.80f, 0.83f, 1.0f};
+// the drawn height of the thickest deposit is at most this fraction of its bead's width
+constexpr double kReliefPerBeadWidth = 0.5;
+// the floor drawn under the machine (darker than the substrate plates, so that they stand
+// out): colour, half-width and drop below the lowest geom (in model extents)
+constexpr float kBackdropColour[4] = {0.50f, 0.52f, 0.55f, 1.0f};
 constexpr double kBackdropHalfWidth = 20.0;
 constexpr double kBackdropDrop = 0.05;
+// layout: the close-up's share of the width; the strip's height (fraction of the image, and
+// bounds in pixels)
+constexpr double kCloseupShare = 0.5;
+constexpr double kStripShare = 0.09;
+constexpr int kMinStrip_px = 30;
+constexpr int kMaxStrip_px = 64;
+// overlay colours: the strip and label backgrounds, text and bars
+constexpr float kPaper[3] = {0.96f, 0.96f, 0.95f};
+constexpr float kInk[3] = {0.08f, 0.08f, 0.10f};
 
 // an OSMesa context made current on its own colour buffer; destroyed last
 class OsMesaContext {
@@ -85,6 +99,11 @@ class OsMesaContext {
   OSMesaContext context_ = nullptr;
 };
 
+// OSMesa's GL entry points, for the deposit mesh
+void* osmesa_proc_address(const char* name) {
+  return reinterpret_cast<void*>(OSMesaGetProcAddress(name));
+}
+
 // mjvScene / mjrContext owners (freed before the GL context goes)
 struct SceneOwner {
   mjvScene scene;
@@ -99,7 +118,7 @@ struct SceneOwner {
 struct RenderContextOwner {
   mjrContext context;
   // made from a copy of the model whose offscreen and shadow sizes are those of `shape`
-  RenderContextOwner(const mjModel& model, int width, int height, int shadow_size) {
+  RenderContextOwner(const mjModel& model, int width, int height, int shadow_size, int font_scale) {
     const ModelPtr sized(mj_copyModel(nullptr, &model));
     if (!sized) throw InternalError("MuJoCo could not copy the model for its render context");
     sized->vis.global.offwidth = width;
@@ -107,7 +126,7 @@ struct RenderContextOwner {
     sized->vis.quality.offsamples = 0;  // anti-aliased by supersampling instead
     sized->vis.quality.shadowsize = shadow_size;
     mjr_defaultContext(&context);
-    mjr_makeContext(sized.get(), &context, mjFONTSCALE_100);
+    mjr_makeContext(sized.get(), &context, font_scale);
   }
   ~RenderContextOwner() { mjr_freeContext(&context); }
   RenderContextOwner(const RenderContextOwner&) = delete;
@@ -115,16 +134,21 @@ struct RenderContextOwner {
 };
 
 // what an mjrContext depends on: the model's shape (models of the same MJCF file have the
-// same one) and the buffers it was made with
+// same one) and the buffers and font it was made with
 struct ContextShape {
   int ngeom, nmesh, nmeshvert, ntex, ntexdata, nmat, nskin, nhfield;
-  int width, height, shadow_size;
+  int width, height, shadow_size, font_scale;
   bool operator==(const ContextShape& o) const {
     return ngeom == o.ngeom && nmesh == o.nmesh && nmeshvert == o.nmeshvert && ntex == o.ntex &&
            ntexdata == o.ntexdata && nmat == o.nmat && nskin == o.nskin && nhfield == o.nhfield &&
-           width == o.width && height == o.height && shadow_size == o.shadow_size;
+           width == o.width && height == o.height && shadow_size == o.shadow_size &&
+           font_scale == o.font_scale;
   }
 };
+// MuJoCo's font scale for text of the usual size after downsampling by `factor`
+int font_scale_for(int factor) {
+  return std::min(300, 100 * factor);
+}
 // The offscreen buffer is the supersampled image's size, not the model's <global offwidth
 // offheight>, without multisampling, and the shadow map is left out when shadows are off: in
 // software GL a multisampled buffer costs its own shader compilation and a resolve pass, and
@@ -140,7 +164,8 @@ ContextShape context_shape(const mjModel& m, const SceneRenderOptions& options) 
           m.nhfield,
           options.width * options.supersampling,
           options.height * options.supersampling,
-          options.shadows ? m.vis.quality.shadowsize : 0};
+          options.shadows ? m.vis.quality.shadowsize : 0,
+          font_scale_for(options.supersampling)};
 }
 
 // substrate-frame point (mm) -> world (m)
@@ -156,74 +181,153 @@ Vec3 substrate_to_world(const mjData& data, int body, const Vec3& local_mm) {
   return world;
 }
 
-// the surface's unit normal at (x, y) from its heights `step_mm` either side (central
-// differences, one-sided at an edge; +z where there are no neighbours)
-Vec3 surface_normal(const SceneRenderOptions& options, double x_mm, double y_mm, double z_mm,
-                    double step_mm) {
-  auto slope = [&](double dx, double dy) {
-    const std::optional<double> ahead = options.surface_height_mm(x_mm + dx, y_mm + dy);
-    const std::optional<double> behind = options.surface_height_mm(x_mm - dx, y_mm - dy);
-    if (ahead && behind) return (*ahead - *behind) / (2.0 * step_mm);
-    if (ahead) return (*ahead - z_mm) / step_mm;
-    if (behind) return (z_mm - *behind) / step_mm;
-    return 0.0;
-  };
-  return Vec3(-slope(step_mm, 0.0), -slope(0.0, step_mm), 1.0).normalized();
-}
-
-// a rotation (row-major, MuJoCo's geom frame) whose z axis is `axis` in the substrate frame and
-// whose x axis is the substrate's x tilted with it, composed with the substrate's orientation
-void box_rotation(const mjData& data, int substrate, const Vec3& axis, mjtNum out[9]) {
-  const Vec3 x_axis = (Vec3::UnitX() - Vec3::UnitX().dot(axis) * axis).normalized();
-  const Vec3 y_axis = axis.cross(x_axis);
+// substrate frame (mm) <- world point (m)
+Vec3 world_to_substrate(const mjData& data, int substrate, const Vec3& world) {
+  const mjtNum* origin = data.xpos + 3 * substrate;
   const mjtNum* rotation = data.xmat + 9 * substrate;
-  for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 3; ++col) {
-      const Vec3& column = col == 0 ? x_axis : (col == 1 ? y_axis : axis);
-      out[3 * row + col] = rotation[3 * row] * column.x() + rotation[3 * row + 1] * column.y() +
-                           rotation[3 * row + 2] * column.z();
-    }
+  Vec3 local = Vec3::Zero();
+  for (int col = 0; col < 3; ++col)
+    for (int row = 0; row < 3; ++row)
+      local[col] += rotation[3 * row + col] * (world[row] - origin[row]);
+  return m_to_mm(1.0) * local;
 }
 
-// the boxes as scene geoms, coloured by their relative thickness
-void add_deposit_boxes(const mjData& data, int substrate, const std::vector<DepositBox>& boxes,
-                       mjvScene& scene) {
-  for (const DepositBox& box : boxes) {
-    if (scene.ngeom >= scene.maxgeom) return;
-    const Vec3 centre = substrate_to_world(
-        data, substrate, box.base_mm + (box.lift_mm + box.half_height_mm) * box.axis);
-    const mjtNum size[3] = {mm_to_m(box.half_width_mm), mm_to_m(box.half_width_mm),
-                            mm_to_m(box.half_height_mm)};
-    const mjtNum position[3] = {centre.x(), centre.y(), centre.z()};
-    mjtNum rotation[9];
-    box_rotation(data, substrate, box.axis, rotation);
-    float rgba[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-    viridis(box.relative, rgba);
-    mjvGeom* geom = scene.geoms + scene.ngeom++;
-    mjv_initGeom(geom, mjGEOM_BOX, size, position, rotation, rgba);
-    geom->emission = 0.25f;
-    geom->specular = 0.2f;
-  }
+// the 8 corners of a box
+std::vector<Vec3> box_corners(const Vec3& lo, const Vec3& hi) {
+  std::vector<Vec3> corners;
+  for (int i = 0; i < 8; ++i)
+    corners.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  return corners;
 }
 
-// A floor under the machine, so that no view shows the empty background (the models have
-// no skybox: in software GL each texture costs a shader compilation per process). Left out
-// when the model has a plane of its own.
-void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene) {
-  double lowest_m = std::numeric_limits<double>::infinity();
+// drawn by mjv_updateScene with the default options: groups 0 to 2, not fully transparent
+bool geom_visible(const mjModel& model, int geom) {
+  if (model.geom_group[geom] < 0 || model.geom_group[geom] > 2) return false;
+  const int material = model.geom_matid[geom];
+  const float alpha =
+      material >= 0 ? model.mat_rgba[4 * material + 3] : model.geom_rgba[4 * geom + 3];
+  return alpha > 0.0f;
+}
+
+// The world bounding box (m) of the model's visible geoms, planes left out: each geom's box in
+// its own frame (a mesh's vertices' box) turned into the world. false when there is none.
+bool machine_bounds(const mjModel& model, const mjData& data, Vec3& lo, Vec3& hi) {
+  lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  bool any = false;
   for (int geom = 0; geom < model.ngeom; ++geom) {
-    if (model.geom_type[geom] == mjGEOM_PLANE) return;
-    lowest_m = std::min(lowest_m, data.geom_xpos[3 * geom + 2] - model.geom_rbound[geom]);
+    if (model.geom_type[geom] == mjGEOM_PLANE || !geom_visible(model, geom)) continue;
+    const mjtNum* size = model.geom_size + 3 * geom;
+    Vec3 centre = Vec3::Zero(), half;
+    switch (model.geom_type[geom]) {
+      case mjGEOM_SPHERE:
+        half = Vec3::Constant(size[0]);
+        break;
+      case mjGEOM_CAPSULE:
+        half = Vec3(size[0], size[0], size[1] + size[0]);
+        break;
+      case mjGEOM_CYLINDER:
+        half = Vec3(size[0], size[0], size[1]);
+        break;
+      case mjGEOM_BOX:
+      case mjGEOM_ELLIPSOID:
+        half = Vec3(size[0], size[1], size[2]);
+        break;
+      case mjGEOM_MESH: {
+        const int mesh = model.geom_dataid[geom];
+        Vec3 mesh_lo = Vec3::Constant(std::numeric_limits<double>::infinity()), mesh_hi = -mesh_lo;
+        for (int v = 0; v < model.mesh_vertnum[mesh]; ++v) {
+          const float* vertex = model.mesh_vert + 3 * (model.mesh_vertadr[mesh] + v);
+          const Vec3 point(vertex[0], vertex[1], vertex[2]);
+          mesh_lo = mesh_lo.cwiseMin(point);
+          mesh_hi = mesh_hi.cwiseMax(point);
+        }
+        if (model.mesh_vertnum[mesh] == 0) continue;
+        centre = 0.5 * (mesh_lo + mesh_hi);
+        half = 0.5 * (mesh_hi - mesh_lo);
+        break;
+      }
+      default:
+        half = Vec3::Constant(model.geom_rbound[geom]);
+    }
+    const mjtNum* rotation = data.geom_xmat + 9 * geom;
+    Vec3 world_centre, world_half;
+    for (int row = 0; row < 3; ++row) {
+      world_centre[row] = data.geom_xpos[3 * geom + row];
+      world_half[row] = 0.0;
+      for (int col = 0; col < 3; ++col) {
+        world_centre[row] += rotation[3 * row + col] * centre[col];
+        world_half[row] += std::abs(rotation[3 * row + col]) * half[col];
+      }
+    }
+    lo = lo.cwiseMin(world_centre - world_half);
+    hi = hi.cwiseMax(world_centre + world_half);
+    any = true;
   }
-  if (!std::isfinite(lowest_m) || scene.ngeom >= scene.maxgeom) return;
-  const double extent_m = model.stat.extent;
-  const double half_thickness_m = 0.01 * extent_m;
-  const mjtNum size[3] = {kBackdropHalfWidth * extent_m, kBackdropHalfWidth * extent_m,
-                          half_thickness_m};
-  const mjtNum position[3] = {model.stat.center[0], model.stat.center[1],
-                              lowest_m - kBackdropDrop * extent_m - half_thickness_m};
-  const mjtNum identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  mjv_initGeom(scene.geoms + scene.ngeom++, mjGEOM_BOX, size, position, identity, kBackdropColour);
+  return any;
+}
+
+// a free camera's forward, up and right directions (MuJoCo's mjv_updateScene convention)
+struct ViewBasis {
+  Vec3 forward, up, right;
+};
+ViewBasis view_basis(double azimuth_deg, double elevation_deg) {
+  const double ca = std::cos(deg_to_rad(azimuth_deg)), sa = std::sin(deg_to_rad(azimuth_deg));
+  const double ce = std::cos(deg_to_rad(elevation_deg)), se = std::sin(deg_to_rad(elevation_deg));
+  ViewBasis basis;
+  basis.forward = Vec3(ce * ca, ce * sa, se);
+  basis.up = Vec3(-se * ca, -se * sa, ce);
+  basis.right = basis.forward.cross(basis.up);
+  return basis;
+}
+
+// The free camera from this direction that shows every point inside kFill of a panel of
+// `aspect` (width / height) with vertical field of view fovy: centred on the points' image
+// (a few passes: the look-at point moves to the middle of their projected extent), then as
+// close as that allows.
+FreeCamera fit_camera(const std::vector<Vec3>& points, double azimuth_deg, double elevation_deg,
+                      double fovy_deg, double aspect) {
+  FreeCamera camera;
+  camera.azimuth_deg = azimuth_deg;
+  camera.elevation_deg = elevation_deg;
+  if (points.empty()) return camera;
+  const ViewBasis basis = view_basis(azimuth_deg, elevation_deg);
+  const double tan_v = std::tan(deg_to_rad(0.5 * fovy_deg)) * kFill;
+  const double tan_h = tan_v * aspect;
+  Vec3 lo = points.front(), hi = points.front();
+  for (const Vec3& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  Vec3 lookat = 0.5 * (lo + hi);
+  // the nearest distance at which every point is inside the panel
+  auto distance_for = [&](const Vec3& at) {
+    double distance = 0.0;
+    for (const Vec3& p : points) {
+      const Vec3 d = p - at;
+      const double depth = d.dot(basis.forward);
+      distance = std::max({distance, std::abs(d.dot(basis.right)) / tan_h - depth,
+                           std::abs(d.dot(basis.up)) / tan_v - depth});
+    }
+    return distance;
+  };
+  for (int pass = 0; pass < 4; ++pass) {
+    const double distance = std::max(distance_for(lookat), 1e-6);
+    double u_lo = std::numeric_limits<double>::infinity(), u_hi = -u_lo, v_lo = u_lo, v_hi = -u_lo;
+    for (const Vec3& p : points) {
+      const Vec3 d = p - lookat;
+      const double depth = std::max(1e-9, distance + d.dot(basis.forward));
+      const double u = d.dot(basis.right) / depth, v = d.dot(basis.up) / depth;
+      u_lo = std::min(u_lo, u);
+      u_hi = std::max(u_hi, u);
+      v_lo = std::min(v_lo, v);
+      v_hi = std::max(v_hi, v);
+    }
+    lookat += distance * (0.5 * (u_lo + u_hi) * basis.right + 0.5 * (v_lo + v_hi) * basis.up);
+  }
+  camera.lookat_m = lookat;
+  camera.distance_m = std::max(distance_for(lookat), 1e-4);
+  return camera;
 }
 
 // The view's azimuth (deg) for a machine that reaches the part through a chain of bodies (an
@@ -233,7 +337,7 @@ void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene) {
 // tool leaning away, else the machine behind it, turned kChainTurn_deg towards the machine), a
 // squarish one from opposite the machine, turned kChainTurn_deg towards render_cam's view
 // (`camera_azimuth`): a three-quarter view of the part with the arm reaching in from behind.
-double machine_side_azimuth(const mjData& data, int substrate, const HeightMap& deposit,
+double machine_side_azimuth(const mjData& data, int substrate, const Vec3& deposit_size_mm,
                             const Vec3& towards_root, const Vec3& tool_lean,
                             double camera_azimuth) {
   const double root = rad_to_deg(std::atan2(towards_root.y(), towards_root.x()));
@@ -241,7 +345,7 @@ double machine_side_azimuth(const mjData& data, int substrate, const HeightMap& 
   auto turned = [](double from, double to, double by) {
     return from + std::clamp(std::remainder(to - from, 360.0), -by, by);
   };
-  const double ex = deposit.nx * deposit.cell_mm, ey = deposit.ny * deposit.cell_mm;
+  const double ex = deposit_size_mm.x(), ey = deposit_size_mm.y();
   if (std::max(ex, ey) < kElongated * std::min(ex, ey))
     return turned(root, camera_azimuth, kChainTurn_deg);
   // the long side's direction in the world, and the two views across it
@@ -263,108 +367,190 @@ double machine_side_azimuth(const mjData& data, int substrate, const HeightMap& 
   return turned(across[side], root, kChainTurn_deg);
 }
 
-// substrate frame (mm) <- world point (m)
-Vec3 world_to_substrate(const mjData& data, int substrate, const Vec3& world) {
-  const mjtNum* origin = data.xpos + 3 * substrate;
-  const mjtNum* rotation = data.xmat + 9 * substrate;
-  Vec3 local = Vec3::Zero();
-  for (int col = 0; col < 3; ++col)
-    for (int row = 0; row < 3; ++row)
-      local[col] += rotation[3 * row + col] * (world[row] - origin[row]);
-  return m_to_mm(1.0) * local;
+// The deposit's bead width (mm): the median length of the runs of cells thicker than half the
+// peak, along the rows and along the columns, the smaller of the two (a line at any angle: its
+// width to within 41 %; a covered area: its size). 0 without a deposit.
+double bead_width_mm(const HeightMap& map) {
+  const float half = 0.5f * map.max_value();
+  if (!(half > 0.0f)) return 0.0;
+  auto median_run = [&](int lines, int length, auto at) {
+    std::vector<int> runs;
+    for (int line = 0; line < lines; ++line) {
+      int run = 0;
+      for (int i = 0; i <= length; ++i) {
+        if (i < length && at(line, i) >= half) {
+          ++run;
+        } else if (run > 0) {
+          runs.push_back(run);
+          run = 0;
+        }
+      }
+    }
+    if (runs.empty()) return std::numeric_limits<double>::infinity();
+    std::nth_element(runs.begin(), runs.begin() + runs.size() / 2, runs.end());
+    return static_cast<double>(runs[runs.size() / 2]);
+  };
+  const double along_rows =
+      median_run(map.ny, map.nx, [&](int row, int i) { return map.at(i, row); });
+  const double along_columns =
+      median_run(map.nx, map.ny, [&](int column, int i) { return map.at(column, i); });
+  return std::min(along_rows, along_columns) * map.cell_mm;
 }
 
-// The free camera that frames the deposit region and the nozzle from render_cam's elevation.
-// Its azimuth points from the deposit towards the nozzle when they are apart, so the print
-// head stands behind the deposit rather than in front of it; otherwise render_cam's azimuth.
-//
-// A machine that carries the nozzle on a chain of bodies (an arm: tool, wrist, forearm, ...)
-// is framed with its tool, and with the tool's ancestors as long as their origins stay within
-// kChainFrameFactor times the deposit-and-nozzle radius of that region's centre. Why: an arm
-// is ten times the size of its part. render_cam's own pose shows all of it, with the part and
-// its deposit a few pixels wide; the deposit and the nozzle alone show a nozzle tip over a
-// strip, the machine cut off. Framed with the tool (and on a larger part the wrist, which
-// then stays within the factor), the deposit is the subject in the lower middle, the head
-// stands over it, the arm reaches in from behind, and the picture says what machine it is.
-// The azimuth then comes from machine_side_azimuth (the part broadside, the arm behind it),
-// and on a part the view looks down at least kPartElevation_deg (see below). A nozzle fixed in
-// the world (the delta, the XY stage) has no chain: their framing is as it was. On a part (a
-// surface) the region also spans the deposit's heights and the nozzle's.
-void frame_camera(const mjModel& model, const mjData& data, int camera, int substrate,
-                  const HeightMap& deposit, const std::vector<DepositBox>& boxes, bool on_surface,
-                  mjvCamera& view) {
-  // region in the substrate frame: the grid's cells (and on a part the boxes' heights), then
-  // the nozzle point
-  Vec3 lo(deposit.origin_x_mm - 0.5 * deposit.cell_mm, deposit.origin_y_mm - 0.5 * deposit.cell_mm,
-          0.0);
-  Vec3 hi(lo.x() + deposit.nx * deposit.cell_mm, lo.y() + deposit.ny * deposit.cell_mm, 0.0);
-  if (on_surface)
-    for (const DepositBox& box : boxes) {
-      const Vec3 top = box.base_mm + (box.lift_mm + 2.0 * box.half_height_mm) * box.axis;
-      lo.z() = std::min({lo.z(), box.base_mm.z(), top.z()});
-      hi.z() = std::max({hi.z(), box.base_mm.z(), top.z()});
-    }
-  const Vec3 deposit_centre = substrate_to_world(data, substrate, 0.5 * (lo + hi));
-  const double deposit_radius_mm = 0.5 * (hi - lo).norm();
-  Vec3 towards_nozzle = Vec3::Zero(), chain_towards = Vec3::Zero(), tool_lean = Vec3::Zero();
-  bool chain_framed = false;
-  const int nozzle = mj_name2id(&model, mjOBJ_SITE, "nozzle");
-  if (nozzle >= 0) {
-    const Vec3 nozzle_world(data.site_xpos[3 * nozzle], data.site_xpos[3 * nozzle + 1],
-                            data.site_xpos[3 * nozzle + 2]);
-    Vec3 local = world_to_substrate(data, substrate, nozzle_world);
-    if (!on_surface) local.z() = 0.0;
-    lo = lo.cwiseMin(local);
-    hi = hi.cwiseMax(local);
-    towards_nozzle = nozzle_world - deposit_centre;
-    towards_nozzle.z() = 0.0;
-
-    // the chain that carries the nozzle: the nozzle's own body (the tool) and its ancestors
-    // as far as they stay near are framed; the direction towards the chain's root (an arm's
-    // base) sets the azimuth
-    const Vec3 base_centre = 0.5 * (lo + hi);
-    const double base_radius_mm = std::max(kMinFrameRadius_mm, 0.5 * (hi - lo).norm());
-    bool near = true;
-    for (int body = model.site_bodyid[nozzle]; body > 0; body = model.body_parentid[body]) {
-      const Vec3 world(data.xpos[3 * body], data.xpos[3 * body + 1], data.xpos[3 * body + 2]);
-      const Vec3 point = world_to_substrate(data, substrate, world);
-      near = near &&
-             (!chain_framed || (point - base_centre).norm() <= kChainFrameFactor * base_radius_mm);
-      if (!near) break;
-      lo = lo.cwiseMin(point);
-      hi = hi.cwiseMax(point);
-      chain_framed = true;
-    }
-    // the direction from the deposit to the chain's root (an arm's base), the tool's lean
-    for (int body = model.site_bodyid[nozzle]; body > 0; body = model.body_parentid[body])
-      chain_towards = Vec3(data.xpos[3 * body] - deposit_centre.x(),
-                           data.xpos[3 * body + 1] - deposit_centre.y(), 0.0);
-    const int tool = model.site_bodyid[nozzle];
-    tool_lean = Vec3(data.xpos[3 * tool] - nozzle_world.x(),
-                     data.xpos[3 * tool + 1] - nozzle_world.y(), 0.0);
+// the deposit mesh's colour top and relief for `deposit` (the framing's when given): the relief
+// a fraction of the region's size, at most kReliefPerBeadWidth of the bead's width (a narrow
+// line as a low mound, not a wall whose flanks hide its crest)
+DepositMeshOptions mesh_options(const HeightMap& deposit, const SceneRenderOptions& options) {
+  DepositMeshOptions mesh;
+  if (options.framing) {
+    mesh.colour_top_um = options.framing->colour_top_um;
+    mesh.relief_mm = options.framing->relief_mm;
+  } else {
+    mesh.colour_top_um = deposit.thickness_um.empty() ? 0.0 : deposit.max_value();
+    mesh.relief_mm =
+        std::min(options.relief_fraction * std::max(deposit.nx, deposit.ny) * deposit.cell_mm,
+                 kReliefPerBeadWidth * bead_width_mm(deposit));
   }
-  const double radius_mm = std::max(kMinFrameRadius_mm, 0.5 * (hi - lo).norm()) * kFrameMargin;
-  const Vec3 centre = substrate_to_world(data, substrate, 0.5 * (lo + hi));
+  mesh.surface_height_mm = options.surface_height_mm;
+  mesh.along_normal = options.tilt_to_surface;
+  mesh.max_vertices = options.max_mesh_vertices;
+  mesh.min_relative_thickness = options.min_relative_thickness;
+  mesh.lift_mm = options.surface_height_mm
+                     ? std::max(kLift_mm, kSurfaceLiftFraction * mesh.relief_mm)
+                     : kLift_mm;
+  return mesh;
+}
 
-  // render_cam looks along its -z axis
+// panel aspect ratio (width / height)
+double aspect_of(const PixelRect& rect) {
+  return rect.height > 0 ? static_cast<double>(rect.width) / rect.height : 1.0;
+}
+
+// The views of frame_scene, from the mesh already built for the deposit (its bounds).
+SceneFraming frame_views(const mjModel& model, const mjData& data, int camera, int substrate,
+                         const DepositMesh& mesh, const SceneRenderOptions& options) {
+  SceneFraming framing;
+  framing.colour_top_um = mesh.colour_top_um;
+  framing.relief_mm = mesh.relief_mm;
+  framing.whole_from_render_cam = !options.frame_deposit;
+  const SceneLayout layout = scene_layout(options);
+  const double fovy = model.vis.global.fovy;
+  const bool on_surface = static_cast<bool>(options.surface_height_mm);
+
+  // the deposit's box in the substrate frame: the mesh's (on a flat plate down to z = 0), else
+  // a few mm around the nozzle's point on the substrate
+  const int nozzle = mj_name2id(&model, mjOBJ_SITE, kNozzleSite);
+  Vec3 nozzle_world = Vec3::Zero();
+  if (nozzle >= 0)
+    nozzle_world = Vec3(data.site_xpos[3 * nozzle], data.site_xpos[3 * nozzle + 1],
+                        data.site_xpos[3 * nozzle + 2]);
+  Vec3 deposit_lo, deposit_hi;
+  if (!mesh.empty()) {
+    deposit_lo = mesh.lo_mm;
+    deposit_hi = mesh.hi_mm;
+    deposit_lo.z() = std::min(deposit_lo.z(), 0.0);
+  } else {
+    Vec3 centre = nozzle >= 0 ? world_to_substrate(data, substrate, nozzle_world) : Vec3::Zero();
+    centre.z() = 0.0;
+    deposit_lo = centre;
+    deposit_hi = centre;
+  }
+  const Vec3 deposit_centre_mm = 0.5 * (deposit_lo + deposit_hi);
+  const Vec3 min_half(kMinCloseupHalf_mm, kMinCloseupHalf_mm, 0.0);
+  const Vec3 closeup_lo = deposit_lo.cwiseMin(deposit_centre_mm - min_half);
+  const Vec3 closeup_hi = deposit_hi.cwiseMax(deposit_centre_mm + min_half);
+  std::vector<Vec3> deposit_points;
+  for (const Vec3& corner : box_corners(closeup_lo, closeup_hi))
+    deposit_points.push_back(substrate_to_world(data, substrate, corner));
+
+  // the direction: render_cam's (it looks along its -z axis)
   const mjtNum* axes = data.cam_xmat + 9 * camera;
   const Vec3 forward(-axes[2], -axes[5], -axes[8]);
-  view.type = mjCAMERA_FREE;
-  for (int i = 0; i < 3; ++i) view.lookat[i] = centre[i];
   const double camera_azimuth = rad_to_deg(std::atan2(forward.y(), forward.x()));
-  view.azimuth = camera_azimuth;
-  view.elevation = rad_to_deg(std::asin(std::clamp(forward.z(), -1.0, 1.0)));
-  if (chain_framed && m_to_mm(chain_towards.norm()) > kNozzleApartFraction * deposit_radius_mm) {
-    view.azimuth =
-        machine_side_azimuth(data, substrate, deposit, chain_towards, tool_lean, camera_azimuth);
-  } else if (m_to_mm(towards_nozzle.norm()) > kNozzleApartFraction * deposit_radius_mm) {
-    view.azimuth = rad_to_deg(std::atan2(towards_nozzle.y(), towards_nozzle.x()));
+  double azimuth = camera_azimuth;
+  double elevation = rad_to_deg(std::asin(std::clamp(forward.z(), -1.0, 1.0)));
+  // a nozzle carried on a chain of bodies (an arm): the part broadside, the arm behind it
+  if (nozzle >= 0 && model.site_bodyid[nozzle] > 0) {
+    const Vec3 deposit_world = substrate_to_world(data, substrate, deposit_centre_mm);
+    Vec3 towards_root = Vec3::Zero();
+    for (int body = model.site_bodyid[nozzle]; body > 0; body = model.body_parentid[body])
+      towards_root = Vec3(data.xpos[3 * body] - deposit_world.x(),
+                          data.xpos[3 * body + 1] - deposit_world.y(), 0.0);
+    const int tool = model.site_bodyid[nozzle];
+    const Vec3 tool_lean(data.xpos[3 * tool] - nozzle_world.x(),
+                         data.xpos[3 * tool + 1] - nozzle_world.y(), 0.0);
+    if (towards_root.norm() > 0.0)
+      azimuth = machine_side_azimuth(data, substrate, closeup_hi - closeup_lo, towards_root,
+                                     tool_lean, camera_azimuth);
   }
-  // on a part, from at least this high: the deposit lies on top of it, and a low view would
-  // look past the floor into the empty background
-  if (on_surface) view.elevation = std::min(view.elevation, -kPartElevation_deg);
-  const double half_fovy_rad = deg_to_rad(0.5 * model.vis.global.fovy);
-  view.distance = mm_to_m(radius_mm) / std::tan(half_fovy_rad);
+  // on a part, from at least this high: the deposit lies on top of it
+  if (on_surface) elevation = std::min(elevation, -kPartElevation_deg);
+
+  // the machine view: the visible geoms, the deposit and the nozzle
+  std::vector<Vec3> machine_points = deposit_points;
+  Vec3 machine_lo, machine_hi;
+  if (machine_bounds(model, data, machine_lo, machine_hi))
+    for (const Vec3& corner : box_corners(machine_lo, machine_hi)) machine_points.push_back(corner);
+  if (nozzle >= 0) machine_points.push_back(nozzle_world);
+  framing.whole = fit_camera(machine_points, azimuth, elevation, fovy, aspect_of(layout.whole));
+
+  // the close-up: the deposit, more steeply
+  const double closeup_elevation = std::min(elevation, -kCloseupElevation_deg);
+  const PixelRect& closeup_panel = layout.closeup.width > 0 ? layout.closeup : layout.whole;
+  framing.closeup =
+      fit_camera(deposit_points, azimuth, closeup_elevation, fovy, aspect_of(closeup_panel));
+  return framing;
+}
+
+// body `body` is `ancestor` or lies in its subtree
+bool in_subtree(const mjModel& model, int body, int ancestor) {
+  for (; body > 0; body = model.body_parentid[body])
+    if (body == ancestor) return true;
+  return body == ancestor;
+}
+
+// The close-up's ghosts: geoms outside the substrate's body tree whose centre is above the
+// deposit's lowest point (the print head, a shutter, an arm's links) become see-through within
+// `reach_mm` above it (the nozzle's tip, a shutter blade), and are left out higher up (they
+// would loom over the panel).
+void ghost_above_substrate(const mjModel& model, const mjData& data, int substrate, double above_mm,
+                           double reach_mm, mjvScene& scene) {
+  int kept = 0;
+  for (int i = 0; i < scene.ngeom; ++i) {
+    mjvGeom geom = scene.geoms[i];
+    if (geom.objtype == mjOBJ_GEOM || geom.objtype == mjOBJ_SITE) {
+      const int body = geom.objtype == mjOBJ_GEOM ? model.geom_bodyid[geom.objid]
+                                                  : model.site_bodyid[geom.objid];
+      const Vec3 centre(geom.pos[0], geom.pos[1], geom.pos[2]);
+      const double height_mm = world_to_substrate(data, substrate, centre).z() - above_mm;
+      if (!in_subtree(model, body, substrate) && height_mm > 0.0) {
+        if (height_mm > reach_mm) continue;
+        geom.rgba[3] = std::min(geom.rgba[3], kGhostAlpha);
+      }
+    }
+    scene.geoms[kept++] = geom;
+  }
+  scene.ngeom = kept;
+}
+
+// A floor under the machine, so that no view shows the empty background (the models have
+// no skybox: in software GL each texture costs a shader compilation per process). Left out
+// when the model has a plane of its own.
+void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene) {
+  double lowest_m = std::numeric_limits<double>::infinity();
+  for (int geom = 0; geom < model.ngeom; ++geom) {
+    if (model.geom_type[geom] == mjGEOM_PLANE) return;
+    lowest_m = std::min(lowest_m, data.geom_xpos[3 * geom + 2] - model.geom_rbound[geom]);
+  }
+  if (!std::isfinite(lowest_m) || scene.ngeom >= scene.maxgeom) return;
+  const double extent_m = model.stat.extent;
+  const double half_thickness_m = 0.01 * extent_m;
+  const mjtNum size[3] = {kBackdropHalfWidth * extent_m, kBackdropHalfWidth * extent_m,
+                          half_thickness_m};
+  const mjtNum position[3] = {model.stat.center[0], model.stat.center[1],
+                              lowest_m - kBackdropDrop * extent_m - half_thickness_m};
+  const mjtNum identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  mjv_initGeom(scene.geoms + scene.ngeom++, mjGEOM_BOX, size, position, identity, kBackdropColour);
 }
 
 // the model's shadow-casting lights moved over the framed camera's shoulder: shadows then
@@ -418,78 +604,180 @@ void write_png(const std::string& path, int width, int height,
   write_file_atomically(path, encode_png(width, height, PngPixels::rgb8, rgb.data()));
 }
 
-}  // namespace
-
-void viridis(double value, float rgb[3]) {
-  // matplotlib's viridis at 0, 1/8, ..., 1 (8-bit), linearly interpolated
-  static const unsigned char kStops[9][3] = {{68, 1, 84},    {71, 44, 122},  {59, 81, 139},
-                                             {44, 113, 142}, {33, 144, 141}, {39, 173, 129},
-                                             {92, 200, 99},  {170, 220, 50}, {253, 231, 37}};
-  const double position = std::clamp(value, 0.0, 1.0) * 8.0;
-  const int index = std::min(7, static_cast<int>(position));
-  const double fraction = position - index;
-  for (int c = 0; c < 3; ++c)
-    rgb[c] = static_cast<float>(
-        ((1.0 - fraction) * kStops[index][c] + fraction * kStops[index + 1][c]) / 255.0);
+// a round length near `target`: 1, 2 or 5 times a power of ten
+double round_length(double target) {
+  const double decade = std::pow(10.0, std::floor(std::log10(target)));
+  for (const double step : {5.0, 2.0, 1.0})
+    if (step * decade <= target) return step * decade;
+  return decade;
 }
 
-std::vector<DepositBox> deposit_boxes(const HeightMap& deposit, double relief_mm,
-                                      const SceneRenderOptions& options) {
-  std::vector<DepositBox> boxes;
-  if (deposit.nx <= 0 || deposit.ny <= 0 || !(deposit.max_value() > 0.0f)) return boxes;
-  int block = 1;
-  while ((static_cast<long>(deposit.nx + block - 1) / block) * ((deposit.ny + block - 1) / block) >
-         options.max_boxes)
-    ++block;
+// a round step at least `target`: 1, 2, 2.5 or 5 times a power of ten
+double round_step(double target) {
+  const double decade = std::pow(10.0, std::floor(std::log10(target)));
+  for (const double step : {1.0, 2.0, 2.5, 5.0})
+    if (step * decade >= target * (1.0 - 1e-12)) return step * decade;
+  return 10.0 * decade;
+}
 
-  // block means, normalised by the largest block mean (the colour scale's top)
-  const int blocks_x = (deposit.nx + block - 1) / block,
-            blocks_y = (deposit.ny + block - 1) / block;
-  std::vector<float> block_mean(static_cast<size_t>(blocks_x) * blocks_y, 0.0f);
-  float block_peak = 0.0f;
-  for (int by = 0; by < blocks_y; ++by)
-    for (int bx = 0; bx < blocks_x; ++bx) {
-      double sum = 0.0;
-      int count = 0;
-      for (int iy = by * block; iy < std::min((by + 1) * block, deposit.ny); ++iy)
-        for (int ix = bx * block; ix < std::min((bx + 1) * block, deposit.nx); ++ix) {
-          sum += deposit.at(ix, iy);
-          ++count;
-        }
-      const float mean = static_cast<float>(sum / count);
-      block_mean[static_cast<size_t>(by) * blocks_x + bx] = mean;
-      block_peak = std::max(block_peak, mean);
-    }
-  if (!(block_peak > 0.0f)) return boxes;
+// the width of a text in MuJoCo's normal font (pixels)
+int text_width(const mjrContext& context, const char* text) {
+  int width = 0;
+  for (const char* c = text; *c; ++c)
+    width += context.charWidth[static_cast<unsigned char>(*c) & 0x7f];
+  return width;
+}
 
-  const bool on_surface = static_cast<bool>(options.surface_height_mm);
-  const double lift_mm =
-      on_surface ? std::max(kLift_mm, kSurfaceLiftFraction * relief_mm) : kLift_mm;
-  const double half_width_mm = 0.5 * block * deposit.cell_mm;
-  for (int by = 0; by < blocks_y; ++by) {
-    for (int bx = 0; bx < blocks_x; ++bx) {
-      const double relative = block_mean[static_cast<size_t>(by) * blocks_x + bx] / block_peak;
-      if (relative < options.min_relative_thickness) continue;
-      // centre of the block's covered area, height proportional to the thickness
-      DepositBox box;
-      const double x_mm = deposit.origin_x_mm + (bx * block + 0.5 * (block - 1)) * deposit.cell_mm;
-      const double y_mm = deposit.origin_y_mm + (by * block + 0.5 * (block - 1)) * deposit.cell_mm;
-      box.base_mm = Vec3(x_mm, y_mm, 0.0);
-      if (on_surface) {
-        if (const std::optional<double> z_mm = options.surface_height_mm(x_mm, y_mm)) {
-          box.base_mm.z() = *z_mm;
-          if (options.tilt_to_surface)
-            box.axis = surface_normal(options, x_mm, y_mm, *z_mm, half_width_mm);
-        }
-      }
-      box.half_width_mm = half_width_mm;
-      box.half_height_mm = 0.5 * relative * relief_mm;
-      box.lift_mm = lift_mm;
-      box.relative = relative;
-      boxes.push_back(box);
+// a number for a label: 3 significant digits, no trailing zeros
+std::string label_number(double value) {
+  char text[32];
+  if (std::abs(value) >= 100.0)
+    std::snprintf(text, sizeof text, "%.0f", value);
+  else
+    std::snprintf(text, sizeof text, "%.3g", std::abs(value) < 1e-12 ? 0.0 : value);
+  return text;
+}
+
+}  // namespace
+
+SceneLayout scene_layout(const SceneRenderOptions& options) {
+  SceneLayout layout;
+  const int strip = options.overlays
+                        ? std::clamp(static_cast<int>(std::lround(kStripShare * options.height)),
+                                     kMinStrip_px, std::min(kMaxStrip_px, options.height / 3))
+                        : 0;
+  const int panels_height = options.height - strip;
+  const int closeup =
+      options.closeup ? static_cast<int>(std::lround(kCloseupShare * options.width)) : 0;
+  layout.whole = {0, 0, options.width - closeup, panels_height};
+  layout.closeup = {options.width - closeup, 0, closeup, closeup > 0 ? panels_height : 0};
+  layout.strip = {0, panels_height, options.width, strip};
+  return layout;
+}
+
+void set_free_camera(const FreeCamera& camera, mjvCamera& view) {
+  view.type = mjCAMERA_FREE;
+  for (int i = 0; i < 3; ++i) view.lookat[i] = camera.lookat_m[i];
+  view.distance = camera.distance_m;
+  view.azimuth = camera.azimuth_deg;
+  view.elevation = camera.elevation_deg;
+}
+
+std::optional<Eigen::Vector2d> project_to_viewport(const mjvGLCamera& camera,
+                                                   const mjrRect& viewport, const Vec3& world_m) {
+  const Vec3 forward = Vec3(camera.forward[0], camera.forward[1], camera.forward[2]).normalized();
+  const Vec3 right = forward.cross(Vec3(camera.up[0], camera.up[1], camera.up[2])).normalized();
+  const Vec3 up = right.cross(forward);
+  const Vec3 d = world_m - Vec3(camera.pos[0], camera.pos[1], camera.pos[2]);
+  const double depth = d.dot(forward);
+  if (!(depth > 0.0)) return std::nullopt;
+  // glFrustum at the near plane, its half-width matched to the viewport (as mjr_render)
+  const double half_height = 0.5 * (camera.frustum_top - camera.frustum_bottom);
+  const double half_width = half_height * viewport.width / viewport.height;
+  const double centre_y = 0.5 * (camera.frustum_top + camera.frustum_bottom);
+  const double x = d.dot(right) / depth * camera.frustum_near;
+  const double y = d.dot(up) / depth * camera.frustum_near;
+  const double ndc_x = (x - camera.frustum_center) / half_width;
+  const double ndc_y = (y - centre_y) / half_height;
+  return Eigen::Vector2d(viewport.left + 0.5 * (ndc_x + 1.0) * viewport.width,
+                         viewport.bottom + 0.5 * (ndc_y + 1.0) * viewport.height);
+}
+
+double pixels_per_mm(const mjvGLCamera& camera, const mjrRect& viewport, const Vec3& world_m) {
+  const Vec3 forward = Vec3(camera.forward[0], camera.forward[1], camera.forward[2]).normalized();
+  const double depth = (world_m - Vec3(camera.pos[0], camera.pos[1], camera.pos[2])).dot(forward);
+  const double frustum_height = camera.frustum_top - camera.frustum_bottom;
+  if (!(depth > 0.0) || !(frustum_height > 0.0)) return 0.0;
+  const double visible_height_m = depth * frustum_height / camera.frustum_near;
+  return viewport.height / m_to_mm(visible_height_m);
+}
+
+void draw_colour_bar(const mjrRect& strip, double colour_top_um, int pixel_scale,
+                     const mjrContext& context, GlProcAddress gl_proc_address) {
+  const int s = std::max(1, pixel_scale);
+  mjr_rectangle(strip, kPaper[0], kPaper[1], kPaper[2], 1.0f);
+  if (!(colour_top_um > 0.0)) {
+    mjr_label(strip, mjFONT_NORMAL, "no deposit", kPaper[0], kPaper[1], kPaper[2], 0.0f, kInk[0],
+              kInk[1], kInk[2], &context);
+    return;
+  }
+  // the title (with the top value) on the left, the bar across the rest with round values
+  // below it
+  const std::string title = "thickness, um (top " + label_number(colour_top_um) + ")";
+  const int title_width = text_width(context, title.c_str()) + 16 * s;
+  mjr_label({strip.left, strip.bottom, title_width, strip.height}, mjFONT_NORMAL, title.c_str(), 0,
+            0, 0, 0.0f, kInk[0], kInk[1], kInk[2], &context);
+  const int label_height = context.charHeight + 2 * s;
+  const int margin = 4 * s, tick = 3 * s;
+  const int bar_left = strip.left + title_width;
+  const int bar_width = strip.left + strip.width - bar_left - 24 * s;
+  const int bar_bottom = strip.bottom + margin + label_height + tick;
+  const int bar_height = std::max(s, strip.bottom + strip.height - margin - bar_bottom);
+  if (bar_width <= 0) return;
+  if (gl_proc_address) {
+    draw_viridis_ramp({bar_left, bar_bottom, bar_width, bar_height}, gl_proc_address);
+  } else {
+    for (int column = 0; column < bar_width; ++column) {
+      float rgb[3];
+      viridis((column + 0.5) / bar_width, rgb);
+      mjr_rectangle({bar_left + column, bar_bottom, 1, bar_height}, rgb[0], rgb[1], rgb[2], 1.0f);
     }
   }
-  return boxes;
+  // ticks at round values (about 5 on a wide bar, 3 on a narrow one), labelled
+  const double step = round_step(colour_top_um / (bar_width >= 240 * s ? 5.0 : 3.0));
+  for (int i = 0; i * step <= colour_top_um * (1.0 + 1e-9); ++i) {
+    const double value = i * step;
+    const int x = bar_left + static_cast<int>(std::lround(value / colour_top_um * (bar_width - s)));
+    mjr_rectangle({x, bar_bottom - tick, s, tick}, kInk[0], kInk[1], kInk[2], 1.0f);
+    const std::string text = label_number(value);
+    const int width = text_width(context, text.c_str()) + 4 * s;
+    mjr_label({x - width / 2, strip.bottom + margin, width, label_height}, mjFONT_NORMAL,
+              text.c_str(), 0, 0, 0, 0.0f, kInk[0], kInk[1], kInk[2], &context);
+  }
+}
+
+void draw_scale_bar(const mjrRect& panel, double px_per_mm, int pixel_scale,
+                    const mjrContext& context) {
+  if (!(px_per_mm > 0.0) || panel.width <= 0) return;
+  const int s = std::max(1, pixel_scale);
+  const double length_mm = round_length(0.2 * panel.width / px_per_mm);
+  const int length = std::max(s, static_cast<int>(std::lround(length_mm * px_per_mm)));
+  char text[48];
+  std::snprintf(text, sizeof text, "%g mm", length_mm);
+  // a paper backing, the bar with end ticks, its length above it
+  const int pad = 6 * s, bar = 3 * s, end = 5 * s;
+  const int width = std::max(length, text_width(context, text)) + 2 * pad;
+  const int height = context.charHeight + bar + end + 2 * pad;
+  const mjrRect box = {panel.left + pad, panel.bottom + pad, width, height};
+  mjr_rectangle(box, kPaper[0], kPaper[1], kPaper[2], 0.8f);
+  const int bar_left = box.left + pad, bar_bottom = box.bottom + pad;
+  mjr_rectangle({bar_left, bar_bottom, length, bar}, kInk[0], kInk[1], kInk[2], 1.0f);
+  mjr_rectangle({bar_left, bar_bottom, s, bar + end}, kInk[0], kInk[1], kInk[2], 1.0f);
+  mjr_rectangle({bar_left + length - s, bar_bottom, s, bar + end}, kInk[0], kInk[1], kInk[2], 1.0f);
+  mjr_label({box.left, bar_bottom + bar + end, width, context.charHeight + pad}, mjFONT_NORMAL,
+            text, 0, 0, 0, 0.0f, kInk[0], kInk[1], kInk[2], &context);
+}
+
+void draw_panel_title(const mjrRect& panel, const char* title, int pixel_scale,
+                      const mjrContext& context) {
+  const int s = std::max(1, pixel_scale);
+  const int pad = 6 * s;
+  const int width = text_width(context, title) + 2 * pad;
+  const int height = context.charHeight + pad;
+  mjr_label({panel.left + pad, panel.bottom + panel.height - pad - height, width, height},
+            mjFONT_NORMAL, title, kPaper[0], kPaper[1], kPaper[2], 0.8f, kInk[0], kInk[1], kInk[2],
+            &context);
+}
+
+SceneFraming frame_scene(const mjModel& model, const mjData& data, const HeightMap& deposit,
+                         const SceneRenderOptions& options) {
+  const int camera = require_id(model, mjOBJ_CAMERA, kCameraName, "model", "the scene camera");
+  const int substrate =
+      require_id(model, mjOBJ_BODY, kSubstrateBody, "model", "the frame of the deposit");
+  SceneRenderOptions unframed = options;
+  unframed.framing.reset();
+  const DepositMesh mesh = build_deposit_mesh(deposit, mesh_options(deposit, unframed));
+  return frame_views(model, data, camera, substrate, mesh, unframed);
 }
 
 // The GL and MuJoCo render contexts, kept between images. mjr_makeContext is most of an
@@ -502,7 +790,7 @@ struct SceneRenderer::Contexts {
   std::vector<unsigned char> readback;  // the rendered pixels, bottom row first
   Contexts(const mjModel& model, const ContextShape& sized)
       : gl(sized.width, sized.height),
-        render(model, sized.width, sized.height, sized.shadow_size),
+        render(model, sized.width, sized.height, sized.shadow_size, sized.font_scale),
         shape(sized) {}
   // mjr_freeContext needs the GL context current on the thread that destroys them
   ~Contexts() { gl.try_make_current(); }
@@ -541,8 +829,13 @@ void SceneRenderer::finish_preparation() {
 std::vector<unsigned char> SceneRenderer::render_rgb(const Simulation& simulation,
                                                      const HeightMap& deposit,
                                                      const SceneRenderOptions& options) {
-  const mjModel& model = SimulationAccess::model(simulation);
-  const mjData& data = SimulationAccess::data(simulation);
+  return render_rgb(SimulationAccess::model(simulation), SimulationAccess::data(simulation),
+                    deposit, options);
+}
+
+std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const mjData& data,
+                                                     const HeightMap& deposit,
+                                                     const SceneRenderOptions& options) {
   install_mujoco_handlers();
   // the image must fit the model's offscreen buffer
   if (options.width <= 0 || options.width > model.vis.global.offwidth)
@@ -567,9 +860,16 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const Simulation& simulatio
       require_id(model, mjOBJ_BODY, kSubstrateBody, "model", "the frame of the deposit");
   const int width = options.width, height = options.height;
 
+  // the deposit mesh and the views (before the lock: no GL yet)
+  DataPtr state = copy_data(model, data);
+  const DepositMesh mesh = build_deposit_mesh(deposit, mesh_options(deposit, options));
+  const SceneFraming framing = options.framing
+                                   ? *options.framing
+                                   : frame_views(model, *state, camera, substrate, mesh, options);
+  const SceneLayout layout = scene_layout(options);
+
   // set up: GL context, MuJoCo render context on the offscreen buffer, scene
   const std::lock_guard<std::mutex> lock(mutex_);
-  DataPtr state = copy_data(model, data);
   // the prepared contexts, or those of the previous image, when the model has the same shape
   // (the same MJCF)
   try {
@@ -591,41 +891,81 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const Simulation& simulatio
   mjr_setBuffer(mjFB_OFFSCREEN, &context);
   if (context.currentBuffer != mjFB_OFFSCREEN)
     throw InternalError("MuJoCo could not select its offscreen buffer");
-  SceneOwner scene(model, 4 * model.ngeom + options.max_boxes + 64);
-
-  // camera: render_cam itself, or its direction aimed at the deposit
-  mjvCamera view;
-  mjv_defaultCamera(&view);
-  view.type = mjCAMERA_FIXED;
-  view.fixedcamid = camera;
-  std::vector<DepositBox> boxes;
-  const bool has_grid = deposit.nx > 0 && deposit.ny > 0;
-  if (has_grid) {
-    const double region_mm = std::max(deposit.nx, deposit.ny) * deposit.cell_mm;
-    boxes = deposit_boxes(deposit, options.relief_fraction * region_mm, options);
-    if (options.frame_deposit)
-      frame_camera(model, *state, camera, substrate, deposit, boxes,
-                   static_cast<bool>(options.surface_height_mm), view);
-  }
-
-  // update the scene, append the deposit, render, read back
+  SceneOwner scene(model, 4 * model.ngeom + 64);
   mjvOption visual_options;
   mjv_defaultOption(&visual_options);
   mjvPerturb perturb;
   mjv_defaultPerturb(&perturb);
-  mjv_updateScene(&model, state.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene.scene);
-  if (view.type == mjCAMERA_FREE) light_over_camera(view, scene.scene);
-  scene.scene.flags[mjRND_SHADOW] = options.shadows ? 1 : 0;
-  add_backdrop(model, *state, scene.scene);
-  add_deposit_boxes(*state, substrate, boxes, scene.scene);
+
+  // panels in framebuffer pixels (bottom-up, supersampled)
   const int factor = options.supersampling;
-  const mjrRect viewport = {0, 0, width * factor, height * factor};
-  mjr_render(viewport, &scene.scene, &context);
+  auto framebuffer_rect = [&](const PixelRect& r) {
+    return mjrRect{r.x * factor, (height - r.y - r.height) * factor, r.width * factor,
+                   r.height * factor};
+  };
+  const mjrRect full = {0, 0, width * factor, height * factor};
+  const mjrRect whole_rect = framebuffer_rect(layout.whole);
+  const mjrRect closeup_rect = framebuffer_rect(layout.closeup);
+  mjr_rectangle(full, kPaper[0], kPaper[1], kPaper[2], 1.0f);
+  const Vec3 deposit_centre = substrate_to_world(
+      *state, substrate, mesh.empty() ? Vec3::Zero() : Vec3(0.5 * (mesh.lo_mm + mesh.hi_mm)));
+
+  // one panel: update the scene from `view`, add the floor, render, draw the deposit on it;
+  // returns the panel's pixels per mm at the deposit
+  auto render_panel = [&](mjvCamera& view, const mjrRect& rect, bool ghosts) {
+    mjv_updateScene(&model, state.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene.scene);
+    if (view.type == mjCAMERA_FREE) light_over_camera(view, scene.scene);
+    scene.scene.flags[mjRND_SHADOW] = options.shadows ? 1 : 0;
+    if (ghosts)
+      ghost_above_substrate(model, *state, substrate, mesh.empty() ? 0.0 : mesh.lo_mm.z(),
+                            std::max(kMinCloseupHalf_mm, 0.5 * (mesh.hi_mm - mesh.lo_mm).norm()),
+                            scene.scene);
+    add_backdrop(model, *state, scene.scene);
+    mjr_render(rect, &scene.scene, &context);
+    draw_deposit_mesh(mesh, scene.scene, rect, state->xpos + 3 * substrate,
+                      state->xmat + 9 * substrate, osmesa_proc_address);
+    const mjvGLCamera gl_camera = mjv_averageCamera(scene.scene.camera, scene.scene.camera + 1);
+    return pixels_per_mm(gl_camera, rect, deposit_centre);
+  };
+
+  // the machine: render_cam itself, or framed
+  mjvCamera view;
+  mjv_defaultCamera(&view);
+  if (framing.whole_from_render_cam) {
+    view.type = mjCAMERA_FIXED;
+    view.fixedcamid = camera;
+  } else {
+    set_free_camera(framing.whole, view);
+  }
+  const double whole_px_per_mm = render_panel(view, whole_rect, false);
+  // the close-up of the deposit
+  double closeup_px_per_mm = 0.0;
+  if (layout.closeup.width > 0) {
+    mjv_defaultCamera(&view);
+    set_free_camera(framing.closeup, view);
+    closeup_px_per_mm = render_panel(view, closeup_rect, true);
+  }
+
+  // the overlays: colour bar, scale bars, titles
+  if (layout.strip.height > 0) {
+    draw_colour_bar(framebuffer_rect(layout.strip), framing.colour_top_um, factor, context,
+                    osmesa_proc_address);
+    draw_scale_bar(whole_rect, whole_px_per_mm, factor, context);
+    if (layout.closeup.width > 0) {
+      draw_scale_bar(closeup_rect, closeup_px_per_mm, factor, context);
+      draw_panel_title(whole_rect, "machine", factor, context);
+      draw_panel_title(closeup_rect, "deposit (close-up)", factor, context);
+      // a thin rule between the panels
+      mjr_rectangle({closeup_rect.left - factor, closeup_rect.bottom, factor, closeup_rect.height},
+                    kPaper[0], kPaper[1], kPaper[2], 1.0f);
+    }
+  }
+
   // read back into a buffer kept with the contexts: a fresh one of this size is several
   // MB of memory to fault in and clear per image
   std::vector<unsigned char>& bottom_up = contexts_->readback;
-  bottom_up.resize(static_cast<size_t>(viewport.width) * viewport.height * 3);
-  mjr_readPixels(bottom_up.data(), nullptr, viewport, &context);
+  bottom_up.resize(static_cast<size_t>(full.width) * full.height * 3);
+  mjr_readPixels(bottom_up.data(), nullptr, full, &context);
   check_warnings(*state, "while rendering");
   return downsample_flipped(bottom_up, width, height, factor);
 }

@@ -1,14 +1,23 @@
-// The MuJoCo scene at the end of a job, rendered headless through OSMesa to a PNG
-// (MuJoCo sample/record.cc as one straight line: set up, update, render, read, free),
-// with the deposited material drawn on the substrate as thin boxes coloured by thickness.
+// The MuJoCo scene at the end of a job (or at any state: a video frame), rendered headless
+// through OSMesa to a PNG (MuJoCo sample/record.cc as one straight line: set up, update,
+// render, read, free).
 //
-// The model must have a camera `render_cam` and a body `substrate` (the frame the
-// HeightMap is given in); its <visual><global offwidth offheight> bounds the image size.
-// Deposited films are micrometres thick: their height is exaggerated (the tallest deposit
-// is drawn as a fraction of the deposit region's size) and the colour carries the value
-// (viridis, a perceptually uniform colormap: dark purple = thin, yellow = the thickest).
-// On a part (conformal work) each box stands on the part's surface, tilted to its slope.
+// The image has two panels over a strip: on the left the whole machine, framed from the
+// bounds of its visible geoms, the deposit and the nozzle; on the right a close-up of the
+// deposit, framed from its bounds, whatever is above the substrate (the print head) ghosted so
+// that it hides nothing; below them a colour bar (viridis, thickness in um) and, in each
+// panel, a scale bar (mm, at the deposit's distance). The deposit is a smooth height-field
+// mesh with per-vertex colour (render/deposit_mesh.hpp), drawn after mjr_render in the same
+// GL context, depth-tested against the machine.
+//
+// The model must have a camera `render_cam` (its direction sets the views' direction) and a
+// body `substrate` (the frame the HeightMap is given in); its <visual><global offwidth
+// offheight> bounds the image size.
 #pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Core>
 
 #include <functional>
 #include <future>
@@ -20,34 +29,59 @@
 
 #include "core/heightmap.hpp"
 #include "core/types.hpp"
+#include "render/deposit_mesh.hpp"
 
 namespace depotwin {
 
 class Simulation;
 
+// a free camera (MuJoCo's mjCAMERA_FREE): looks at lookat_m from distance_m, its direction
+// given by azimuth and elevation (deg; elevation < 0 looks down)
+struct FreeCamera {
+  Vec3 lookat_m = Vec3::Zero();
+  double distance_m = 1.0;
+  double azimuth_deg = 90.0;
+  double elevation_deg = -45.0;
+};
+
+// The views and the colour scale of a scene. render_* frames them from the deposit it is given;
+// a series of frames (a video) computes them once from the final deposit (frame_scene) and
+// passes them in SceneRenderOptions::framing, so that the cameras and colours stay put.
+struct SceneFraming {
+  FreeCamera whole;                    // the whole machine, the deposit and the nozzle
+  bool whole_from_render_cam = false;  // true: render_cam's own pose instead of `whole`
+  FreeCamera closeup;                  // the deposit only
+  double colour_top_um = 0.0;          // the thickness at the colour scale's top (0: no deposit)
+  double relief_mm = 0.0;              // the drawn height of colour_top_um
+};
+
 struct SceneRenderOptions {
-  int width = 640;
+  int width = 640;  // the whole image, both panels and the strip
   int height = 480;
-  // true: look along render_cam's direction at the deposit region and the nozzle, from a
-  // distance that fits them (and, for a machine that carries the nozzle on a chain of bodies,
-  // such as an arm, its tool and, on a large enough part, its wrist, seen from beside the part
-  // with the arm behind it: see frame_camera in scene.cpp); false: render_cam's own pose and
-  // field of view
+  // two panels: the whole machine on the left, a close-up of the deposit on the right;
+  // false: the machine view alone
+  bool closeup = true;
+  // the strip below the panels with the colour bar, and the scale bars in the panels
+  bool overlays = true;
+  // true: the machine view is framed from the machine's, the deposit's and the nozzle's
+  // bounds, seen from render_cam's direction (a machine carrying the nozzle on a chain of
+  // bodies, an arm, from beside its part: see frame_scene); false: render_cam's own pose
   bool frame_deposit = true;
+  // fixed views and colour scale (a video's frames); nullopt: framed from the deposit given
+  std::optional<SceneFraming> framing;
   // The part's top surface under the deposit (conformal work): its height (mm) at (x, y) in
   // the substrate frame, nullopt where there is no part (the deposit there lies on z = 0).
-  // Empty: a flat substrate, every box on z = 0. The part itself is a mesh geom of the model.
-  // Called from the rendering thread (prepare's options are copied): it must be safe to call
-  // from any thread, e.g. a SurfaceProjector::height_at held by a shared_ptr to const.
+  // Empty: a flat substrate. The part itself is a mesh geom of the model. Called from the
+  // rendering thread (prepare's options are copied): it must be safe to call from any thread,
+  // e.g. a SurfaceProjector::height_at held by a shared_ptr to const.
   std::function<std::optional<double>(double x_mm, double y_mm)> surface_height_mm;
-  // on a surface, boxes are tilted to its slope (their axis the normal the heights around them
-  // give) rather than standing upright as a staircase
+  // on a surface, the deposit's relief stands along its normal (else vertically)
   bool tilt_to_surface = true;
-  // drawn height of the thickest deposit as a fraction of the framed region's size
+  // drawn height of the thickest deposit as a fraction of the deposit region's size
   double relief_fraction = 0.04;
-  // at most this many grid cells are drawn (the grid is averaged over square blocks to fit)
-  int max_boxes = 10000;
-  // cells thinner than this fraction of the thickest are not drawn (footprint tails)
+  // at most this many mesh vertices (the grid is resampled by block maxima to fit)
+  int max_mesh_vertices = 250000;
+  // the deposit thinner than this fraction of the colour scale's top is not drawn
   double min_relative_thickness = 0.02;
   // anti-aliasing: the scene is rendered this many times larger in each direction and each
   // image pixel is the mean of its block (1 = none). Supersampling rather than the model's
@@ -57,6 +91,54 @@ struct SceneRenderOptions {
   // image) and the delta's platform throws its shadow over the deposit it should show
   bool shadows = false;
 };
+
+// where the parts of an image are, in image pixels from its top-left corner (y down)
+struct PixelRect {
+  int x = 0, y = 0, width = 0, height = 0;
+};
+struct SceneLayout {
+  PixelRect whole;    // the machine
+  PixelRect closeup;  // the deposit (width 0 without a close-up)
+  PixelRect strip;    // colour bar (height 0 without overlays)
+};
+SceneLayout scene_layout(const SceneRenderOptions& options);
+
+// The framing render_rgb uses for this state and deposit: the deposit mesh's colour top and
+// relief, the machine view fitted to the bounds of the model's visible geoms (planes left
+// out), the deposit and the nozzle site, the close-up to the deposit's (at least a few mm
+// around the nozzle's point on the substrate without a deposit), both tightly to their panels'
+// aspect. Both look from render_cam's azimuth (for a nozzle on a chain of bodies, an arm: the
+// part broadside with the arm behind it), the close-up more steeply.
+SceneFraming frame_scene(const mjModel& model, const mjData& data, const HeightMap& deposit,
+                         const SceneRenderOptions& options);
+
+// MuJoCo's free camera for `camera`
+void set_free_camera(const FreeCamera& camera, mjvCamera& view);
+
+// Where a world point (m) appears through an OpenGL camera of a scene (mjv_averageCamera of
+// an updated mjvScene) drawn into `viewport` (mjr_render's projection): pixels from the
+// viewport's bottom-left corner; nullopt behind the camera.
+std::optional<Eigen::Vector2d> project_to_viewport(const mjvGLCamera& camera,
+                                                   const mjrRect& viewport, const Vec3& world_m);
+// viewport pixels per mm at a world point (m) seen through `camera` (a scale bar's length)
+double pixels_per_mm(const mjvGLCamera& camera, const mjrRect& viewport, const Vec3& world_m);
+
+// The overlays, drawn in the current GL context with MuJoCo's renderer (mjr_rectangle,
+// mjr_label; `context` made with a font scale of about 100 x `pixel_scale`); rects in
+// framebuffer pixels, sizes multiplied by `pixel_scale` (a supersampled render's factor).
+// A colour bar over `strip`: viridis from 0 to colour_top_um with its values in um ("no
+// deposit" without one).
+// `gl_proc_address` draws the ramp as one smooth-shaded strip; without it, one mjr_rectangle
+// per pixel column (slower in software GL).
+void draw_colour_bar(const mjrRect& strip, double colour_top_um, int pixel_scale,
+                     const mjrContext& context, GlProcAddress gl_proc_address = nullptr);
+// a scale bar in the bottom-left corner of `panel`: a round length in mm about a fifth of its
+// width, at `px_per_mm` (nothing when not positive)
+void draw_scale_bar(const mjrRect& panel, double px_per_mm, int pixel_scale,
+                    const mjrContext& context);
+// a panel's title in its top-left corner
+void draw_panel_title(const mjrRect& panel, const char* title, int pixel_scale,
+                      const mjrContext& context);
 
 // Renders scenes, keeping its GL and MuJoCo render contexts between images (rebuilt when
 // a model of another shape, another image size or another shadow setting comes). Callable
@@ -81,6 +163,12 @@ class SceneRenderer {
                                         const SceneRenderOptions& options = {});
   void render_png(const Simulation& simulation, const HeightMap& deposit,
                   const std::string& png_path, const SceneRenderOptions& options = {});
+  // at an explicit MuJoCo state (a replayed frame: qpos set and mj_forward done); `data` is
+  // not modified (the renderer works on a copy). The contexts are reused for models of the
+  // same shape (the same MJCF)
+  std::vector<unsigned char> render_rgb(const mjModel& model, const mjData& data,
+                                        const HeightMap& deposit,
+                                        const SceneRenderOptions& options = {});
 
  private:
   struct Contexts;
@@ -102,29 +190,7 @@ std::vector<unsigned char> render_scene_rgb(const Simulation& simulation, const 
 void render_scene_png(const Simulation& simulation, const HeightMap& deposit,
                       const std::string& png_path, const SceneRenderOptions& options = {});
 
-// One box of the drawn deposit, in the substrate frame (mm): it stands on `base_mm` (a point of
-// the surface, or of z = 0) along `axis` (unit: the surface normal, or +z), a square of
-// 2 half_width_mm across and 2 half_height_mm tall (the exaggerated relief), lifted
-// `lift_mm` off the surface so it never z-fights with it; `relative` is its thickness over
-// the colour scale's top (its viridis value).
-struct DepositBox {
-  Vec3 base_mm = Vec3::Zero();
-  Vec3 axis = Vec3::UnitZ();
-  double half_width_mm = 0.0;
-  double half_height_mm = 0.0;
-  double lift_mm = 0.0;
-  double relative = 0.0;
-};
-// The boxes render_scene_* draw for `deposit`: the grid averaged over square blocks so that
-// at most options.max_boxes remain, one box per block at least min_relative_thickness of the
-// thickest block; the tallest relief_mm tall.
-std::vector<DepositBox> deposit_boxes(const HeightMap& deposit, double relief_mm,
-                                      const SceneRenderOptions& options);
-
 // the largest SceneRenderOptions::supersampling
 constexpr int kMaxSupersampling = 4;
-
-// viridis colour of a value in [0, 1] (clamped), RGB in [0, 1]
-void viridis(double value, float rgb[3]);
 
 }  // namespace depotwin

@@ -14,6 +14,8 @@
 #include "kinematics/machine.hpp"
 #include "kinematics/xy_stage.hpp"
 #include "render/scene.hpp"
+#include "sim/mujoco_access.hpp"
+#include "sim/mujoco_boundary.hpp"
 #include "sim/part_model.hpp"
 #include "sim/simulation.hpp"
 #include "toolpath/analytic_surfaces.hpp"
@@ -90,40 +92,59 @@ TEST(Scene, WritesAPngOfTheRequestedSizeThatIsNotBlank) {
     EXPECT_EQ(entry.path().string().find(path + ".tmp"), std::string::npos) << entry.path();
 }
 
-TEST(Scene, APrintedLineChangesTheMiddleOfThePictureOnly) {
+// the pixels that differ clearly between two renders of the same size, per panel
+struct PanelChanges {
+  long whole = 0, closeup = 0, strip = 0;
+  double closeup_row_sum = 0.0, closeup_column_sum = 0.0;
+};
+PanelChanges changed_pixels(const std::vector<unsigned char>& a,
+                            const std::vector<unsigned char>& b, const SceneLayout& layout) {
+  PanelChanges changes;
+  const int width = layout.strip.width;
+  for (size_t i = 0; i < a.size(); i += 3) {
+    int difference = 0;
+    for (int c = 0; c < 3; ++c) difference = std::max(difference, std::abs(a[i + c] - b[i + c]));
+    if (difference <= 40) continue;
+    const int row = static_cast<int>(i / 3 / width), column = static_cast<int>(i / 3 % width);
+    if (row >= layout.strip.y) {
+      ++changes.strip;
+    } else if (column >= layout.closeup.x && layout.closeup.width > 0) {
+      ++changes.closeup;
+      changes.closeup_row_sum += row;
+      changes.closeup_column_sum += column - layout.closeup.x;
+    } else {
+      ++changes.whole;
+    }
+  }
+  return changes;
+}
+
+// With the views and the colour scale fixed (as for a video's frames), a printed line changes
+// the close-up in its middle and nothing else; the same inputs, the same picture
+TEST(Scene, APrintedLineChangesTheCloseUpOnly) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
   SceneRenderOptions options = sized(320, 240);
+  options.framing = frame_scene(SimulationAccess::model(simulation),
+                                SimulationAccess::data(simulation), deposit_grid(true), options);
   const auto empty = render_scene_rgb(simulation, deposit_grid(false), options);
   const auto printed = render_scene_rgb(simulation, deposit_grid(true), options);
   ASSERT_EQ(empty.size(), 320u * 240u * 3u);
   ASSERT_EQ(printed.size(), empty.size());
-  // pixels that changed clearly, and where they are
-  long changed = 0, changed_in_top_rows = 0;
-  double row_sum = 0.0, column_sum = 0.0;
-  for (int row = 0; row < options.height; ++row)
-    for (int column = 0; column < options.width; ++column) {
-      const size_t i = 3 * (static_cast<size_t>(row) * options.width + column);
-      int difference = 0;
-      for (int c = 0; c < 3; ++c)
-        difference = std::max(difference, std::abs(printed[i + c] - empty[i + c]));
-      if (difference > 40) {
-        ++changed;
-        if (row < options.height / 10) ++changed_in_top_rows;
-        row_sum += row;
-        column_sum += column;
-      }
-    }
-  std::printf("changed pixels: %ld of %d\n", changed, options.width * options.height);
-  // the 16 mm line spans much of the framed view: hundreds of pixels
-  EXPECT_GT(changed, 500);
-  // and sits in the middle of the picture (the camera is aimed at the deposit region)
-  ASSERT_GT(changed, 0);
-  EXPECT_NEAR(row_sum / changed, 0.5 * options.height, 0.25 * options.height);
-  EXPECT_NEAR(column_sum / changed, 0.5 * options.width, 0.25 * options.width);
-  // far from the substrate (the top of the picture: the print head and beyond) nothing moves
-  EXPECT_EQ(changed_in_top_rows, 0);
-  // the same inputs render the same picture
+  const SceneLayout layout = scene_layout(options);
+  const PanelChanges changes = changed_pixels(empty, printed, layout);
+  std::printf("changed pixels: close-up %ld, machine %ld, strip %ld\n", changes.closeup,
+              changes.whole, changes.strip);
+  // the 16 mm line spans much of the close-up: hundreds of pixels, in its middle
+  EXPECT_GT(changes.closeup, 500);
+  ASSERT_GT(changes.closeup, 0);
+  EXPECT_NEAR(changes.closeup_row_sum / changes.closeup, 0.5 * layout.closeup.height,
+              0.25 * layout.closeup.height);
+  EXPECT_NEAR(changes.closeup_column_sum / changes.closeup, 0.5 * layout.closeup.width,
+              0.25 * layout.closeup.width);
+  EXPECT_EQ(changes.strip, 0);  // the colour scale is the framing's, whatever the deposit
+  // in the machine view the plate is far away: the line is a few pixels at most
+  EXPECT_LT(changes.whole, changes.closeup / 4);
   EXPECT_EQ(render_scene_rgb(simulation, deposit_grid(true), options), printed);
 }
 
@@ -134,7 +155,9 @@ TEST(Scene, RendersTheStateAfterARunFromTheModelCamera) {
       straight_print(Vec3(-8, 0, 0), Vec3(1, 0, 0), 3.0, 16.0, MachineLimits::uniform(4, 30));
   simulation.run(print.trajectory);
   SceneRenderOptions options = sized(320, 240);
-  options.frame_deposit = false;  // render_cam as placed in the MJCF
+  options.frame_deposit = false;  // render_cam as placed in the MJCF, the machine view alone
+  options.closeup = false;
+  options.overlays = false;
   const auto before = render_scene_rgb(simulation, deposit_grid(false), options);
   const auto after = render_scene_rgb(simulation, deposit_grid(true), options);
   long changed = 0;
@@ -183,8 +206,10 @@ TEST(Scene, SupersampledImageIsTheBlockMeanOfTheLargerRender) {
   Simulation simulation(xy_stage_model(), *machine);
   SceneRenderOptions supersampled = sized(160, 120);
   supersampled.supersampling = 2;
+  supersampled.overlays = false;  // the text is drawn at each size's own font scale
   SceneRenderOptions large = sized(320, 240);
   large.supersampling = 1;
+  large.overlays = false;
   const auto small = render_scene_rgb(simulation, deposit_grid(true), supersampled);
   const auto full = render_scene_rgb(simulation, deposit_grid(true), large);
   ASSERT_EQ(small.size(), 160u * 120u * 3u);
@@ -228,6 +253,181 @@ TEST(Scene, NoViewShowsTheEmptyBackground) {
   }
 }
 
+// a panel of a layout as MuJoCo's viewport (framebuffer pixels, bottom-up, no supersampling)
+mjrRect viewport_of(const PixelRect& panel, int image_height) {
+  return {panel.x, image_height - panel.y - panel.height, panel.width, panel.height};
+}
+
+// the GL camera mjv_updateScene makes of a free camera (the one mjr_render projects with)
+mjvGLCamera gl_camera(const mjModel& model, const mjData& data, const FreeCamera& free) {
+  mjvScene scene;
+  mjv_defaultScene(&scene);
+  mjv_makeScene(&model, &scene, 4 * model.ngeom + 64);
+  DataPtr copy = copy_data(model, data);
+  mjvOption visual_options;
+  mjv_defaultOption(&visual_options);
+  mjvPerturb perturb;
+  mjv_defaultPerturb(&perturb);
+  mjvCamera view;
+  mjv_defaultCamera(&view);
+  set_free_camera(free, view);
+  mjv_updateScene(&model, copy.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene);
+  const mjvGLCamera camera = mjv_averageCamera(scene.camera, scene.camera + 1);
+  mjv_freeScene(&scene);
+  return camera;
+}
+
+// the world point (m) of a substrate-frame point (mm)
+Vec3 on_substrate(const mjModel& model, const mjData& data, const Vec3& local_mm) {
+  const int body = mj_name2id(&model, mjOBJ_BODY, "substrate");
+  Vec3 world;
+  for (int row = 0; row < 3; ++row) {
+    world[row] = data.xpos[3 * body + row];
+    for (int col = 0; col < 3; ++col)
+      world[row] += data.xmat[9 * body + 3 * row + col] * 1e-3 * local_mm[col];
+  }
+  return world;
+}
+
+// Framing of deposit_grid(true): in the machine view every geom's centre, the nozzle and the
+// grid's corners project inside the panel; in the close-up the drawn line does, and fills it
+// (tightly framed: it reaches at least 80 % across its width or height).
+void expect_framed(const mjModel& model, const mjData& data, const HeightMap& deposit,
+                   const char* name) {
+  SceneRenderOptions options;  // 640 x 480, two panels
+  const SceneFraming framing = frame_scene(model, data, deposit, options);
+  const SceneLayout layout = scene_layout(options);
+  const mjrRect whole = viewport_of(layout.whole, options.height);
+  const mjrRect closeup = viewport_of(layout.closeup, options.height);
+  auto inside = [](const mjrRect& rect, const std::optional<Eigen::Vector2d>& pixel) {
+    return pixel && pixel->x() >= rect.left && pixel->x() <= rect.left + rect.width &&
+           pixel->y() >= rect.bottom && pixel->y() <= rect.bottom + rect.height;
+  };
+  const mjvGLCamera whole_camera = gl_camera(model, data, framing.whole);
+  const mjvGLCamera closeup_camera = gl_camera(model, data, framing.closeup);
+  for (int geom = 0; geom < model.ngeom; ++geom) {
+    const Vec3 centre(data.geom_xpos[3 * geom], data.geom_xpos[3 * geom + 1],
+                      data.geom_xpos[3 * geom + 2]);
+    EXPECT_TRUE(inside(whole, project_to_viewport(whole_camera, whole, centre)))
+        << name << ": geom " << mj_id2name(&model, mjOBJ_GEOM, geom);
+  }
+  const int nozzle = mj_name2id(&model, mjOBJ_SITE, "nozzle");
+  const Vec3 nozzle_world(data.site_xpos[3 * nozzle], data.site_xpos[3 * nozzle + 1],
+                          data.site_xpos[3 * nozzle + 2]);
+  EXPECT_TRUE(inside(whole, project_to_viewport(whole_camera, whole, nozzle_world))) << name;
+  // the deposit grid's corners on the substrate are in the machine view
+  const double half = 0.5 * deposit.cell_mm;
+  const double x0 = deposit.origin_x_mm - half, x1 = x0 + deposit.nx * deposit.cell_mm;
+  const double y0 = deposit.origin_y_mm - half, y1 = y0 + deposit.ny * deposit.cell_mm;
+  for (const Vec3& corner : {Vec3(x0, y0, 0), Vec3(x1, y0, 0), Vec3(x0, y1, 0), Vec3(x1, y1, 0)})
+    EXPECT_TRUE(
+        inside(whole, project_to_viewport(whole_camera, whole, on_substrate(model, data, corner))))
+        << name;
+  // the drawn line (x -8 to 8 mm, |y| up to 0.6 mm, where it is 3 % of its crest) is in the
+  // close-up
+  double lo_x = 1e9, hi_x = -1e9, lo_y = 1e9, hi_y = -1e9;
+  for (const Vec3& corner :
+       {Vec3(-8, -0.6, 0), Vec3(8, -0.6, 0), Vec3(-8, 0.6, 0), Vec3(8, 0.6, 0)}) {
+    const auto pixel =
+        project_to_viewport(closeup_camera, closeup, on_substrate(model, data, corner));
+    EXPECT_TRUE(inside(closeup, pixel)) << name;
+    if (!pixel) continue;
+    lo_x = std::min(lo_x, pixel->x());
+    hi_x = std::max(hi_x, pixel->x());
+    lo_y = std::min(lo_y, pixel->y());
+    hi_y = std::max(hi_y, pixel->y());
+  }
+  EXPECT_GT(std::max((hi_x - lo_x) / closeup.width, (hi_y - lo_y) / closeup.height), 0.8) << name;
+  // the colour scale's top is the deposit's peak; the close-up looks down steeply
+  EXPECT_FLOAT_EQ(framing.colour_top_um, deposit.max_value());
+  EXPECT_LE(framing.closeup.elevation_deg, -55.0 + 1e-9);
+}
+
+TEST(Framing, TheXyStageAndItsDepositFitTheirPanels) {
+  const auto machine = make_xy_stage();
+  Simulation simulation(xy_stage_model(), *machine);
+  expect_framed(SimulationAccess::model(simulation), SimulationAccess::data(simulation),
+                deposit_grid(true), "xy_stage");
+}
+
+// the delta's towers, carriages, rods and platform are all in the machine view
+TEST(Framing, TheDeltaAndItsDepositFitTheirPanels) {
+  const auto machine = make_machine("linear_delta");
+  ASSERT_TRUE(machine);
+  Simulation simulation(std::string(DEPOTWIN_MODELS_DIR) + "/linear_delta.xml", *machine);
+  expect_framed(SimulationAccess::model(simulation), SimulationAccess::data(simulation),
+                deposit_grid(true), "linear_delta");
+}
+
+// the projection agrees with MuJoCo's: the look-at point is the viewport's centre
+TEST(Framing, TheLookAtPointProjectsToTheViewportCentre) {
+  const auto machine = make_xy_stage();
+  Simulation simulation(xy_stage_model(), *machine);
+  const mjModel& model = SimulationAccess::model(simulation);
+  const mjData& data = SimulationAccess::data(simulation);
+  FreeCamera free;
+  free.lookat_m = Vec3(0.01, -0.02, 0.005);
+  free.distance_m = 0.3;
+  free.azimuth_deg = 120.0;
+  free.elevation_deg = -35.0;
+  const mjrRect viewport = {10, 20, 300, 200};
+  const auto centre = project_to_viewport(gl_camera(model, data, free), viewport, free.lookat_m);
+  ASSERT_TRUE(centre);
+  EXPECT_NEAR(centre->x(), 160.0, 1e-3);
+  EXPECT_NEAR(centre->y(), 120.0, 1e-3);
+  // and a point one visible half-height above it, at the top edge: tan(fovy / 2) d
+  const mjvGLCamera camera = gl_camera(model, data, free);
+  const Vec3 up(camera.up[0], camera.up[1], camera.up[2]);
+  const double half_height_m = std::tan(0.5 * model.vis.global.fovy * kPi / 180.0) * 0.3;
+  const auto top = project_to_viewport(camera, viewport, free.lookat_m + half_height_m * up);
+  ASSERT_TRUE(top);
+  EXPECT_NEAR(top->y(), 220.0, 1e-2);
+  EXPECT_NEAR(pixels_per_mm(camera, viewport, free.lookat_m), 100.0 / (1e3 * half_height_m), 1e-6);
+}
+
+// the colour bar's pixels are viridis, from dark purple to yellow, left to right
+TEST(Scene, TheColourBarIsViridis) {
+  const auto machine = make_xy_stage();
+  Simulation simulation(xy_stage_model(), *machine);
+  const SceneRenderOptions options;  // 640 x 480
+  const auto rgb = render_scene_rgb(simulation, deposit_grid(true), options);
+  const SceneLayout layout = scene_layout(options);
+  // the longest run of viridis pixels along each row of the strip; their viridis values
+  std::vector<double> best;
+  for (int row = layout.strip.y; row < layout.strip.y + layout.strip.height; ++row) {
+    std::vector<double> run;
+    for (int column = 0; column < options.width; ++column) {
+      const unsigned char* pixel =
+          rgb.data() + 3 * (static_cast<size_t>(row) * options.width + column);
+      double best_value = -1.0, best_distance = 1e9;
+      for (int k = 0; k <= 1000; ++k) {
+        float colour[3];
+        viridis(k / 1000.0, colour);
+        double distance = 0.0;
+        for (int c = 0; c < 3; ++c)
+          distance = std::max(distance, std::abs(pixel[c] - 255.0 * colour[c]));
+        if (distance < best_distance) {
+          best_distance = distance;
+          best_value = k / 1000.0;
+        }
+      }
+      if (best_distance <= 3.0) {
+        run.push_back(best_value);
+      } else {
+        if (run.size() > best.size()) best = run;
+        run.clear();
+      }
+    }
+    if (run.size() > best.size()) best = run;
+  }
+  // most of the width, from ~0 to ~1, never decreasing
+  EXPECT_GT(best.size(), static_cast<size_t>(options.width / 2));
+  ASSERT_FALSE(best.empty());
+  EXPECT_LT(best.front(), 0.02);
+  EXPECT_GT(best.back(), 0.98);
+  for (size_t i = 1; i < best.size(); ++i) EXPECT_GE(best[i], best[i - 1] - 0.004) << i;
+}
+
 TEST(Scene, ImageLargerThanTheOffscreenBufferIsBadInput) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
@@ -248,58 +448,6 @@ TEST(Scene, ImageLargerThanTheOffscreenBufferIsBadInput) {
 std::optional<double> bump_mm(double x, double y) {
   if (std::abs(x) >= 6.0 || std::abs(y) >= 5.0) return std::nullopt;
   return 4.0 * (1.0 - x * x / 36.0);
-}
-
-TEST(DepositBoxes, OnTheSubstrateUpright) {
-  SceneRenderOptions options;
-  const auto boxes = deposit_boxes(deposit_grid(true), 0.8, options);
-  ASSERT_GT(boxes.size(), 100u);
-  for (const DepositBox& box : boxes) {
-    EXPECT_EQ(box.base_mm.z(), 0.0);
-    EXPECT_EQ(box.axis, Vec3::UnitZ());
-    EXPECT_LE(box.half_height_mm, 0.4 + 1e-12);
-    EXPECT_GE(box.relative, options.min_relative_thickness);
-  }
-}
-
-TEST(DepositBoxes, FollowTheSurfaceAndTiltToItsSlope) {
-  SceneRenderOptions options;
-  options.surface_height_mm = bump_mm;
-  const auto boxes = deposit_boxes(deposit_grid(true), 0.8, options);
-  SceneRenderOptions flat_options;
-  const auto flat = deposit_boxes(deposit_grid(true), 0.8, flat_options);
-  ASSERT_EQ(boxes.size(), flat.size());  // the same cells, placed differently
-  long on_part = 0, beside = 0;
-  for (size_t i = 0; i < boxes.size(); ++i) {
-    const DepositBox& box = boxes[i];
-    EXPECT_EQ(box.base_mm.x(), flat[i].base_mm.x());
-    EXPECT_EQ(box.base_mm.y(), flat[i].base_mm.y());
-    EXPECT_EQ(box.half_height_mm, flat[i].half_height_mm);
-    const std::optional<double> z = bump_mm(box.base_mm.x(), box.base_mm.y());
-    if (z) {
-      ++on_part;
-      // on the surface at its cell, along its normal (-dz/dx, 0, 1): central differences of
-      // a parabola are exact
-      EXPECT_DOUBLE_EQ(box.base_mm.z(), *z);
-      const double x = box.base_mm.x(), h = box.half_width_mm;
-      if (std::abs(x) + h < 6.0) {
-        const Vec3 normal = Vec3(8.0 * x / 36.0, 0.0, 1.0).normalized();
-        EXPECT_LT((box.axis - normal).norm(), 1e-9) << x;
-      }
-    } else {
-      ++beside;  // beyond the part: on the substrate plane
-      EXPECT_EQ(box.base_mm.z(), 0.0);
-      EXPECT_EQ(box.axis, Vec3::UnitZ());
-    }
-    // lifted off the surface, more than on a plate (a fraction of the relief)
-    EXPECT_DOUBLE_EQ(box.lift_mm, 0.02 * 0.8);
-  }
-  EXPECT_GT(on_part, 100);
-  EXPECT_GT(beside, 10);
-  // upright when asked
-  options.tilt_to_surface = false;
-  for (const DepositBox& box : deposit_boxes(deposit_grid(true), 0.8, options))
-    EXPECT_EQ(box.axis, Vec3::UnitZ());
 }
 
 // the mean row of the pixels that differ clearly between two renders, and their count
@@ -324,7 +472,9 @@ TEST(Scene, DepositOnASurfaceIsDrawnOnIt) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
   SceneRenderOptions flat = sized(320, 240);
-  flat.frame_deposit = false;  // one camera for both pictures
+  flat.frame_deposit = false;  // one camera for both pictures, the machine view alone
+  flat.closeup = false;
+  flat.overlays = false;
   SceneRenderOptions on_part = flat;
   on_part.surface_height_mm = [](double, double) { return std::optional<double>(6.0); };
   const auto empty = render_scene_rgb(simulation, deposit_grid(false), flat);
@@ -413,9 +563,11 @@ void render_arm_scene(const ArmScene& scene, const HeightMap& map, const std::st
   options.surface_height_mm = [projector](double x, double y) {
     return projector->height_at(x, y);
   };
+  options.framing = frame_scene(SimulationAccess::model(*scene.simulation),
+                                SimulationAccess::data(*scene.simulation), map, options);
   const auto rgb = render_scene_rgb(*scene.simulation, map, options);
   EXPECT_EQ(render_scene_rgb(*scene.simulation, map, options), rgb);
-  // the deposit shows: the picture without it differs
+  // the deposit shows: the picture without it (the same views) differs
   const auto bare = render_scene_rgb(*scene.simulation, HeightMap{}, options);
   long changed = 0;
   for (size_t i = 0; i < rgb.size(); ++i) changed += std::abs(rgb[i] - bare[i]) > 40;
@@ -427,6 +579,7 @@ void render_arm_scene(const ArmScene& scene, const HeightMap& map, const std::st
   EXPECT_EQ(black, 0) << name;
   render_scene_png(*scene.simulation, map,
                    std::string(DEPOTWIN_BINARY_DIR) + "/test_render_" + name + ".png", options);
+  options.framing.reset();
   options.frame_deposit = false;
   render_scene_png(*scene.simulation, map,
                    std::string(DEPOTWIN_BINARY_DIR) + "/test_render_" + name + "_cam.png", options);
@@ -447,26 +600,6 @@ TEST(Scene, ArmOverABonnet) {
   const ArmScene scene = arm_over(part, Vec3(70.0, 40.0, 40.0));
   if (!scene.skip.empty()) GTEST_SKIP() << scene.skip;
   render_arm_scene(scene, hatched(-73.0, 73.0, -63.0, 63.0, 2.0), "arm_bonnet");
-}
-
-TEST(Viridis, RunsFromDarkPurpleToYellowWithRisingLightness) {
-  float rgb[3];
-  viridis(0.0, rgb);
-  EXPECT_NEAR(rgb[0], 68 / 255.0, 1e-6);
-  EXPECT_NEAR(rgb[1], 1 / 255.0, 1e-6);
-  EXPECT_NEAR(rgb[2], 84 / 255.0, 1e-6);
-  viridis(1.0, rgb);
-  EXPECT_NEAR(rgb[0], 253 / 255.0, 1e-6);
-  EXPECT_NEAR(rgb[1], 231 / 255.0, 1e-6);
-  EXPECT_NEAR(rgb[2], 37 / 255.0, 1e-6);
-  // perceptual: the luma rises monotonically, so thicker always looks lighter
-  double previous = -1.0;
-  for (int i = 0; i <= 64; ++i) {
-    viridis(i / 64.0, rgb);
-    const double luma = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
-    EXPECT_GT(luma, previous) << i;
-    previous = luma;
-  }
 }
 
 }  // namespace
