@@ -17,6 +17,9 @@ packages=(
   libstb-dev                             # tests read the PNGs back with stb_image
   gnuplot-nox                            # plots (pngcairo terminal, headless)
   fonts-dejavu-core                      # fonts for plot and image text
+  ffmpeg                                 # run.mp4 (render/video: raw frames piped to its H.264 encoder)
+  libglfw3-dev                           # the `view` window (viewer/)
+  xvfb xauth                             # the viewer's screenshot test runs under xvfb-run
 )
 
 missing=()
