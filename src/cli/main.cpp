@@ -1,11 +1,15 @@
 // depotwin: the command line. Each verb is a thin wrapper around the pipeline.
 // Exit status: 0 success, 2 bad input (file:line: key: message), 1 internal failure.
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <iostream>
+#include <string>
 
+#include "cli/describe.hpp"
 #include "cli/move_verb.hpp"
 #include "cli/verbs.hpp"
 #include "core/error.hpp"
+#include "viewer/viewer.hpp"  // view
 
 using namespace depotwin;
 
@@ -13,6 +17,34 @@ namespace {
 
 void print_problems(const InputError& error) {
   for (const Problem& problem : error.problems()) std::cerr << "error: " << problem.str() << '\n';
+}
+
+// "run, compare, plan, ...": every verb the app knows, in the order they were added
+std::string verb_list(CLI::App& app) {
+  const std::function<bool(CLI::App*)> every = [](CLI::App*) { return true; };
+  std::string list;
+  for (const CLI::App* verb : app.get_subcommands(every))
+    list += (list.empty() ? "" : ", ") + verb->get_name();
+  return list;
+}
+
+// The verb comes first: without one, the usage and the verbs; an unknown one is named with
+// the verbs (CLI11 alone says "A subcommand is required"). Returns the exit status when the
+// command line is refused here, -1 otherwise.
+int check_verb(CLI::App& app, int argc, char** argv) {
+  if (argc < 2) {
+    std::cerr << app.help() << "\nerror: a verb is required; verbs are " << verb_list(app) << '\n';
+    return kExitBadInput;
+  }
+  const std::string first = argv[1];
+  if (!first.empty() && first[0] == '-') return -1;  // --help, --version, or CLI11's message
+  const std::function<bool(CLI::App*)> named = [&](CLI::App* verb) {
+    return verb->check_name(first);
+  };
+  if (!app.get_subcommands(named).empty()) return -1;
+  std::cerr << "error: unknown verb '" << first << "'; verbs are " << verb_list(app)
+            << "\n(depotwin --help says what each does)\n";
+  return kExitBadInput;
 }
 
 }  // namespace
@@ -34,6 +66,13 @@ int main(int argc, char** argv) {
   run->add_option("--out", run_options.out, "output directory (default: results/<scenario name>)");
   run->add_flag("--no-render", run_options.no_render, "write no images or plots");
   run->add_flag("--quiet", run_options.quiet, "no progress line");
+  // ---- moving pictures (src/render/video.hpp) ----
+  run->add_flag("--video", run_options.video,
+                "also write run.mp4 in each run folder: the scene over time, the deposit growing");
+  run->add_option("--video-length", run_options.video_length_s,
+                  "longest video, seconds: a longer run is sped up to fit (default 30)")
+      ->check(CLI::PositiveNumber);
+  // ---- end moving pictures ----
 
   CompareOptions compare_options;
   CLI::App* compare =
@@ -48,29 +87,76 @@ int main(int argc, char** argv) {
                       "output directory (default: results/<scenario name>)");
   compare->add_flag("--no-render", compare_options.run.no_render, "write no images or plots");
   compare->add_flag("--quiet", compare_options.run.quiet, "no progress line");
+  // ---- moving pictures (src/render/video.hpp) ----
+  compare->add_flag("--video", compare_options.run.video, "also write run.mp4 in each run folder");
+  compare
+      ->add_option("--video-length", compare_options.run.video_length_s,
+                   "longest video, seconds: a longer run is sped up to fit (default 30)")
+      ->check(CLI::PositiveNumber);
+  // ---- end moving pictures ----
 
   RunOptions plan_options;
-  CLI::App* plan = app.add_subcommand("plan", "plan only (no simulation): trajectory and planned metrics");
+  CLI::App* plan =
+      app.add_subcommand("plan", "plan only (no simulation): trajectory and planned metrics");
   plan->add_option("scenario", plan_options.scenario, "scenario YAML file")->required();
   plan->add_option("--planner", plan_options.planners,
                    "planner(s), comma-separated (default: all of the scenario's)");
-  plan->add_option("--out", plan_options.out, "output directory (default: results/<scenario name>)");
+  plan->add_option("--out", plan_options.out,
+                   "output directory (default: results/<scenario name>)");
 
   std::string validate_scenario;
-  CLI::App* validate = app.add_subcommand("validate", "load and check a scenario; explain every problem");
+  CLI::App* validate =
+      app.add_subcommand("validate", "load and check a scenario; explain every problem");
   validate->add_option("scenario", validate_scenario, "scenario YAML file")->required();
 
+  // ---- view (a finished run replayed in a window: src/viewer/viewer.cpp) ----
+  ViewOptions view_options;
+  CLI::App* view = app.add_subcommand(
+      "view", "replay a finished run in an interactive MuJoCo window (needs a display)");
+  view->add_option("run_dir", view_options.run_directory,
+                   "a run's folder, e.g. results/<scenario>/<planner> (holds replay.json)")
+      ->required();
+  view->add_option("--screenshot", view_options.screenshot,
+                   "render one frame in the window, write it to this PNG and exit");
+  view->add_option("--at", view_options.at_s,
+                   "start at this run time, s (default: the start; a screenshot: the end)");
+  view->add_option("--width", view_options.width, "window width, pixels (default 1280)");
+  view->add_option("--height", view_options.height, "window height, pixels (default 640)");
+  view->footer(std::string("Keys and mouse:\n") + kViewControls);
+  // ---- end view ----
+
+  // ---- describe (the schema tables: src/cli/describe.cpp) ----
+  std::string describe_topic;
+  bool describe_as_json = false;
+  CLI::App* describe = app.add_subcommand(
+      "describe",
+      "every parameter with its unit, range, default and meaning; topics: machines, planners, "
+      "sequencers, processes, limits, toolpath, arm, sim, outputs, scenario");
+  describe->add_option("topic", describe_topic, "what to describe (none: list the topics)");
+  describe->add_flag("--json", describe_as_json, "print JSON instead of tables");
+  // ---- end describe ----
+
+  // positions give the axes, one value each; a velocity or limit list has one value per
+  // axis, or one value for every axis
   std::string q0, q1, v0, v1, vmax, amax, jmax;
   CLI::App* move = app.add_subcommand(
-      "move", "minimum-time move of one to six axes (comma lists, one value per axis), as JSON");
-  move->add_option("--q0", q0, "start positions, mm")->required();
-  move->add_option("--q1", q1, "end positions, mm")->required();
-  move->add_option("--v0", v0, "start velocities, mm/s")->default_str("0");
-  move->add_option("--v1", v1, "end velocities, mm/s")->default_str("0");
-  move->add_option("--vmax", vmax, "velocity limits, mm/s")->required();
-  move->add_option("--amax", amax, "acceleration limits, mm/s^2")->required();
-  move->add_option("--jmax", jmax, "jerk limits, mm/s^3 (0: none)");
+      "move",
+      "minimum-time move of one to six axes, as JSON. Comma lists: --q0 and --q1 give one "
+      "position per axis (same count); --v0, --v1, --vmax, --amax, --jmax one value per axis "
+      "or one value for every axis");
+  move->add_option("--q0", q0, "start positions, mm, one per axis")->required();
+  move->add_option("--q1", q1, "end positions, mm, one per axis")->required();
+  move->add_option("--v0", v0, "start velocities, mm/s (one per axis, or one for all)")
+      ->default_str("0");
+  move->add_option("--v1", v1, "end velocities, mm/s (one per axis, or one for all)")
+      ->default_str("0");
+  move->add_option("--vmax", vmax, "velocity limits, mm/s (one per axis, or one for all)")
+      ->required();
+  move->add_option("--amax", amax, "acceleration limits, mm/s^2 (one per axis, or one for all)")
+      ->required();
+  move->add_option("--jmax", jmax, "jerk limits, mm/s^3, 0: none (one per axis, or one for all)");
 
+  if (const int status = check_verb(app, argc, argv); status >= 0) return status;
   try {
     try {
       app.parse(argc, argv);
@@ -88,6 +174,8 @@ int main(int argc, char** argv) {
     if (*compare) return compare_verb(compare_options);
     if (*plan) return plan_verb(plan_options);
     if (*validate) return validate_verb(validate_scenario);
+    if (*view) return view_verb(view_options);                              // view
+    if (*describe) return describe_verb(describe_topic, describe_as_json);  // describe
     if (*move) {
       MoveRequest request;
       request.q0 = parse_number_list(q0, "--q0");

@@ -27,7 +27,12 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
 
 namespace {
 
-// broadcast a one-value list to every axis; otherwise the sizes must match
+// "1 value", "3 values"
+std::string count_text(size_t count) {
+  return std::to_string(count) + (count == 1 ? " value" : " values");
+}
+
+// a one-value list stands for every axis (velocities and limits only); otherwise one per axis
 double value_for_axis(const std::vector<double>& list, size_t axis) {
   return list.size() == 1 ? list[0] : list[axis];
 }
@@ -54,24 +59,28 @@ nlohmann::ordered_json phases_json(const AxisProfile& profile, bool jerk_limited
 
 nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
   using Json = nlohmann::ordered_json;
+  // the positions give the axes, one each: they are never broadcast
+  const size_t axes = request.q0.size();
+  if (axes == 0) throw InputError("--q0", "no value given");
+  if (request.q1.size() != axes)
+    throw InputError("--q1", "has " + count_text(request.q1.size()) + " but --q0 has " +
+                                 count_text(axes) + " (one position per axis in each)");
+  if (axes > 6) throw InputError("--q0", "has " + count_text(axes) + ": at most six axes");
+  // velocities and limits: one per axis, or one for every axis; --jmax is optional
   const std::vector<std::pair<std::string, const std::vector<double>*>> lists{
-      {"--q0", &request.q0}, {"--q1", &request.q1},      {"--v0", &request.v0},
-      {"--v1", &request.v1}, {"--vmax", &request.v_max}, {"--amax", &request.a_max}};
-  size_t axes = 1;
-  for (const auto& [name, list] : lists) axes = std::max(axes, list->size());
-  if (axes > 6) throw InputError("--q0", "at most six axes");
+      {"--v0", &request.v0},
+      {"--v1", &request.v1},
+      {"--vmax", &request.v_max},
+      {"--amax", &request.a_max},
+      {"--jmax", &request.j_max}};
   std::vector<Problem> problems;
   for (const auto& [name, list] : lists) {
-    if (list->size() != 1 && list->size() != axes)
+    if (list->size() > 1 && list->size() != axes)
       problems.push_back({"", 0, name,
-                          "has " + std::to_string(list->size()) + " values for " +
-                              std::to_string(axes) + " axes (give one per axis, or one for all)"});
+                          "has " + count_text(list->size()) + " but --q0 and --q1 have " +
+                              count_text(axes) + " (give one per axis, or one for every axis)"});
+    if (list->empty() && name != "--jmax") problems.push_back({"", 0, name, "no value given"});
   }
-  // --jmax is optional: one value for all axes or one per axis, 0 = no jerk limit
-  if (request.j_max.size() > 1 && request.j_max.size() != axes)
-    problems.push_back({"", 0, "--jmax",
-                        "has " + std::to_string(request.j_max.size()) + " values for " +
-                            std::to_string(axes) + " axes (give one per axis, or one for all)"});
   if (!problems.empty()) throw InputError(problems);
 
   // per axis: limits and boundary velocities, then the synchronised move

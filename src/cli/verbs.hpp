@@ -11,6 +11,10 @@ struct RunOptions {
   std::string out;
   bool no_render = false;
   bool quiet = false;
+  // ---- moving pictures: run.mp4 (RunSettings::video) ----
+  bool video = false;
+  double video_length_s = 30.0;
+  // ---- end moving pictures ----
 };
 
 struct CompareOptions {

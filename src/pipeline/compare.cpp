@@ -4,12 +4,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include "core/error.hpp"
 #include "plots/plots.hpp"
 #include "render/scene.hpp"
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
+#include "report/summary_table.hpp"
 
 namespace depotwin {
 
@@ -30,13 +32,50 @@ OrderSpec parse_order_label(const std::string& label, const OrderSpec& defaults)
   return spec;
 }
 
-namespace {
-
-std::string number(double value) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.6g", value);
-  return text;
+std::vector<OrderSpec> parse_order_list(const std::string& list, const OrderSpec& defaults) {
+  std::vector<OrderSpec> orders;
+  std::stringstream stream(list);
+  std::string label;
+  while (std::getline(stream, label, ',')) {
+    if (label.empty()) continue;
+    orders.push_back(parse_order_label(label, defaults));
+    // each order once: its label names its results folder
+    for (size_t i = 0; i + 1 < orders.size(); ++i)
+      if (orders[i].label() == orders.back().label())
+        throw InputError("--orders", "'" + label + "' is named twice");
+  }
+  return orders;
 }
+
+std::vector<ComparisonCase> comparison_cases(const Scenario& scenario,
+                                             const std::vector<PlannerSpec>& planners,
+                                             const std::vector<OrderSpec>& orders) {
+  // every order (or the scenario's) under every planner, orders outermost
+  std::vector<ComparisonCase> cases;
+  if (orders.empty()) {
+    for (const PlannerSpec& p : planners) cases.push_back({p.run_label(), p, scenario.order});
+  } else {
+    for (const OrderSpec& o : orders)
+      for (const PlannerSpec& p : planners) {
+        // one planner: the order names the run; several: "<order>+<planner>"
+        const std::string label =
+            planners.size() == 1 ? o.label() : o.label() + "+" + p.run_label();
+        cases.push_back({label, p, o});
+      }
+  }
+  // the label names the results folder and the progress line: unique, or refused
+  for (size_t i = 0; i < cases.size(); ++i) {
+    cases[i].planner.label = cases[i].label;
+    for (size_t k = 0; k < i; ++k)
+      if (cases[k].label == cases[i].label)
+        throw InputError(orders.empty() ? "--planners" : "--orders",
+                         "two runs would both be named '" + cases[i].label +
+                             "' (name each planner and order once)");
+  }
+  return cases;
+}
+
+namespace {
 
 // the comparison sheet's column for one run
 plots::ComparisonColumn sheet_column(const std::string& label, const SimulatedRun& run,
@@ -46,11 +85,15 @@ plots::ComparisonColumn sheet_column(const std::string& label, const SimulatedRu
   column.thickness = map;
   plots::set_speed_error(column, run.simulated);
   column.transitions = plots::transition_intervals(run.plan.trajectory);
+  // the print order and its travels (an orders comparison shows these instead of the maps)
+  column.order = run.report.sequencer;
+  plots::set_travels(column, run.plan.planned);
   const MetricsReport& r = run.report;
   if (r.velocity_error) {
     column.max_speed_error_rel = r.velocity_error->max_rel;
     column.rms_speed_error_rel = r.velocity_error->rms_rel;
   }
+  if (r.velocity_error_steady) column.steady_speed_error_rel = r.velocity_error_steady->max_rel;
   if (r.thickness) column.thickness_cv = r.thickness->cv;
   if (r.waste) column.waste_fraction = r.waste->fraction;
   column.total_time_s = r.time.total_s;
@@ -63,19 +106,7 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
                                         const std::vector<PlannerSpec>& planners,
                                         const std::vector<OrderSpec>& orders,
                                         const std::string& directory, const RunSettings& settings) {
-  // what to run: planners on the scenario's order, or the first planner on each order
-  struct Case {
-    std::string label;
-    PlannerSpec planner;
-    OrderSpec order;
-  };
-  std::vector<Case> cases;
-  if (orders.empty()) {
-    for (const PlannerSpec& p : planners) cases.push_back({p.run_label(), p, scenario.order});
-  } else {
-    for (const OrderSpec& o : orders) cases.push_back({o.label(), planners.front(), o});
-  }
-
+  const std::vector<ComparisonCase> cases = comparison_cases(scenario, planners, orders);
   std::vector<ComparisonRow> rows;
   std::vector<SimulatedRun> runs;
   std::vector<HeightMap> maps;
@@ -85,7 +116,7 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
   runs.reserve(cases.size());
   jobs.reserve(cases.size());
   BackgroundRunWriter writer;
-  for (const Case& c : cases) {
+  for (const ComparisonCase& c : cases) {
     Scenario variant = scenario;
     variant.order = c.order;
     jobs.push_back(prepare_job(variant));
@@ -122,12 +153,18 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
 }
 
 std::string comparison_json(const std::string& scenario, const std::vector<ComparisonRow>& rows) {
+  // the summary table (the columns of comparison.csv and .md), then every run's metrics
   nlohmann::ordered_json j;
   j["scenario"] = scenario;
+  std::vector<MetricsReport> reports;
+  for (const ComparisonRow& row : rows) reports.push_back(row.report);
+  const nlohmann::ordered_json table = summary_json(reports);
+  j["columns"] = table["columns"];
+  j["rows"] = table["rows"];
   nlohmann::ordered_json runs = nlohmann::ordered_json::array();
   for (const ComparisonRow& row : rows) {
     nlohmann::ordered_json entry;
-    entry["label"] = row.label;
+    entry["run"] = row.label;
     entry["metrics"] = to_json(row.report);
     runs.push_back(entry);
   }
@@ -137,89 +174,31 @@ std::string comparison_json(const std::string& scenario, const std::vector<Compa
 
 namespace {
 
-// the comparison columns: (header, value of a report)
-struct Column {
-  const char* header;
-  std::string (*value)(const MetricsReport&);
-};
-
-const std::vector<Column>& columns() {
-  static const std::vector<Column> list = {
-      {"planner", [](const MetricsReport& r) { return r.planner; }},
-      {"order", [](const MetricsReport& r) { return r.sequencer; }},
-      {"time_s", [](const MetricsReport& r) { return number(r.time.total_s); }},
-      {"print_s", [](const MetricsReport& r) { return number(r.time.print_s); }},
-      {"transition_s", [](const MetricsReport& r) { return number(r.time.transition_s); }},
-      {"vel_err_max",
-       [](const MetricsReport& r) {
-         return r.velocity_error ? number(r.velocity_error->max_rel) : std::string("");
-       }},
-      {"vel_err_rms",
-       [](const MetricsReport& r) {
-         return r.velocity_error ? number(r.velocity_error->rms_rel) : std::string("");
-       }},
-      {"vel_err_frac_over_1pct",
-       [](const MetricsReport& r) {
-         return r.velocity_error ? number(r.velocity_error->frac_len_over_1pct) : std::string("");
-       }},
-      {"planned_vel_err_max",
-       [](const MetricsReport& r) { return number(r.planned_velocity_error.max_rel); }},
-      {"path_err_max_mm", [](const MetricsReport& r) { return number(r.path_error.max_mm); }},
-      {"thickness_cv",
-       [](const MetricsReport& r) {
-         return r.thickness ? number(r.thickness->cv) : std::string("");
-       }},
-      {"line_cv",
-       [](const MetricsReport& r) {
-         return r.thickness ? number(r.thickness->line_cv) : std::string("");
-       }},
-      {"waste_fraction",
-       [](const MetricsReport& r) {
-         return r.waste ? number(r.waste->fraction) : std::string("");
-       }},
-      {"shutter_captured",
-       [](const MetricsReport& r) {
-         return r.waste ? number(r.waste->shutter_captured) : std::string("");
-       }},
-      {"overspray",
-       [](const MetricsReport& r) {
-         return r.waste ? number(r.waste->overspray) : std::string("");
-       }},
-      {"warnings", [](const MetricsReport& r) { return std::to_string(r.warnings.size()); }},
-  };
-  return list;
+// the reports of the rows, each under its row's label (the `run` column)
+std::vector<MetricsReport> labelled_reports(const std::vector<ComparisonRow>& rows) {
+  std::vector<MetricsReport> reports;
+  for (const ComparisonRow& row : rows) {
+    reports.push_back(row.report);
+    reports.back().label = row.label;
+  }
+  return reports;
 }
 
 }  // namespace
 
 std::string comparison_csv(const std::vector<ComparisonRow>& rows) {
-  std::string out = "label";
-  for (const Column& c : columns()) out += std::string(",") + c.header;
-  out += '\n';
-  for (const ComparisonRow& row : rows) {
-    out += row.label;
-    for (const Column& c : columns()) out += "," + c.value(row.report);
-    out += '\n';
-  }
-  return out;
+  return summary_csv(labelled_reports(rows));
 }
 
 std::string comparison_markdown(const std::string& scenario, const std::vector<ComparisonRow>& rows,
                                 bool with_images) {
   std::string out = "# " + scenario + ": comparison\n\n";
   if (with_images) out += "![comparison sheet](comparison.png)\n\n";
-  out += "| run |";
-  for (const Column& c : columns()) out += std::string(" ") + c.header + " |";
-  out += "\n|---|";
-  for (size_t i = 0; i < columns().size(); ++i) out += "---|";
-  out += '\n';
-  for (const ComparisonRow& row : rows) {
-    out += "| " + row.label + " |";
-    for (const Column& c : columns()) out += " " + c.value(row.report) + " |";
-    out += '\n';
-  }
+  out += summary_markdown(labelled_reports(rows));
   out +=
-      "\nDefinitions: README.md, \"Metrics\". Speed errors and waste are fractions (0.01 = 1 %).\n";
+      "\nDefinitions: README.md, \"Metrics\". planned_* come from the plan alone, sim_* from the "
+      "simulated nozzle; _pct are percent; vel_err_steady leaves out each printed stretch's "
+      "start and end ramps (metrics.json speed_ramps).\n";
   if (with_images) {
     out += "\n## Images per run\n\n";
     for (const ComparisonRow& row : rows) {

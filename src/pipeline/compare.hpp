@@ -11,12 +11,28 @@
 namespace depotwin {
 
 struct ComparisonRow {
-  std::string label;  // the run's folder under DIR: the planner, or the order for --orders
+  std::string label;  // the run's folder under DIR (ComparisonCase::label)
   MetricsReport report;
 };
 
-// Run every planner named (or, with `orders` non-empty, the first planner under each of the
-// orders) and write DIR/<label>/... plus DIR/comparison.*. Returns the rows in order.
+// One run of a comparison: a planner under a print order, named by its label.
+struct ComparisonCase {
+  std::string label;    // its results folder and progress label
+  PlannerSpec planner;  // labelled with `label`
+  OrderSpec order;
+};
+
+// What `compare` runs: every planner on the scenario's order; with `orders`, every order under
+// every planner (orders outermost). Labels: the planner's run label; with orders and one
+// planner, the order's label ("christofides+three_opt"); with orders and several planners,
+// "<order>+<planner>" ("nearest_neighbor+bezier", "christofides+three_opt+lspb_mtt").
+// InputError when two runs would share a label.
+std::vector<ComparisonCase> comparison_cases(const Scenario& scenario,
+                                             const std::vector<PlannerSpec>& planners,
+                                             const std::vector<OrderSpec>& orders);
+
+// Run comparison_cases(...) and write DIR/<label>/... plus DIR/comparison.*. Returns the rows
+// in order.
 std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
                                         const std::vector<PlannerSpec>& planners,
                                         const std::vector<OrderSpec>& orders,
@@ -24,6 +40,9 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
 
 // "christofides+three_opt" -> {method christofides, refine three_opt}; InputError for unknown names
 OrderSpec parse_order_label(const std::string& label, const OrderSpec& defaults);
+// "as_given,nearest_neighbor+two_opt" -> one OrderSpec each; InputError for an unknown name
+// or one named twice
+std::vector<OrderSpec> parse_order_list(const std::string& list, const OrderSpec& defaults);
 
 std::string comparison_csv(const std::vector<ComparisonRow>& rows);
 std::string comparison_markdown(const std::string& scenario, const std::vector<ComparisonRow>& rows,

@@ -1,5 +1,6 @@
 #include "pipeline/job.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -8,8 +9,10 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "kinematics/arm6.hpp"
+#include "pipeline/models_dir.hpp"
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
+#include "report/summary_table.hpp"
 #include "report/trajectory_csv.hpp"
 #include "sim/part_model.hpp"
 
@@ -36,61 +39,35 @@ std::unique_ptr<Machine> machine_for(const Scenario& scenario, std::string& mode
                      "unknown machine '" + scenario.machine + "' (known: " + known + ")");
   }
   model_path = scenario.model_path.empty()
-                   ? (fs::path(DEPOTWIN_MODELS_DIR) / machine->model_file()).string()
+                   ? (fs::path(models_directory()) / machine->model_file()).string()
                    : scenario.model_path;
   return machine;
 }
 
-// "" when every toolpath pose is reachable; else one problem per unreachable pose
-std::vector<Problem> unreachable_poses(const Scenario& scenario, const Machine& machine) {
-  std::vector<Problem> problems;
-  size_t unnamed = 0;  // beyond kMaxNamedPoints: counted, not listed
-  JointVector joints;
-  const int surface_line = scenario.surface ? scenario.surface->line : 0;
-  auto check_reachable = [&](const Pose& pose, const std::string& key, int line,
-                             const std::string& where) {
-    std::string why;
-    if (machine.inverse(pose, joints, &why)) return;
-    if (problems.size() >= kMaxNamedPoints) {
-      ++unnamed;
-      return;
-    }
-    const Vec3& p = pose.position_mm;
-    std::ostringstream msg;
-    msg << where << "point (" << p.x() << ", " << p.y() << ", " << p.z()
-        << ") mm is not reachable by " << machine.name() << ": " << why;
-    problems.push_back(Problem{scenario.file, line, key, msg.str()});
-  };
-  const Toolpath& toolpath = scenario.toolpath;
-  check_reachable(Pose(toolpath.start_mm), "toolpath.start", 0, "");
-  check_reachable(Pose(toolpath.end_mm), "toolpath.end", 0, "");
-  for (const PrintPath& path : toolpath.paths)
-    for (size_t i = 0; i < path.points.size(); ++i) {
-      // a surface's points by their layer, line and index (only the ones listed are named)
-      const bool named = scenario.surface && problems.size() < kMaxNamedPoints;
-      check_reachable(Pose(path.points[i], path.tool_axis(i)),
-                      scenario.surface ? "toolpath.surface"
-                                       : "toolpath path " + std::to_string(path.source_index),
-                      surface_line,
-                      named ? scenario.surface->describe_point(path.source_index, i,
-                                                               path.points.size(), false) +
-                                  ": "
-                            : "");
-    }
-  if (unnamed > 0)
-    problems.push_back(
-        Problem{scenario.file, surface_line, scenario.surface ? "toolpath.surface" : "toolpath",
-                "... and " + std::to_string(unnamed) + " more unreachable points (the first " +
-                    std::to_string(kMaxNamedPoints) + " are listed)"});
-  return problems;
-}
+// A point as the posture's messages name it, and where its problems belong
+struct NamedPoint {
+  std::string name;  // what the posture's message starts with
+  Problem location;  // file, line and key of the point; message: its name for the user
+};
 
-// Problems of the arm's posture (no file, key "toolpath") placed at the scenario's toolpath
-std::vector<Problem> at_toolpath(const Scenario& scenario, std::vector<Problem> problems) {
+// Problems of the arm's posture (no file, key "toolpath") placed at the point they name (its
+// file, line and dotted key), else at the scenario's toolpath
+std::vector<Problem> at_toolpath(const Scenario& scenario, const std::vector<NamedPoint>& named,
+                                 std::vector<Problem> problems) {
   for (Problem& p : problems) {
     if (!p.file.empty()) continue;
+    const auto point = std::find_if(named.begin(), named.end(), [&](const NamedPoint& n) {
+      return p.message.rfind(n.name, 0) == 0;
+    });
+    if (point != named.end()) {
+      p.file = point->location.file;
+      p.line = point->location.line;
+      p.key = point->location.key;
+      p.message = point->location.message + p.message.substr(point->name.size());
+      continue;
+    }
     p.file = scenario.file;
-    p.line = scenario.surface ? scenario.surface->line : 0;
+    p.line = scenario.surface ? scenario.surface->line : scenario.toolpath_line;
     p.key = scenario.surface ? "toolpath.surface" : "toolpath";
   }
   return problems;
@@ -100,23 +77,33 @@ std::vector<Problem> at_toolpath(const Scenario& scenario, std::vector<Problem> 
 // ladder graph of posture/), checked against the part
 void choose_posture(const Scenario& scenario, Arm6& arm, PreparedJob& job) {
   if (job.part) job.clearance = std::make_shared<const PartClearance>(*job.part);
-  // a point named by its layer, line and index for a surface toolpath
+  // a point named by its layer, line and index for a surface toolpath, else by its path's key
+  // and index as given in the file (a sequencer may have reversed the path)
+  std::vector<NamedPoint> named;
   const auto name = [&](size_t path, size_t point) {
     const PrintPath& printed = job.toolpath.paths[path];
     const int source = printed.source_index;
-    if (!scenario.surface || source < 0 ||
-        static_cast<size_t>(source) >= scenario.toolpath.paths.size())
-      return "toolpath path " + std::to_string(source) + ", point " + std::to_string(point);
-    const PrintPath& given = scenario.toolpath.paths[static_cast<size_t>(source)];
-    const bool reversed = (given.front() - printed.front()).norm() > kJoinTolerance_mm;
-    return scenario.surface->describe_point(printed.source_index, point, printed.points.size(),
-                                            reversed);
+    const PrintPath* given = nullptr;
+    for (const PrintPath& candidate : scenario.toolpath.paths)
+      if (candidate.source_index == source) given = &candidate;
+    const bool reversed = given && (given->front() - printed.front()).norm() > kJoinTolerance_mm;
+    const size_t given_point = reversed ? printed.points.size() - 1 - point : point;
+    NamedPoint entry;
+    entry.location = path_point_problem(scenario, source, given_point, "");
+    // the message without the trailing separator is the name the user reads
+    entry.name = entry.location.key + " " + entry.location.message;
+    while (!entry.name.empty() && (entry.name.back() == ' ' || entry.name.back() == ':'))
+      entry.name.pop_back();
+    std::string& shown = entry.location.message;
+    while (!shown.empty() && (shown.back() == ' ' || shown.back() == ':')) shown.pop_back();
+    named.push_back(entry);
+    return entry.name;
   };
   try {
     job.posture = choose_arm_posture(arm, job.clearance.get(), job.toolpath,
                                      scenario.arm.value_or(ArmPostureSettings{}), name);
   } catch (const InputError& e) {
-    throw InputError(at_toolpath(scenario, e.problems()));
+    throw InputError(at_toolpath(scenario, named, e.problems()));
   }
   arm.set_branch(job.posture->branch);
   job.toolpath = job.posture->toolpath;
@@ -128,10 +115,14 @@ PreparedJob prepare_job(const Scenario& scenario) {
   PreparedJob job;
   job.scenario = scenario;
   job.machine = machine_for(scenario, job.model_path);
+  // every problem of the machine with the scenario in one list (load_scenario has found
+  // these already for a scenario it loaded; a scenario changed in code is checked again)
+  std::vector<Problem> problems;
   if (scenario.has_joint_limits) {
     const std::string problem = job.machine->set_joint_limits(scenario.joint_limits);
     if (!problem.empty())
-      throw InputError(scenario.file, scenario.joint_limits_line, "limits.joint", problem);
+      problems.push_back(
+          Problem{scenario.file, scenario.joint_limits_line, "limits.joint", problem});
   }
 
   // the part, in the machine's model too (shown in the scene, carried by the substrate)
@@ -146,9 +137,10 @@ PreparedJob prepare_job(const Scenario& scenario) {
   // every pose of the toolpath must be reachable by the machine (an arm: for some roll, on
   // its posture's branch, below)
   if (!arm) {
-    const std::vector<Problem> problems = unreachable_poses(scenario, *job.machine);
-    if (!problems.empty()) throw InputError(problems);
+    std::vector<Problem> unreachable = unreachable_points(scenario, *job.machine, kMaxNamedPoints);
+    problems.insert(problems.end(), unreachable.begin(), unreachable.end());
   }
+  if (!problems.empty()) throw InputError(problems);
 
   // the TCP limits: the user's, refined per move by the machine (Klipper's check_move)
   job.limits = job.machine->tcp_limits(scenario.limits);
@@ -232,8 +224,12 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   r.time.total_s = run.trajectory.duration_s();
   r.time.print_s = run.trajectory.depositing_time_s();
   r.time.transition_s = run.trajectory.transition_time_s();
+  // planned figures only (simulate_job adds the simulated ones); the steady speed error
+  // leaves out each printed stretch's start and end ramps
+  r.speed_ramps = speed_ramps(run.planned);
   r.planned_velocity_error = velocity_error(run.planned);
-  r.path_error = path_error(run.planned, job.toolpath);
+  r.planned_velocity_error_steady = velocity_error(run.planned, r.speed_ramps);
+  r.planned_path_error = path_error(run.planned, job.toolpath);
   OrderStats order;
   order.method = job.scenario.order.method;
   order.refine = job.scenario.order.refine;
@@ -260,70 +256,9 @@ std::vector<MetricsReport> write_plans(const PreparedJob& job,
   return reports;
 }
 
-namespace {
-
-std::string percent(double fraction) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.2f %%", 100.0 * fraction);
-  return text;
-}
-
-std::string fixed(double value, int digits) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*f", digits, value);
-  return text;
-}
-
-}  // namespace
-
 std::string summary_table(const std::vector<MetricsReport>& reports) {
-  // one row per planner; simulated columns only when a simulation ran
-  const bool simulated = !reports.empty() && reports.front().velocity_error.has_value();
-  std::vector<std::vector<std::string>> rows;
-  std::vector<std::string> header{"planner",          "order",      "time s",
-                                  "print s",          "transit s",  "plan vel err max",
-                                  "plan vel err rms", "path err mm"};
-  if (simulated) {
-    header.insert(header.end(), {"sim vel err max", "thickness cv", "line cv", "waste"});
-  }
-  header.push_back("warnings");
-  rows.push_back(header);
-  for (const MetricsReport& r : reports) {
-    std::vector<std::string> row{r.label.empty() ? r.planner : r.label,
-                                 r.sequencer,
-                                 fixed(r.time.total_s, 3),
-                                 fixed(r.time.print_s, 3),
-                                 fixed(r.time.transition_s, 3),
-                                 percent(r.planned_velocity_error.max_rel),
-                                 percent(r.planned_velocity_error.rms_rel),
-                                 fixed(r.path_error.max_mm, 4)};
-    if (simulated) {
-      row.push_back(r.velocity_error ? percent(r.velocity_error->max_rel) : "-");
-      row.push_back(r.thickness ? fixed(r.thickness->cv, 4) : "-");
-      row.push_back(r.thickness ? fixed(r.thickness->line_cv, 4) : "-");
-      row.push_back(r.waste ? percent(r.waste->fraction) : "-");
-    }
-    row.push_back(std::to_string(r.warnings.size()));
-    rows.push_back(row);
-  }
-  // column widths, then the rows
-  std::vector<size_t> width(header.size(), 0);
-  for (const auto& row : rows)
-    for (size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], row[c].size());
-  std::string out;
-  for (size_t i = 0; i < rows.size(); ++i) {
-    for (size_t c = 0; c < rows[i].size(); ++c) {
-      const std::string& cell = rows[i][c];
-      const std::string pad(width[c] - cell.size(), ' ');
-      out += c == 0 ? cell + pad : "  " + pad + cell;
-    }
-    out += '\n';
-    if (i == 0) {
-      for (size_t c = 0; c < width.size(); ++c) out += std::string(width[c] + (c ? 2 : 0), '-');
-      out += '\n';
-    }
-  }
-  return out;
+  // the same columns and names as comparison.{csv,md,json} (report/summary_table.hpp)
+  return summary_console(reports);
 }
 
 }  // namespace depotwin

@@ -67,7 +67,8 @@ std::vector<MetricsReport> write_plans(const PreparedJob& job,
                                        const std::vector<PlannerSpec>& planners,
                                        const std::string& directory);
 
-// a fixed-width summary table of the reports
+// the console's summary of the reports: one line per column of report/summary_table.hpp
+// (the columns of comparison.{csv,md,json}), one column per run
 std::string summary_table(const std::vector<MetricsReport>& reports);
 
 }  // namespace depotwin

@@ -7,14 +7,18 @@
 #include <cstdio>
 #include <filesystem>
 #include <future>
+#include <iostream>
 
 #include "core/error.hpp"
 #include "deposition/deposition_metrics.hpp"
 #include "deposition/field_io.hpp"
 #include "kinematics/arm6.hpp"
 #include "metrics/run_report.hpp"
+#include "pipeline/progress_line.hpp"
+#include "pipeline/replay.hpp"  // moving pictures
 #include "plots/plots.hpp"
 #include "render/scene.hpp"
+#include "render/video.hpp"  // moving pictures
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
 #include "report/trajectory_csv.hpp"
@@ -41,39 +45,6 @@ DepositionSettings deposition_settings(const Scenario& scenario) {
   s.tau_s = p.tau_s;
   return s;
 }
-
-namespace {
-
-// "\r<label> 42 %" on a terminal once the run has taken a second; nothing otherwise
-class ProgressLine {
- public:
-  ProgressLine(std::string label, bool enabled)
-      : label_(std::move(label)),
-        enabled_(enabled && ::isatty(STDERR_FILENO)),
-        start_(std::chrono::steady_clock::now()) {}
-  void update(double fraction) {
-    if (!enabled_) return;
-    const double elapsed = seconds();
-    if (elapsed < 1.0) return;
-    std::fprintf(stderr, "\r%s %3.0f %% (%.1f s)", label_.c_str(), 100.0 * fraction, elapsed);
-    std::fflush(stderr);
-    shown_ = true;
-  }
-  void finish() {
-    if (shown_) std::fprintf(stderr, "\r%s done in %.1f s        \n", label_.c_str(), seconds());
-  }
-
- private:
-  double seconds() const {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  }
-  std::string label_;
-  bool enabled_;
-  bool shown_ = false;
-  std::chrono::steady_clock::time_point start_;
-};
-
-}  // namespace
 
 std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
                                                     const Toolpath& toolpath) {
@@ -173,12 +144,18 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   LayeredDeposit& deposit = *run.deposit;
   const double job_end_s = trajectory.duration_s();
   int layer = 0;
+  // moving pictures: MuJoCo's whole state sampled for the replay data
+  run.states = std::make_shared<StateSamples>(*run.simulation);
+  StateSamples& states = *run.states;
   auto on_step = [&](const StepState& before, const StepState& after) {
     if (before.path_index >= 0) layer = job.toolpath.paths[before.path_index].layer;
     DepositionStep step;
     if (deposition_step(before, after, job_end_s, step)) deposit.advance(step, layer);
+    states.on_step(after);
   };
-  ProgressLine progress(scenario.name + "/" + spec.run_label() + ": simulating", settings.progress);
+  // the progress line names the run (a compare's order and planner: its label)
+  ProgressLine progress(scenario.name + "/" + spec.run_label() + ": simulating",
+                        ProgressLine::style_for_stderr(settings.progress));
   run.record =
       run.simulation->run(trajectory, on_step, [&](double fraction) { progress.update(fraction); });
   progress.finish();
@@ -252,6 +229,14 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
       if (!map.thickness_um.empty()) input.thickness = &map;
       input.profiles = centreline_profiles(field, job.toolpath);
       input.target_thickness_um = target_thickness_um(run.deposit->front(), job.toolpath);
+      // where that target comes from, said under thickness_profile.png
+      const DepositionSettings& process = run.deposit->front().settings();
+      input.target_note = plots::target_thickness_note(
+          process.type == ProcessType::extrusion, input.target_thickness_um,
+          job.toolpath.paths.empty() ? 0.0 : job.toolpath.paths.front().speed_mm_s,
+          process.footprint_sigma_mm(),
+          process.type == ProcessType::aerosol ? process.aerosol_flow_mm3_s() : process.flow_mm3_s,
+          process.bead_width_mm, process.layer_height_mm);
       if (run.report.thickness) input.mean_thickness_um = run.report.thickness->mean_um;
       // every machine's joints against their limits
       std::vector<bool> revolute;
@@ -280,6 +265,23 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
   // the plots are waited for (and their errors rethrown) even when this part fails, so no
   // thread outlives its inputs
   try {
+    // --- moving pictures: the replay data `depotwin view` reads (always)
+    const ReplayData replay =
+        build_replay(job, run, run_replay_timing(run, settings.video_length_s));
+    write_replay(replay, directory);
+    // ... and, asked for, run.mp4 (stated on the console: its length and speed-up)
+    if (settings.video) {
+      const VideoStats video = write_replay_video(replay, out.file("run.mp4"));
+      char line[256];
+      std::snprintf(line, sizeof line,
+                    "%s/%s: run.mp4, %.1f s of video at %s (%d frames at %g fps), rendered in "
+                    "%.1f s\n",
+                    job.scenario.name.c_str(), run.plan.spec.run_label().c_str(), video.length_s,
+                    speedup_text(replay.timing.speedup).c_str(), video.frames, replay.timing.fps,
+                    video.render_s);
+      std::cout << line << std::flush;
+    }
+    // --- end moving pictures
     write_file_atomically(out.file("metrics.json"), metrics_json_text(run.report));
     write_file_atomically(out.file("trajectory.csv"),
                           planned_and_simulated_csv(run.planned_at_steps, run.simulated));

@@ -14,12 +14,17 @@
 #include "pipeline/job.hpp"
 #include "plots/plots.hpp"
 #include "render/scene.hpp"
+#include "render/state_samples.hpp"  // moving pictures: SimulatedRun::states
 #include "sim/simulation.hpp"
 
 namespace depotwin {
 
 struct RunSettings {
-  bool render = true;    // images and plots
+  bool render = true;  // images and plots
+  // moving pictures: run.mp4 in each run folder (the replay data is written always), at most
+  // video_length_s long (sped up to fit)
+  bool video = false;
+  double video_length_s = 30.0;
   bool progress = true;  // a progress line on stderr for runs longer than a second
   // scene renderer shared by the runs of one verb, so its context is built once (null: one
   // per image)
@@ -37,6 +42,8 @@ struct SimulatedRun {
   MotionSamples simulated;         // the simulated nozzle, one sample per recorded state
   MotionSamples planned_at_steps;  // the plan at the same times
   MetricsReport report;
+  // moving pictures: MuJoCo's whole state sampled over the run, for the replay data
+  std::shared_ptr<StateSamples> states;
 };
 
 // thickness along each print path's centreline, sampled every cell length

@@ -1,7 +1,11 @@
 #include "report/output_dir.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <system_error>
@@ -12,10 +16,76 @@ namespace depotwin {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+std::string staging_name(const std::string& final_path) {
+  return final_path + ".partial-" + std::to_string(::getpid());
+}
+
+// Puts the folder `staging` in the place of `target` (absent, or a folder). Where the file
+// system can exchange two names atomically (Linux renameat2), a reader of `target` sees the
+// old folder or the new one, never neither; elsewhere the old folder is moved aside first, so
+// a failure leaves it intact. The old folder is deleted afterwards.
+void replace_directory(const std::string& staging, const std::string& target) {
+  std::error_code error;
+  const bool had_old = fs::exists(fs::symlink_status(target));
+  if (had_old && fs::is_directory(fs::symlink_status(target)) &&
+      ::renameat2(AT_FDCWD, staging.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
+    fs::remove_all(staging, error);  // the old result, now under the staging name
+    return;
+  }
+  // no exchange here: move the old result aside, the new one in, then drop the old one
+  const std::string old = target + ".old-" + std::to_string(::getpid());
+  if (had_old) {
+    fs::rename(target, old, error);
+    if (error) throw InternalError("cannot replace " + target + ": " + error.message());
+  }
+  fs::rename(staging, target, error);
+  if (error) {
+    const std::string reason = error.message();
+    if (had_old) fs::rename(old, target, error);
+    throw InternalError("cannot move results to " + target + ": " + reason);
+  }
+  if (had_old) fs::remove_all(old, error);
+}
+
+// `inner` is `outer` or lies inside it (both absolute and normalised)
+bool is_within(const fs::path& inner, const fs::path& outer) {
+  auto o = outer.begin();
+  for (auto i = inner.begin(); o != outer.end(); ++i, ++o)
+    if (i == inner.end() || *i != *o) return false;
+  return true;
+}
+
+// a folder depotwin may replace: empty, holding the marker, or shaped like a result written
+// before the marker existed (comparison.* files and run folders holding a metrics.json)
+bool is_depotwin_output(const fs::path& folder) {
+  std::error_code error;
+  if (fs::exists(folder / kOutputMarker, error)) return true;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    const fs::file_status status = entry.symlink_status();
+    if (fs::is_directory(status) && fs::is_regular_file(entry.path() / "metrics.json")) continue;
+    if (fs::is_regular_file(status) && name.rfind("comparison.", 0) == 0) continue;
+    return false;
+  }
+  return !error;
+}
+
+// "the nearest existing ancestor of `path`"
+fs::path nearest_existing(fs::path path) {
+  std::error_code error;
+  while (!path.empty() && !fs::exists(path, error) && path.has_relative_path())
+    path = path.parent_path();
+  return path;
+}
+
+}  // namespace
+
 StagedDirectory::StagedDirectory(std::string final_path) : final_path_(std::move(final_path)) {
   // strip trailing slashes so the staging name sits beside the final directory
   while (final_path_.size() > 1 && final_path_.back() == '/') final_path_.pop_back();
-  staging_path_ = final_path_ + ".partial-" + std::to_string(::getpid());
+  staging_path_ = staging_name(final_path_);
   std::error_code error;
   fs::remove_all(staging_path_, error);
   fs::create_directories(staging_path_, error);
@@ -32,19 +102,92 @@ void StagedDirectory::commit() {
   std::error_code error;
   const fs::path target(final_path_);
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), error);
-  // replace an older result: move it aside first so a failure leaves it intact
-  const std::string old = final_path_ + ".old-" + std::to_string(::getpid());
-  const bool had_old = fs::exists(target);
-  if (had_old) {
-    fs::rename(target, old, error);
-    if (error) throw InternalError("cannot replace " + final_path_ + ": " + error.message());
+  replace_directory(staging_path_, final_path_);
+  committed_ = true;
+}
+
+OutputFolder::OutputFolder(const std::string& final_path, const std::string& verb,
+                           const std::string& scenario_file)
+    : final_path_(final_path) {
+  auto refuse = [&](const std::string& why) {
+    throw InputError("--out", final_path_ + ": " + why);
+  };
+  if (final_path_.empty()) throw InputError("--out", "an empty path names no folder");
+
+  // the folder by its absolute name; a symlink to a folder stands for its target
+  std::error_code error;
+  fs::path target = fs::absolute(final_path_, error).lexically_normal();
+  if (!target.has_filename()) target = target.parent_path();  // a trailing '/'
+  if (fs::is_symlink(fs::symlink_status(target, error))) {
+    target = fs::canonical(target, error);
+    if (error) refuse("is a symbolic link to nothing");
   }
-  fs::rename(staging_path_, target, error);
-  if (error) {
-    if (had_old) fs::rename(old, target, error);
-    throw InternalError("cannot move results to " + final_path_);
+  if (!target.has_relative_path()) refuse("is the root folder");
+  const fs::file_status status = fs::status(target, error);
+
+  // a file, or a path under a file
+  if (fs::exists(status) && !fs::is_directory(status)) refuse("is a file, not a folder");
+  const fs::path existing = nearest_existing(target.parent_path());
+  if (!fs::is_directory(existing, error))
+    refuse("lies under " + existing.string() + ", which is a file, not a folder");
+
+  // an existing folder: it is replaced whole, so it must be ours and hold nothing we need
+  if (fs::is_directory(status)) {
+    const fs::path canonical = fs::canonical(target, error);
+    if (is_within(fs::current_path(error), canonical))
+      refuse("holds the current directory; choose a folder of its own for the results");
+    const fs::path scenario = fs::weakly_canonical(scenario_file, error);
+    if (!scenario_file.empty() && is_within(scenario, canonical))
+      refuse("holds the scenario file " + scenario_file +
+             "; choose a folder of its own for the results");
+    if (!is_depotwin_output(target))
+      refuse("exists and is not a depotwin output folder (it has files but no " +
+             std::string(kOutputMarker) +
+             " marker); it is replaced whole, so choose an empty or new folder, or remove it");
+    if (::access(target.c_str(), W_OK | X_OK) != 0)
+      refuse(std::string("cannot be replaced: ") + std::strerror(errno));
   }
-  if (had_old) fs::remove_all(old, error);
+
+  // the staging folder beside it is the probe: creating it proves the parent writable (as
+  // root, access(2) says yes even on a read-only mount)
+  target_path_ = target.string();
+  staging_path_ = staging_name(target_path_);
+  fs::create_directories(target.parent_path(), error);
+  if (error) refuse("cannot create " + target.parent_path().string() + ": " + error.message());
+  if (::access(target.parent_path().c_str(), W_OK | X_OK) != 0)
+    refuse("cannot write in " + target.parent_path().string() + ": " + std::strerror(errno));
+  fs::remove_all(staging_path_, error);
+  if (!fs::create_directory(staging_path_, error) || error)
+    refuse("cannot write in " + target.parent_path().string() + ": " +
+           (error ? error.message() : "the staging folder exists"));
+
+  // the marker: the next verb run into this folder may replace it
+  try {
+    write_file_atomically(staging_path_ + "/" + kOutputMarker,
+                          "depotwin output folder, written by `depotwin " + verb +
+                              "`; the next depotwin run, compare or plan into it replaces it "
+                              "whole\n");
+  } catch (const InternalError& failure) {
+    fs::remove_all(staging_path_, error);
+    refuse(std::string("cannot write in it: ") + failure.what());
+  }
+}
+
+OutputFolder::~OutputFolder() {
+  if (committed_) return;
+  std::error_code ignored;
+  fs::remove_all(staging_path_, ignored);
+}
+
+void OutputFolder::commit() {
+  // a folder that appeared meanwhile and is not ours is left alone
+  std::error_code error;
+  if (fs::is_directory(fs::symlink_status(target_path_, error)) &&
+      !is_depotwin_output(target_path_))
+    throw InputError("--out", final_path_ +
+                                  ": appeared during the run and is not a depotwin output "
+                                  "folder; the results were not written");
+  replace_directory(staging_path_, target_path_);
   committed_ = true;
 }
 

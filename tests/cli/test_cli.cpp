@@ -2,7 +2,11 @@
 // messages naming file/line/key, and nothing half-written on failure.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -32,6 +36,30 @@ TEST(Cli, HelpOnEveryVerb) {
   EXPECT_EQ(depotwin("fly-to-mars").status, 2);
 }
 
+// the text after `prefix` up to the end of its line
+std::string line_after(const std::string& text, const std::string& prefix) {
+  const size_t at = text.find(prefix);
+  if (at == std::string::npos) return "";
+  const size_t begin = at + prefix.size();
+  return text.substr(begin, text.find('\n', begin) - begin);
+}
+
+TEST(Cli, UnknownVerbIsNamedWithTheVerbs) {
+  const Result r = depotwin("frobnicate --out x");
+  EXPECT_EQ(r.status, 2) << r.output;
+  const std::string verbs = line_after(r.output, "error: unknown verb 'frobnicate'; verbs are ");
+  ASSERT_FALSE(verbs.empty()) << r.output;
+  EXPECT_EQ(r.output.find("A subcommand is required"), std::string::npos) << r.output;
+  for (const char* verb : {"run, ", "compare, ", "plan, ", "validate, ", "move"})
+    EXPECT_NE(verbs.find(verb), std::string::npos) << verb << " missing from: " << verbs;
+
+  // no verb at all: the usage, and the same list of verbs
+  const Result none = depotwin("");
+  EXPECT_EQ(none.status, 2) << none.output;
+  EXPECT_NE(none.output.find("Usage"), std::string::npos) << none.output;
+  EXPECT_EQ(line_after(none.output, "error: a verb is required; verbs are "), verbs);
+}
+
 TEST(Cli, MoveOvershootCase) {
   // v0 = 4 towards a target 0.1 mm ahead: overshoot and come back, 0.282405 s
   const Result r = depotwin("move --q0 0 --q1 0.1 --v0 4 --v1 0 --vmax 4 --amax 30");
@@ -55,6 +83,40 @@ TEST(Cli, MoveSynchronisesAxesAndRejectsBadInput) {
   EXPECT_NE(bad.output.find("--v0"), std::string::npos) << bad.output;
   EXPECT_EQ(depotwin("move --q0 0,1,2 --q1 1,2 --vmax 4 --amax 30").status, 2);
   EXPECT_EQ(depotwin("move --q0 x --q1 1 --vmax 4 --amax 30").status, 2);
+}
+
+// positions never broadcast: both lists name one position per axis
+TEST(Cli, MovePositionListsMustMatch) {
+  const Result r = depotwin("move --q0 0,0 --q1 10 --vmax 4 --amax 30");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("error: --q1: has 1 value but --q0 has 2 values"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("duration_s"), std::string::npos) << r.output;
+  // a velocity or limit list: one per axis or one for all, nothing in between
+  const Result v0 = depotwin("move --q0 0,0 --q1 1,2 --v0 0,0,0 --vmax 4 --amax 30,20,10");
+  EXPECT_EQ(v0.status, 2) << v0.output;
+  EXPECT_NE(v0.output.find("error: --v0: has 3 values but --q0 and --q1 have 2 values"),
+            std::string::npos)
+      << v0.output;
+  EXPECT_NE(v0.output.find("error: --amax: has 3 values but --q0 and --q1 have 2 values"),
+            std::string::npos)
+      << v0.output;
+}
+
+// one limit for every axis: a 10 mm and a 2 mm move from rest at v_max 4, a_max 30 (no jerk
+// limit); the long axis sets the time: 10/4 + 4/30 s (a trapezoid from and to rest)
+TEST(Cli, MoveLimitsBroadcastToEveryAxis) {
+  const Result r = depotwin("move --q0 0,0 --q1 10,2 --vmax 4 --amax 30");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto json = nlohmann::json::parse(r.output);
+  ASSERT_EQ(json["axes"].size(), 2u);
+  for (const auto& axis : json["axes"]) {
+    EXPECT_EQ(axis["v_max"].get<double>(), 4.0);
+    EXPECT_EQ(axis["a_max"].get<double>(), 30.0);
+    EXPECT_EQ(axis["v0"].get<double>(), 0.0);
+  }
+  EXPECT_EQ(json["axes"][1]["q1"].get<double>(), 2.0);
+  EXPECT_NEAR(json["duration_s"].get<double>(), 10.0 / 4.0 + 4.0 / 30.0, 1e-9);
 }
 
 TEST(Cli, ValidateReportsEveryProblemWithFileLineAndKey) {
@@ -82,12 +144,16 @@ TEST(Cli, PlanWritesMetricsAndTrajectory) {
   ASSERT_EQ(r.status, 0) << r.output;
   const auto metrics =
       nlohmann::json::parse(testing_support::read_text(dir + "/lspb_mtt/metrics.json"));
-  for (const char* key :
-       {"scenario", "planner", "time_s", "planned_velocity_error", "path_error_mm", "warnings"})
+  // a plan has planned figures only: every one under its planned_ name, none unprefixed
+  for (const char* key : {"scenario", "planner", "time_s", "planned_velocity_error",
+                          "planned_velocity_error_steady", "planned_path_error_mm", "warnings"})
     EXPECT_TRUE(metrics.contains(key)) << key;
+  for (const char* key : {"velocity_error", "path_error_mm", "thickness", "waste"})
+    EXPECT_FALSE(metrics.contains(key)) << key;
   const std::string csv = testing_support::read_text(dir + "/lspb_mtt/trajectory.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
-            "t,x,y,z,vx,vy,vz,speed,depositing,segment,desired_speed");
+            "t_s,x_mm,y_mm,z_mm,vx_mm_s,vy_mm_s,vz_mm_s,speed_mm_s,depositing,path,"
+            "desired_speed_mm_s");
   // 1 ms samples over the whole plan
   const double total = metrics["time_s"]["total"].get<double>();
   EXPECT_NEAR(std::count(csv.begin(), csv.end(), '\n') - 1, std::floor(total * 1000) + 2, 1.0);
@@ -140,7 +206,9 @@ TEST(Cli, RunAndCompareWriteResults) {
   const std::string dir = fresh_directory("cli_compare");
   const Result r =
       depotwin("compare " + scenario_path("thompson_fig7.yaml") +
-               " --no-render --quiet --orders as_given,nearest_neighbor+two_opt --out " + dir);
+               " --no-render --quiet --orders as_given,nearest_neighbor+two_opt --planners "
+               "lspb_mtt --out " +
+               dir);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir + "/as_given/metrics.json"));
   EXPECT_TRUE(fs::exists(dir + "/nearest_neighbor+two_opt/metrics.json"));
@@ -151,6 +219,184 @@ TEST(Cli, RunAndCompareWriteResults) {
   EXPECT_EQ(reordered["refine"], "two_opt");
   // the sequencer's objective never beats its own lower bound
   EXPECT_GE(reordered["cost_s"].get<double>(), reordered["lower_bound_s"].get<double>());
+}
+
+// ---------------------------------------------------------------------------------------
+// the output folder: checked before any work, owned by the verb, replaced whole
+
+// the names in a folder, sorted (dot files included)
+std::vector<std::string> folder_names(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir))
+    names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// `depotwin VERB thompson_fig7 ARGS --out OUT` refused with status 2 and `message`, before
+// any simulation (no progress line, although every update would print one)
+void expect_out_refused(const std::string& verb, const std::string& out,
+                        const std::string& message) {
+  ::setenv("DEPOTWIN_PROGRESS_PERIOD_S", "0", 1);
+  const Result r = depotwin(verb + " " + scenario_path("thompson_fig7.yaml") + " --planner" +
+                            (verb == "compare" ? "s" : "") + " lspb_mtt --out " + out +
+                            (verb == "plan" ? "" : " --no-render"));
+  ::unsetenv("DEPOTWIN_PROGRESS_PERIOD_S");
+  EXPECT_EQ(r.status, 2) << verb << ": " << r.output;
+  EXPECT_NE(r.output.find("error: --out: " + out + ": " + message), std::string::npos)
+      << verb << ": " << r.output;
+  EXPECT_EQ(r.output.find("simulating"), std::string::npos) << verb << ": " << r.output;
+  EXPECT_EQ(r.output.find("scenario thompson_fig7"), std::string::npos) << verb << ": " << r.output;
+}
+
+TEST(CliOut, AFileOrAPathUnderAFileIsBadInput) {
+  const std::string dir = fresh_directory("cli_out_file");
+  const std::string file = write_text(dir, "notes.txt", "keep me\n");
+  for (const std::string verb : {"run", "compare", "plan"}) {
+    expect_out_refused(verb, file, "is a file, not a folder");
+    expect_out_refused(verb, file + "/results/x", "lies under " + file + ", which is a file");
+  }
+  EXPECT_EQ(testing_support::read_text(file), "keep me\n");
+  EXPECT_EQ(folder_names(dir), std::vector<std::string>{"notes.txt"});  // nothing staged
+}
+
+// a read-only folder; root writes anywhere, so as root the CLI runs as nobody (util-linux's
+// setpriv)
+TEST(CliOut, AReadOnlyFolderIsBadInput) {
+  const std::string dir = fresh_directory("cli_out_read_only");
+  fs::permissions(dir, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                           fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  const std::string as_user =
+      ::geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : "";
+  for (const std::string verb : {"run", "compare", "plan"}) {
+    const std::string command = as_user + DEPOTWIN_BINARY_DIR + "/depotwin " + verb + " " +
+                                scenario_path("thompson_fig7.yaml") +
+                                (verb == "plan" ? "" : " --quiet") + " --out " + dir +
+                                "/results 2>&1";
+    FILE* pipe = ::popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string output;
+    char buffer[4096];
+    for (size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) output.append(buffer, n);
+    const int status = ::pclose(pipe);
+    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2) << verb << ": " << output;
+    EXPECT_NE(output.find("error: --out: " + dir + "/results: cannot write in " + dir +
+                          ": Permission denied"),
+              std::string::npos)
+        << verb << ": " << output;
+  }
+  fs::permissions(dir, fs::perms::owner_all);
+  EXPECT_TRUE(folder_names(dir).empty());
+}
+
+// a folder with someone else's files is never replaced
+TEST(CliOut, AFolderThatIsNotADepotwinOutputIsRefused) {
+  const std::string dir = fresh_directory("cli_out_foreign");
+  write_text(dir, "thesis.tex", "chapter 1\n");
+  for (const std::string verb : {"run", "compare", "plan"})
+    expect_out_refused(verb, dir, "exists and is not a depotwin output folder");
+  EXPECT_EQ(folder_names(dir), std::vector<std::string>{"thesis.tex"});
+  for (const auto& entry : fs::directory_iterator(fs::path(dir).parent_path()))
+    EXPECT_EQ(entry.path().filename().string().find("cli_out_foreign."), std::string::npos)
+        << entry.path();
+
+  // nor one that holds the scenario
+  const std::string scenario =
+      write_text(dir, "fig7.yaml", testing_support::read_text(scenario_path("thompson_fig7.yaml")));
+  const Result r = depotwin("plan " + scenario + " --out " + dir);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("error: --out: " + dir + ": holds the scenario file " + scenario),
+            std::string::npos)
+      << r.output;
+}
+
+// a compare's folder run into by `plan`: the old comparison.* and run folders are gone, and
+// the folder carries the marker; a result from before the marker is recognised and replaced
+TEST(CliOut, AVerbReplacesItsFolderWhole) {
+  const std::string dir = fresh_directory("cli_out_replace");
+  const std::string out = dir + "/results";
+  const Result compare = depotwin("compare " + scenario_path("thompson_fig7.yaml") +
+                                  " --planners lspb_mtt --no-render --quiet --out " + out);
+  ASSERT_EQ(compare.status, 0) << compare.output;
+  EXPECT_EQ(folder_names(out),
+            (std::vector<std::string>{".depotwin", "comparison.csv", "comparison.json",
+                                      "comparison.md", "lspb_mtt"}));
+  const Result plan = depotwin("plan " + scenario_path("thompson_fig7.yaml") +
+                               " --planner stop_and_go --out " + out + "/");
+  ASSERT_EQ(plan.status, 0) << plan.output;
+  EXPECT_EQ(folder_names(out), (std::vector<std::string>{".depotwin", "stop_and_go"}));
+  EXPECT_EQ(folder_names(dir), std::vector<std::string>{"results"});  // nothing staged left
+
+  // an older result without the marker: comparison files and run folders with metrics.json
+  fs::remove(out + "/.depotwin");
+  write_text(out, "comparison.csv", "label\n");
+  const Result again =
+      depotwin("plan " + scenario_path("thompson_fig7.yaml") + " --planner lspb_mtt --out " + out);
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_EQ(folder_names(out), (std::vector<std::string>{".depotwin", "lspb_mtt"}));
+}
+
+// every order under every planner, each in its own folder; the progress lines (every update
+// printed: stderr is a pipe here) name the order and the planner, without \r
+TEST(CliCompare, OrdersTimesPlanners) {
+  const std::string dir = fresh_directory("cli_compare_cross");
+  ::setenv("DEPOTWIN_PROGRESS_PERIOD_S", "0", 1);
+  const Result r = depotwin("compare " + scenario_path("thompson_fig7.yaml") +
+                            " --no-render --orders as_given,nearest_neighbor+two_opt "
+                            "--planners lspb_mtt,stop_and_go --out " +
+                            dir);
+  ::unsetenv("DEPOTWIN_PROGRESS_PERIOD_S");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::vector<std::string> labels{"as_given+lspb_mtt", "as_given+stop_and_go",
+                                        "nearest_neighbor+two_opt+lspb_mtt",
+                                        "nearest_neighbor+two_opt+stop_and_go"};
+  const auto table = nlohmann::json::parse(testing_support::read_text(dir + "/comparison.json"));
+  ASSERT_EQ(table["runs"].size(), labels.size());
+  for (size_t i = 0; i < labels.size(); ++i) {
+    // in order, each in its folder: the planner under the order
+    const auto& metrics = table["runs"][i]["metrics"];
+    EXPECT_EQ(metrics["planner"], i % 2 == 0 ? "lspb_mtt" : "stop_and_go") << i;
+    EXPECT_EQ(metrics["order"]["method"], i < 2 ? "as_given" : "nearest_neighbor") << i;
+    const auto folder =
+        nlohmann::json::parse(testing_support::read_text(dir + "/" + labels[i] + "/metrics.json"));
+    EXPECT_EQ(folder["planner"], metrics["planner"]) << labels[i];
+    EXPECT_EQ(folder["order"]["method"], metrics["order"]["method"]) << labels[i];
+    EXPECT_EQ(folder["time_s"]["total"], metrics["time_s"]["total"]) << labels[i];
+    EXPECT_NE(r.output.find("thompson_fig7/" + labels[i] + ": simulating 100 % ("),
+              std::string::npos)
+        << r.output;
+  }
+  EXPECT_EQ(r.output.find('\r'), std::string::npos);
+  // the same order under both planners: the same sequence, at the same cost
+  EXPECT_EQ(table["runs"][2]["metrics"]["order"]["cost_s"],
+            table["runs"][3]["metrics"]["order"]["cost_s"]);
+
+  // a run named twice is refused before any work
+  const Result twice = depotwin("compare " + scenario_path("thompson_fig7.yaml") +
+                                " --orders as_given,as_given --out " + dir + "/twice");
+  EXPECT_EQ(twice.status, 2) << twice.output;
+  EXPECT_NE(twice.output.find("error: --orders: 'as_given' is named twice"), std::string::npos)
+      << twice.output;
+  EXPECT_FALSE(fs::exists(dir + "/twice"));
+}
+
+// progress on a pipe: plain lines, silenced by --quiet
+TEST(CliProgress, PlainLinesOffATerminalAndNoneWhenQuiet) {
+  const std::string dir = fresh_directory("cli_progress");
+  const std::string run =
+      "run " + scenario_path("thompson_fig7.yaml") + " --planner lspb_mtt --no-render --out " + dir;
+  ::setenv("DEPOTWIN_PROGRESS_PERIOD_S", "0", 1);
+  const Result shown = depotwin(run);
+  const Result quiet = depotwin(run + " --quiet");
+  ::unsetenv("DEPOTWIN_PROGRESS_PERIOD_S");
+  ASSERT_EQ(shown.status, 0) << shown.output;
+  EXPECT_NE(shown.output.find("thompson_fig7/lspb_mtt: simulating 100 % ("), std::string::npos)
+      << shown.output;
+  EXPECT_NE(shown.output.find("thompson_fig7/lspb_mtt: simulating done in "), std::string::npos)
+      << shown.output;
+  EXPECT_EQ(shown.output.find('\r'), std::string::npos);
+  ASSERT_EQ(quiet.status, 0) << quiet.output;
+  EXPECT_EQ(quiet.output.find("simulating"), std::string::npos) << quiet.output;
 }
 
 // ---------------------------------------------------------------------------------------

@@ -1,0 +1,28 @@
+#include "pipeline/models_dir.hpp"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <system_error>
+
+namespace depotwin {
+
+namespace fs = std::filesystem;
+
+std::string models_directory() {
+  // an explicit choice wins
+  if (const char* from_env = std::getenv("DEPOTWIN_MODELS_DIR"); from_env && *from_env)
+    return from_env;
+  // an installed binary: <prefix>/bin/depotwin next to <prefix>/share/depotwin/models
+  std::error_code error;
+  const fs::path binary = fs::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    const fs::path installed = binary.parent_path().parent_path() / "share" / "depotwin" / "models";
+    if (fs::is_directory(installed, error)) return installed.string();
+  }
+  // a build tree: the sources it was configured from
+  return DEPOTWIN_MODELS_DIR;
+}
+
+}  // namespace depotwin
