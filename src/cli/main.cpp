@@ -9,6 +9,7 @@
 #include "cli/move_verb.hpp"
 #include "cli/verbs.hpp"
 #include "core/error.hpp"
+#include "pipeline/models_dir.hpp"
 #include "viewer/viewer.hpp"  // view
 
 using namespace depotwin;
@@ -53,9 +54,11 @@ int main(int argc, char** argv) {
   CLI::App app{
       "DepoTwin: a physics-simulated digital twin of material-deposition machines.\n"
       "Plan a scenario's toolpath, simulate the machine in MuJoCo, record where material\n"
-      "lands, and score thickness uniformity, velocity error and waste."};
+      "lands, and score thickness uniformity, velocity error and waste.",
+      "depotwin"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "depotwin 0.1.0");
+  // the version, and where the shipped machine models are read from (installed or source tree)
+  app.set_version_flag("--version", "depotwin 0.1.0\nmodels: " + models_directory());
 
   // run / compare / plan / validate share the scenario argument
   RunOptions run_options;
