@@ -533,26 +533,6 @@ void ghost_above_substrate(const mjModel& model, const mjData& data, int substra
   scene.ngeom = kept;
 }
 
-// A floor under the machine, so that no view shows the empty background (the models have
-// no skybox: in software GL each texture costs a shader compilation per process). Left out
-// when the model has a plane of its own.
-void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene) {
-  double lowest_m = std::numeric_limits<double>::infinity();
-  for (int geom = 0; geom < model.ngeom; ++geom) {
-    if (model.geom_type[geom] == mjGEOM_PLANE) return;
-    lowest_m = std::min(lowest_m, data.geom_xpos[3 * geom + 2] - model.geom_rbound[geom]);
-  }
-  if (!std::isfinite(lowest_m) || scene.ngeom >= scene.maxgeom) return;
-  const double extent_m = model.stat.extent;
-  const double half_thickness_m = 0.01 * extent_m;
-  const mjtNum size[3] = {kBackdropHalfWidth * extent_m, kBackdropHalfWidth * extent_m,
-                          half_thickness_m};
-  const mjtNum position[3] = {model.stat.center[0], model.stat.center[1],
-                              lowest_m - kBackdropDrop * extent_m - half_thickness_m};
-  const mjtNum identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  mjv_initGeom(scene.geoms + scene.ngeom++, mjGEOM_BOX, size, position, identity, kBackdropColour);
-}
-
 // the model's shadow-casting lights moved over the framed camera's shoulder: shadows then
 // fall away from the viewer, behind the print head instead of across the deposit
 void light_over_camera(const mjvCamera& view, mjvScene& scene) {
@@ -639,6 +619,23 @@ std::string label_number(double value) {
 }
 
 }  // namespace
+
+void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene) {
+  double lowest_m = std::numeric_limits<double>::infinity();
+  for (int geom = 0; geom < model.ngeom; ++geom) {
+    if (model.geom_type[geom] == mjGEOM_PLANE) return;
+    lowest_m = std::min(lowest_m, data.geom_xpos[3 * geom + 2] - model.geom_rbound[geom]);
+  }
+  if (!std::isfinite(lowest_m) || scene.ngeom >= scene.maxgeom) return;
+  const double extent_m = model.stat.extent;
+  const double half_thickness_m = 0.01 * extent_m;
+  const mjtNum size[3] = {kBackdropHalfWidth * extent_m, kBackdropHalfWidth * extent_m,
+                          half_thickness_m};
+  const mjtNum position[3] = {model.stat.center[0], model.stat.center[1],
+                              lowest_m - kBackdropDrop * extent_m - half_thickness_m};
+  const mjtNum identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  mjv_initGeom(scene.geoms + scene.ngeom++, mjGEOM_BOX, size, position, identity, kBackdropColour);
+}
 
 SceneLayout scene_layout(const SceneRenderOptions& options) {
   SceneLayout layout;

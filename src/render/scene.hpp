@@ -126,6 +126,11 @@ double pixels_per_mm(const mjvGLCamera& camera, const mjrRect& viewport, const V
 // The overlays, drawn in the current GL context with MuJoCo's renderer (mjr_rectangle,
 // mjr_label; `context` made with a font scale of about 100 x `pixel_scale`); rects in
 // framebuffer pixels, sizes multiplied by `pixel_scale` (a supersampled render's factor).
+// Add a floor under the machine to `scene`, so that no view shows the empty background (the
+// models have no skybox: in software GL each texture costs a shader compilation per process).
+// Left out when the model has a plane of its own. scene.png, the videos and the viewer share it.
+void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene);
+
 // A colour bar over `strip`: viridis from 0 to colour_top_um with its values in um ("no
 // deposit" without one).
 // `gl_proc_address` draws the ramp as one smooth-shaded strip; without it, one mjr_rectangle

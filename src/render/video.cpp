@@ -36,10 +36,6 @@ namespace {
 constexpr int kTimelineMargin = 6;
 // scene geoms beyond the model's own (the backdrop)
 constexpr int kExtraGeoms = 16;
-// the floor drawn under a machine without a plane of its own (as scene.png)
-constexpr float kBackdropColour[4] = {0.78f, 0.80f, 0.83f, 1.0f};
-constexpr double kBackdropHalfWidth = 20.0;
-constexpr double kBackdropDrop = 0.05;
 
 // The part's surface under a point of the replay grid: bilinear between the four cell centres
 // around it when all are on the part, else the nearest cell's; nullopt off the part (NaN) or
@@ -65,24 +61,6 @@ std::function<std::optional<double>(double, double)> grid_surface(const ReplayDe
     if (std::isnan(nearest)) return std::nullopt;
     return static_cast<double>(nearest);
   };
-}
-
-// the floor under the machine (the models have no plane; scene.png draws the same)
-void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene) {
-  double lowest_m = std::numeric_limits<double>::infinity();
-  for (int geom = 0; geom < model.ngeom; ++geom) {
-    if (model.geom_type[geom] == mjGEOM_PLANE) return;
-    lowest_m = std::min(lowest_m, data.geom_xpos[3 * geom + 2] - model.geom_rbound[geom]);
-  }
-  if (!std::isfinite(lowest_m) || scene.ngeom >= scene.maxgeom) return;
-  const double extent_m = model.stat.extent;
-  const double half_thickness_m = 0.01 * extent_m;
-  const mjtNum size[3] = {kBackdropHalfWidth * extent_m, kBackdropHalfWidth * extent_m,
-                          half_thickness_m};
-  const mjtNum position[3] = {model.stat.center[0], model.stat.center[1],
-                              lowest_m - kBackdropDrop * extent_m - half_thickness_m};
-  const mjtNum identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  mjv_initGeom(scene.geoms + scene.ngeom++, mjGEOM_BOX, size, position, identity, kBackdropColour);
 }
 
 // GL entry points for the deposit mesh in an OSMesa context
