@@ -620,6 +620,13 @@ std::string label_number(double value) {
 
 }  // namespace
 
+void ghost_over_deposit(const mjModel& model, const mjData& data, int substrate,
+                        const Vec3& deposit_lo_mm, const Vec3& deposit_hi_mm, mjvScene& scene) {
+  ghost_above_substrate(model, data, substrate, deposit_lo_mm.z(),
+                        std::max(kMinCloseupHalf_mm, 0.5 * (deposit_hi_mm - deposit_lo_mm).norm()),
+                        scene);
+}
+
 void add_backdrop(const mjModel& model, const mjData& data, mjvScene& scene) {
   double lowest_m = std::numeric_limits<double>::infinity();
   for (int geom = 0; geom < model.ngeom; ++geom) {
@@ -913,10 +920,10 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
     mjv_updateScene(&model, state.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene.scene);
     if (view.type == mjCAMERA_FREE) light_over_camera(view, scene.scene);
     scene.scene.flags[mjRND_SHADOW] = options.shadows ? 1 : 0;
-    if (ghosts)
-      ghost_above_substrate(model, *state, substrate, mesh.empty() ? 0.0 : mesh.lo_mm.z(),
-                            std::max(kMinCloseupHalf_mm, 0.5 * (mesh.hi_mm - mesh.lo_mm).norm()),
-                            scene.scene);
+    if (ghosts && !mesh.empty())
+      ghost_over_deposit(model, *state, substrate, mesh.lo_mm, mesh.hi_mm, scene.scene);
+    else if (ghosts)
+      ghost_over_deposit(model, *state, substrate, Vec3::Zero(), Vec3::Zero(), scene.scene);
     add_backdrop(model, *state, scene.scene);
     mjr_render(rect, &scene.scene, &context);
     draw_deposit_mesh(mesh, scene.scene, rect, state->xpos + 3 * substrate,

@@ -126,6 +126,13 @@ double pixels_per_mm(const mjvGLCamera& camera, const mjrRect& viewport, const V
 // The overlays, drawn in the current GL context with MuJoCo's renderer (mjr_rectangle,
 // mjr_label; `context` made with a font scale of about 100 x `pixel_scale`); rects in
 // framebuffer pixels, sizes multiplied by `pixel_scale` (a supersampled render's factor).
+// The close-up's view of a deposit with bounds [deposit_lo_mm, deposit_hi_mm] (substrate frame;
+// both zero: none yet) on body `substrate`: geoms outside the substrate's tree above the
+// deposit become see-through near it (the nozzle's tip, a shutter blade) and are left out
+// higher up, where they would loom over the panel. scene.png, the videos and the viewer share it.
+void ghost_over_deposit(const mjModel& model, const mjData& data, int substrate,
+                        const Vec3& deposit_lo_mm, const Vec3& deposit_hi_mm, mjvScene& scene);
+
 // Add a floor under the machine to `scene`, so that no view shows the empty background (the
 // models have no skybox: in software GL each texture costs a shader compilation per process).
 // Left out when the model has a plane of its own. scene.png, the videos and the viewer share it.

@@ -95,6 +95,8 @@ struct ReplayView::Impl {
   DepositMeshOptions mesh_options;
   DepositPlayback playback;
   DepositMesh mesh;
+  // the finished deposit's bounds (substrate frame): what the close-up clears its view of
+  Vec3 final_lo_mm = Vec3::Zero(), final_hi_mm = Vec3::Zero();
   size_t mesh_frame = std::numeric_limits<size_t>::max();
   size_t state_frame = std::numeric_limits<size_t>::max();
 
@@ -145,10 +147,13 @@ struct ReplayView::Impl {
   }
   // one panel: the scene from `camera`, the backdrop, the deposit; returns the scene's
   // pixels per mm at `scale_point_m` (for the scale bar)
+  // (`ghosts`: the close-up's see-through print head, as scene.png's)
   double draw_panel(const mjrRect& panel, mjvCamera& camera, const Vec3& scale_point_m,
-                    const mjrContext& context) {
+                    const mjrContext& context, bool ghosts = false) {
     mjv_updateScene(model.get(), data.get(), &visual, &perturb, &camera, mjCAT_ALL, &scene);
     scene.flags[mjRND_SHADOW] = 0;  // as scene.png: shadows cost a second pass in software
+    if (ghosts && substrate >= 0)
+      ghost_over_deposit(*model, *data, substrate, final_lo_mm, final_hi_mm, scene);
     add_backdrop(*model, *data, scene);
     mjr_render(panel, &scene, &context);
     if (!mesh.empty()) draw_deposit_mesh(mesh, scene, panel, *model, *data, gl_proc_address);
@@ -199,6 +204,11 @@ ReplayView::ReplayView(const ReplayData& replay, GlProcAddress gl_proc_address, 
   impl_->mesh_options.relief_mm = impl_->framing.relief_mm;
   impl_->mesh_options.colour_top_um = impl_->framing.colour_top_um;
   impl_->mesh_options.surface_height_mm = options.surface_height_mm;
+  const DepositMesh final_mesh = build_deposit_mesh(impl_->playback.at(last), impl_->mesh_options);
+  if (!final_mesh.empty()) {
+    impl_->final_lo_mm = final_mesh.lo_mm;
+    impl_->final_hi_mm = final_mesh.hi_mm;
+  }
 }
 
 ReplayView::~ReplayView() = default;
@@ -276,8 +286,9 @@ void ReplayView::draw(size_t frame, const mjrRect& viewport, const mjrContext& c
   mjr_overlay(mjFONT_SHADOW, mjGRID_TOPLEFT, whole, run_text.c_str(), nullptr, &context);
   if (options.closeup && layout.closeup.width > 0) {
     const mjrRect closeup = to_gl(layout.closeup);
-    draw_scale_bar(closeup, impl_->draw_panel(closeup, impl_->closeup, deposit_centre_m, context),
-                   1, context);
+    draw_scale_bar(closeup,
+                   impl_->draw_panel(closeup, impl_->closeup, deposit_centre_m, context, true), 1,
+                   context);
     mjr_overlay(mjFONT_SHADOW, mjGRID_TOPLEFT, closeup, process_text.c_str(), nullptr, &context);
   } else {
     mjr_overlay(mjFONT_SHADOW, mjGRID_TOPRIGHT, whole, process_text.c_str(), nullptr, &context);
