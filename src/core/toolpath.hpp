@@ -9,7 +9,22 @@
 
 namespace depotwin {
 
-// One print path: a polyline (mm) printed at one desired speed with material on.
+// One edge of a print path as an exact circular or helical arc (G2/G3): the centre at the
+// level of the edge's start along `axis` (unit), the arc turning positively (right hand) about
+// the axis by `sweep_rad` (0 < sweep <= 2 pi; a full circle ends where it started, plus the
+// rise). With r = |start - centre| and the rise h = (end - start) . axis, the point at s in
+// [0, 1] is centre + Rot(axis, s sweep)(start - centre) + s h axis, and the length is
+// sqrt((r sweep)^2 + h^2). A sweep of 0 is a straight edge.
+struct EdgeArc {
+  Vec3 center_mm = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();
+  double sweep_rad = 0.0;
+
+  bool is_arc() const { return sweep_rad > 0.0; }
+};
+
+// One print path: a polyline (mm) printed at one desired speed with material on; edges may be
+// exact arcs (`arcs`), which planners that need polylines chord first (`chorded`).
 struct PrintPath {
   std::vector<Vec3> points;   // at least two, consecutive points distinct
   std::vector<Vec3> normals;  // optional unit surface normals per point (conformal work): the
@@ -18,14 +33,27 @@ struct PrintPath {
                               // by a machine with a wrist; none: roll 0 everywhere
   double speed_mm_s = 0.0;    // desired TCP speed while printing
   int source_index = 0;       // index in the scenario's list, for messages and reports
-  int layer = 0;              // the layer it belongs to (surface toolpaths; 0 otherwise)
+  int layer = 0;              // the layer it belongs to (surface toolpaths, G-code; 0 otherwise)
+  std::vector<EdgeArc> arcs;  // empty: every edge straight; else one per edge (sweep 0: straight)
+
+  // true when some edge is an arc
+  bool has_arcs() const;
+  // the length of edge i (points i to i + 1): helical for an arc
+  double edge_length(size_t edge) const;
+  // the point at s in [0, 1] along edge i
+  Vec3 edge_point(size_t edge, double s) const;
+  // The path with its arcs replaced by chords whose sagitta is at most `tolerance_mm` (and that
+  // turn at most 90 degrees each); no arcs left. Normals are slerped and rolls interpolated
+  // along an arc. `source_point` (optional, out): for each new point, the index of the original
+  // point that ends the edge it lies on (0 for the first), to carry per-point data over.
+  PrintPath chorded(double tolerance_mm, std::vector<size_t>* source_point = nullptr) const;
 
   double length_mm() const;
   const Vec3& front() const { return points.front(); }
   const Vec3& back() const { return points.back(); }
   // the same path printed the other way round
   PrintPath reversed() const;
-  // axis-aligned bounds of its points
+  // axis-aligned bounds of the path (its points and the exact extent of its arcs)
   void bounds(Vec3& lo, Vec3& hi) const;
   // the tool axis at point i (its normal, or vertical without normals)
   Vec3 tool_axis(size_t i) const;
@@ -57,6 +85,8 @@ struct Toolpath {
   int layer_count() const;
 
   double print_length_mm() const;
+  // every path chorded (PrintPath::chorded)
+  Toolpath chorded(double tolerance_mm) const;
   // axis-aligned bounds over start, end and every path point
   void bounds(Vec3& lo, Vec3& hi) const;
 };
@@ -66,6 +96,13 @@ struct Toolpath {
 // surface is convex between them, below 1 concave, 1 flat (1 for coincident points). For
 // points on a curve of normal curvature k it is 1 + d k (exactly, on a circle).
 double gap_ratio(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1, double d);
+
+// The number of chords that follow an arc of radius r and sweep within a sagitta tolerance,
+// each turning at most 90 degrees: the smallest n with r (1 - cos(sweep / 2n)) <= tolerance.
+int arc_chord_count(double radius_mm, double sweep_rad, double tolerance_mm);
+
+// The exact axis-aligned bounds of an arc edge from `start` (EdgeArc above), grown into lo/hi.
+void grow_arc_bounds(const Vec3& start, const Vec3& end, const EdgeArc& arc, Vec3& lo, Vec3& hi);
 
 // Two path ends closer than this (mm) are one point: printing continues through them.
 constexpr double kJoinTolerance_mm = 1e-6;

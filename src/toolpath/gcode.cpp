@@ -1,14 +1,17 @@
 #include "toolpath/gcode.hpp"
 
-#include <cctype>
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <optional>
+#include <iterator>
+#include <sstream>
 
 #include "core/error.hpp"
-#include "core/number_text.hpp"
 
 namespace depotwin {
 
@@ -19,329 +22,796 @@ constexpr double kMmPerInch = 25.4;
 constexpr double kSecondsPerMinute = 60.0;
 // report this many malformed lines, then only count the rest
 constexpr std::size_t kMaxListedProblems = 20;
+// a move shorter than this is no move (mm)
+constexpr double kMinMove_mm = 1e-9;
+// the largest magnitude a number may have (beyond: a typo or garbage)
+constexpr double kMaxMagnitude = 1e9;
+// z levels closer than this are one layer (mm)
+constexpr double kLayerTolerance_mm = 1e-6;
+// an arc's end may miss its centre's radius by this much (absolute mm, relative)
+constexpr double kArcRadiusTolerance_mm = 0.005;
+constexpr double kArcRadiusTolerance_rel = 1e-3;
 
-// one address word of a G-code line, e.g. X12.5
-struct Word {
+// text for a message: printable ASCII kept, other bytes as \xNN, at most 32 characters
+std::string printable(const char* begin, const char* end) {
+  std::string out;
+  for (const char* c = begin; c < end && out.size() < 32; ++c) {
+    const auto byte = static_cast<unsigned char>(*c);
+    if (byte >= 0x20 && byte < 0x7F) {
+      out += *c;
+    } else {
+      static const char* kHex = "0123456789ABCDEF";
+      out += "\\x";
+      out += kHex[byte >> 4];
+      out += kHex[byte & 15];
+    }
+  }
+  if (end - begin > 32) out += "...";
+  return out;
+}
+
+bool is_space(char c) {
+  return c == ' ' || c == '\t' || c == '\r';
+}
+bool is_digit(char c) {
+  return c >= '0' && c <= '9';
+}
+bool is_letter(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z');
+}
+char upper(char c) {
+  return c >= 'a' && c <= 'z' ? static_cast<char>(c - 'a' + 'A') : c;
+}
+
+// A command code: G or M and its number times 10 (G90.1 = 901).
+struct Code {
   char letter = 0;
-  double value = 0.0;
-  std::string text;  // the number as written
+  int tenths = 0;
 };
 
-// the whole text as a finite double, or nothing
-std::optional<double> parse_number(const std::string& text) {
-  const std::optional<double> value = parse_double(text);
-  if (!value || !std::isfinite(*value)) return std::nullopt;
-  return value;
-}
+// The words of one line: at most one value per parameter letter, any number of G/M codes.
+struct LineWords {
+  std::array<double, 26> value{};
+  std::uint32_t present = 0;
+  std::array<const char*, 26> text{};  // where each word starts, for messages
+  std::array<Code, 16> codes{};
+  int n_codes = 0;
 
-// the line without comments (`;...` and `(...)`) and checksum (`*...`)
-std::string strip_comments(const std::string& raw) {
-  std::string text;
-  bool in_paren = false;
-  for (char c : raw) {
-    if (in_paren) {
-      in_paren = c != ')';
-      continue;
-    }
-    if (c == ';' || c == '*') break;
-    if (c == '(') {
-      in_paren = true;
-      continue;
-    }
-    if (c != '\r') text += c;
+  bool has(char letter) const { return (present >> (letter - 'A')) & 1u; }
+  double get(char letter) const { return value[letter - 'A']; }
+};
+
+// Marlin's text commands (M117 message, M23 file name, ...): the rest of the line is text
+bool is_text_command(int number) {
+  switch (number) {
+    case 0:
+    case 1:
+    case 16:
+    case 23:
+    case 28:
+    case 30:
+    case 32:
+    case 33:
+    case 117:
+    case 118:
+    case 928:
+      return true;
+    default:
+      return false;
   }
-  return text;
 }
 
-bool is_number_char(char c) {
-  return std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+';
-}
-
-// Split a line into words. Returns "" or what is malformed.
-std::string split_words(const std::string& text, std::vector<Word>& words) {
-  words.clear();
-  std::size_t i = 0;
-  while (i < text.size()) {
-    const char c = text[i];
-    if (std::isspace(static_cast<unsigned char>(c))) {
-      ++i;
-      continue;
-    }
-    if (!std::isalpha(static_cast<unsigned char>(c)))
-      return std::string("unexpected '") + c + "' (expected a letter followed by a number)";
-    Word word;
-    word.letter = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-    ++i;
-    while (i < text.size() && is_number_char(text[i])) word.text += text[i++];
-    const bool ends_cleanly =
-        i == text.size() || std::isspace(static_cast<unsigned char>(text[i])) ||
-        (!word.text.empty() && std::isalpha(static_cast<unsigned char>(text[i])));
-    const std::optional<double> value = parse_number(word.text);
-    if (!ends_cleanly || !value) {
-      std::size_t end = i;
-      while (end < text.size() && !std::isspace(static_cast<unsigned char>(text[end]))) ++end;
-      const std::size_t start = i - word.text.size() - 1;
-      return "malformed word '" + text.substr(start, end - start) + "' (expected " +
-             std::string(1, word.letter) + " followed by a number)";
-    }
-    word.value = *value;
-    words.push_back(word);
-  }
-  return "";
+// "M3" -> Code{M, 30}; nothing if not a G/M code
+std::optional<Code> code_of(const std::string& text) {
+  if (text.size() < 2 || (upper(text[0]) != 'G' && upper(text[0]) != 'M')) return std::nullopt;
+  double number = 0.0;
+  const auto [end, error] = std::from_chars(text.data() + 1, text.data() + text.size(), number);
+  if (error != std::errc() || end != text.data() + text.size() || number < 0.0) return std::nullopt;
+  return Code{upper(text[0]), static_cast<int>(std::lround(number * 10.0))};
 }
 
 // the parser's state: modal settings and the position reached so far
 class GcodeParser {
  public:
-  GcodeParser(std::string file_label, double default_speed_mm_s)
-      : file_(std::move(file_label)), default_speed_mm_s_(default_speed_mm_s) {}
+  GcodeParser(std::string file_label, const GcodeOptions& options)
+      : options_(options),
+        open_code_(code_of(options.open_code)),
+        close_code_(code_of(options.close_code)) {
+    program_.file_label = std::move(file_label);
+  }
 
-  void line(const std::string& raw, int line_number);
-  GcodeImport finish();
+  void line(const char* begin, const char* end, int line_number);
+  GcodeProgram finish(int n_lines);
 
  private:
   void problem(int line_number, const std::string& message);
-  void move(const std::vector<Word>& words, int line_number);
-  void set_position(const std::vector<Word>& words);
-  void home(const std::vector<Word>& words);
-  void end_path();
+  // words of the line from `p` on into words_; false (and a problem) when malformed
+  bool split_words(const char* p, const char* end, int line_number);
+  void execute(int line_number);
+  void move(int motion, int line_number);
+  bool arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc);
+  void set_position();
+  void home();
+  void extrude(double delta);
 
-  std::string file_;
-  double default_speed_mm_s_;
+  const GcodeOptions& options_;
+  std::optional<Code> open_code_;
+  std::optional<Code> close_code_;
   std::vector<Problem> problems_;
   std::size_t problem_count_ = 0;
+  LineWords words_;
 
   // modal state
-  Vec3 position_mm_ = Vec3::Zero();  // machine frame
-  Vec3 offset_mm_ = Vec3::Zero();    // machine = programmed + offset (G92)
-  double extruder_ = 0.0;            // programmed E
-  bool axes_relative_ = false;       // G91
-  bool extruder_relative_ = false;   // M83
-  double unit_mm_ = 1.0;             // G20: 25.4
-  double feed_mm_s_ = 0.0;           // 0: no F given yet
-  bool reported_missing_feed_ = false;
+  Vec3 position_mm_ = Vec3::Zero();   // machine frame
+  Vec3 offset_mm_ = Vec3::Zero();     // machine = programmed + offset (G92)
+  double extruder_ = 0.0;             // programmed E
+  bool axes_relative_ = false;        // G91
+  bool arc_centre_absolute_ = false;  // G90.1
+  bool extruder_relative_ = false;    // M83
+  double unit_mm_ = 1.0;              // G20: 25.4
+  double feed_mm_s_ = 0.0;            // 0: no F given yet
+  int motion_mode_ = -1;              // last G0..G3, -1: none
+  int plane_ = 17;                    // G17, G18, G19
+  bool open_ = false;                 // the shutter's open code is active
+  bool retracting_ = false;           // the last E change was a decrease
 
-  // output
-  GcodeImport result_;
-  PrintPath path_;
-  std::vector<int> path_lines_;
+  GcodeProgram program_;
 };
 
 void GcodeParser::problem(int line_number, const std::string& message) {
   ++problem_count_;
   if (problems_.size() < kMaxListedProblems)
-    problems_.push_back(Problem{file_, line_number, kKey, message});
+    problems_.push_back(Problem{program_.file_label, line_number, kKey, message});
 }
 
-void GcodeParser::line(const std::string& raw, int line_number) {
-  const std::string text = strip_comments(raw);
-  // the command word (after an optional line number N...)
-  std::size_t pos = text.find_first_not_of(" \t");
-  if (pos == std::string::npos || text.substr(pos, 1) == "%") return;  // blank, or a CNC % marker
-  std::vector<Word> words;
-  std::string command;
-  while (pos != std::string::npos) {
-    std::size_t end = pos;
-    while (end < text.size() && !std::isspace(static_cast<unsigned char>(text[end]))) ++end;
-    const std::string token = text.substr(pos, end - pos);
-    pos = text.find_first_not_of(" \t", end);
-    const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(token[0])));
-    if (letter == 'N' && token.size() > 1 && std::isdigit(static_cast<unsigned char>(token[1])))
-      continue;
-    command = token;
-    break;
-  }
-  if (command.empty()) return;
-  // command letter and number, e.g. G1, g01, M83 (sub-codes like G29.1 are other commands)
-  const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(command[0])));
-  std::size_t digits_end = 1;
-  while (digits_end < command.size() &&
-         std::isdigit(static_cast<unsigned char>(command[digits_end])))
-    ++digits_end;
-  if (!std::isalpha(static_cast<unsigned char>(command[0])) || digits_end == 1) {
-    problem(line_number, "'" + command + "' is not a G-code command (expected e.g. G1 X10 Y5)");
-    return;
-  }
-  // words glued to the command (G1X10Y5) are part of the rest
-  const std::string rest =
-      command.substr(digits_end) + (pos == std::string::npos ? "" : " " + text.substr(pos));
-  int number = -1;
-  const char* digits_last = command.data() + digits_end;
-  const auto [digits_stop, digits_error] = std::from_chars(command.data() + 1, digits_last, number);
-  const bool plain_number =
-      digits_error == std::errc() && digits_stop == digits_last && (rest.empty() || rest[0] != '.');
-  const bool handled =
-      plain_number &&
-      ((letter == 'G' && (number <= 3 || number == 20 || number == 21 || number == 28 ||
-                          number == 90 || number == 91 || number == 92)) ||
-       (letter == 'M' && (number == 82 || number == 83)));
-  if (!handled) return;  // every other command (M104, T0, M117 text, ...) is ignored
-  const std::string error = split_words(rest, words);
-  if (!error.empty()) {
-    problem(line_number, error);
-    return;
-  }
-  for (std::size_t i = 0; i < words.size(); ++i) {
-    if (words[i].letter == 'G' || words[i].letter == 'M') {
-      problem(line_number, "one command per line expected, found " + std::string(1, letter) +
-                               std::to_string(number) + " and " + words[i].letter + words[i].text);
+void GcodeParser::line(const char* begin, const char* end, int line_number) {
+  // control bytes: a binary file, or a broken one (never echoed raw)
+  for (const char* c = begin; c < end; ++c) {
+    const auto byte = static_cast<unsigned char>(*c);
+    if ((byte < 0x20 && *c != '\t' && *c != '\r') || byte == 0x7F) {
+      problem(line_number, "binary or control byte " + printable(c, c + 1) + " at column " +
+                               std::to_string(c - begin + 1) + " (is this a G-code text file?)");
       return;
     }
-    for (std::size_t j = 0; j < i; ++j)
-      if (words[j].letter == words[i].letter) {
-        problem(line_number, std::string(1, words[i].letter) + " given twice on one line");
-        return;
-      }
   }
+  const char* p = begin;
+  while (p < end && is_space(*p)) ++p;
+  if (p < end && *p == '/') ++p;  // block delete: the line runs (block delete off)
+  while (p < end && is_space(*p)) ++p;
+  if (p == end || *p == '%' || *p == ';' || *p == '(') {
+    if (p < end && *p == '(') {
+      // a line that is a comment, or a comment then words
+      const char* close = std::find(p, end, ')');
+      if (close == end) return;
+      line(close + 1, end, line_number);
+    }
+    return;
+  }
+  // Klipper's extended commands (a name, not a letter and a number): not motion
+  if (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_')) return;
+  // the first code after an optional line number: Marlin's text commands end here
+  const char* q = p;
+  if (upper(*q) == 'N') {
+    ++q;
+    while (q < end && (is_digit(*q) || is_space(*q))) ++q;
+  }
+  if (q < end && upper(*q) == 'M') {
+    const char* digits = q + 1;
+    while (digits < end && is_space(*digits)) ++digits;
+    int number = 0;
+    const auto [stop, error] = std::from_chars(digits, end, number);
+    if (error == std::errc() && stop > digits && (stop == end || *stop != '.') &&
+        is_text_command(number) &&
+        !(open_code_ && open_code_->letter == 'M' && open_code_->tenths == number * 10) &&
+        !(close_code_ && close_code_->letter == 'M' && close_code_->tenths == number * 10))
+      return;
+  }
+  if (!split_words(p, end, line_number)) return;
+  execute(line_number);
+}
 
-  if (letter == 'M') {
-    extruder_relative_ = number == 83;
-  } else if (number == 0 || number == 1) {
-    move(words, line_number);
-  } else if (number == 2 || number == 3) {
-    problem(line_number,
-            "arc moves (G2/G3) are not supported: export line segments (turn off arc fitting)");
-  } else if (number == 20 || number == 21) {
-    unit_mm_ = number == 20 ? kMmPerInch : 1.0;
-  } else if (number == 28) {
-    home(words);
-  } else if (number == 90 || number == 91) {
-    axes_relative_ = number == 91;
-  } else if (number == 92) {
-    set_position(words);
+bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
+  words_.present = 0;
+  words_.n_codes = 0;
+  while (p < end) {
+    const char c = *p;
+    if (is_space(c)) {
+      ++p;
+      continue;
+    }
+    if (c == ';' || c == '*') break;  // comment or checksum to the end
+    if (c == '(') {
+      const char* close = std::find(p, end, ')');
+      if (close == end) {
+        problem(line_number, "comment '(' not closed on its line");
+        return false;
+      }
+      p = close + 1;
+      continue;
+    }
+    if (!is_letter(c)) {
+      problem(line_number,
+              "unexpected '" + printable(p, p + 1) + "' (expected a letter followed by a number)");
+      return false;
+    }
+    const char letter = upper(c);
+    const char* word_start = p;
+    ++p;
+    while (p < end && is_space(*p)) ++p;  // spaces inside a word: `Z  15.000`
+    // the number: sign, digits and one point, a lowercase exponent glued to it
+    const char* number_start = p;
+    if (p < end && (*p == '+' || *p == '-')) ++p;
+    const char* mantissa = p;
+    int digits = 0;
+    bool point = false;
+    while (p < end && (is_digit(*p) || (*p == '.' && !point))) {
+      point = point || *p == '.';
+      digits += is_digit(*p) ? 1 : 0;
+      ++p;
+    }
+    if (digits > 0 && p + 1 < end && *p == 'e' &&
+        (is_digit(p[1]) || ((p[1] == '+' || p[1] == '-') && p + 2 < end && is_digit(p[2])))) {
+      p += 2;
+      while (p < end && is_digit(*p)) ++p;
+    }
+    // the word as written, to the next space, for messages
+    const char* word_end = p;
+    while (word_end < end && !is_space(*word_end) && *word_end != ';' && *word_end != '(')
+      ++word_end;
+    const bool clean = digits > 0 && (p == end || !(is_digit(*p) || *p == '.'));
+    if (!clean ||
+        (p < end && !is_space(*p) && !is_letter(*p) && *p != ';' && *p != '(' && *p != '*')) {
+      problem(line_number, "malformed word '" + printable(word_start, word_end) + "' (expected " +
+                               std::string(1, letter) + " followed by a number)");
+      return false;
+    }
+    double value = 0.0;
+    const char* convert_from = *number_start == '+' ? number_start + 1 : number_start;
+    const auto [stop, error] = std::from_chars(convert_from, p, value);
+    (void)mantissa;
+    if (error != std::errc() || stop != p || !std::isfinite(value) ||
+        std::abs(value) > kMaxMagnitude) {
+      problem(line_number, "number out of range in '" + printable(word_start, p) +
+                               "' (at most 1e9 in magnitude)");
+      return false;
+    }
+    if (letter == 'G' || letter == 'M') {
+      const double tenths = value * 10.0;
+      if (value < 0.0 || std::abs(tenths - std::round(tenths)) > 1e-6 ||
+          words_.n_codes == static_cast<int>(words_.codes.size())) {
+        problem(line_number, "malformed code '" + printable(word_start, p) + "'");
+        return false;
+      }
+      words_.codes[words_.n_codes++] = Code{letter, static_cast<int>(std::lround(tenths))};
+      continue;
+    }
+    if (letter == 'N' && words_.present == 0 && words_.n_codes == 0) continue;  // line number
+    if (words_.has(letter)) {
+      problem(line_number, std::string(1, letter) + " given twice on one line");
+      return false;
+    }
+    words_.present |= 1u << (letter - 'A');
+    words_.value[letter - 'A'] = value;
+    words_.text[letter - 'A'] = word_start;
+  }
+  return true;
+}
+
+void GcodeParser::execute(int line_number) {
+  // feed rate first (RS274/NGC order): per minute, in the current unit
+  if (words_.has('F')) {
+    if (words_.get('F') <= 0.0) {
+      problem(line_number, "feed rate F must be > 0 (per minute)");
+      return;
+    }
+  }
+  // G/M codes: check, then modes before motion
+  int motion = -1;
+  bool uses_axes = false;  // G92, G28, G10, G4: the axis words belong to the command
+  bool dwell = false, set_position = false, home = false;
+  for (int i = 0; i < words_.n_codes; ++i) {
+    const Code code = words_.codes[i];
+    const auto is_code = [&](const std::optional<Code>& c) {
+      return c && c->letter == code.letter && c->tenths == code.tenths;
+    };
+    if (is_code(open_code_)) {
+      open_ = true;
+      program_.has_shutter_codes = true;
+    } else if (is_code(close_code_)) {
+      open_ = false;
+      program_.has_shutter_codes = true;
+    }
+    if (code.letter == 'M') {
+      if (code.tenths == 820 || code.tenths == 830) extruder_relative_ = code.tenths == 830;
+      continue;
+    }
+    switch (code.tenths) {
+      case 0:
+      case 10:
+      case 20:
+      case 30:
+        if (motion >= 0) {
+          problem(line_number, "two motion commands (G0-G3) on one line");
+          return;
+        }
+        motion = code.tenths / 10;
+        break;
+      case 40:
+        dwell = uses_axes = true;
+        break;
+      case 170:
+      case 180:
+      case 190:
+        plane_ = code.tenths / 10;
+        break;
+      case 200:
+      case 210:
+        unit_mm_ = code.tenths == 200 ? kMmPerInch : 1.0;
+        break;
+      case 280:
+        home = uses_axes = true;
+        break;
+      case 800:
+        motion_mode_ = -1;
+        break;
+      case 900:
+      case 910:
+        axes_relative_ = code.tenths == 910;
+        break;
+      case 901:
+      case 911:
+        arc_centre_absolute_ = code.tenths == 901;
+        break;
+      case 920:
+        set_position = uses_axes = true;
+        break;
+      case 100:
+      case 530:
+        uses_axes = true;
+        break;  // G10, G53: not moves here
+      case 50:
+      case 51:
+      case 52:
+      case 330:
+      case 331:
+      case 730:
+      case 760:
+      case 810:
+      case 820:
+      case 830:
+      case 840:
+      case 850:
+      case 860:
+      case 870:
+      case 880:
+      case 890:
+      case 930:
+      case 950:
+        problem(line_number, "G" + std::to_string(code.tenths / 10) +
+                                 (code.tenths % 10 ? "." + std::to_string(code.tenths % 10) : "") +
+                                 " is not supported (splines, canned cycles, threading and "
+                                 "inverse-time or per-revolution feed change the path)");
+        return;
+      default:
+        break;  // other G codes (G29, G54, G64, G94, ...) change no geometry here
+    }
+  }
+  if (words_.has('F')) {
+    feed_mm_s_ = words_.get('F') * unit_mm_ / kSecondsPerMinute;
+  }
+  if (dwell) {
+    if (words_.has('S')) program_.dwell_s += std::max(0.0, words_.get('S'));
+    if (words_.has('P')) program_.dwell_s += std::max(0.0, words_.get('P')) / 1000.0;
+  }
+  if (set_position) this->set_position();
+  if (home) this->home();
+  const bool axis_words = words_.has('X') || words_.has('Y') || words_.has('Z') ||
+                          words_.has('E') || words_.has('I') || words_.has('J') ||
+                          words_.has('K') || words_.has('R');
+  if (motion < 0 && !uses_axes && axis_words) {
+    if (motion_mode_ < 0) {
+      problem(line_number, "axis words without a motion command (G0, G1, G2 or G3)");
+      return;
+    }
+    motion = motion_mode_;
+  }
+  if (motion >= 0) {
+    motion_mode_ = motion;
+    move(motion, line_number);
   }
 }
 
-void GcodeParser::move(const std::vector<Word>& words, int line_number) {
+void GcodeParser::extrude(double delta) {
+  // net extrusion and retractions (a run of decreases is one)
+  program_.extrusion_e_total += delta;
+  if (delta < 0.0 && !retracting_) ++program_.n_retractions;
+  if (delta != 0.0) retracting_ = delta < 0.0;
+}
+
+void GcodeParser::move(int motion, int line_number) {
   // target position and extrusion of this move
   Vec3 target_mm = position_mm_;
-  double extruded = 0.0;
-  for (const Word& word : words) {
-    const double value = word.value * unit_mm_;
-    if (word.letter >= 'X' && word.letter <= 'Z') {
-      const int axis = word.letter - 'X';
-      target_mm[axis] = axes_relative_ ? target_mm[axis] + value : value + offset_mm_[axis];
-    } else if (word.letter == 'E') {
-      const bool relative = axes_relative_ || extruder_relative_;
-      extruded = relative ? value : value - extruder_;
-      extruder_ = relative ? extruder_ + value : value;
-    } else if (word.letter == 'F') {
-      if (word.value <= 0.0) {
-        problem(line_number, "feed rate F" + word.text + " must be > 0 (mm/min)");
-        return;
-      }
-      feed_mm_s_ = value / kSecondsPerMinute;
-      reported_missing_feed_ = false;
-    }
-  }
-  const double displacement_mm = (target_mm - position_mm_).norm();
-  // no displacement (retract, prime, feed change): the path carries on
-  if (displacement_mm <= kJoinTolerance_mm) {
-    position_mm_ = target_mm;
-    return;
-  }
-  // travel: ends the current path
-  if (extruded <= 0.0) {
-    end_path();
-    position_mm_ = target_mm;
-    return;
-  }
-  // print move: extend the path, or start a new one (after a travel or at a new speed)
-  const double speed_mm_s = feed_mm_s_ > 0.0 ? feed_mm_s_ : default_speed_mm_s_;
-  if (speed_mm_s <= 0.0) {
-    if (!reported_missing_feed_)
-      problem(line_number,
-              "print move before any feed rate: give F (mm/min) or toolpath.speed in the scenario");
-    reported_missing_feed_ = true;
-    end_path();
-    position_mm_ = target_mm;
-    return;
-  }
-  if (!path_.points.empty() && path_.speed_mm_s != speed_mm_s) end_path();
-  if (path_.points.empty()) {
-    path_.points.push_back(position_mm_);
-    path_.speed_mm_s = speed_mm_s;
-    path_lines_.push_back(line_number);
-  }
-  path_.points.push_back(target_mm);
-  path_lines_.push_back(line_number);
-  position_mm_ = target_mm;
-}
-
-void GcodeParser::set_position(const std::vector<Word>& words) {
-  // G92 without words: every axis and E become 0 here
-  if (words.empty()) {
-    offset_mm_ = position_mm_;
-    extruder_ = 0.0;
-    return;
-  }
-  for (const Word& word : words) {
-    const double value = word.value * unit_mm_;
-    if (word.letter >= 'X' && word.letter <= 'Z') {
-      const int axis = word.letter - 'X';
-      offset_mm_[axis] = position_mm_[axis] - value;
-    } else if (word.letter == 'E') {
-      extruder_ = value;
-    }
-  }
-}
-
-void GcodeParser::home(const std::vector<Word>& words) {
-  // homing is a travel to 0 on the named axes (all when none is named)
-  end_path();
-  bool any_axis = false;
-  for (const Word& word : words) any_axis = any_axis || (word.letter >= 'X' && word.letter <= 'Z');
   for (int axis = 0; axis < 3; ++axis) {
-    bool named = !any_axis;
-    for (const Word& word : words) named = named || word.letter == 'X' + axis;
-    if (!named) continue;
+    const char letter = static_cast<char>('X' + axis);
+    if (!words_.has(letter)) continue;
+    const double value = words_.get(letter) * unit_mm_;
+    target_mm[axis] = axes_relative_ ? target_mm[axis] + value : value + offset_mm_[axis];
+  }
+  double e_delta = 0.0;
+  if (words_.has('E')) {
+    program_.has_e_values = true;
+    const double value = words_.get('E') * unit_mm_;
+    const bool relative = axes_relative_ || extruder_relative_;
+    e_delta = relative ? value : value - extruder_;
+    extruder_ = relative ? extruder_ + value : value;
+    extrude(e_delta);
+  }
+  EdgeArc arc;
+  if (motion >= 2 && !arc_geometry(motion, target_mm, line_number, arc)) return;
+  GcodeMove record;
+  record.line = line_number;
+  record.motion = motion;
+  record.from_mm = position_mm_;
+  record.to_mm = target_mm;
+  record.arc = arc;
+  if (arc.is_arc()) {
+    const Vec3 radius = position_mm_ - arc.center_mm;
+    const double rise = (target_mm - position_mm_).dot(arc.axis);
+    record.length_mm =
+        std::hypot((radius - radius.dot(arc.axis) * arc.axis).norm() * arc.sweep_rad, rise);
+  } else {
+    record.length_mm = (target_mm - position_mm_).norm();
+  }
+  record.e_delta = e_delta;
+  record.feed_mm_s = feed_mm_s_;
+  record.has_e = words_.has('E');
+  record.open = open_;
+  position_mm_ = target_mm;
+  if (record.length_mm > kMinMove_mm) program_.moves.push_back(record);
+}
+
+bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc) {
+  // the plane's axes (a0, a1) and its normal, right-handed: G17 XY/Z, G18 ZX/Y, G19 YZ/X
+  const int a0 = plane_ == 17 ? 0 : plane_ == 18 ? 2 : 1;
+  const int a1 = plane_ == 17 ? 1 : plane_ == 18 ? 0 : 2;
+  const int normal = 3 - a0 - a1;
+  const char offset_letters[3] = {'I', 'J', 'K'};
+  const bool has_offset = words_.has(offset_letters[a0]) || words_.has(offset_letters[a1]);
+  const std::string plane_name = "G" + std::to_string(plane_);
+  if (has_offset == words_.has('R')) {
+    problem(line_number, std::string("an arc needs either R or the centre offsets ") +
+                             offset_letters[a0] + "/" + offset_letters[a1] + " (plane " +
+                             plane_name + "), not " + (has_offset ? "both" : "neither"));
+    return false;
+  }
+  // G3 turns positively about the plane's normal, G2 negatively (seen from its + end)
+  const double turn = motion == 3 ? 1.0 : -1.0;
+  const Vec3 start = position_mm_;
+  const double s0 = start[a0], s1 = start[a1];
+  const double e0 = target[a0], e1 = target[a1];
+  const double chord0 = e0 - s0, chord1 = e1 - s1;
+  const double chord = std::hypot(chord0, chord1);
+  double c0 = 0.0, c1 = 0.0;
+  bool full_circle = false;
+  if (has_offset) {
+    const double i0 =
+        words_.has(offset_letters[a0]) ? words_.get(offset_letters[a0]) * unit_mm_ : 0.0;
+    const double i1 =
+        words_.has(offset_letters[a1]) ? words_.get(offset_letters[a1]) * unit_mm_ : 0.0;
+    c0 = arc_centre_absolute_ ? i0 + offset_mm_[a0] : s0 + i0;
+    c1 = arc_centre_absolute_ ? i1 + offset_mm_[a1] : s1 + i1;
+    const double r_start = std::hypot(s0 - c0, s1 - c1);
+    const double r_end = std::hypot(e0 - c0, e1 - c1);
+    if (r_start <= kMinMove_mm) {
+      problem(line_number, "arc of radius 0 (the centre is the start point)");
+      return false;
+    }
+    if (std::abs(r_end - r_start) >
+        std::max(kArcRadiusTolerance_mm, kArcRadiusTolerance_rel * r_start)) {
+      std::ostringstream message;
+      message << "the arc's end is " << r_end << " mm from its centre, its start " << r_start
+              << " mm (they must agree within " << kArcRadiusTolerance_mm << " mm)";
+      problem(line_number, message.str());
+      return false;
+    }
+    full_circle = chord <= kMinMove_mm;
+    if (!full_circle) {
+      // the centre moved onto the chord's bisector: one exact circle through both ends
+      const double m0 = 0.5 * (s0 + e0), m1 = 0.5 * (s1 + e1);
+      const double p0 = -chord1 / chord, p1 = chord0 / chord;
+      const double along = (c0 - m0) * p0 + (c1 - m1) * p1;
+      c0 = m0 + along * p0;
+      c1 = m1 + along * p1;
+    }
+  } else {
+    const double radius = words_.get('R') * unit_mm_;
+    if (chord <= kMinMove_mm) {
+      problem(line_number, "an R arc cannot end where it starts (give I/J/K for a full circle)");
+      return false;
+    }
+    const double half = 0.5 * chord;
+    if (std::abs(radius) <
+        half - std::max(kArcRadiusTolerance_mm, kArcRadiusTolerance_rel * std::abs(radius))) {
+      std::ostringstream message;
+      message << "radius R" << words_.get('R') << " is shorter than half the chord (" << half
+              << " mm)";
+      problem(line_number, message.str());
+      return false;
+    }
+    // centre on the left of the chord (seen turning) for the short arc, right for R < 0
+    const double height = std::sqrt(std::max(0.0, radius * radius - half * half));
+    const double side = (radius > 0.0 ? 1.0 : -1.0) * turn;
+    c0 = 0.5 * (s0 + e0) + side * height * (-chord1 / chord);
+    c1 = 0.5 * (s1 + e1) + side * height * (chord0 / chord);
+  }
+  // the sweep in the turning direction, (0, 2 pi]
+  double sweep = 2.0 * kPi;
+  if (!full_circle) {
+    const double u0 = s0 - c0, u1 = s1 - c1, v0 = e0 - c0, v1 = e1 - c1;
+    const double angle = turn * std::atan2(u0 * v1 - u1 * v0, u0 * v0 + u1 * v1);
+    sweep = angle > 0.0 ? angle : angle + 2.0 * kPi;
+  }
+  arc.center_mm = start;
+  arc.center_mm[a0] = c0;
+  arc.center_mm[a1] = c1;
+  arc.axis = Vec3::Zero();
+  arc.axis[normal] = turn;
+  arc.sweep_rad = sweep;
+  return true;
+}
+
+void GcodeParser::set_position() {
+  // G92 without words: every axis and E become 0 here
+  const bool any = words_.has('X') || words_.has('Y') || words_.has('Z') || words_.has('E');
+  for (int axis = 0; axis < 3; ++axis) {
+    const char letter = static_cast<char>('X' + axis);
+    if (words_.has(letter))
+      offset_mm_[axis] = position_mm_[axis] - words_.get(letter) * unit_mm_;
+    else if (!any)
+      offset_mm_[axis] = position_mm_[axis];
+  }
+  if (words_.has('E')) extruder_ = words_.get('E') * unit_mm_;
+  if (!any) extruder_ = 0.0;
+}
+
+void GcodeParser::home() {
+  // homing goes to 0 on the named axes (all when none is named)
+  const bool any_axis = words_.has('X') || words_.has('Y') || words_.has('Z');
+  for (int axis = 0; axis < 3; ++axis) {
+    if (any_axis && !words_.has(static_cast<char>('X' + axis))) continue;
     position_mm_[axis] = 0.0;
     offset_mm_[axis] = 0.0;
   }
 }
 
-void GcodeParser::end_path() {
-  if (path_.points.size() >= 2) {
-    path_.source_index = static_cast<int>(result_.toolpath.paths.size());
-    result_.toolpath.paths.push_back(path_);
-    result_.point_lines.push_back(path_lines_);
-  }
-  path_ = PrintPath{};
-  path_lines_.clear();
-}
-
-GcodeImport GcodeParser::finish() {
-  end_path();
+GcodeProgram GcodeParser::finish(int n_lines) {
+  program_.n_lines = n_lines;
   if (problem_count_ > problems_.size())
     problems_.push_back(
-        Problem{file_, 0, kKey,
+        Problem{program_.file_label, 0, kKey,
                 std::to_string(problem_count_ - problems_.size()) + " more problems not listed"});
   if (!problems_.empty()) throw InputError(problems_);
-  return std::move(result_);
+  return std::move(program_);
+}
+
+// the index of z among ascending levels (grouped within the layer tolerance)
+int level_index(const std::vector<double>& levels, double z) {
+  const auto it = std::lower_bound(levels.begin(), levels.end(), z - kLayerTolerance_mm);
+  return static_cast<int>(it - levels.begin());
+}
+
+// Calls on_run(first_move, end_move) for every uninterrupted run of print moves.
+template <typename OnRun>
+void for_each_print_run(const GcodeProgram& program, PrintRule rule, OnRun on_run) {
+  const std::vector<GcodeMove>& moves = program.moves;
+  std::size_t i = 0;
+  while (i < moves.size()) {
+    if (!move_prints(moves[i], rule)) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i + 1;
+    while (end < moves.size() && move_prints(moves[end], rule) &&
+           (moves[end].from_mm - moves[end - 1].to_mm).norm() <= kJoinTolerance_mm)
+      ++end;
+    on_run(i, end);
+    i = end;
+  }
 }
 
 }  // namespace
 
-GcodeImport parse_gcode(std::istream& in, const std::string& file_label,
-                        double default_speed_mm_s) {
-  GcodeParser parser(file_label, default_speed_mm_s);
-  std::string raw;
-  int line_number = 0;
-  while (std::getline(in, raw)) {
-    // a UTF-8 byte order mark is not part of the first command
-    if (line_number == 0 && raw.rfind("\xEF\xBB\xBF", 0) == 0) raw.erase(0, 3);
-    parser.line(raw, ++line_number);
+const char* print_rule_name(PrintRule rule) {
+  switch (rule) {
+    case PrintRule::automatic:
+      return "auto";
+    case PrintRule::e:
+      return "e";
+    case PrintRule::shutter:
+      return "shutter";
+    case PrintRule::feed:
+      return "feed";
   }
-  return parser.finish();
+  return "auto";
 }
 
-GcodeImport read_gcode(const std::string& path, double default_speed_mm_s) {
+std::optional<PrintRule> print_rule_from_name(const std::string& name) {
+  for (PrintRule rule : {PrintRule::automatic, PrintRule::e, PrintRule::shutter, PrintRule::feed})
+    if (name == print_rule_name(rule)) return rule;
+  return std::nullopt;
+}
+
+GcodeProgram parse_gcode_program(const std::string& text, const std::string& file_label,
+                                 const GcodeOptions& options) {
+  // the shutter codes must be G or M codes (M3, M106, ...)
+  for (const auto& [key, code] :
+       {std::pair<const char*, const std::string*>{"open", &options.open_code},
+        {"close", &options.close_code}})
+    if (!code_of(*code))
+      throw InputError(std::string(kKey) + "." + key,
+                       "'" + printable(code->data(), code->data() + code->size()) +
+                           "' is not a G or M code (e.g. M3, M5, M106, M107)");
+  GcodeParser parser(file_label, options);
+  const char* p = text.data();
+  const char* end = p + text.size();
+  // a UTF-8 byte order mark is not part of the first command
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) p += 3;
+  int line_number = 0;
+  while (p < end) {
+    const char* line_end = static_cast<const char*>(std::memchr(p, '\n', end - p));
+    if (!line_end) line_end = end;
+    parser.line(p, line_end, ++line_number);
+    p = line_end + 1;
+  }
+  return parser.finish(line_number);
+}
+
+GcodeProgram read_gcode_program(const std::string& path, const GcodeOptions& options) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error))
     throw InputError(path, 0, kKey, "G-code file not found");
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, kKey, "cannot read the G-code file");
-  return parse_gcode(in, path, default_speed_mm_s);
+  std::string text;
+  in.seekg(0, std::ios::end);
+  text.resize(static_cast<std::size_t>(std::max<std::streamoff>(0, in.tellg())));
+  in.seekg(0, std::ios::beg);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (!in) throw InputError(path, 0, kKey, "cannot read the G-code file");
+  return parse_gcode_program(text, path, options);
+}
+
+PrintRule resolve_print_rule(const GcodeProgram& program, PrintRule rule, std::string* reason) {
+  if (rule != PrintRule::automatic) {
+    if (reason) *reason = std::string("rule ") + print_rule_name(rule) + " (as given)";
+    return rule;
+  }
+  if (program.has_e_values) {
+    if (reason) *reason = "auto chose e: the file has E values (printing while E increases)";
+    return PrintRule::e;
+  }
+  if (program.has_shutter_codes) {
+    if (reason)
+      *reason =
+          "auto chose shutter: no E values, and the file opens or closes the shutter "
+          "(G1/G2/G3 print while it is open)";
+    return PrintRule::shutter;
+  }
+  if (reason)
+    *reason = "auto chose feed: no E values and no shutter codes (G1/G2/G3 print, G0 travels)";
+  return PrintRule::feed;
+}
+
+bool move_prints(const GcodeMove& move, PrintRule resolved_rule) {
+  switch (resolved_rule) {
+    case PrintRule::e:
+      return move.e_delta > 0.0;
+    case PrintRule::shutter:
+      return move.motion >= 1 && move.open;
+    case PrintRule::feed:
+      return move.motion >= 1;
+    case PrintRule::automatic:
+      break;
+  }
+  return false;
+}
+
+std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
+  std::vector<double> levels;
+  for_each_print_run(program, resolved_rule, [&](std::size_t first, std::size_t) {
+    levels.push_back(program.moves[first].from_mm.z());
+  });
+  std::sort(levels.begin(), levels.end());
+  // levels within the tolerance of the previous kept one are that layer
+  std::vector<double> distinct;
+  for (const double z : levels)
+    if (distinct.empty() || z - distinct.back() > kLayerTolerance_mm) distinct.push_back(z);
+  return distinct;
+}
+
+GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions& options) {
+  GcodeImport result;
+  result.rule = resolve_print_rule(program, options.rule, &result.rule_reason);
+  result.layer_z_mm = print_layer_levels(program, result.rule);
+  const int n_layers = static_cast<int>(result.layer_z_mm.size());
+  const int last_layer = options.last_layer < 0 ? n_layers - 1 : options.last_layer;
+  if (n_layers > 0 &&
+      (options.first_layer < 0 || options.first_layer > last_layer || last_layer >= n_layers))
+    throw InputError(program.file_label, 0, kKey,
+                     "layers [" + std::to_string(options.first_layer) + ", " +
+                         std::to_string(options.last_layer) + "] not in the file's " +
+                         std::to_string(n_layers) + " layers (0 to " +
+                         std::to_string(n_layers - 1) + ")");
+  result.first_layer = options.first_layer;
+  std::vector<Problem> problems;
+  bool reported_missing_feed = false;
+  for_each_print_run(program, result.rule, [&](std::size_t first, std::size_t end) {
+    const int layer = level_index(result.layer_z_mm, program.moves[first].from_mm.z());
+    if (layer < options.first_layer || layer > last_layer) return;
+    PrintPath path;
+    std::vector<int> lines;
+    // a new path at every change of feed rate, at the same point
+    const auto close_path = [&] {
+      if (path.points.size() >= 2) {
+        path.source_index = static_cast<int>(result.toolpath.paths.size());
+        path.layer = layer - options.first_layer;
+        if (!path.has_arcs()) path.arcs.clear();
+        result.toolpath.paths.push_back(std::move(path));
+        result.point_lines.push_back(std::move(lines));
+      }
+      path = PrintPath{};
+      lines.clear();
+    };
+    for (std::size_t i = first; i < end; ++i) {
+      const GcodeMove& move = program.moves[i];
+      const double speed = move.feed_mm_s > 0.0 ? move.feed_mm_s : options.default_speed_mm_s;
+      if (speed <= 0.0) {
+        if (!reported_missing_feed)
+          problems.push_back(Problem{program.file_label, move.line, kKey,
+                                     "print move before any feed rate: give F (mm/min) or "
+                                     "toolpath.speed in the scenario"});
+        reported_missing_feed = true;
+        close_path();
+        continue;
+      }
+      if (!path.points.empty() && path.speed_mm_s != speed) close_path();
+      if (path.points.empty()) {
+        path.points.push_back(move.from_mm);
+        path.speed_mm_s = speed;
+        lines.push_back(move.line);
+      }
+      path.points.push_back(move.to_mm);
+      path.arcs.push_back(move.arc);
+      lines.push_back(move.line);
+    }
+    close_path();
+  });
+  if (!problems.empty()) throw InputError(problems);
+  if (!result.toolpath.paths.empty()) result.first_point_mm = result.toolpath.paths[0].front();
+  return result;
+}
+
+GcodeImport parse_gcode(std::istream& in, const std::string& file_label,
+                        const GcodeOptions& options) {
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  return import_gcode_program(parse_gcode_program(text, file_label, options), options);
+}
+
+GcodeImport read_gcode(const std::string& path, const GcodeOptions& options) {
+  return import_gcode_program(read_gcode_program(path, options), options);
+}
+
+GcodeImport parse_gcode(std::istream& in, const std::string& file_label,
+                        double default_speed_mm_s) {
+  GcodeOptions options;
+  options.default_speed_mm_s = default_speed_mm_s;
+  return parse_gcode(in, file_label, options);
+}
+
+GcodeImport read_gcode(const std::string& path, double default_speed_mm_s) {
+  GcodeOptions options;
+  options.default_speed_mm_s = default_speed_mm_s;
+  return read_gcode(path, options);
 }
 
 Toolpath import_gcode(const std::string& path, double default_speed_mm_s) {

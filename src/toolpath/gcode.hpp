@@ -1,20 +1,28 @@
-// G-code importer: turns the print moves of a RepRap/Marlin-style G-code file into
-// print paths. Understood: G0/G1 (X Y Z E F), G90/G91 (absolute/relative positions),
-// M82/M83 (absolute/relative extrusion), G92 (set position, e.g. G92 E0), G20/G21
-// (inch/mm), G28 (home: the named axes, or all, to 0). Arcs (G2/G3) are an error; every
-// other command (M104, T0, M117 text, ...) is ignored. Comments (`;` to end of line and
-// `( ... )`), line numbers (N) and checksums (*) are skipped.
+// G-code importer for RS274/NGC (LinuxCNC) and RepRap/Marlin/Klipper files.
 //
-// A move with an XYZ displacement whose E increases is a print move; consecutive print
-// moves form one polyline, printed at the move's feed rate (F is modal, mm/min ->
-// mm/s) or at the default speed while no F has been given. A move that changes
-// position without extruding is a travel and ends the polyline; a change of feed rate
-// starts a new path at the same point. Moves without displacement (retract/prime)
-// change nothing. E is relative under M83 or G91 (Klipper's rule; Marlin agrees for
-// slicer output, where M82/M83 follows G90).
+// Read: G0/G1, G2/G3 arcs (I/J/K offsets or R, R < 0 the long way; a full circle when an
+// I/J/K arc ends where it starts; helical: the third axis moves linearly) in the G17/G18/G19
+// planes, G90/G91 (and G90.1/G91.1 for arc centres), M82/M83, G92, G20/G21, G28, G4 dwell
+// (P milliseconds, S seconds, as Marlin and Klipper), F (modal, per minute), E. Several G/M
+// words may share a line (G17 G21 G90) and run in RS274/NGC order (F, M, modes, motion);
+// axis words without a G word use the last motion mode. Spaces inside words are allowed
+// (`G0 Z  15.000`), numbers as `Z.2` or `E-.8`, a lowercase exponent (`1e3`; `1E3` is X1
+// then E3, as firmware reads compact lines). Comments `;...` and `(...)`, N words and
+// `*checksums` are skipped, as are Klipper's extended commands (`PRINT_START ...`), the text
+// commands (M117, M118, M23, ...) and every other G or M code, except the ones that would
+// change the geometry and are not supported (G5 splines, canned cycles G73/G76/G81-G89,
+// G93/G95 feed modes, G33 threading), which are errors.
+//
+// Print rules decide which moves deposit: `e` (E increases), `shutter` (G1/G2/G3 while the
+// open code is active), `feed` (G1/G2/G3 print, G0 travels) and `auto` (E values: e; else the
+// open or close code present: shutter; else feed). Consecutive print moves at one feed rate
+// form one print path; arcs stay exact (PrintPath::arcs) until a planner chords them.
+// A path's layer is the z of the first point of its uninterrupted print run; layers are
+// numbered 0, 1, ... by increasing z (levels within 1e-6 mm are one).
 #pragma once
 
 #include <istream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,22 +30,87 @@
 
 namespace depotwin {
 
+enum class PrintRule { automatic, e, shutter, feed };
+
+// "auto", "e", "shutter", "feed"
+const char* print_rule_name(PrintRule rule);
+// the rule of a name above, or nothing
+std::optional<PrintRule> print_rule_from_name(const std::string& name);
+
+struct GcodeOptions {
+  PrintRule rule = PrintRule::automatic;
+  std::string open_code = "M3";     // shutter rule: the code that opens (e.g. M106)
+  std::string close_code = "M5";    // and the one that closes (e.g. M107)
+  double default_speed_mm_s = 0.0;  // <= 0: none (then a print move before any F is an error)
+  int first_layer = 0;              // layers [first, last] are imported (0-based)
+  int last_layer = -1;              // -1: to the last layer
+};
+
+// One G0-G3 of the file whose path is longer than 1e-9 mm, in the machine frame (mm).
+struct GcodeMove {
+  int line = 0;    // 1-based line in the file
+  int motion = 0;  // 0, 1, 2, 3 for G0..G3
+  Vec3 from_mm = Vec3::Zero();
+  Vec3 to_mm = Vec3::Zero();
+  EdgeArc arc;             // sweep 0 for G0/G1
+  double length_mm = 0.0;  // helical for arcs
+  double e_delta = 0.0;    // extruder change during the move (mm of filament)
+  double feed_mm_s = 0.0;  // modal feed rate (0: none given yet)
+  bool has_e = false;      // an E word on the line
+  bool open = false;       // the shutter's open code was the last of open/close
+};
+
+// Everything a file does, before a print rule is applied.
+struct GcodeProgram {
+  std::string file_label;
+  std::vector<GcodeMove> moves;
+  bool has_e_values = false;       // some G0-G3 carries E
+  bool has_shutter_codes = false;  // the open or close code occurs
+  int n_retractions = 0;           // runs of consecutive E decreases (moving or not)
+  double extrusion_e_total = 0.0;  // net E over the file (G92 resets excluded), mm
+  double dwell_s = 0.0;            // sum of G4 dwells
+  int n_lines = 0;
+};
+
+// Parse G-code text; `file_label` names the source in messages. Throws InputError listing
+// the first 20 malformed lines ("file:line: toolpath.gcode: ...") and then how many more.
+GcodeProgram parse_gcode_program(const std::string& text, const std::string& file_label,
+                                 const GcodeOptions& options);
+// read a file whole and parse it; a missing or unreadable file is an InputError naming it
+GcodeProgram read_gcode_program(const std::string& path, const GcodeOptions& options);
+
+// the rule `rule` means for this program (auto resolved), and why (e.g. "auto chose e: ...")
+PrintRule resolve_print_rule(const GcodeProgram& program, PrintRule rule, std::string* reason);
+// whether a move deposits under a resolved rule
+bool move_prints(const GcodeMove& move, PrintRule resolved_rule);
+// the z levels of the program's print runs under a resolved rule, ascending (file layers)
+std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule);
+
 struct GcodeImport {
-  Toolpath toolpath;  // print paths in file order (source_index = position); start/end zero
+  // print paths in file order (source_index = position); start/end zero; arcs exact.
+  // PrintPath::layer counts from the first selected layer (0 = file layer first_layer).
+  Toolpath toolpath;
   // per path, per point: the 1-based line of the move that reached the point (the first
   // point's entry is the line of the path's first print move), for messages
   std::vector<std::vector<int>> point_lines;
+  PrintRule rule = PrintRule::e;       // the rule applied (never automatic)
+  std::string rule_reason;             // e.g. "auto chose e: the file has E values"
+  std::vector<double> layer_z_mm;      // z of every layer of the file, ascending
+  int first_layer = 0;                 // file layer of toolpath layer 0
+  std::optional<Vec3> first_point_mm;  // the first imported print point
 };
 
-// Parse G-code text. `file_label` names the source in messages; `default_speed_mm_s`
-// <= 0 means none (then a print move before any F is an error). Throws InputError
-// listing every malformed line ("file:line: toolpath.gcode: ...").
+// Print paths of a parsed program under the options' rule and layer selection.
+GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions& options);
+
+GcodeImport parse_gcode(std::istream& in, const std::string& file_label,
+                        const GcodeOptions& options);
+GcodeImport read_gcode(const std::string& path, const GcodeOptions& options);
+
+// Earlier signatures: rule auto, every layer, the given default speed.
 GcodeImport parse_gcode(std::istream& in, const std::string& file_label, double default_speed_mm_s);
-
-// Read and parse a file; a missing or unreadable file is an InputError naming it.
 GcodeImport read_gcode(const std::string& path, double default_speed_mm_s);
-
-// The print paths only (start and end left at the origin: the scenario sets them).
+// the print paths only (start and end left at the origin: the scenario sets them)
 Toolpath import_gcode(const std::string& path, double default_speed_mm_s);
 
 }  // namespace depotwin

@@ -111,34 +111,39 @@ TEST(Gcode, DefaultSpeedUntilTheFirstFeedRate) {
 
 TEST(Gcode, EveryMalformedLineIsReported) {
   const auto problems = problems_of(
-      "G1 X1 E1 F600\n"   // 1 fine
-      "G1 Xabc\n"         // 2 letter without number
-      "G1 X1.2.3 E2\n"    // 3 not a number
-      "G2 X1 Y1 I1 J0\n"  // 4 arcs unsupported
-      "G1 X2 F0\n"        // 5 zero feed
-      "G1 X3 X4 E3\n"     // 6 duplicate word
-      "G90 G21\n"         // 7 two commands
-      "hello world\n"     // 8 not G-code
-      "G1 X5 E5 #\n"      // 9 stray character
+      "G1 X1 E1 F600\n"     // 1 fine
+      "G1 Xabc\n"           // 2 letter without number
+      "G1 X1.2.3 E2\n"      // 3 not a number
+      "G2 X1 Y1 I1 R1\n"    // 4 arc with both centre and radius
+      "G1 X2 F0\n"          // 5 zero feed
+      "G1 X3 X4 E3\n"       // 6 duplicate word
+      "G0 G1 X1\n"          // 7 two motions
+      "G1 X1e308\n"         // 8 out of range (never echoed as a huge number)
+      "G1 X5 E5 #\n"        // 9 stray character
+      "G1 X\x01\x02\n"      // 10 control bytes
+      "G81 X1 Y1 Z-1 R1\n"  // 11 canned cycle
       "M117 anything: goes here\n"
+      "PRINT_START BED=60\n"
       "G1 X6 E6\n");
-  ASSERT_EQ(problems.size(), 8u) << dump(problems);
-  const std::vector<int> lines{2, 3, 4, 5, 6, 7, 8, 9};
-  for (std::size_t i = 0; i < lines.size(); ++i) {
+  ASSERT_EQ(problems.size(), 10u) << dump(problems);
+  for (std::size_t i = 0; i < problems.size(); ++i) {
     EXPECT_EQ(problems[i].file, "test.gcode");
-    EXPECT_EQ(problems[i].line, lines[i]) << problems[i].str();
+    EXPECT_EQ(problems[i].line, static_cast<int>(i) + 2) << problems[i].str();
     EXPECT_EQ(problems[i].key, "toolpath.gcode");
   }
   EXPECT_EQ(
       problems[0].str(),
       "test.gcode:2: toolpath.gcode: malformed word 'Xabc' (expected X followed by a number)");
   EXPECT_NE(problems[1].message.find("'X1.2.3'"), std::string::npos);
-  EXPECT_NE(problems[2].message.find("G2/G3"), std::string::npos);
-  EXPECT_NE(problems[3].message.find("F0 must be > 0"), std::string::npos);
+  EXPECT_NE(problems[2].message.find("not both"), std::string::npos);
+  EXPECT_NE(problems[3].message.find("F must be > 0"), std::string::npos);
   EXPECT_NE(problems[4].message.find("X given twice"), std::string::npos);
-  EXPECT_NE(problems[5].message.find("one command per line"), std::string::npos);
-  EXPECT_NE(problems[6].message.find("'hello' is not a G-code command"), std::string::npos);
+  EXPECT_NE(problems[5].message.find("two motion commands"), std::string::npos);
+  EXPECT_EQ(problems[6].message, "number out of range in 'X1e308' (at most 1e9 in magnitude)");
   EXPECT_NE(problems[7].message.find("unexpected '#'"), std::string::npos);
+  EXPECT_EQ(problems[8].message,
+            "binary or control byte \\x01 at column 5 (is this a G-code text file?)");
+  EXPECT_NE(problems[9].message.find("G81 is not supported"), std::string::npos);
 }
 
 TEST(Gcode, ManyBadLinesAreSummarised) {

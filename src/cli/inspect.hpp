@@ -1,0 +1,52 @@
+// `depotwin inspect FILE`: facts of a G-code file under a print rule, as JSON.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/types.hpp"
+#include "toolpath/gcode.hpp"
+
+namespace depotwin {
+
+// An axis-aligned box; empty until something is added.
+struct Box3 {
+  bool empty = true;
+  Vec3 lo = Vec3::Zero();
+  Vec3 hi = Vec3::Zero();
+};
+
+// What a G-code file does under a rule. A move is a G0-G3 whose path is longer than 1e-9 mm;
+// an arc's length is helical, sqrt((r theta)^2 + h^2); boxes include arcs' bulges exactly.
+struct GcodeFacts {
+  std::string rule;         // the rule applied: e, shutter or feed
+  std::string rule_reason;  // why (auto says which it chose)
+  int n_lines = 0;
+  int n_print_moves = 0;
+  int n_travel_moves = 0;
+  int n_print_paths = 0;  // uninterrupted print runs
+  int n_print_arcs = 0;   // print moves that are G2/G3
+  double print_length_mm = 0.0;
+  double travel_length_mm = 0.0;
+  std::vector<double> layer_z_values;  // z of each layer's print runs, ascending
+  Box3 print_bbox;
+  Box3 all_moves_bbox;
+  int n_retractions = 0;           // runs of consecutive E decreases
+  double extrusion_e_total = 0.0;  // net E over the file, mm of filament
+  // every move at the file's own feed rate plus the dwells; moves before any F are left out
+  // and counted
+  double estimated_time_s = 0.0;
+  int n_moves_without_feed = 0;
+};
+
+GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule);
+
+// the facts as the JSON `depotwin inspect` prints
+nlohmann::json gcode_facts_json(const GcodeFacts& facts);
+
+// the verb: parse `path`, print the JSON on stdout. Throws InputError on a bad file.
+void inspect_gcode_file(const std::string& path, const GcodeOptions& options);
+
+}  // namespace depotwin

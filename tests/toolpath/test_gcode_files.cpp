@@ -1,0 +1,214 @@
+// The shipped G-code files (scenarios/gcode/): each one's moves, lengths, layers and rule,
+// computed by hand from the file, through the importer and `inspect`'s facts.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cli/inspect.hpp"
+#include "core/error.hpp"
+#include "toolpath/gcode.hpp"
+
+namespace depotwin {
+namespace {
+
+const std::string kDir = std::string(DEPOTWIN_SOURCE_DIR) + "/scenarios/gcode/";
+
+GcodeFacts facts_of(const std::string& name, PrintRule rule = PrintRule::automatic) {
+  return gcode_facts(read_gcode_program(kDir + name, GcodeOptions{}), rule);
+}
+
+void expect_box(const Box3& box, const Vec3& lo, const Vec3& hi) {
+  ASSERT_FALSE(box.empty);
+  EXPECT_LT((box.lo - lo).norm(), 1e-9) << box.lo.transpose();
+  EXPECT_LT((box.hi - hi).norm(), 1e-9) << box.hi.transpose();
+}
+
+TEST(GcodeFiles, SpacesInsideWords) {
+  // G0 Z15, G0 Z0 (X0 Y0: no displacement), three 10 mm G1 (one modal), G0 Z15; feed rule
+  const GcodeFacts facts = facts_of("spaces_in_words.ngc");
+  EXPECT_EQ(facts.rule, "feed");
+  EXPECT_EQ(facts.n_print_moves, 3);
+  EXPECT_EQ(facts.n_travel_moves, 3);
+  EXPECT_DOUBLE_EQ(facts.print_length_mm, 30.0);
+  EXPECT_DOUBLE_EQ(facts.travel_length_mm, 45.0);
+  EXPECT_EQ(facts.layer_z_values, std::vector<double>{0.0});
+  expect_box(facts.print_bbox, Vec3(0, 0, 0), Vec3(10, 10, 0));
+  // F600 = 10 mm/s from the first G1 on (45 mm); the two G0 before any F are left out
+  EXPECT_NEAR(facts.estimated_time_s, 4.5, 1e-12);
+  EXPECT_EQ(facts.n_moves_without_feed, 2);
+}
+
+TEST(GcodeFiles, RArcFullCircleAndLongArc) {
+  // a quarter of radius 10 (5 pi), a full circle of radius 5 (10 pi), 270 degrees of radius 10
+  // (15 pi): one path of 30 pi mm
+  const GcodeFacts facts = facts_of("arcs.gcode");
+  EXPECT_EQ(facts.rule, "e");
+  EXPECT_EQ(facts.n_print_moves, 3);
+  EXPECT_EQ(facts.n_print_arcs, 3);
+  EXPECT_EQ(facts.n_print_paths, 1);
+  EXPECT_NEAR(facts.print_length_mm, 30.0 * kPi, 1e-9);
+  EXPECT_EQ(facts.n_travel_moves, 1);
+  EXPECT_NEAR(facts.travel_length_mm, std::sqrt(100.0 + 0.04), 1e-12);
+  EXPECT_NEAR(facts.extrusion_e_total, 3.0, 1e-12);
+  // the long arc passes (-10, 0) and (0, -10)
+  expect_box(facts.print_bbox, Vec3(-10, -10, 0.2), Vec3(10, 10, 0.2));
+  // the import keeps the arcs exact and chords them on demand within a sagitta
+  const GcodeImport imported = read_gcode(kDir + "arcs.gcode", GcodeOptions{});
+  ASSERT_EQ(imported.toolpath.paths.size(), 1u);
+  const PrintPath& path = imported.toolpath.paths[0];
+  ASSERT_EQ(path.points.size(), 4u);
+  EXPECT_NEAR(path.length_mm(), 30.0 * kPi, 1e-9);
+  EXPECT_NEAR(path.arcs[1].sweep_rad, 2.0 * kPi, 1e-12);
+  EXPECT_NEAR(path.arcs[2].sweep_rad, 1.5 * kPi, 1e-12);
+  std::vector<size_t> source;
+  const PrintPath chorded = path.chorded(0.01, &source);
+  EXPECT_FALSE(chorded.has_arcs());
+  // chords of radius 10 over 90 degrees: n = ceil(pi/2 / (2 acos(1 - 0.001))) = 18
+  EXPECT_EQ(arc_chord_count(10.0, kPi / 2, 0.01), 18);
+  EXPECT_EQ(chorded.points.size(),
+            1u + 18 + arc_chord_count(5.0, 2 * kPi, 0.01) + arc_chord_count(10.0, 1.5 * kPi, 0.01));
+  EXPECT_EQ(source.size(), chorded.points.size());
+  EXPECT_EQ(source.back(), 3u);
+  // every chord point on its circle; the chorded length within the sagitta's bound below
+  for (size_t i = 1; i <= 18; ++i) EXPECT_NEAR(chorded.points[i].head<2>().norm(), 10.0, 1e-9);
+  EXPECT_LT(chorded.length_mm(), 30.0 * kPi);
+  EXPECT_GT(chorded.length_mm(), 30.0 * kPi * (1.0 - 0.001));
+}
+
+TEST(GcodeFiles, HelixAndG18Arc) {
+  // one turn of radius 5 rising 2 mm: sqrt((10 pi)^2 + 2^2); then half a circle of radius 5
+  const GcodeFacts facts = facts_of("helix.ngc");
+  EXPECT_EQ(facts.rule, "feed");
+  EXPECT_EQ(facts.n_print_moves, 2);
+  EXPECT_EQ(facts.n_print_arcs, 2);
+  EXPECT_NEAR(facts.print_length_mm, std::hypot(10.0 * kPi, 2.0) + 5.0 * kPi, 1e-9);
+  // G18 G3 turns positively about +Y: from x = 5 down through z = 2 - 5 to x = -5
+  expect_box(facts.print_bbox, Vec3(-5, -5, -3), Vec3(5, 5, 2));
+  // F300: 5 mm/s (the G0 before it has no feed rate)
+  EXPECT_NEAR(facts.estimated_time_s, (std::hypot(10.0 * kPi, 2.0) + 5.0 * kPi) / 5.0, 1e-9);
+  EXPECT_EQ(facts.n_moves_without_feed, 1);
+  // a helix reversed is the same curve
+  const GcodeImport imported = read_gcode(kDir + "helix.ngc", GcodeOptions{});
+  const PrintPath& path = imported.toolpath.paths.at(0);
+  const PrintPath back = path.reversed();
+  for (double s : {0.1, 0.37, 0.8})
+    EXPECT_LT((back.edge_point(1, s) - path.edge_point(0, 1.0 - s)).norm(), 1e-12);
+}
+
+TEST(GcodeFiles, G91Block) {
+  const GcodeFacts facts = facts_of("relative_moves_g91.gcode");
+  EXPECT_EQ(facts.rule, "e");
+  EXPECT_EQ(facts.n_print_moves, 4);
+  EXPECT_DOUBLE_EQ(facts.print_length_mm, 60.0);
+  EXPECT_EQ(facts.n_travel_moves, 2);  // G1 Z0.3 without E, G0 X50 Y50
+  EXPECT_NEAR(facts.travel_length_mm, 0.3 + std::sqrt(5000.0), 1e-12);
+  expect_box(facts.print_bbox, Vec3(0, 0, 0.3), Vec3(20, 10, 0.3));
+  EXPECT_DOUBLE_EQ(facts.extrusion_e_total, 3.0);
+}
+
+TEST(GcodeFiles, M83RelativeExtrusionAndShortNumbers) {
+  // Z.2, E.8 prime, E-.8 retracts (two), two print paths of 30 and 20 mm
+  const GcodeFacts facts = facts_of("relative_e_m83.gcode");
+  EXPECT_EQ(facts.n_print_moves, 3);
+  EXPECT_EQ(facts.n_print_paths, 2);
+  EXPECT_DOUBLE_EQ(facts.print_length_mm, 50.0);
+  EXPECT_EQ(facts.n_travel_moves, 3);
+  EXPECT_NEAR(facts.travel_length_mm, 0.2 + std::sqrt(200.0) + 10.0, 1e-12);
+  EXPECT_EQ(facts.n_retractions, 2);
+  EXPECT_NEAR(facts.extrusion_e_total, 2.5, 1e-12);
+  EXPECT_EQ(facts.layer_z_values, std::vector<double>{0.2});
+}
+
+TEST(GcodeFiles, AerosolShutterCodes) {
+  // auto: no E, M3/M5 present -> shutter: 25 + 20 mm printed, the G1 with M5 is a travel
+  const GcodeFacts facts = facts_of("aerosol_m3_m5.ngc");
+  EXPECT_EQ(facts.rule, "shutter");
+  EXPECT_EQ(facts.n_print_moves, 3);
+  EXPECT_EQ(facts.n_print_paths, 2);
+  EXPECT_DOUBLE_EQ(facts.print_length_mm, 45.0);
+  EXPECT_EQ(facts.n_travel_moves, 3);
+  EXPECT_NEAR(facts.travel_length_mm, 1.0 + std::sqrt(425.0) + std::sqrt(500.0), 1e-12);
+  // the feed rule prints the closed-shutter G1 too
+  const GcodeFacts feed = facts_of("aerosol_m3_m5.ngc", PrintRule::feed);
+  EXPECT_EQ(feed.n_print_moves, 4);
+  EXPECT_NEAR(feed.print_length_mm, 45.0 + std::sqrt(425.0), 1e-12);
+  // other codes: with M106/M107 nothing opens, so nothing prints
+  GcodeOptions fan;
+  fan.rule = PrintRule::shutter;
+  fan.open_code = "M106";
+  fan.close_code = "M107";
+  EXPECT_EQ(
+      gcode_facts(read_gcode_program(kDir + "aerosol_m3_m5.ngc", fan), fan.rule).n_print_moves, 0);
+  // the import: two paths at F300 = 5 mm/s
+  const GcodeImport imported = read_gcode(kDir + "aerosol_m3_m5.ngc", GcodeOptions{});
+  EXPECT_EQ(imported.rule, PrintRule::shutter);
+  ASSERT_EQ(imported.toolpath.paths.size(), 2u);
+  EXPECT_DOUBLE_EQ(imported.toolpath.paths[0].speed_mm_s, 5.0);
+  EXPECT_EQ(imported.point_lines[1], (std::vector<int>{11, 11}));
+}
+
+TEST(GcodeFiles, CuraPurgeLine) {
+  // two 180 mm purge lines and a 2 x 10 mm start of the wall, all at z = 0.3
+  const GcodeFacts facts = facts_of("cura_purge.gcode");
+  EXPECT_EQ(facts.rule, "e");
+  EXPECT_EQ(facts.n_print_moves, 4);
+  EXPECT_EQ(facts.n_print_paths, 3);
+  EXPECT_DOUBLE_EQ(facts.print_length_mm, 380.0);
+  EXPECT_EQ(facts.n_travel_moves, 5);
+  EXPECT_NEAR(facts.travel_length_mm,
+              2.0 + std::sqrt(0.01 + 400.0 + 2.89) + 0.3 + 1.7 + std::sqrt(92.16 + 100.0 + 2.89),
+              1e-9);
+  EXPECT_EQ(facts.n_retractions, 1);
+  EXPECT_NEAR(facts.extrusion_e_total, 30.66, 1e-12);
+  EXPECT_EQ(facts.layer_z_values, std::vector<double>{0.3});
+  expect_box(facts.print_bbox, Vec3(0.1, 10, 0.3), Vec3(20, 200, 0.3));
+}
+
+TEST(GcodeFiles, FiveLayerSquare) {
+  const GcodeFacts facts = facts_of("square_5_layers.gcode");
+  EXPECT_EQ(facts.n_print_moves, 20);
+  EXPECT_NEAR(facts.print_length_mm, 400.0, 1e-9);
+  EXPECT_EQ(facts.n_travel_moves, 6);  // five Z steps and the first XY travel
+  EXPECT_NEAR(facts.travel_length_mm, 1.0 + std::sqrt(200.0), 1e-9);
+  ASSERT_EQ(facts.layer_z_values.size(), 5u);
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(facts.layer_z_values[k], 0.2 * (k + 1), 1e-12);
+  EXPECT_NEAR(facts.extrusion_e_total, 13.3, 1e-9);
+  // 400 mm at 20 mm/s, 1 mm of Z at 10 mm/s, sqrt(200) mm at 100 mm/s
+  EXPECT_NEAR(facts.estimated_time_s, 20.0 + 0.1 + std::sqrt(200.0) / 100.0, 1e-9);
+  // layers [1, 3]: three paths numbered 0..2 from z = 0.4
+  GcodeOptions options;
+  options.first_layer = 1;
+  options.last_layer = 3;
+  const GcodeImport selected = read_gcode(kDir + "square_5_layers.gcode", options);
+  ASSERT_EQ(selected.toolpath.paths.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(selected.toolpath.paths[k].layer, k);
+    EXPECT_NEAR(selected.toolpath.paths[k].front().z(), 0.2 * (k + 2), 1e-12);
+  }
+  EXPECT_EQ(selected.first_layer, 1);
+  EXPECT_EQ(selected.layer_z_mm.size(), 5u);
+  ASSERT_TRUE(selected.first_point_mm.has_value());
+  EXPECT_LT((*selected.first_point_mm - Vec3(10, 10, 0.4)).norm(), 1e-12);
+  // a range outside the file is one clear error
+  options.last_layer = 5;
+  try {
+    read_gcode(kDir + "square_5_layers.gcode", options);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problems().at(0).message, "layers [1, 5] not in the file's 5 layers (0 to 4)");
+  }
+}
+
+TEST(GcodeFiles, InspectJsonKeys) {
+  const nlohmann::json json = gcode_facts_json(facts_of("arcs.gcode"));
+  for (const char* key :
+       {"n_print_moves", "n_travel_moves", "print_length_mm", "travel_length_mm", "n_layers",
+        "layer_z_values", "print_bbox", "all_moves_bbox", "n_print_arcs", "n_retractions",
+        "extrusion_e_total", "estimated_time_s", "rule"})
+    EXPECT_TRUE(json.contains(key)) << key;
+  EXPECT_EQ(json["n_layers"], 1);
+  EXPECT_EQ(json["print_bbox"]["min"][0], -10.0);
+}
+
+}  // namespace
+}  // namespace depotwin
