@@ -367,7 +367,8 @@ std::vector<std::string> topic_sections(const std::string& topic) {
   if (topic == "limits") return {"limits", "limits.x", "limits.joint"};
   if (topic == "processes") return {"process"};
   if (topic == "toolpath")
-    return {"toolpath", "toolpath.polylines[]", "toolpath.random_segments", "toolpath.surface"};
+    return {"toolpath", "toolpath.polylines[]", "toolpath.gcode", "toolpath.random_segments",
+            "toolpath.surface"};
   if (topic == "arm" || topic == "sim" || topic == "outputs") return {topic};
   return {};
 }

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "kinematics/arm6.hpp"
+#include "kinematics/cartesian.hpp"
 #include "kinematics/linear_delta.hpp"
 #include "kinematics/machine.hpp"
 #include "kinematics/xy_stage.hpp"
@@ -18,6 +19,9 @@ const std::vector<MachineInfo>& machine_registry() {
        "Giberti et al.'s linear delta: three vertical carriages carry the substrate platform",
        &make_linear_delta},
       {"arm6", "6-DOF arm (ABB IRB 120) carrying a tilted-nozzle head over a table", &make_arm6},
+      {"cartesian",
+       "XYZ gantry printer (Klipper's cartesian): the head moves in x and y, the bed drops in z",
+       &make_cartesian},
   };
   return registry;
 }

@@ -237,7 +237,10 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   order.cost_s = job.order.cost_s;
   if (job.order.lower_bound_s > 0.0) order.lower_bound_s = job.order.lower_bound_s;
   r.order = order;
-  r.warnings = run.trajectory.warnings();
+  // the scenario's own (e.g. the rule a G-code file was read by, moves slowed to the
+  // machine's limits), then the planner's
+  r.warnings = job.scenario.notes;
+  for (const std::string& warning : run.trajectory.warnings()) r.warnings.push_back(warning);
   return run;
 }
 

@@ -120,7 +120,20 @@ class Loader {
   void read_toolpath(const Field* field);
   void read_segments(const Field& field, const std::optional<double>& default_speed);
   void read_polylines(const Field& field, const std::optional<double>& default_speed);
-  void read_gcode_file(const Field& field, const std::optional<double>& default_speed);
+  void read_gcode_file(const Field& field, const std::optional<double>& default_speed,
+                       bool start_given, bool end_given);
+  // the moves (distinct lines) among a path's points from `from` on
+  static std::size_t distinct_moves(const std::vector<int>& point_lines, std::size_t from);
+  // false for a machine that cannot move the TCP in z (the XY stage)
+  static bool machine_moves_z(const Machine& machine);
+  // one problem when the imported paths lie at several z levels, at the first move off the
+  // first level; false (nothing added) for a single level
+  bool multi_level_problem(const GcodeImport& imported, const std::string& file,
+                           const std::string& key);
+  // `feed: clamp`: each edge slowed to what the limits allow along it, paths split where the
+  // speed changes; counts and reports the moves slowed
+  void clamp_feed_rates(std::vector<PrintPath>& paths, std::vector<std::vector<int>>& lines,
+                        GcodeToolpath& settings);
   void read_random_segments(const Field& field, const std::optional<double>& default_speed,
                             bool start_given, bool end_given);
   void read_surface(const Field& field, const std::optional<double>& default_speed,
@@ -483,7 +496,7 @@ void Loader::read_toolpath(const Field* field) {
   } else if (name == "polylines") {
     read_polylines(kind, default_speed);
   } else if (name == "gcode") {
-    read_gcode_file(kind, default_speed);
+    read_gcode_file(kind, default_speed, view.has("start"), view.has("end"));
   } else if (name == "random_segments") {
     read_random_segments(kind, default_speed, view.has("start"), view.has("end"));
   } else {
@@ -605,33 +618,260 @@ void Loader::read_polylines(const Field& field, const std::optional<double>& def
   }
 }
 
-void Loader::read_gcode_file(const Field& field, const std::optional<double>& default_speed) {
-  const std::optional<std::string> given = read_string(field, problems_);
+void Loader::read_gcode_file(const Field& field, const std::optional<double>& default_speed,
+                             bool start_given, bool end_given) {
+  // `gcode: FILE`, or `gcode: {file, rule, open, close, layers, feed, chord_tolerance_mm}`
+  auto settings = std::make_shared<GcodeToolpath>();
+  settings->line = field.key_line;
+  const Field* file_field = &field;
+  std::optional<MapView> view;
+  if (field.node.IsMap()) {
+    view.emplace(field, keys_of("toolpath.gcode"), problems_);
+    file_field = view->find("file");
+    if (!file_field) {
+      problems_.add(field.line, field.key, "missing file: (the G-code file)");
+      return;
+    }
+  }
+  const std::optional<std::string> given = read_string(*file_field, problems_);
   if (!given) return;
   const fs::path resolved = resolve(*given);
+  settings->file = resolved.string();
+  GcodeOptions options;
+  options.default_speed_mm_s = default_speed.value_or(0.0);
+  if (view) {
+    const auto read_word = [&](const char* key, std::string& target) {
+      const Field* f = view->find(key);
+      if (!f) return;
+      const std::optional<std::string> word = read_string(*f, problems_);
+      if (!word) return;
+      const std::vector<std::string>& choices = schema_section("toolpath.gcode").key(key).choices;
+      if (!choices.empty() && !contains(choices, *word))
+        problems_.add(f->line, f->key,
+                      "unknown value '" + *word + "' (expected " + join(choices, " | ") + ")");
+      else
+        target = *word;
+    };
+    read_word("rule", settings->rule);
+    read_word("open", settings->open_code);
+    read_word("close", settings->close_code);
+    read_word("feed", settings->feed);
+    if (const Field* f = view->find("chord_tolerance_mm"))
+      settings->chord_tolerance_mm =
+          read_number(*f, problems_, range_of("toolpath.gcode", "chord_tolerance_mm"))
+              .value_or(settings->chord_tolerance_mm);
+    if (const Field* f = view->find("layers")) {
+      if (expect_list(*f, problems_, "[from, to]")) {
+        if (f->node.size() != 2) {
+          problems_.add(f->line, f->key,
+                        "expected [from, to] (two layer indices), got " +
+                            std::to_string(f->node.size()) + " values");
+        } else {
+          const auto from = read_integer(f->item(0), problems_, 0, 1000000000);
+          const auto to = read_integer(f->item(1), problems_, 0, 1000000000);
+          if (from && to && *from > *to)
+            problems_.add(
+                f->line, f->key,
+                "from (" + std::to_string(*from) + ") is after to (" + std::to_string(*to) + ")");
+          else if (from && to) {
+            settings->first_layer = static_cast<int>(*from);
+            settings->last_layer = static_cast<int>(*to);
+          }
+        }
+      }
+    }
+  }
+  options.rule = print_rule_from_name(settings->rule).value_or(PrintRule::automatic);
+  options.open_code = settings->open_code;
+  options.close_code = settings->close_code;
+  options.first_layer = settings->first_layer;
+  options.last_layer = settings->last_layer;
+  scenario_.gcode = settings;
+
   std::error_code error;
   if (!fs::is_regular_file(resolved, error)) {
-    problems_.add(field.line, field.key,
+    problems_.add(file_field->line, file_field->key,
                   "G-code file '" + *given + "' not found (looked for " + resolved.string() + ")");
     return;
   }
   GcodeImport imported;
   try {
-    imported = read_gcode(resolved.string(), default_speed.value_or(0.0));
+    imported = read_gcode(resolved.string(), options);
   } catch (const InputError& e) {
     for (const Problem& p : e.problems()) problems_.add_problem(p);
     return;
   }
+  settings->rule_applied = print_rule_name(imported.rule);
+  settings->rule_reason = imported.rule_reason;
+  settings->layer_z_mm = imported.layer_z_mm;
+  if (settings->rule == "auto")
+    scenario_.notes.push_back("toolpath.gcode: " + imported.rule_reason);
   if (imported.toolpath.paths.empty()) {
-    problems_.add(field.line, field.key,
-                  "G-code file '" + *given + "' has no print moves (G1 with increasing E)");
+    problems_.add(
+        field.line, field.key,
+        "G-code file '" + *given + "' has no print moves under rule " + settings->rule_applied +
+            (imported.rule_reason.empty() ? "" : " (" + imported.rule_reason + ")") +
+            (settings->last_layer >= 0 ? " in layers [" + std::to_string(settings->first_layer) +
+                                             ", " + std::to_string(settings->last_layer) + "]"
+                                       : ""));
     return;
   }
+
+  // a machine without a z axis cannot print several z levels: one problem, at the first move
+  // that leaves the first level (never one per point)
+  if (machine_ && !machine_moves_z(*machine_) &&
+      multi_level_problem(imported, resolved.string(), field.key))
+    return;
+
+  // arcs become chords within the tolerance (every planner then gets polylines); each chord
+  // point keeps the line of the move it lies on
+  const double tolerance_mm = settings->chord_tolerance_mm;
+  std::vector<PrintPath> paths;
+  std::vector<std::vector<int>> lines;
   for (std::size_t i = 0; i < imported.toolpath.paths.size(); ++i) {
-    PrintPath& path = imported.toolpath.paths[i];
-    check_path(path, PathOrigin{resolved.string(), field.key, imported.point_lines[i], true});
+    const PrintPath& path = imported.toolpath.paths[i];
+    if (!path.has_arcs()) {
+      paths.push_back(path);
+      lines.push_back(imported.point_lines[i]);
+      continue;
+    }
+    std::vector<std::size_t> source_point;
+    paths.push_back(path.chorded(tolerance_mm, &source_point));
+    std::vector<int> chord_lines;
+    for (std::size_t k : source_point) chord_lines.push_back(imported.point_lines[i].at(k));
+    lines.push_back(std::move(chord_lines));
+  }
+  for (const std::vector<int>& path_lines : lines)
+    settings->print_moves += static_cast<int>(distinct_moves(path_lines, 1));
+
+  // feed rates above what the machine can do along a move: slowed to it, as firmware does
+  if (settings->feed == "clamp") clamp_feed_rates(paths, lines, *settings);
+
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    PrintPath& path = paths[i];
+    path.source_index = static_cast<int>(scenario_.toolpath.paths.size());
+    check_path(path, PathOrigin{resolved.string(), field.key, lines[i], true});
     scenario_.toolpath.paths.push_back(std::move(path));
   }
+
+  // the start (and so the end) defaults to the file's first print point; `offset` then moves
+  // start and paths together
+  Toolpath& toolpath = scenario_.toolpath;
+  if (!start_given) toolpath.start_mm = toolpath.paths.front().points.front();
+  if (!end_given) toolpath.end_mm = toolpath.start_mm;
+}
+
+std::size_t Loader::distinct_moves(const std::vector<int>& point_lines, std::size_t from) {
+  // a move is a line of the file; the chords of an arc share their move's line
+  std::size_t count = 0;
+  int previous = -1;
+  for (std::size_t k = from; k < point_lines.size(); ++k) {
+    if (point_lines[k] != previous) ++count;
+    previous = point_lines[k];
+  }
+  return count;
+}
+
+bool Loader::machine_moves_z(const Machine& machine) {
+  // the TCP's z row of the Jacobian at the work frame's origin: zero for a machine without z
+  JointVector joints;
+  if (!machine.inverse(Pose(Vec3::Zero()), joints)) return true;
+  return machine.jacobian(joints).row(2).norm() > 0.0;
+}
+
+bool Loader::multi_level_problem(const GcodeImport& imported, const std::string& file,
+                                 const std::string& key) {
+  const double first_z_mm = imported.toolpath.paths.front().points.front().z();
+  std::vector<double> levels{first_z_mm};
+  int first_off_line = 0;
+  double first_off_z_mm = first_z_mm;
+  for (std::size_t i = 0; i < imported.toolpath.paths.size(); ++i) {
+    const std::vector<Vec3>& points = imported.toolpath.paths[i].points;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const double z_mm = points[k].z();
+      if (std::none_of(levels.begin(), levels.end(),
+                       [&](double level) { return std::abs(level - z_mm) <= 1e-6; }))
+        levels.push_back(z_mm);
+      if (first_off_line == 0 && std::abs(z_mm - first_z_mm) > 1e-6) {
+        first_off_line = imported.point_lines[i].at(k);
+        first_off_z_mm = z_mm;
+      }
+    }
+  }
+  if (levels.size() < 2) return false;
+  std::sort(levels.begin(), levels.end());
+  problems_.add_problem(Problem{
+      file, first_off_line, key,
+      "the file prints at " + std::to_string(levels.size()) + " z levels (" +
+          format_number(levels.front()) + " to " + format_number(levels.back()) + " mm) but " +
+          scenario_.machine + " has no z axis: this move leaves z = " + format_number(first_z_mm) +
+          " mm for z = " + format_number(first_off_z_mm) +
+          " mm (select one layer with gcode: {file: ..., layers: [k, k]}, or use a machine "
+          "with z such as cartesian)"});
+  return true;
+}
+
+void Loader::clamp_feed_rates(std::vector<PrintPath>& paths, std::vector<std::vector<int>>& lines,
+                              GcodeToolpath& settings) {
+  std::vector<PrintPath> clamped_paths;
+  std::vector<std::vector<int>> clamped_lines;
+  double largest_cut = 1.0, from_mm_s = 0.0, to_mm_s = 0.0;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const PrintPath& path = paths[i];
+    const std::vector<int>& path_lines = lines[i];
+    // each edge's speed: the path's, or the most every axis allows along it (the user's
+    // limits, with the machine's joint limits mapped over the edge)
+    std::vector<double> edge_speed(path.points.size() - 1, path.speed_mm_s);
+    int last_clamped_line = -1;
+    for (std::size_t k = 0; k + 1 < path.points.size() && path.speed_mm_s > 0.0; ++k) {
+      const Vec3 step = path.points[k + 1] - path.points[k];
+      const double length_mm = step.norm();
+      if (length_mm <= kJoinTolerance_mm) continue;
+      const MachineLimits limits =
+          tcp_limits_ ? tcp_limits_->along(path.points[k], path.points[k + 1]) : scenario_.limits;
+      double allowed_mm_s = path.speed_mm_s;
+      for (int axis = 0; axis < 3; ++axis)
+        if (axis_v_max_known_[axis] && std::abs(step[axis]) > 0.0)
+          allowed_mm_s = std::min(allowed_mm_s,
+                                  limits.axes[axis].v_max_mm_s * length_mm / std::abs(step[axis]));
+      if (allowed_mm_s >= path.speed_mm_s) continue;
+      edge_speed[k] = allowed_mm_s;
+      // a move (a line of the file) counts once, however many chords it has
+      if (path_lines.at(k + 1) != last_clamped_line) ++settings.clamped_moves;
+      last_clamped_line = path_lines.at(k + 1);
+      if (allowed_mm_s / path.speed_mm_s < largest_cut) {
+        largest_cut = allowed_mm_s / path.speed_mm_s;
+        from_mm_s = path.speed_mm_s;
+        to_mm_s = allowed_mm_s;
+      }
+    }
+    // runs of edges at one speed become paths (a speed change starts a new path at the same
+    // point, as the importer does for a change of F)
+    std::size_t run_start = 0;
+    for (std::size_t k = 1; k <= edge_speed.size(); ++k) {
+      if (k < edge_speed.size() && edge_speed[k] == edge_speed[run_start]) continue;
+      PrintPath piece = path;
+      piece.points.assign(path.points.begin() + static_cast<long>(run_start),
+                          path.points.begin() + static_cast<long>(k) + 1);
+      if (!path.normals.empty())
+        piece.normals.assign(path.normals.begin() + static_cast<long>(run_start),
+                             path.normals.begin() + static_cast<long>(k) + 1);
+      piece.speed_mm_s = edge_speed[run_start];
+      clamped_paths.push_back(std::move(piece));
+      clamped_lines.emplace_back(path_lines.begin() + static_cast<long>(run_start),
+                                 path_lines.begin() + static_cast<long>(k) + 1);
+      run_start = k;
+    }
+  }
+  paths = std::move(clamped_paths);
+  lines = std::move(clamped_lines);
+  if (settings.clamped_moves > 0)
+    scenario_.notes.push_back(
+        "toolpath.gcode: " + std::to_string(settings.clamped_moves) + " of " +
+        std::to_string(settings.print_moves) +
+        " print moves asked for more than the machine's speed limits and were slowed to them "
+        "(feed: clamp, as firmware does; the largest cut " +
+        format_speed(from_mm_s) + " -> " + format_speed(to_mm_s) + " mm/s)");
 }
 
 void Loader::read_random_segments(const Field& field, const std::optional<double>& default_speed,

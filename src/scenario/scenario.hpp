@@ -80,6 +80,27 @@ struct SurfaceToolpath {
                              bool reversed) const;
 };
 
+// `toolpath: {gcode: ...}` — a G-code file and how it was read (toolpath/gcode.hpp): its print
+// rule, layers, what to do with feed rates above the machine's limits, and the chord tolerance
+// its arcs were chorded within. `gcode: FILE` is the same with every default.
+struct GcodeToolpath {
+  std::string file;                  // resolved against the scenario's directory
+  std::string rule = "auto";         // auto | e | shutter | feed, as given
+  std::string rule_applied;          // the rule used (auto resolved): e | shutter | feed
+  std::string rule_reason;           // e.g. "auto chose e: the file has E values"
+  std::string open_code = "M3";      // shutter rule: opens
+  std::string close_code = "M5";     // shutter rule: closes
+  int first_layer = 0;               // `layers: [from, to]`, 0-based, inclusive
+  int last_layer = -1;               // -1: to the last
+  std::string feed = "clamp";        // clamp | error
+  double chord_tolerance_mm = 0.01;  // arcs become chords within this sagitta
+  int print_moves = 0;               // print moves imported (after chording: chords of one move
+                                     // count once)
+  int clamped_moves = 0;             // of those, slowed to the machine's limits (feed: clamp)
+  std::vector<double> layer_z_mm;    // z of every layer of the file, ascending
+  int line = 0;                      // the `gcode:` key's line
+};
+
 // Where a print path was given, for messages: the file (the scenario, or an imported G-code
 // file), the dotted key (`toolpath.segments[3]`, `toolpath.polylines[0]`, `toolpath.gcode`) and
 // each point's line in that file.
@@ -113,6 +134,11 @@ struct Scenario {
   // conformal work: the surface toolpath's settings and the part, placed in the work frame
   // (mm); null / empty for planar toolpaths
   std::shared_ptr<const SurfaceToolpath> surface;
+  // a G-code toolpath's settings and what the import found; null for other toolpaths
+  std::shared_ptr<const GcodeToolpath> gcode;
+  // what every run of this scenario reports in metrics.json's warnings (e.g. the rule `auto`
+  // chose, moves slowed to the machine's limits)
+  std::vector<std::string> notes;
   std::shared_ptr<const TriangleMesh> part;
   // ray casting onto the part, built once for its hatch and kept for the run (`part` is its
   // mesh); null with `part`

@@ -228,7 +228,8 @@ std::vector<SchemaSection> make_schema() {
        {number("speed", "mm/s", ValueRange::positive(), 0.0,
                "print speed of every path that gives none"),
         other("start", "point [x, y] or [x, y, z]", "mm", "[0, 0, 0]",
-              "where the machine starts, at rest (surface: 20 mm above the part)"),
+              "where the machine starts, at rest (surface: 20 mm above the part; gcode: the "
+              "file's first print point, before offset)"),
         other("end", "point [x, y] or [x, y, z]", "mm", "start", "where the machine ends, at rest"),
         other("offset", "point [dx, dy] or [dx, dy, dz]", "mm", "none",
               "added to every point, start and end (not with surface)"),
@@ -236,8 +237,9 @@ std::vector<SchemaSection> make_schema() {
               "print segments in this order; segments whose ends touch meet at a joint"),
         other("polylines", "list of point lists or {points, speed}", "mm", "-",
               "print polylines; each interior point is a joint"),
-        other("gcode", "text", "", "-",
-              "a G-code file: print moves (E increasing) become polylines at their feed rate"),
+        other("gcode", "text or map", "", "-",
+              "a G-code file (or {file, rule, ...}, see toolpath.gcode): print moves become "
+              "polylines at their feed rate"),
         other("random_segments", "map", "", "-",
               "Ganganath et al.'s random instances (see toolpath.random_segments)"),
         other("surface", "map", "", "-",
@@ -251,6 +253,29 @@ std::vector<SchemaSection> make_schema() {
         number("speed", "mm/s", ValueRange::positive(), 0.0, "this polyline's print speed")}});
   schema.back().keys.back().default_text = "toolpath.speed";
   schema.back().keys.back().default_value = std::nullopt;
+  {
+    // `gcode: FILE` is `gcode: {file: FILE}` with every default below
+    const GcodeToolpath gcode;
+    schema.push_back(
+        {"toolpath.gcode",
+         "a G-code file (RS274/NGC, RepRap/Marlin/Klipper) and how its moves print",
+         {other("file", "text", "", "required", "the G-code file, relative to the scenario"),
+          word("rule", {"auto", "e", "shutter", "feed"}, gcode.rule,
+               "what prints: e (E increases), shutter (G1-G3 while `open` is active), feed "
+               "(G1-G3 print, G0 travels); auto: e if the file has E, else shutter if it has "
+               "the codes, else feed (metrics.json's warnings say which)"),
+          other("open", "text", "", gcode.open_code, "the shutter rule's open code (e.g. M106)"),
+          other("close", "text", "", gcode.close_code, "the shutter rule's close code (e.g. M107)"),
+          other("layers", "[from, to], whole numbers >= 0, from <= to", "", "every layer",
+                "the file's layers to print, 0-based, inclusive (layers by increasing z)"),
+          word("feed", {"clamp", "error"}, gcode.feed,
+               "feed rates above the machine's limits: clamp slows each move to what every "
+               "axis can do along it (as firmware does; metrics.json counts them), error "
+               "refuses them"),
+          number("chord_tolerance_mm", "mm", ValueRange{0.0, false, 1.0, true},
+                 gcode.chord_tolerance_mm,
+                 "arcs (G2/G3) become chords whose sagitta is at most this")}});
+  }
   {
     SchemaKey speed =
         number("speed", "mm/s", ValueRange::positive(), random.speed_mm_s, "print speed");

@@ -342,11 +342,11 @@ toolpath:
 }
 
 TEST_F(ScenarioErrors, GcodePrintSpeedAboveLimits) {
-  // F600 = 10 mm/s along x on line 2, above v_max 4
+  // F600 = 10 mm/s along x on line 2, above v_max 4 (feed: error; clamp slows it instead)
   write("fast.gcode", "G1 X1 Y0 E1 F120\nG1 X11 Y0 E2 F600\n");
   const auto problems = problems_of(R"(
 limits: {v_max: 4, a_max: 30}
-toolpath: {gcode: fast.gcode}
+toolpath: {gcode: {file: fast.gcode, feed: error}}
 )");
   ASSERT_EQ(problems.size(), 1u) << dump(problems);
   expect_problem(problems, (dir_ / "fast.gcode").string(), "toolpath.gcode", 2,
@@ -366,7 +366,7 @@ toolpath:
 
 TEST_F(ScenarioErrors, GcodeWithoutPrintMoves) {
   write("travel.gcode", "G0 X10 Y10\nG1 X20 Y10 F600\n");
-  const auto problems = problems_of("toolpath: {speed: 3, gcode: travel.gcode}\n");
+  const auto problems = problems_of("toolpath: {speed: 3, gcode: {file: travel.gcode, rule: e}}\n");
   ASSERT_EQ(problems.size(), 1u) << dump(problems);
   expect_problem(problems, scenario_path(), "toolpath.gcode", 1, "has no print moves");
 }
@@ -427,8 +427,9 @@ machine: scara
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(unknown.size(), 1u) << dump(unknown);
-  expect_problem(unknown, scenario_path(), "machine", 1,
-                 "unknown machine 'scara' (expected xy_stage, linear_delta, arm6, or {model:");
+  expect_problem(
+      unknown, scenario_path(), "machine", 1,
+      "unknown machine 'scara' (expected xy_stage, linear_delta, arm6, cartesian, or {model:");
   const auto missing = problems_of(R"(
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 machine: {model: models/none.xml, kinematics: xy_stage}
@@ -456,8 +457,9 @@ machine: {model: models/mine.xml, kinematics: scara}
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(unknown_family.size(), 1u) << dump(unknown_family);
-  expect_problem(unknown_family, scenario_path(), "machine.kinematics", 1,
-                 "unknown kinematics family 'scara' (expected xy_stage, linear_delta, arm6)");
+  expect_problem(
+      unknown_family, scenario_path(), "machine.kinematics", 1,
+      "unknown kinematics family 'scara' (expected xy_stage, linear_delta, arm6, cartesian)");
   const auto missing_family = problems_of(R"(
 machine: {model: models/mine.xml}
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}

@@ -34,6 +34,7 @@ std::string with_unknown_key(const std::string& path) {
   if (path == "toolpath.random_segments")
     return "toolpath: {speed: 1, random_segments: {n: 2, bed: [20, 20], length: [1, 2], zzz: "
            "1}}\n";
+  if (path == "toolpath.gcode") return "toolpath: {speed: 1, gcode: {file: a.gcode, zzz: 1}}\n";
   if (path == "toolpath.surface") return "toolpath: {speed: 1, surface: {file: a.stl, zzz: 1}}\n";
   if (path == "arm") return std::string("machine: arm6\narm: {zzz: 1}\n") + kSegments;
   return path + ": {zzz: 1}\n" + kSegments;
@@ -68,7 +69,7 @@ TEST_F(SchemaFiles, EveryAcceptedKeyIsDescribedAndViceVersa) {
     ASSERT_NE(unknown, problems.end()) << section.path << ":\n" << dump(problems);
     EXPECT_EQ(listed_keys(unknown->message), section.key_names()) << unknown->message;
   }
-  EXPECT_EQ(sections, 13);
+  EXPECT_EQ(sections, 14);
 }
 
 // a planner entry's keys: name, label, and the registry's parameters

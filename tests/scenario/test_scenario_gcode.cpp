@@ -1,0 +1,174 @@
+// `toolpath: {gcode: {file, rule, open, close, layers, feed, chord_tolerance_mm}}` (issue 14):
+// feed rates clamped to the machine's limits and counted, the start at the file's first point,
+// one error for several z levels on a machine without z, layer selection, arcs chorded.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "scenario/scenario_test_util.hpp"
+#include "scenario/schema.hpp"
+
+namespace depotwin {
+namespace {
+
+using testing_scenario::dump;
+using testing_scenario::expect_problem;
+
+class ScenarioGcode : public testing_scenario::ScenarioFiles {};
+
+// three layers of a 10 mm line, z = 0, 0.2, 0.4 (lines 2, 4, 6 start them)
+constexpr const char* kThreeLayers =
+    "G90\nG1 X0 Y0 Z0 F600\nG1 X10 Y0 E1\nG0 X0 Y0 Z0.2\nG1 X10 Y0 E2\nG0 X0 Y0 Z0.4\n"
+    "G1 X10 Y0 E3\n";
+
+// F600 = 10 mm/s: along x and along y it needs 10 mm/s of one axis (v_max 4: slowed to 4), on
+// the diagonal 7.07 mm/s of each (slowed to 4 sqrt 2); the first move, 2 mm/s, is within
+TEST_F(ScenarioGcode, FeedAboveTheLimitsIsClampedPerMoveAndCounted) {
+  write("fast.gcode", "G1 X1 Y0 E1 F120\nG1 X11 Y0 E2 F600\nG1 X11 Y10 E3\nG1 X21 Y20 E4\n");
+  const Scenario s = load_scenario(write("s.yaml", R"(
+limits: {v_max: 4, a_max: 30}
+toolpath: {gcode: fast.gcode}
+)"));
+  ASSERT_TRUE(s.gcode);
+  EXPECT_EQ(s.gcode->feed, "clamp");
+  EXPECT_EQ(s.gcode->print_moves, 4);
+  EXPECT_EQ(s.gcode->clamped_moves, 3);
+  // a speed change starts a new path at the same point
+  ASSERT_EQ(s.toolpath.paths.size(), 3u);
+  EXPECT_DOUBLE_EQ(s.toolpath.paths[0].speed_mm_s, 2.0);
+  EXPECT_DOUBLE_EQ(s.toolpath.paths[1].speed_mm_s, 4.0);
+  EXPECT_EQ(s.toolpath.paths[1].points.size(), 3u);
+  EXPECT_NEAR(s.toolpath.paths[2].speed_mm_s, 4.0 * std::sqrt(2.0), 1e-12);
+  for (std::size_t i = 0; i < s.toolpath.paths.size(); ++i)
+    EXPECT_EQ(s.toolpath.paths[i].source_index, static_cast<int>(i));
+  EXPECT_DOUBLE_EQ(s.toolpath.print_length_mm(), 1.0 + 10.0 + 10.0 + std::hypot(10.0, 10.0));
+  // the count reaches metrics.json's warnings; auto says which rule it chose
+  ASSERT_EQ(s.notes.size(), 2u);
+  EXPECT_EQ(s.notes[0].rfind("toolpath.gcode: auto chose e", 0), 0u) << s.notes[0];
+  EXPECT_EQ(s.notes[1],
+            "toolpath.gcode: 3 of 4 print moves asked for more than the machine's speed limits "
+            "and were slowed to them (feed: clamp, as firmware does; the largest cut 10 -> 4 "
+            "mm/s)");
+}
+
+// `feed: error` keeps the error, at the move's line
+TEST_F(ScenarioGcode, FeedErrorRefusesMovesAboveTheLimits) {
+  write("fast.gcode", "G1 X1 Y0 E1 F120\nG1 X11 Y0 E2 F600\n");
+  const auto problems = problems_of(R"(
+limits: {v_max: 4, a_max: 30}
+toolpath: {gcode: {file: fast.gcode, feed: error}}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, (dir_ / "fast.gcode").string(), "toolpath.gcode", 2,
+                 "print speed 10 mm/s needs 10 mm/s on x, above limits v_max 4");
+}
+
+// the start (and end) default to the file's first print point; offset moves them with it
+TEST_F(ScenarioGcode, StartDefaultsToTheFirstPointAndMovesWithTheOffset) {
+  write("far.gcode", "G0 X30 Y40\nG1 X50 Y60 F120\nG1 X60 Y60 E1\nG1 X60 Y70 E2\n");
+  const Scenario s = load_scenario(write("s.yaml", R"(
+toolpath:
+  gcode: {file: far.gcode, rule: e}
+  offset: [-50, -60]
+)"));
+  ASSERT_EQ(s.toolpath.paths.size(), 1u);
+  EXPECT_EQ(s.toolpath.paths[0].points.front(), Vec3(0, 0, 0));
+  EXPECT_EQ(s.toolpath.start_mm, Vec3(0, 0, 0));
+  EXPECT_EQ(s.toolpath.end_mm, Vec3(0, 0, 0));
+  EXPECT_TRUE(s.notes.empty());  // no auto, nothing clamped
+}
+
+// several z levels on the XY stage: one problem, at the first move off the first level
+TEST_F(ScenarioGcode, SeveralZLevelsWithoutZIsOneError) {
+  write("layers.gcode", kThreeLayers);
+  const auto problems = problems_of(R"(
+limits: {v_max: 20, a_max: 300}
+toolpath: {gcode: layers.gcode}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, (dir_ / "layers.gcode").string(), "toolpath.gcode", 5,
+                 "the file prints at 3 z levels (0 to 0.4 mm) but xy_stage has no z axis");
+}
+
+// on the cartesian machine every layer loads; `layers: [from, to]` selects some
+TEST_F(ScenarioGcode, CartesianLoadsLayersAndSelectsThem) {
+  write("layers.gcode", kThreeLayers);
+  const Scenario all = load_scenario(write("all.yaml", R"(
+machine: cartesian
+limits: {v_max: 20, a_max: 300}
+toolpath: {gcode: layers.gcode}
+)"));
+  ASSERT_EQ(all.toolpath.paths.size(), 3u);
+  EXPECT_EQ(all.toolpath.layer_count(), 3);
+  const Scenario some = load_scenario(write("some.yaml", R"(
+machine: cartesian
+limits: {v_max: 20, a_max: 300}
+toolpath: {gcode: {file: layers.gcode, layers: [1, 2]}}
+)"));
+  ASSERT_EQ(some.toolpath.paths.size(), 2u);
+  EXPECT_EQ(some.toolpath.paths[0].layer, 0);
+  EXPECT_EQ(some.toolpath.paths[1].layer, 1);
+  EXPECT_NEAR(some.toolpath.paths[0].points.front().z(), 0.2, 1e-12);
+  EXPECT_EQ(some.gcode->layer_z_mm.size(), 3u);
+  EXPECT_EQ(some.toolpath.start_mm, some.toolpath.paths[0].points.front());
+}
+
+// bad settings: each at its key and line
+TEST_F(ScenarioGcode, BadSettingsNameTheirKeys) {
+  write("layers.gcode", kThreeLayers);
+  const auto problems = problems_of(R"(
+machine: cartesian
+toolpath:
+  gcode:
+    file: layers.gcode
+    rule: sideways
+    layers: [2, 1]
+    feed: slow
+    chord_tolerance_mm: 0
+)");
+  ASSERT_EQ(problems.size(), 4u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.gcode.rule", 5,
+                 "unknown value 'sideways' (expected auto | e | shutter | feed)");
+  expect_problem(problems, scenario_path(), "toolpath.gcode.layers", 6, "from (2) is after to (1)");
+  expect_problem(problems, scenario_path(), "toolpath.gcode.feed", 7,
+                 "unknown value 'slow' (expected clamp | error)");
+  expect_problem(problems, scenario_path(), "toolpath.gcode.chord_tolerance_mm", 8,
+                 "must be in (0, 1], got 0");
+}
+
+// a G3 quarter circle of radius 10 becomes chords within the tolerance, on the circle
+TEST_F(ScenarioGcode, ArcsAreChordedWithinTheTolerance) {
+  write("arc.gcode", "G1 X10 Y0 F600\nG3 X0 Y10 I-10 J0 E1\n");
+  const Scenario s = load_scenario(write("s.yaml", R"(
+machine: cartesian
+limits: {v_max: 50, a_max: 500}
+toolpath: {gcode: {file: arc.gcode, chord_tolerance_mm: 0.01}}
+)"));
+  ASSERT_EQ(s.toolpath.paths.size(), 1u);
+  const PrintPath& path = s.toolpath.paths[0];
+  EXPECT_FALSE(path.has_arcs());
+  // 10 (1 - cos(theta / 2)) <= 0.01 needs at least 18 chords over 90 degrees
+  EXPECT_GE(path.points.size(), 19u);
+  for (std::size_t k = 0; k < path.points.size(); ++k)
+    EXPECT_NEAR(path.points[k].head<2>().norm(), 10.0, 1e-9) << k;
+  for (std::size_t k = 0; k + 1 < path.points.size(); ++k) {
+    const double chord_mm = (path.points[k + 1] - path.points[k]).norm();
+    EXPECT_LE(10.0 - std::sqrt(100.0 - chord_mm * chord_mm / 4.0), 0.01 + 1e-12) << k;
+  }
+  EXPECT_EQ(s.gcode->print_moves, 1);
+  EXPECT_EQ(s.gcode->rule_applied, "e");
+}
+
+// describe shows the keys (the same tables the loader checks)
+TEST(ScenarioGcodeSchema, TheTablesHoldTheGcodeKeys) {
+  const SchemaSection& section = schema_section("toolpath.gcode");
+  EXPECT_EQ(section.key_names(),
+            (std::vector<std::string>{"file", "rule", "open", "close", "layers", "feed",
+                                      "chord_tolerance_mm"}));
+  EXPECT_EQ(section.key("chord_tolerance_mm").default_text, "0.01");
+  EXPECT_EQ(section.key("feed").default_text, "clamp");
+  EXPECT_EQ(section.key("rule").default_text, "auto");
+}
+
+}  // namespace
+}  // namespace depotwin
