@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "planners/motion/bezier/bezier.hpp"
 #include "planners/motion/conformal.hpp"
+#include "planners/motion/firmware.hpp"
 #include "planners/motion/lspb_mtt.hpp"
 #include "planners/motion/stop_and_go.hpp"
 #include "planners/planner.hpp"
@@ -40,6 +41,11 @@ const std::vector<PlannerInfo>& planner_registry() {
        "Shembekar et al. 2018: conformal paths flown by with zone blends, time-optimal under TCP "
        "and joint limits (TOPP-RA), speed and flow control",
        conformal_parameters(), [](const PlannerSpec& spec) { return make_conformal_planner(spec); },
+       false},
+      {"firmware",
+       "the printer's own firmware as baseline: Marlin (junction deviation) or Klipper "
+       "(square-corner velocity) trapezoidal look-ahead, material on while printing",
+       firmware_parameters(), [](const PlannerSpec& spec) { return make_firmware_planner(spec); },
        false},
   };
   return registry;

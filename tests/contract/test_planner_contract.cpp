@@ -184,6 +184,23 @@ std::vector<std::string> registered_names() {
 INSTANTIATE_TEST_SUITE_P(EveryPlanner, PlannerContract, ::testing::ValuesIn(registered_names()),
                          [](const auto& info) { return info.param; });
 
+// The firmware baseline's other look-ahead (Klipper: square-corner velocity, minimum cruise
+// ratio, the short-move centripetal cap) keeps the same contract on the same toolpaths.
+TEST(PlannerContractModes, FirmwareKlipperMode) {
+  const auto planner = make_planner(PlannerSpec{"firmware", {}, 0, {{"mode", "klipper"}}});
+  for (std::uint64_t seed = 1; seed <= 25; ++seed) {
+    SCOPED_TRACE(testing::Message() << "seed " << seed);
+    const Toolpath toolpath = testing_support::random_toolpath(seed, 3.0);
+    const MachineLimits limits = MachineLimits::uniform(4.0, 30.0);
+    testing_support::expect_contract(planner->plan(toolpath, limits), toolpath, limits);
+    const Toolpath toolpath_3d = testing_support::random_toolpath_3d(seed, 3.0);
+    const Trajectory plan_3d = planner->plan(toolpath_3d, limits);
+    testing_support::expect_contract(plan_3d, toolpath_3d, limits);
+    testing_support::expect_tool_axis_contract(plan_3d, toolpath_3d);
+    if (HasFatalFailure()) return;
+  }
+}
+
 TEST(PlannerRegistry, UnknownNamesAndParametersAreRejected) {
   EXPECT_NE(check_planner_spec({"warp_drive", {}, 0}).find("unknown planner"), std::string::npos);
   EXPECT_NE(check_planner_spec({"lspb_mtt", {{"delta", {0.3}}}, 0}).find("no parameter 'delta'"),

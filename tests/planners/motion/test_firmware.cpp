@@ -1,0 +1,210 @@
+// The firmware baseline planner against closed forms: Marlin's junction deviation speed,
+// Klipper's square-corner conversion and minimum cruise ratio, collinear joints at full
+// speed, reversals at rest, reachable junction speeds and a single trapezoid's time.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "contract/planner_checks.hpp"
+#include "core/error.hpp"
+#include "planners/motion/firmware.hpp"
+
+namespace depotwin {
+namespace {
+
+// one polyline printed at `speed`, starting and ending where the job does (no travels)
+Toolpath polyline(const std::vector<Vec3>& points, double speed) {
+  Toolpath toolpath;
+  PrintPath path;
+  path.points = points;
+  path.speed_mm_s = speed;
+  toolpath.paths.push_back(path);
+  toolpath.start_mm = points.front();
+  toolpath.end_mm = points.back();
+  return toolpath;
+}
+
+Trajectory plan_with(const PlannerSpec& spec, const Toolpath& toolpath,
+                     const MachineLimits& limits) {
+  return make_planner(spec)->plan(toolpath, limits);
+}
+
+FirmwareMove move_along(const Vec3& direction, double length, double accel, double speed) {
+  FirmwareMove move;
+  move.direction = direction.normalized();
+  move.length_mm = length;
+  move.accel_mm_s2 = accel;
+  move.cruise_speed_mm_s = speed;
+  move.blend_accel_mm_s2 = Vec3(accel, accel, accel);
+  return move;
+}
+
+TEST(Firmware, NinetyDegreeJunctionSpeedIsMarlinsFormula) {
+  // theta = 90 deg: v^2 = a jd sin 45 / (1 - sin 45)
+  const double a = 1000.0, jd = 0.013, s = std::sqrt(0.5);
+  const double expected2 = a * jd * s / (1 - s);  // 31.38 (mm/s)^2
+  EXPECT_NEAR(junction_speed_squared(Vec3::UnitX(), Vec3::UnitY(), a, jd), expected2, 1e-12);
+  // the planner takes the corner of a long L at that speed: the velocity there before the
+  // blend turns it is sqrt(expected2) along x
+  const Toolpath toolpath = polyline({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const Trajectory plan = plan_with({"firmware", {}, 0}, toolpath, MachineLimits::uniform(100, a));
+  ASSERT_EQ(plan.pieces().size(), 2u);
+  const double v = std::sqrt(expected2), tau = v / a;  // max_i |dv_i| / a_i = v / a
+  const TrajectorySample before = plan.at(plan.pieces()[0].t_end_s - 0.5 * tau - 1e-9);
+  EXPECT_NEAR(before.velocity_mm_s.x(), v, 1e-5);
+  EXPECT_NEAR(before.velocity_mm_s.y(), 0.0, 1e-9);
+  const TrajectorySample after = plan.at(plan.pieces()[1].t_begin_s + 0.5 * tau + 1e-9);
+  EXPECT_NEAR(after.velocity_mm_s.x(), 0.0, 1e-9);
+  EXPECT_NEAR(after.velocity_mm_s.y(), v, 1e-5);
+  // the blend cuts the corner by |dv| tau / 8 = sqrt(2) v tau / 8, less than jd
+  double nearest = 1e300;
+  for (double t = 0; t < plan.duration_s(); t += 1e-5)
+    nearest = std::min(nearest, (plan.at(t).position_mm - Vec3(20, 0, 0)).norm());
+  EXPECT_NEAR(nearest, std::sqrt(2.0) * v * tau / 8, 1e-6);
+  EXPECT_LT(nearest, jd);
+}
+
+TEST(Firmware, KlipperSquareCornerVelocityIsTheNinetyDegreeSpeed) {
+  // jd = scv^2 (sqrt 2 - 1) / accel
+  EXPECT_NEAR(klipper_junction_deviation(5.0, 1000.0), 25.0 * (std::sqrt(2.0) - 1) / 1000.0, 1e-15);
+  FirmwareSettings klipper;
+  klipper.mode = FirmwareMode::klipper;
+  klipper.minimum_cruise_ratio = 0.0;
+  const std::vector<FirmwareMove> moves{move_along(Vec3::UnitX(), 20, 1000, 50),
+                                        move_along(Vec3::UnitY(), 20, 1000, 50)};
+  const FirmwareProfile profile =
+      firmware_lookahead(moves, klipper, klipper_junction_deviation(5.0, 1000.0));
+  EXPECT_NEAR(profile.junction_speed_mm_s[1], 5.0, 1e-12);
+  // through the planner, square_corner_velocity 7 at max_accel 1000: the corner at 7 mm/s
+  const Toolpath toolpath = polyline({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const PlannerSpec spec{"firmware",
+                         {{"square_corner_velocity", {7.0}}, {"minimum_cruise_ratio", {0.0}}},
+                         0,
+                         {{"mode", "klipper"}}};
+  const Trajectory plan = plan_with(spec, toolpath, MachineLimits::uniform(100, 1000));
+  const TrajectorySample before = plan.at(plan.pieces()[0].t_end_s - 0.5 * 7.0 / 1000 - 1e-9);
+  EXPECT_NEAR(before.velocity_mm_s.x(), 7.0, 1e-5);
+}
+
+TEST(Firmware, CollinearMovesNeverSlowAtTheJoints) {
+  // 30 mm in three collinear moves at 50 mm/s, a = 1000: one trapezoid, d / v + v / a
+  const Toolpath toolpath = polyline({{0, 0, 0}, {10, 0, 0}, {17, 0, 0}, {30, 0, 0}}, 50.0);
+  for (const char* mode : {"marlin", "klipper"}) {
+    SCOPED_TRACE(mode);
+    const Trajectory plan = plan_with({"firmware", {}, 0, {{"mode", mode}}}, toolpath,
+                                      MachineLimits::uniform(100, 1000));
+    EXPECT_NEAR(plan.duration_s(), 30.0 / 50.0 + 50.0 / 1000.0, 1e-12);
+    for (size_t k = 1; k < plan.pieces().size(); ++k)
+      EXPECT_NEAR(plan.at(plan.pieces()[k].t_begin_s).velocity_mm_s.x(), 50.0, 1e-9);
+  }
+}
+
+TEST(Firmware, AReversalStops) {
+  EXPECT_EQ(junction_speed_squared(Vec3::UnitX(), -Vec3::UnitX(), 1000, 0.013), 0.0);
+  const Toolpath toolpath = polyline({{0, 0, 0}, {10, 0, 0}, {0, 0, 0}}, 50.0);
+  const Trajectory plan =
+      plan_with({"firmware", {}, 0}, toolpath, MachineLimits::uniform(100, 1000));
+  ASSERT_EQ(plan.pieces().size(), 2u);
+  EXPECT_NEAR(plan.at(plan.pieces()[1].t_begin_s).velocity_mm_s.norm(), 0.0, 1e-12);
+  // two rest-to-rest trapezoids of 10 mm
+  EXPECT_NEAR(plan.duration_s(), 2 * (10.0 / 50.0 + 50.0 / 1000.0), 1e-12);
+}
+
+TEST(Firmware, JunctionSpeedsAreReachableFromNeighbours) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> heading(0, 2 * kPi), length(0.05, 5.0);
+  std::vector<FirmwareMove> moves;
+  for (int k = 0; k < 200; ++k) {
+    const double h = heading(rng);
+    moves.push_back(move_along(Vec3(std::cos(h), std::sin(h), 0), length(rng), 1500, 80));
+  }
+  for (const FirmwareMode mode : {FirmwareMode::marlin, FirmwareMode::klipper}) {
+    FirmwareSettings settings;
+    settings.mode = mode;
+    const FirmwareProfile profile = firmware_lookahead(moves, settings, 0.05);
+    const auto& v = profile.junction_speed_mm_s;
+    EXPECT_EQ(v.front(), 0.0);
+    EXPECT_EQ(v.back(), 0.0);
+    for (size_t k = 0; k < moves.size(); ++k) {
+      // v_{k+1}^2 <= v_k^2 + 2 a d and back, and within the cruise speed
+      const double reach = 2 * moves[k].accel_mm_s2 * moves[k].length_mm;
+      EXPECT_LE(v[k + 1] * v[k + 1], v[k] * v[k] + reach + 1e-9) << "move " << k;
+      EXPECT_LE(v[k] * v[k], v[k + 1] * v[k + 1] + reach + 1e-9) << "move " << k;
+      EXPECT_LE(v[k], profile.cruise_speed_mm_s[k] + 1e-12);
+      if (k > 0) {
+        const double jd2 =
+            junction_speed_squared(moves[k - 1].direction, moves[k].direction, 1500, 0.05);
+        EXPECT_LE(v[k] * v[k], jd2 + 1e-9) << "junction " << k;
+      }
+    }
+  }
+}
+
+TEST(Firmware, SingleTrapezoidTime) {
+  const MachineLimits limits = MachineLimits::uniform(100, 1000);
+  // trapezoid: d / v + v / a
+  EXPECT_NEAR(
+      plan_with({"firmware", {}, 0}, polyline({{0, 0, 0}, {10, 0, 0}}, 50), limits).duration_s(),
+      10.0 / 50 + 50.0 / 1000, 1e-12);
+  // triangle: 2 sqrt(d / a)
+  EXPECT_NEAR(
+      plan_with({"firmware", {}, 0}, polyline({{0, 0, 0}, {1, 0, 0}}, 50), limits).duration_s(),
+      2 * std::sqrt(1.0 / 1000), 1e-12);
+  // along a diagonal the move's acceleration is a / |u_y| (no axis beyond a): 3-4-5
+  EXPECT_NEAR(
+      plan_with({"firmware", {}, 0}, polyline({{0, 0, 0}, {3, 4, 0}}, 50), limits).duration_s(),
+      5.0 / 50 + 50.0 / (1000 / 0.8), 1e-12);
+  // Klipper's minimum_cruise_ratio 0.5: a 1.5 mm move cruises 0.75 mm (its docs' example) at
+  // sqrt(a d / 2)
+  const Trajectory klipper = plan_with({"firmware", {}, 0, {{"mode", "klipper"}}},
+                                       polyline({{0, 0, 0}, {1.5, 0, 0}}, 50), limits);
+  const double peak = std::sqrt(1000 * 1.5 / 2);
+  EXPECT_NEAR(klipper.duration_s(), 2 * peak / 1000 + 0.75 / peak, 1e-12);
+  // the older max_accel_to_decel = 500 at max_accel 1000 is the same ratio
+  const Trajectory older =
+      plan_with({"firmware", {{"max_accel_to_decel", {500.0}}}, 0, {{"mode", "klipper"}}},
+                polyline({{0, 0, 0}, {1.5, 0, 0}}, 50), limits);
+  EXPECT_NEAR(older.duration_s(), klipper.duration_s(), 1e-12);
+  // max_velocity and max_accel cap the limits' own
+  EXPECT_NEAR(plan_with({"firmware", {{"max_velocity", {20.0}}, {"max_accel", {400.0}}}, 0},
+                        polyline({{0, 0, 0}, {10, 0, 0}}, 50), limits)
+                  .duration_s(),
+              10.0 / 20 + 20.0 / 400, 1e-12);
+}
+
+TEST(Firmware, ZigZagKeepsTheContract) {
+  // a 0.4 mm-pitch infill zig-zag: blends at every corner, material on throughout
+  std::vector<Vec3> points;
+  for (int i = 0; i < 20; ++i) {
+    const double x0 = i % 2 == 0 ? 0.0 : 10.0;
+    points.emplace_back(x0, 0.4 * i, 0);
+    points.emplace_back(10.0 - x0, 0.4 * i, 0);
+  }
+  const Toolpath toolpath = polyline(points, 40);
+  const MachineLimits limits = MachineLimits::uniform(100, 1500);
+  for (const char* mode : {"marlin", "klipper"}) {
+    SCOPED_TRACE(mode);
+    const Trajectory plan = plan_with({"firmware", {}, 0, {{"mode", mode}}}, toolpath, limits);
+    testing_support::expect_contract(plan, toolpath, limits);
+    for (const TrajectoryPiece& piece : plan.pieces()) EXPECT_TRUE(piece.depositing);
+  }
+}
+
+TEST(Firmware, ParametersOfTheOtherFirmwareAreRefused) {
+  EXPECT_EQ(check_planner_spec({"firmware", {{"junction_deviation_mm", {0.02}}}, 0}), "");
+  EXPECT_NE(check_planner_spec({"firmware", {}, 0, {{"mode", "grbl"}}}).find("marlin | klipper"),
+            std::string::npos);
+  EXPECT_THROW(make_planner({"firmware", {{"square_corner_velocity", {5.0}}}, 0}), InputError);
+  EXPECT_THROW(
+      make_planner({"firmware", {{"junction_deviation_mm", {0.02}}}, 0, {{"mode", "klipper"}}}),
+      InputError);
+  EXPECT_THROW(make_planner({"firmware",
+                             {{"minimum_cruise_ratio", {0.3}}, {"max_accel_to_decel", {500.0}}},
+                             0,
+                             {{"mode", "klipper"}}}),
+               InputError);
+}
+
+}  // namespace
+}  // namespace depotwin
