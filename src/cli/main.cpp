@@ -6,6 +6,8 @@
 #include <string>
 
 #include "cli/describe.hpp"
+#include "cli/export_verb.hpp"  // export
+#include "cli/inspect.hpp"      // inspect
 #include "cli/move_verb.hpp"
 #include "cli/verbs.hpp"
 #include "core/error.hpp"
@@ -139,6 +141,42 @@ int main(int argc, char** argv) {
   describe->add_flag("--json", describe_as_json, "print JSON instead of tables");
   // ---- end describe ----
 
+  // ---- export (the planned motion as G-code: src/cli/export_verb.cpp) ----
+  ExportOptions export_options;
+  CLI::App* export_gcode = app.add_subcommand(
+      "export", "plan a scenario with one planner and write its motion as G-code");
+  export_gcode->add_option("scenario", export_options.scenario, "scenario YAML file")->required();
+  export_gcode->add_option("--planner", export_options.planner,
+                           "the planner (run label) to export (default: the scenario's only one)");
+  export_gcode->add_option("--out", export_options.out, "the G-code file to write")->required();
+  export_gcode
+      ->add_option("--tolerance", export_options.settings.chord_tolerance_mm,
+                   "every planned point within this of the written lines, mm (default 0.005)")
+      ->check(CLI::PositiveNumber);
+  export_gcode
+      ->add_option("--filament-diameter", export_options.settings.filament_diameter_mm,
+                   "extrusion: E is filament length of this diameter, mm (default 1.75)")
+      ->check(CLI::PositiveNumber);
+  export_gcode->add_option("--open", export_options.settings.open_code,
+                           "aerosol: the shutter-open code (default M3)");
+  export_gcode->add_option("--close", export_options.settings.close_code,
+                           "aerosol: the shutter-close code (default M5)");
+  // ---- end export ----
+
+  // ---- inspect (facts of a G-code file: src/cli/inspect.cpp) ----
+  std::string inspect_file, inspect_rule = "auto";
+  GcodeOptions inspect_options;
+  CLI::App* inspect = app.add_subcommand(
+      "inspect", "facts of a G-code file as JSON: moves, lengths, layers, boxes, arcs, time");
+  inspect->add_option("file", inspect_file, "G-code file")->required();
+  inspect->add_option("--rule", inspect_rule, "print rule: auto, e, shutter or feed (default auto)")
+      ->check(CLI::IsMember({"auto", "e", "shutter", "feed"}));
+  inspect->add_option("--open", inspect_options.open_code,
+                      "shutter rule: the code that opens (default M3)");
+  inspect->add_option("--close", inspect_options.close_code,
+                      "shutter rule: the code that closes (default M5)");
+  // ---- end inspect ----
+
   // positions give the axes, one value each; a velocity or limit list has one value per
   // axis, or one value for every axis
   std::string q0, q1, v0, v1, vmax, amax, jmax;
@@ -179,6 +217,13 @@ int main(int argc, char** argv) {
     if (*validate) return validate_verb(validate_scenario);
     if (*view) return view_verb(view_options);                              // view
     if (*describe) return describe_verb(describe_topic, describe_as_json);  // describe
+    if (*export_gcode) return export_verb(export_options);                  // export
+    // inspect
+    if (*inspect) {
+      inspect_options.rule = *print_rule_from_name(inspect_rule);
+      inspect_gcode_file(inspect_file, inspect_options);
+      return kExitOk;
+    }
     if (*move) {
       MoveRequest request;
       request.q0 = parse_number_list(q0, "--q0");

@@ -1,0 +1,340 @@
+#include "cli/export_verb.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/file_io.hpp"
+#include "pipeline/job.hpp"
+
+#ifndef DEPOTWIN_VERSION
+#define DEPOTWIN_VERSION "unknown"
+#endif
+
+namespace depotwin {
+
+const char* depotwin_version() {
+  return DEPOTWIN_VERSION;
+}
+
+namespace {
+
+constexpr double kMinMove_mm = 1e-9;  // shorter displacements are no move (the importer's rule)
+constexpr double kMinWrittenMove_mm =
+    1e-3;  // a speed run is at least this long (10 digits of 1e-4)
+
+// a number with at most `decimals` decimals, trailing zeros dropped, never "-0"
+std::string number_text(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  std::string text = buffer;
+  if (text.find('.') != std::string::npos) {
+    while (text.back() == '0') text.pop_back();
+    if (text.back() == '.') text.pop_back();
+  }
+  if (text == "-0") text = "0";
+  return text;
+}
+
+// one piece sampled at the export's period: times (local), positions, speeds, and the
+// cumulative commanded volume (extrusion) from the piece's start
+struct PieceSamples {
+  std::vector<double> t_s;
+  std::vector<Vec3> position_mm;
+  std::vector<double> speed_mm_s;
+  std::vector<double> volume_mm3;
+};
+
+PieceSamples sample_piece(const TrajectoryPiece& piece, double period_s,
+                          double nominal_flow_mm3_s) {
+  PieceSamples samples;
+  const double duration_s = piece.t_end_s - piece.t_begin_s;
+  const size_t steps = std::max<size_t>(1, static_cast<size_t>(std::ceil(duration_s / period_s)));
+  for (size_t k = 0; k <= steps; ++k) {
+    const double tau = std::min(duration_s, static_cast<double>(k) * period_s);
+    Vec3 position, velocity, acceleration;
+    evaluate_motion(piece, tau, position, velocity, acceleration);
+    const double flow = evaluate_flow_fraction(piece, tau) * nominal_flow_mm3_s;
+    // the commanded volume by the trapezoid rule between samples
+    double volume = 0.0;
+    if (k > 0)
+      volume = samples.volume_mm3.back() +
+               0.5 *
+                   (flow + evaluate_flow_fraction(piece, samples.t_s.back()) * nominal_flow_mm3_s) *
+                   (tau - samples.t_s.back());
+    samples.t_s.push_back(tau);
+    samples.position_mm.push_back(position);
+    samples.speed_mm_s.push_back(velocity.norm());
+    samples.volume_mm3.push_back(volume);
+  }
+  return samples;
+}
+
+// distance from p to the segment a-b
+double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double length2 = ab.squaredNorm();
+  if (length2 <= 0.0) return (p - a).norm();
+  const double u = std::clamp((p - a).dot(ab) / length2, 0.0, 1.0);
+  return (p - (a + u * ab)).norm();
+}
+
+// Douglas-Peucker over samples [first, last]: the kept indices (first and last included), so
+// every sample between two kept ones lies within tolerance of their chord
+std::vector<size_t> simplify(const std::vector<Vec3>& points, size_t first, size_t last,
+                             double tolerance_mm) {
+  std::vector<bool> keep(last - first + 1, false);
+  keep.front() = keep.back() = true;
+  std::vector<std::pair<size_t, size_t>> stack{{first, last}};
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    double farthest_mm = -1.0;
+    size_t farthest = a;
+    for (size_t i = a + 1; i < b; ++i) {
+      const double d = distance_to_segment(points[i], points[a], points[b]);
+      if (d > farthest_mm) farthest_mm = d, farthest = i;
+    }
+    if (farthest_mm > tolerance_mm) {
+      keep[farthest - first] = true;
+      stack.push_back({a, farthest});
+      stack.push_back({farthest, b});
+    }
+  }
+  std::vector<size_t> kept;
+  for (size_t i = first; i <= last; ++i)
+    if (keep[i - first]) kept.push_back(i);
+  return kept;
+}
+
+// The G-code lines, with the modal position and feed rate written only when they change.
+class GcodeWriter {
+ public:
+  explicit GcodeWriter(bool extrusion) : extrusion_(extrusion) {}
+
+  void line(const std::string& text) { body_ << text << '\n'; }
+
+  // G0 or G1 to `to` at `feed_mm_min` (<= 0: no F), with an E increment when e_mm > 0
+  void move(const char* code, const Vec3& to, double feed_mm_min, double e_mm) {
+    std::string text = code;
+    const char* axis_names[3] = {" X", " Y", " Z"};
+    for (int axis = 0; axis < 3; ++axis) {
+      const std::string value = number_text(to[axis], 4);
+      if (value != axis_text_[axis]) text += axis_names[axis] + value, axis_text_[axis] = value;
+    }
+    // E with at least 3 significant digits (a slow ramp's moves carry very little), so a
+    // print move never reads as E0
+    if (extrusion_ && e_mm > 0.0) {
+      int decimals = 5;
+      while (decimals < 10 && e_mm < std::pow(10.0, 2 - decimals)) ++decimals;
+      text += " E" + number_text(e_mm, decimals);
+    }
+    if (feed_mm_min > 0.0) {
+      int decimals = 1;
+      while (decimals < 4 && feed_mm_min < std::pow(10.0, 2 - decimals)) ++decimals;
+      const std::string feed = number_text(feed_mm_min, decimals);
+      if (feed != feed_text_) text += " F" + feed, feed_text_ = feed;
+    }
+    body_ << text << '\n';
+  }
+
+  // whether a move to `to` changes the written position (4 decimals)
+  bool changes_position(const Vec3& to) const {
+    for (int axis = 0; axis < 3; ++axis)
+      if (number_text(to[axis], 4) != axis_text_[axis]) return true;
+    return false;
+  }
+
+  std::string text() const { return body_.str(); }
+
+ private:
+  bool extrusion_;
+  std::ostringstream body_;
+  std::string axis_text_[3];
+  std::string feed_text_;
+};
+
+}  // namespace
+
+std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob& job,
+                             const GcodeExportSettings& settings) {
+  const bool extrusion = job.process == "extrusion";
+  const double filament_area_mm2 =
+      kPi * 0.25 * settings.filament_diameter_mm * settings.filament_diameter_mm;
+  GcodeWriter gcode(extrusion);
+  size_t print_moves = 0;
+  double print_length_mm = 0.0, e_total_mm = 0.0;
+  bool open = false;  // aerosol: the shutter code last written
+
+  // the job's start, at rest
+  if (!trajectory.pieces().empty()) {
+    Vec3 start, velocity, acceleration;
+    evaluate_motion(trajectory.pieces().front(), 0.0, start, velocity, acceleration);
+    gcode.move("G0", start, 0.0, 0.0);
+  }
+  for (const TrajectoryPiece& piece : trajectory.pieces()) {
+    const double duration_s = piece.t_end_s - piece.t_begin_s;
+    if (duration_s <= 0.0) continue;
+    const double nominal_flow_mm3_s =
+        !extrusion             ? 0.0
+        : job.flow_mm3_s > 0.0 ? job.flow_mm3_s
+                               : piece.desired_speed_mm_s * job.bead_width_mm * job.layer_height_mm;
+    const PieceSamples samples = sample_piece(piece, settings.sample_period_s, nominal_flow_mm3_s);
+    const size_t last = samples.t_s.size() - 1;
+
+    // a transition: one travel to its end, at the feed rate of its planned time
+    if (!piece.depositing) {
+      if (open) gcode.line(settings.close_code + " ; shutter closed"), open = false;
+      double travel_mm = 0.0;
+      for (size_t k = 1; k <= last; ++k)
+        travel_mm += (samples.position_mm[k] - samples.position_mm[k - 1]).norm();
+      if ((samples.position_mm[last] - samples.position_mm[0]).norm() > kMinMove_mm)
+        gcode.move("G0", samples.position_mm[last], 60.0 * travel_mm / duration_s, 0.0);
+      else
+        gcode.line("G4 P" + number_text(1000.0 * duration_s, 0) + " ; planned pause");
+      continue;
+    }
+    if (!extrusion && !open) gcode.line(settings.open_code + " ; shutter open"), open = true;
+
+    // runs of nearly constant speed, each simplified within the chord tolerance
+    const double band_mm_s =
+        settings.speed_tolerance *
+        (piece.desired_speed_mm_s > 0.0
+             ? piece.desired_speed_mm_s
+             : *std::max_element(samples.speed_mm_s.begin(), samples.speed_mm_s.end()));
+    size_t written = 0;  // the sample the last written move ended at
+    double pending_dwell_s = 0.0;
+    size_t run_first = 0;
+    while (run_first < last) {
+      // a run: the speed within the band, or too short yet to be a move of its own
+      size_t run_last = run_first + 1;
+      double low = std::min(samples.speed_mm_s[run_first], samples.speed_mm_s[run_last]);
+      double high = std::max(samples.speed_mm_s[run_first], samples.speed_mm_s[run_last]);
+      while (run_last < last) {
+        const double next = samples.speed_mm_s[run_last + 1];
+        const bool short_run =
+            (samples.position_mm[run_last] - samples.position_mm[run_first]).norm() <
+            kMinWrittenMove_mm;
+        if (!short_run && std::max(high, next) - std::min(low, next) > band_mm_s) break;
+        low = std::min(low, next), high = std::max(high, next), ++run_last;
+      }
+      for (const size_t to :
+           simplify(samples.position_mm, run_first, run_last, settings.chord_tolerance_mm)) {
+        if (to == written) continue;
+        const double length_mm = (samples.position_mm[to] - samples.position_mm[written]).norm();
+        const double move_s = samples.t_s[to] - samples.t_s[written];
+        // the nozzle at rest: a dwell; its material goes with the next move
+        if (length_mm <= kMinMove_mm) {
+          pending_dwell_s += move_s;
+          continue;
+        }
+        // a move the written digits cannot show waits for the next point
+        if (!gcode.changes_position(samples.position_mm[to])) continue;
+        if (pending_dwell_s >= 0.0005)
+          gcode.line("G4 P" + number_text(1000.0 * pending_dwell_s, 0) + " ; planned dwell");
+        pending_dwell_s = 0.0;
+        const double e_mm =
+            (samples.volume_mm3[to] - samples.volume_mm3[written]) / filament_area_mm2;
+        gcode.move("G1", samples.position_mm[to], 60.0 * length_mm / move_s, e_mm);
+        written = to;
+        ++print_moves;
+        print_length_mm += length_mm;
+        e_total_mm += e_mm;
+      }
+      run_first = run_last;
+    }
+  }
+  if (open) gcode.line(settings.close_code + " ; shutter closed");
+
+  // the header: what was exported, from what, and the conventions
+  std::ostringstream header;
+  header << "; G-code exported by depotwin " << depotwin_version() << '\n'
+         << "; scenario: " << job.scenario_name << " (" << job.scenario_file << ")\n"
+         << "; planner: " << job.planner << '\n'
+         << "; machine: " << job.machine << '\n';
+  if (extrusion)
+    header << "; process: extrusion, M83 relative E in mm of "
+           << number_text(settings.filament_diameter_mm, 3)
+           << " mm filament (E = commanded volume / filament area)\n";
+  else
+    header << "; process: aerosol, shutter " << settings.open_code << " open / "
+           << settings.close_code << " closed\n";
+  header << "; planned duration: " << number_text(trajectory.duration_s(), 3) << " s, "
+         << print_moves << " print moves, print length " << number_text(print_length_mm, 3)
+         << " mm";
+  if (extrusion) header << ", E total " << number_text(e_total_mm, 3) << " mm";
+  header << '\n'
+         << "; every planned sample within " << number_text(settings.chord_tolerance_mm, 4)
+         << " mm of these lines; F = each move's planned average speed\n"
+         << "G21 ; millimetres\n"
+         << "G90 ; absolute positions\n";
+  if (extrusion) header << "M83 ; relative extrusion\n";
+  return header.str() + gcode.text() + "; end of job\n";
+}
+
+namespace {
+
+// --out must name a file in an existing, writable directory; checked before any planning
+void check_out_path(const std::string& out) {
+  namespace fs = std::filesystem;
+  if (out.empty()) throw InputError("--out", "a G-code file to write is required");
+  std::error_code error;
+  if (fs::is_directory(out, error))
+    throw InputError("--out",
+                     "'" + out + "' is a directory; name a file, e.g. " + out + "/job.gcode");
+  const fs::path parent =
+      fs::path(out).parent_path().empty() ? fs::path(".") : fs::path(out).parent_path();
+  if (!fs::is_directory(parent, error))
+    throw InputError("--out", "'" + parent.string() + "' is not a directory (for '" + out + "')");
+  if (access(parent.c_str(), W_OK) != 0)
+    throw InputError("--out", "cannot write in '" + parent.string() + "' (for '" + out + "')");
+}
+
+}  // namespace
+
+int export_verb(const ExportOptions& options) {
+  check_out_path(options.out);
+  const Scenario scenario = load_scenario(options.scenario);
+  // 3-axis G-code has no tool axis: a conformal job's tilts would be lost silently
+  bool tilted = scenario.surface != nullptr;
+  for (const PrintPath& path : scenario.toolpath.paths) tilted = tilted || !path.normals.empty();
+  if (tilted)
+    throw InputError(scenario.file, scenario.toolpath_line, "toolpath",
+                     "export writes 3-axis G-code, which cannot carry the tilted tool axis of a "
+                     "conformal toolpath");
+  const std::vector<PlannerSpec> planners = select_planners(scenario, options.planner);
+  if (planners.size() != 1) {
+    std::string labels;
+    for (const PlannerSpec& spec : planners)
+      labels += (labels.empty() ? "" : ", ") + spec.run_label();
+    throw InputError("--planner", "export writes one planner's motion; choose one of " + labels);
+  }
+  const PreparedJob job = prepare_job(scenario);
+  const PlannedRun planned = plan_job(job, planners.front());
+
+  GcodeExportJob export_job;
+  export_job.scenario_name = scenario.name;
+  export_job.scenario_file = scenario.file;
+  export_job.planner = planners.front().run_label();
+  export_job.machine = job.machine->name();
+  export_job.process = scenario.process.type;
+  export_job.flow_mm3_s = scenario.process.flow_mm3_s;
+  export_job.bead_width_mm = scenario.process.bead_width_mm;
+  export_job.layer_height_mm = scenario.process.layer_height_mm;
+  write_file_atomically(options.out,
+                        trajectory_gcode(planned.trajectory, export_job, options.settings));
+  std::cout << "scenario " << scenario.name << ", planner " << export_job.planner << ": "
+            << number_text(planned.trajectory.duration_s(), 3) << " s of planned motion written to "
+            << options.out << '\n';
+  return kExitOk;
+}
+
+}  // namespace depotwin

@@ -1,0 +1,256 @@
+// `depotwin export`: the planned motion as G-code. Exact lines for a hand-made trajectory, the
+// export -> import round trip on every shipped planar scenario, and the verb's refusals.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "cli/export_verb.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/pipeline_test_util.hpp"
+#include "toolpath/gcode.hpp"
+
+namespace depotwin {
+namespace {
+
+using testing_support::depotwin;
+using testing_support::fresh_directory;
+using testing_support::read_text;
+using testing_support::scenario_path;
+
+// one depositing piece: (0,0,0) to (2,0,0) at a constant 2 mm/s, sampled every 1 ms
+Trajectory straight_line_trajectory() {
+  SampledMotion motion;
+  for (int k = 0; k <= 1000; ++k) {
+    motion.position_mm.push_back(Vec3(0.002 * k, 0.0, 0.0));
+    motion.velocity_mm_s.push_back(Vec3(2.0, 0.0, 0.0));
+  }
+  TrajectoryPiece piece;
+  piece.t_end_s = 1.0;
+  piece.path_index = 0;
+  piece.depositing = true;
+  piece.desired_speed_mm_s = 2.0;
+  piece.motion = motion;
+  return Trajectory("hand", {piece});
+}
+
+// the lines after the header (from the first G0), comments after ';' kept
+std::string body(const std::string& gcode) {
+  return gcode.substr(gcode.find("G0 "));
+}
+
+// extrusion: one G1 with F = 2 mm/s x 60 and E = 0.4 x 0.2 x 2 / (pi 0.875^2) = 0.066520 mm
+TEST(ExportGcode, ExtrusionLineHasFeedAndFilamentE) {
+  GcodeExportJob job;
+  job.scenario_name = "hand";
+  job.planner = "hand";
+  job.machine = "xy_stage";
+  job.process = "extrusion";
+  const std::string gcode = trajectory_gcode(straight_line_trajectory(), job, {});
+  EXPECT_EQ(body(gcode), "G0 X0 Y0 Z0\nG1 X2 E0.06652 F120\n; end of job\n") << gcode;
+  EXPECT_NE(gcode.find("G21 ; millimetres\nG90 ; absolute positions\nM83 ; relative extrusion\n"),
+            std::string::npos)
+      << gcode;
+  EXPECT_NE(gcode.find("; G-code exported by depotwin 0.1.0\n"), std::string::npos) << gcode;
+}
+
+// aerosol: the shutter codes around the print move, no E; the codes are configurable
+TEST(ExportGcode, AerosolLineIsBetweenShutterCodes) {
+  GcodeExportJob job;
+  job.process = "aerosol";
+  EXPECT_EQ(body(trajectory_gcode(straight_line_trajectory(), job, {})),
+            "G0 X0 Y0 Z0\nM3 ; shutter open\nG1 X2 F120\nM5 ; shutter closed\n; end of job\n");
+  GcodeExportSettings fan;
+  fan.open_code = "M106";
+  fan.close_code = "M107";
+  EXPECT_EQ(body(trajectory_gcode(straight_line_trajectory(), job, fan)),
+            "G0 X0 Y0 Z0\nM106 ; shutter open\nG1 X2 F120\nM107 ; shutter closed\n; end of job\n");
+}
+
+// the distance from p to the segment a-b
+double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double length2 = ab.squaredNorm();
+  const double u = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return (p - (a + u * ab)).norm();
+}
+
+// Segments bucketed in a grid of 1 mm cells: the distance from a point to the nearest one,
+// capped at 1 mm (enough to check tolerances of micrometres).
+class SegmentGrid {
+ public:
+  void add(const Vec3& a, const Vec3& b) {
+    segments_.push_back({a, b});
+    const Vec3 lo = a.cwiseMin(b), hi = a.cwiseMax(b);
+    for (long x = cell(lo.x()); x <= cell(hi.x()); ++x)
+      for (long y = cell(lo.y()); y <= cell(hi.y()); ++y)
+        for (long z = cell(lo.z()); z <= cell(hi.z()); ++z)
+          cells_[{x, y, z}].push_back(segments_.size() - 1);
+  }
+  double distance(const Vec3& p) const {
+    double best = 1.0;
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy)
+        for (long dz = -1; dz <= 1; ++dz) {
+          const auto found = cells_.find({cell(p.x()) + dx, cell(p.y()) + dy, cell(p.z()) + dz});
+          if (found == cells_.end()) continue;
+          for (size_t i : found->second)
+            best = std::min(best, segment_distance(p, segments_[i].first, segments_[i].second));
+        }
+    return best;
+  }
+
+ private:
+  static long cell(double v) { return static_cast<long>(std::floor(v)); }
+  std::vector<std::pair<Vec3, Vec3>> segments_;
+  std::map<std::array<long, 3>, std::vector<size_t>> cells_;
+};
+
+// the planned depositing motion every 1 ms, as polylines (one per depositing piece)
+std::vector<std::vector<Vec3>> planned_print_polylines(const Trajectory& trajectory) {
+  std::vector<std::vector<Vec3>> polylines;
+  for (const TrajectoryPiece& piece : trajectory.pieces()) {
+    if (!piece.depositing || piece.t_end_s <= piece.t_begin_s) continue;
+    polylines.emplace_back();
+    const double duration_s = piece.t_end_s - piece.t_begin_s;
+    const int steps = static_cast<int>(std::ceil(duration_s / 0.001));
+    for (int k = 0; k <= steps; ++k) {
+      Vec3 p, v, a;
+      evaluate_motion(piece, std::min(duration_s, 0.001 * k), p, v, a);
+      polylines.back().push_back(p);
+    }
+  }
+  return polylines;
+}
+
+double polyline_length(const std::vector<Vec3>& points) {
+  double length = 0.0;
+  for (size_t i = 1; i < points.size(); ++i) length += (points[i] - points[i - 1]).norm();
+  return length;
+}
+
+// Every shipped scenario that 3-axis G-code can represent (the planar ones), every planner:
+// exported, imported again, the print length agrees to 0.1 % and the two paths lie within
+// the chord tolerance of each other both ways (Hausdorff distance), plus the 0.05 um of the
+// written numbers' rounding. Conformal scenarios are skipped: their tool axis tilts.
+TEST(ExportGcode, RoundTripOnEveryShippedPlanarScenario) {
+  const std::string dir = fresh_directory("export_round_trip");
+  GcodeExportSettings settings;
+  const double tolerance_mm = settings.chord_tolerance_mm + 1e-4;
+  std::set<std::string> exported, skipped;
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(DEPOTWIN_SCENARIOS_DIR))
+    if (entry.path().extension() == ".yaml") files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  for (const std::string& file : files) {
+    const Scenario scenario = load_scenario(file);
+    if (scenario.surface) {
+      skipped.insert(scenario.name);
+      continue;
+    }
+    const PreparedJob job = prepare_job(scenario);
+    for (const PlannerSpec& spec : scenario.planners) {
+      SCOPED_TRACE(scenario.name + " / " + spec.run_label());
+      const Trajectory trajectory = plan_job(job, spec).trajectory;
+      GcodeExportJob export_job;
+      export_job.process = scenario.process.type;
+      export_job.bead_width_mm = scenario.process.bead_width_mm;
+      export_job.layer_height_mm = scenario.process.layer_height_mm;
+      const std::string gcode = trajectory_gcode(trajectory, export_job, settings);
+      // the importer's automatic rule finds E (extrusion) or the M3/M5 shutter (aerosol)
+      std::istringstream in(gcode);
+      const GcodeImport import = parse_gcode(in, scenario.name + ".gcode", GcodeOptions{});
+      EXPECT_EQ(import.rule,
+                scenario.process.type == "extrusion" ? PrintRule::e : PrintRule::shutter);
+      const Toolpath& imported = import.toolpath;
+
+      // print length: the planned motion's against the file's
+      const std::vector<std::vector<Vec3>> planned = planned_print_polylines(trajectory);
+      double planned_length_mm = 0.0;
+      for (const auto& polyline : planned) planned_length_mm += polyline_length(polyline);
+      EXPECT_NEAR(imported.print_length_mm(), planned_length_mm, 1e-3 * planned_length_mm);
+
+      // Hausdorff distance: planned samples to the file's lines, the file's points to the plan
+      SegmentGrid imported_grid, planned_grid;
+      for (const PrintPath& path : imported.paths)
+        for (size_t i = 1; i < path.points.size(); ++i)
+          imported_grid.add(path.points[i - 1], path.points[i]);
+      for (const auto& polyline : planned)
+        for (size_t i = 1; i < polyline.size(); ++i) planned_grid.add(polyline[i - 1], polyline[i]);
+      double planned_to_file_mm = 0.0, file_to_planned_mm = 0.0;
+      for (const auto& polyline : planned)
+        for (const Vec3& p : polyline)
+          planned_to_file_mm = std::max(planned_to_file_mm, imported_grid.distance(p));
+      for (const PrintPath& path : imported.paths)
+        for (size_t i = 0; i < path.points.size(); ++i) {
+          file_to_planned_mm = std::max(file_to_planned_mm, planned_grid.distance(path.points[i]));
+          if (i > 0)
+            file_to_planned_mm =
+                std::max(file_to_planned_mm,
+                         planned_grid.distance(0.5 * (path.points[i - 1] + path.points[i])));
+        }
+      EXPECT_LE(planned_to_file_mm, tolerance_mm);
+      EXPECT_LE(file_to_planned_mm, tolerance_mm);
+      exported.insert(scenario.name);
+    }
+  }
+  EXPECT_EQ(skipped,
+            (std::set<std::string>{"shembekar_beam", "shembekar_bonnet", "shembekar_fillet"}));
+  EXPECT_EQ(exported.size(), 6u);
+}
+
+// the CLI: the header names the scenario and planner; the same input gives the same bytes
+TEST(ExportVerb, WritesTheNamedPlannerDeterministically) {
+  const std::string dir = fresh_directory("export_verb");
+  const std::string scenario = scenario_path("thompson_fig7.yaml");
+  const auto first =
+      depotwin("export " + scenario + " --planner lspb_mtt --out " + dir + "/a.gcode");
+  ASSERT_EQ(first.status, 0) << first.output;
+  const auto second =
+      depotwin("export " + scenario + " --planner lspb_mtt --out " + dir + "/b.gcode");
+  ASSERT_EQ(second.status, 0) << second.output;
+  const std::string gcode = read_text(dir + "/a.gcode");
+  EXPECT_EQ(gcode, read_text(dir + "/b.gcode"));
+  EXPECT_EQ(gcode.rfind("; G-code exported by depotwin 0.1.0\n; scenario: thompson_fig7 (" +
+                            scenario + ")\n; planner: lspb_mtt\n; machine: xy_stage\n",
+                        0),
+            0u)
+      << gcode.substr(0, 300);
+  EXPECT_NE(gcode.find("\nM3 ; shutter open\n"), std::string::npos);
+  size_t files = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 2u);  // no temporary file left beside them
+}
+
+// refusals: exit 2, the option or key named, nothing written
+TEST(ExportVerb, RefusesBadOutputPlannerChoiceAndConformalScenarios) {
+  const std::string dir = fresh_directory("export_refusals");
+  const std::string fig7 = scenario_path("thompson_fig7.yaml");
+  auto r = depotwin("export " + fig7 + " --planner lspb_mtt --out " + dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: --out: '" + dir + "' is a directory; name a file, e.g. " + dir +
+                          "/job.gcode\n");
+  r = depotwin("export " + fig7 + " --planner lspb_mtt --out " + dir + "/missing/job.gcode");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: --out: '" + dir + "/missing' is not a directory (for '" + dir +
+                          "/missing/job.gcode')\n");
+  r = depotwin("export " + fig7 + " --out " + dir + "/job.gcode");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: --planner: export writes one planner's motion; choose one of lspb_mtt, "
+            "stop_and_go\n");
+  r = depotwin("export " + scenario_path("shembekar_fillet.yaml") + " --out " + dir + "/job.gcode");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("toolpath: export writes 3-axis G-code, which cannot carry the tilted "
+                          "tool axis of a conformal toolpath"),
+            std::string::npos)
+      << r.output;
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+}  // namespace
+}  // namespace depotwin
