@@ -1,10 +1,120 @@
 #include "cli/inspect.hpp"
 
+#include <cmath>
 #include <iostream>
+
+#include "core/error.hpp"
+#include "kinematics/machine.hpp"
+#include "planners/motion/firmware.hpp"
 
 namespace depotwin {
 
 namespace {
+
+// arcs become chords within this sagitta (the default of a scenario's `chord_tolerance_mm`),
+// as firmware cuts G2/G3 into short segments
+constexpr double kChordTolerance_mm = 0.01;
+// the limits asked of the machine: none of its own, so its joints' limits decide
+constexpr double kUnbounded = 1e12;
+
+// The time of one move of a look-ahead chain: a trapezoid from v0 to v1 under the cruise cap
+// over what the junction blends leave of it, plus half of each blend (as FirmwarePlanner).
+double move_time_s(const FirmwareMove& move, const FirmwareProfile& profile, size_t k) {
+  const double v0 = profile.junction_speed_mm_s[k], v1 = profile.junction_speed_mm_s[k + 1];
+  const double tau0 = profile.blend_time_s[k], tau1 = profile.blend_time_s[k + 1];
+  const double a = move.accel_mm_s2;
+  const double free_length = move.length_mm - 0.5 * v0 * tau0 - 0.5 * v1 * tau1;
+  const double cap = profile.cruise_speed_mm_s[k];
+  double peak = std::sqrt(std::min(cap * cap, 0.5 * (v0 * v0 + v1 * v1) + a * free_length));
+  peak = std::max({peak, v0, v1});
+  const double cruise_length =
+      std::max(0.0, free_length - (2.0 * peak * peak - v0 * v0 - v1 * v1) / (2.0 * a));
+  const double cruise_s = peak > 0.0 ? cruise_length / peak : 0.0;
+  return 0.5 * tau0 + (peak - v0) / a + cruise_s + (peak - v1) / a + 0.5 * tau1;
+}
+
+// What the firmware baseline predicts for the whole file: every move, printing or not, goes
+// through one look-ahead queue as a printer's firmware plans it (Marlin and Klipper treat G0
+// as G1 at the modal feed rate; before any F, the machine's top speed). The queue empties at
+// dwells, E-only moves (retractions, primes) and jumps of the position (G92, G28), where the
+// machine stands still; those pauses' own times are added. Each move's speed and acceleration
+// are capped so no axis exceeds the machine's limits over the file's box.
+double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
+                           const std::string& mode, const Box3& all_moves_bbox) {
+  if (program.moves.empty()) {
+    double pauses_s = 0.0;
+    for (const GcodePause& pause : program.pauses) pauses_s += pause.duration_s;
+    return pauses_s;
+  }
+  const MachineLimits limits = machine.cartesian_limits(
+      MachineLimits::uniform(kUnbounded, kUnbounded), all_moves_bbox.lo, all_moves_bbox.hi);
+  // the firmware's configuration: Marlin's junction deviation, or Klipper's square-corner
+  // velocity at the x and y axes' acceleration
+  FirmwareSettings settings;
+  settings.mode = mode == "klipper" ? FirmwareMode::klipper : FirmwareMode::marlin;
+  const double config_accel = std::min(limits.axes[0].a_max_mm_s2, limits.axes[1].a_max_mm_s2);
+  const double junction_deviation_mm =
+      settings.mode == FirmwareMode::klipper
+          ? klipper_junction_deviation(settings.square_corner_velocity, config_accel)
+          : settings.junction_deviation_mm;
+  const Vec3 axis_accel(limits.axes[0].a_max_mm_s2, limits.axes[1].a_max_mm_s2,
+                        limits.axes[2].a_max_mm_s2);
+
+  double total_s = 0.0;
+  std::vector<FirmwareMove> chain;
+  const auto flush = [&] {
+    if (chain.empty()) return;
+    const FirmwareProfile profile = firmware_lookahead(chain, settings, junction_deviation_mm);
+    for (size_t k = 0; k < chain.size(); ++k) total_s += move_time_s(chain[k], profile, k);
+    chain.clear();
+  };
+  size_t next_pause = 0;
+  Vec3 previous_end = program.moves.front().from_mm;
+  for (size_t m = 0; m < program.moves.size(); ++m) {
+    const GcodeMove& move = program.moves[m];
+    // pauses before this move stop the queue
+    bool stops = (move.from_mm - previous_end).norm() > kJoinTolerance_mm;
+    for (; next_pause < program.pauses.size() && program.pauses[next_pause].before_move <= m;
+         ++next_pause) {
+      total_s += program.pauses[next_pause].duration_s;
+      stops = true;
+    }
+    if (stops) flush();
+    previous_end = move.to_mm;
+    // the move's straight pieces (an arc's chords)
+    std::vector<Vec3> points{move.from_mm, move.to_mm};
+    if (move.arc.is_arc()) {
+      PrintPath arc_path;
+      arc_path.points = points;
+      arc_path.arcs = {move.arc};
+      points = arc_path.chorded(kChordTolerance_mm).points;
+    }
+    for (size_t i = 0; i + 1 < points.size(); ++i) {
+      const Vec3 step = points[i + 1] - points[i];
+      const double length_mm = step.norm();
+      if (length_mm <= 1e-12) continue;
+      FirmwareMove piece;
+      piece.length_mm = length_mm;
+      piece.direction = step / length_mm;
+      // no axis beyond its own speed and acceleration (Marlin's max_feedrate, max_acceleration)
+      piece.cruise_speed_mm_s = move.feed_mm_s > 0.0 ? move.feed_mm_s : kUnbounded;
+      piece.accel_mm_s2 = kUnbounded;
+      for (int axis = 0; axis < 3; ++axis) {
+        const double share = std::abs(piece.direction[axis]);
+        if (share < 1e-15) continue;
+        piece.cruise_speed_mm_s =
+            std::min(piece.cruise_speed_mm_s, limits.axes[axis].v_max_mm_s / share);
+        piece.accel_mm_s2 = std::min(piece.accel_mm_s2, limits.axes[axis].a_max_mm_s2 / share);
+      }
+      piece.blend_accel_mm_s2 = axis_accel;
+      chain.push_back(piece);
+    }
+  }
+  flush();
+  for (; next_pause < program.pauses.size(); ++next_pause)
+    total_s += program.pauses[next_pause].duration_s;
+  return total_s;
+}
 
 // grow a box by a move's whole path (its arc's bulge included)
 void grow(Box3& box, const GcodeMove& move) {
@@ -23,15 +133,29 @@ nlohmann::json box_json(const Box3& box) {
 
 }  // namespace
 
-GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule) {
+GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
+                       const InspectBaseline& baseline) {
+  // the baseline named must exist
+  const std::unique_ptr<Machine> machine = make_machine(baseline.machine);
+  if (!machine) {
+    std::string known;
+    for (const std::string& name : machine_names()) known += (known.empty() ? "" : ", ") + name;
+    throw InputError("--machine",
+                     "unknown machine '" + baseline.machine + "' (known: " + known + ")");
+  }
+  if (baseline.mode != "marlin" && baseline.mode != "klipper")
+    throw InputError("--mode",
+                     "unknown firmware mode '" + baseline.mode + "' (known: marlin, klipper)");
   GcodeFacts facts;
+  facts.baseline_machine = baseline.machine;
+  facts.baseline_mode = baseline.mode;
   const PrintRule resolved = resolve_print_rule(program, rule, &facts.rule_reason);
   facts.rule = print_rule_name(resolved);
   facts.n_lines = program.n_lines;
   facts.layer_z_values = print_layer_levels(program, resolved);
   facts.n_retractions = program.n_retractions;
   facts.extrusion_e_total = program.extrusion_e_total;
-  facts.estimated_time_s = program.dwell_s;
+  facts.feed_rate_time_s = program.dwell_s;
   bool previous_printed = false;
   Vec3 previous_end = Vec3::Zero();
   // every move: print or travel, its length, boxes and time
@@ -53,10 +177,13 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule) {
     previous_printed = prints;
     previous_end = move.to_mm;
     if (move.feed_mm_s > 0.0)
-      facts.estimated_time_s += move.length_mm / move.feed_mm_s;
+      facts.feed_rate_time_s += move.length_mm / move.feed_mm_s;
     else
       ++facts.n_moves_without_feed;
   }
+  // what the firmware baseline predicts for the whole file
+  facts.estimated_time_s =
+      firmware_estimate_s(program, *machine, baseline.mode, facts.all_moves_bbox);
   return facts;
 }
 
@@ -78,13 +205,17 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
   out["n_retractions"] = facts.n_retractions;
   out["extrusion_e_total"] = facts.extrusion_e_total;
   out["estimated_time_s"] = facts.estimated_time_s;
+  out["baseline"] = {
+      {"planner", "firmware"}, {"mode", facts.baseline_mode}, {"machine", facts.baseline_machine}};
+  out["feed_rate_time_s"] = facts.feed_rate_time_s;
   out["n_moves_without_feed"] = facts.n_moves_without_feed;
   return out;
 }
 
-void inspect_gcode_file(const std::string& path, const GcodeOptions& options) {
+void inspect_gcode_file(const std::string& path, const GcodeOptions& options,
+                        const InspectBaseline& baseline) {
   const GcodeProgram program = read_gcode_program(path, options);
-  std::cout << gcode_facts_json(gcode_facts(program, options.rule)).dump(2) << '\n';
+  std::cout << gcode_facts_json(gcode_facts(program, options.rule, baseline)).dump(2) << '\n';
 }
 
 }  // namespace depotwin

@@ -1,4 +1,5 @@
-// `depotwin inspect FILE`: facts of a G-code file under a print rule, as JSON.
+// `depotwin inspect FILE`: facts of a G-code file under a print rule, as JSON, with the time the
+// firmware baseline (planners/motion/firmware.hpp) plans for it on a machine's own limits.
 #pragma once
 
 #include <string>
@@ -35,18 +36,37 @@ struct GcodeFacts {
   Box3 all_moves_bbox;
   int n_retractions = 0;           // runs of consecutive E decreases
   double extrusion_e_total = 0.0;  // net E over the file, mm of filament
+  // what the firmware baseline (planners/motion/firmware.hpp) predicts for the whole file:
+  // every move, printing or travelling, through one look-ahead queue at the modal feed rate
+  // (the machine's top speed before any F), each axis within the machine's limits, arcs cut
+  // into chords within 0.01 mm; the queue stops at dwells, E-only moves and position jumps,
+  // whose times are added (an E-only move takes |dE| / F)
+  double estimated_time_s = 0.0;
   // every move at the file's own feed rate plus the dwells; moves before any F are left out
   // and counted
-  double estimated_time_s = 0.0;
+  double feed_rate_time_s = 0.0;
   int n_moves_without_feed = 0;
+  std::string baseline_machine;  // the machine and firmware mode estimated_time_s assumes
+  std::string baseline_mode;
 };
 
-GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule);
+// What `inspect` plans the file with: the `firmware` planner with its default parameters in
+// this mode, under this registered machine's own limits (kinematics/registry.cpp).
+struct InspectBaseline {
+  std::string machine = "cartesian";
+  std::string mode = "marlin";  // marlin | klipper
+};
+
+// Throws InputError naming --machine or --mode when the baseline names neither a machine
+// nor a mode that exists.
+GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
+                       const InspectBaseline& baseline = {});
 
 // the facts as the JSON `depotwin inspect` prints
 nlohmann::json gcode_facts_json(const GcodeFacts& facts);
 
 // the verb: parse `path`, print the JSON on stdout. Throws InputError on a bad file.
-void inspect_gcode_file(const std::string& path, const GcodeOptions& options);
+void inspect_gcode_file(const std::string& path, const GcodeOptions& options,
+                        const InspectBaseline& baseline = {});
 
 }  // namespace depotwin

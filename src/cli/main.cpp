@@ -175,6 +175,12 @@ int main(int argc, char** argv) {
                       "shutter rule: the code that opens (default M3)");
   inspect->add_option("--close", inspect_options.close_code,
                       "shutter rule: the code that closes (default M5)");
+  InspectBaseline inspect_baseline;
+  inspect->add_option("--machine", inspect_baseline.machine,
+                      "the machine whose limits estimated_time_s assumes (default cartesian)");
+  inspect->add_option("--mode", inspect_baseline.mode,
+                      "the firmware's look-ahead for estimated_time_s: marlin (junction "
+                      "deviation) or klipper (square-corner velocity); default marlin");
   // ---- end inspect ----
 
   // positions give the axes, one value each; a velocity or limit list has one value per
@@ -221,7 +227,7 @@ int main(int argc, char** argv) {
     // inspect
     if (*inspect) {
       inspect_options.rule = *print_rule_from_name(inspect_rule);
-      inspect_gcode_file(inspect_file, inspect_options);
+      inspect_gcode_file(inspect_file, inspect_options, inspect_baseline);
       return kExitOk;
     }
     if (*move) {

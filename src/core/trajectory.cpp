@@ -149,6 +149,12 @@ void evaluate_tool_axis(const TrajectoryPiece& piece, double tau, const Vec3& po
 
 double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau) {
   if (!piece.depositing) return 0.0;
+  // E tied to the motion: volume per length stays nominal whatever the speed
+  if (piece.flow_follows_speed && piece.desired_speed_mm_s > 0.0) {
+    Vec3 position_mm, velocity_mm_s, acceleration_mm_s2;
+    evaluate_motion(piece, tau, position_mm, velocity_mm_s, acceleration_mm_s2);
+    return velocity_mm_s.norm() / piece.desired_speed_mm_s;
+  }
   const auto* sampled = std::get_if<SampledMotion>(&piece.motion);
   if (sampled == nullptr || sampled->flow_fraction.empty()) return piece.flow_fraction;
   const std::vector<double>& flow = sampled->flow_fraction;

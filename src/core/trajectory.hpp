@@ -63,6 +63,9 @@ struct TrajectoryPiece {
   // speed (extrusion: 1 = nominal; a planner that slows a path may lower it, SampledMotion
   // may give it per sample). An aerosol stream cannot be modulated: it ignores this.
   double flow_fraction = 1.0;
+  // true: the flow follows the TCP's speed, |v| / desired_speed_mm_s, as a printer's E axis is
+  // tied to its motion (the firmware baseline); flow_fraction is then not read
+  bool flow_follows_speed = false;
   std::variant<PhaseMotion, SampledMotion> motion;
   ToolAxisMotion tool_axis;  // the orientation channel
 };

@@ -113,6 +113,36 @@ MotionSamples only_layer(const MotionSamples& samples, const Toolpath& toolpath,
   return kept;
 }
 
+namespace {
+
+// only_layer restricted to the samples that can affect a layer's scores: from one sample
+// before its first printing sample to one after its last (each sample's time weight and
+// each ramp's span reach one neighbour on either side), so every score is the same, sum for
+// sum, as over the whole run's samples, at a cost in the layer's own samples
+MotionSamples layer_window(const MotionSamples& samples, const Toolpath& toolpath, int layer) {
+  const auto prints_layer = [&](size_t k) {
+    const int path = samples.path_index[k];
+    return samples.depositing[k] && path >= 0 &&
+           toolpath.paths[static_cast<size_t>(path)].layer == layer;
+  };
+  const size_t n = samples.size();
+  size_t first = 0;
+  while (first < n && !prints_layer(first)) ++first;
+  if (first == n) return MotionSamples{};  // the layer is never printed: nothing to score
+  size_t last = n - 1;
+  while (!prints_layer(last)) --last;
+  const size_t begin = first > 0 ? first - 1 : 0;
+  const size_t end = std::min(n, last + 2);
+  MotionSamples window;
+  window.reserve(end - begin);
+  for (size_t k = begin; k < end; ++k)
+    window.push_back(samples.t_s[k], samples.position_mm[k], samples.velocity_mm_s[k],
+                     prints_layer(k), samples.path_index[k], samples.desired_speed_mm_s[k]);
+  return window;
+}
+
+}  // namespace
+
 std::vector<LayerReport> layer_reports(const Toolpath& toolpath, const MotionSamples& planned,
                                        const MotionSamples& simulated,
                                        const LayeredDeposit& deposit) {
@@ -130,7 +160,7 @@ std::vector<LayerReport> layer_reports(const Toolpath& toolpath, const MotionSam
       paths.paths.push_back(path);
     }
     // motion: the samples printing this layer
-    const MotionSamples planned_here = only_layer(planned, toolpath, layer);
+    const MotionSamples planned_here = layer_window(planned, toolpath, layer);
     for (size_t k = 0; k + 1 < planned_here.size(); ++k)
       if (planned_here.depositing[k]) r.print_s += period_s;
     const std::vector<TimeSpan> ramps = speed_ramps(planned_here);
@@ -138,7 +168,7 @@ std::vector<LayerReport> layer_reports(const Toolpath& toolpath, const MotionSam
     r.planned_velocity_error_steady = velocity_error(planned_here, ramps);
     r.planned_path_error = path_error(planned_here, toolpath);
     if (!simulated.t_s.empty()) {
-      const MotionSamples simulated_here = only_layer(simulated, toolpath, layer);
+      const MotionSamples simulated_here = layer_window(simulated, toolpath, layer);
       r.velocity_error = velocity_error(simulated_here);
       r.velocity_error_steady = velocity_error(simulated_here, ramps);
       r.path_error = path_error(simulated_here, toolpath);

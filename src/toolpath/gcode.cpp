@@ -400,8 +400,11 @@ void GcodeParser::execute(int line_number) {
     feed_mm_s_ = words_.get('F') * unit_mm_ / kSecondsPerMinute;
   }
   if (dwell) {
-    if (words_.has('S')) program_.dwell_s += std::max(0.0, words_.get('S'));
-    if (words_.has('P')) program_.dwell_s += std::max(0.0, words_.get('P')) / 1000.0;
+    double dwell_s = 0.0;
+    if (words_.has('S')) dwell_s += std::max(0.0, words_.get('S'));
+    if (words_.has('P')) dwell_s += std::max(0.0, words_.get('P')) / 1000.0;
+    program_.dwell_s += dwell_s;
+    program_.pauses.push_back(GcodePause{program_.moves.size(), dwell_s, line_number});
   }
   if (set_position) this->set_position();
   if (home) this->home();
@@ -467,7 +470,12 @@ void GcodeParser::move(int motion, int line_number) {
   record.has_e = words_.has('E');
   record.open = open_;
   position_mm_ = target_mm;
-  if (record.length_mm > kMinMove_mm) program_.moves.push_back(record);
+  if (record.length_mm > kMinMove_mm)
+    program_.moves.push_back(record);
+  else if (e_delta != 0.0)  // the extruder alone: a retraction or a prime, at the feed rate
+    program_.pauses.push_back(GcodePause{
+        program_.moves.size(), feed_mm_s_ > 0.0 ? std::abs(e_delta) / feed_mm_s_ : 0.0,
+        line_number});
 }
 
 bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc) {

@@ -60,6 +60,15 @@ struct GcodeMove {
   bool open = false;       // the shutter's open code was the last of open/close
 };
 
+// Where the machine stands still between moves: a G4 dwell, or an E-only move (a retraction
+// or prime: the extruder alone moves |dE| at the feed rate). Firmware empties its move queue
+// there, so the moves on either side start and end at rest.
+struct GcodePause {
+  size_t before_move = 0;  // index into GcodeProgram::moves of the next move
+  double duration_s = 0.0;
+  int line = 0;  // 1-based
+};
+
 // Everything a file does, before a print rule is applied.
 struct GcodeProgram {
   std::string file_label;
@@ -69,6 +78,7 @@ struct GcodeProgram {
   int n_retractions = 0;           // runs of consecutive E decreases (moving or not)
   double extrusion_e_total = 0.0;  // net E over the file (G92 resets excluded), mm
   double dwell_s = 0.0;            // sum of G4 dwells
+  std::vector<GcodePause> pauses;  // dwells and E-only moves, in file order
   int n_lines = 0;
 };
 

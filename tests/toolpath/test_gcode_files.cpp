@@ -34,7 +34,9 @@ TEST(GcodeFiles, SpacesInsideWords) {
   EXPECT_EQ(facts.layer_z_values, std::vector<double>{0.0});
   expect_box(facts.print_bbox, Vec3(0, 0, 0), Vec3(10, 10, 0));
   // F600 = 10 mm/s from the first G1 on (45 mm); the two G0 before any F are left out
-  EXPECT_NEAR(facts.estimated_time_s, 4.5, 1e-12);
+  EXPECT_NEAR(facts.feed_rate_time_s, 4.5, 1e-12);
+  // the firmware takes longer: it accelerates, and the two G0 take their time at the top speed
+  EXPECT_GT(facts.estimated_time_s, facts.feed_rate_time_s);
   EXPECT_EQ(facts.n_moves_without_feed, 2);
 }
 
@@ -85,7 +87,8 @@ TEST(GcodeFiles, HelixAndG18Arc) {
   // G18 G3 turns positively about +Y: from x = 5 down through z = 2 - 5 to x = -5
   expect_box(facts.print_bbox, Vec3(-5, -5, -3), Vec3(5, 5, 2));
   // F300: 5 mm/s (the G0 before it has no feed rate)
-  EXPECT_NEAR(facts.estimated_time_s, (std::hypot(10.0 * kPi, 2.0) + 5.0 * kPi) / 5.0, 1e-9);
+  EXPECT_NEAR(facts.feed_rate_time_s, (std::hypot(10.0 * kPi, 2.0) + 5.0 * kPi) / 5.0, 1e-9);
+  EXPECT_GT(facts.estimated_time_s, facts.feed_rate_time_s);
   EXPECT_EQ(facts.n_moves_without_feed, 1);
   // a helix reversed is the same curve
   const GcodeImport imported = read_gcode(kDir + "helix.ngc", GcodeOptions{});
@@ -174,7 +177,8 @@ TEST(GcodeFiles, FiveLayerSquare) {
   for (int k = 0; k < 5; ++k) EXPECT_NEAR(facts.layer_z_values[k], 0.2 * (k + 1), 1e-12);
   EXPECT_NEAR(facts.extrusion_e_total, 13.3, 1e-9);
   // 400 mm at 20 mm/s, 1 mm of Z at 10 mm/s, sqrt(200) mm at 100 mm/s
-  EXPECT_NEAR(facts.estimated_time_s, 20.0 + 0.1 + std::sqrt(200.0) / 100.0, 1e-9);
+  EXPECT_NEAR(facts.feed_rate_time_s, 20.0 + 0.1 + std::sqrt(200.0) / 100.0, 1e-9);
+  EXPECT_GT(facts.estimated_time_s, facts.feed_rate_time_s);
   // layers [1, 3]: three paths numbered 0..2 from z = 0.4
   GcodeOptions options;
   options.first_layer = 1;
@@ -197,6 +201,32 @@ TEST(GcodeFiles, FiveLayerSquare) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.problems().at(0).message, "layers [1, 5] not in the file's 5 layers (0 to 4)");
   }
+}
+
+// estimated_time_s is the firmware's trapezoids, in closed form on straight lines: a move of L
+// at feed v from rest to rest with acceleration a takes L / v + v / a (when L >= v^2 / a)
+TEST(GcodeFiles, EstimatedTimeIsTheFirmwaresTrapezoids) {
+  const auto estimate = [](const std::string& text, const std::string& mode = "marlin") {
+    const GcodeProgram program = parse_gcode_program(text, "estimate.gcode", GcodeOptions{});
+    InspectBaseline baseline;
+    baseline.mode = mode;
+    return gcode_facts(program, PrintRule::automatic, baseline).estimated_time_s;
+  };
+  // the cartesian machine: 300 mm/s and 3000 mm/s^2 in x and y
+  const double a = 3000.0;
+  EXPECT_NEAR(estimate("G21 G90\nG1 X100 F3000\n"), 100.0 / 50.0 + 50.0 / a, 1e-9);
+  EXPECT_NEAR(estimate("G21 G90\nG1 X100 F3000\n", "klipper"), 100.0 / 50.0 + 50.0 / a, 1e-9);
+  // two collinear moves are one queue: no stop between them
+  EXPECT_NEAR(estimate("G1 X40 F3000\nG1 X100\n"), 100.0 / 50.0 + 50.0 / a, 1e-9);
+  // a dwell, and a retraction at 30 mm/s, each empty the queue: two stops and their own times
+  EXPECT_NEAR(estimate("G1 X40 F3000\nG4 P250\nG1 X100\n"),
+              100.0 / 50.0 + 2.0 * 50.0 / a + 0.25, 1e-9);
+  EXPECT_NEAR(estimate("M83\nG1 X40 E1 F3000\nG1 E-0.8 F1800\nG1 X100 E1 F3000\n"),
+              100.0 / 50.0 + 2.0 * 50.0 / a + 0.8 / 30.0, 1e-9);
+  // no F: the axis' top speed, 300 mm/s, reached after 15 mm of the 100
+  EXPECT_NEAR(estimate("G0 X100\n"), 100.0 / 300.0 + 300.0 / a, 1e-9);
+  // a corner costs time: the 90 degree junction is slower than going on straight
+  EXPECT_GT(estimate("G1 X50 F3000\nG1 Y50\n"), 100.0 / 50.0 + 50.0 / a);
 }
 
 TEST(GcodeFiles, InspectJsonKeys) {

@@ -65,6 +65,23 @@ TEST(Firmware, NinetyDegreeJunctionSpeedIsMarlinsFormula) {
   EXPECT_LT(nearest, jd);
 }
 
+// E is tied to the motion: while printing, the commanded flow is |v| / v_des at every instant
+// (nominal volume per length), 0 at rest, 1 at the print speed
+TEST(Firmware, FlowFollowsTheSpeedAsTheEAxisDoes) {
+  const Toolpath toolpath = polyline({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const Trajectory plan =
+      plan_with({"firmware", {}, 0}, toolpath, MachineLimits::uniform(100, 1000));
+  bool cruised = false;
+  for (double t = 0; t <= plan.duration_s(); t += 1e-3) {
+    const TrajectorySample sample = plan.at(t);
+    if (!sample.depositing) continue;
+    EXPECT_NEAR(sample.flow_fraction, sample.velocity_mm_s.norm() / 50.0, 1e-9) << t;
+    cruised = cruised || sample.flow_fraction > 1.0 - 1e-9;
+  }
+  EXPECT_TRUE(cruised);  // it reaches the print speed, and the nominal flow, on the long lines
+  EXPECT_NEAR(plan.at(0.0).flow_fraction, 0.0, 1e-9);  // from rest
+}
+
 TEST(Firmware, KlipperSquareCornerVelocityIsTheNinetyDegreeSpeed) {
   // jd = scv^2 (sqrt 2 - 1) / accel
   EXPECT_NEAR(klipper_junction_deviation(5.0, 1000.0), 25.0 * (std::sqrt(2.0) - 1) / 1000.0, 1e-15);
