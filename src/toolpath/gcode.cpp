@@ -473,9 +473,9 @@ void GcodeParser::move(int motion, int line_number) {
   if (record.length_mm > kMinMove_mm)
     program_.moves.push_back(record);
   else if (e_delta != 0.0)  // the extruder alone: a retraction or a prime, at the feed rate
-    program_.pauses.push_back(GcodePause{
-        program_.moves.size(), feed_mm_s_ > 0.0 ? std::abs(e_delta) / feed_mm_s_ : 0.0,
-        line_number});
+    program_.pauses.push_back(GcodePause{program_.moves.size(),
+                                         feed_mm_s_ > 0.0 ? std::abs(e_delta) / feed_mm_s_ : 0.0,
+                                         line_number});
 }
 
 bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc) {

@@ -219,8 +219,8 @@ TEST(GcodeFiles, EstimatedTimeIsTheFirmwaresTrapezoids) {
   // two collinear moves are one queue: no stop between them
   EXPECT_NEAR(estimate("G1 X40 F3000\nG1 X100\n"), 100.0 / 50.0 + 50.0 / a, 1e-9);
   // a dwell, and a retraction at 30 mm/s, each empty the queue: two stops and their own times
-  EXPECT_NEAR(estimate("G1 X40 F3000\nG4 P250\nG1 X100\n"),
-              100.0 / 50.0 + 2.0 * 50.0 / a + 0.25, 1e-9);
+  EXPECT_NEAR(estimate("G1 X40 F3000\nG4 P250\nG1 X100\n"), 100.0 / 50.0 + 2.0 * 50.0 / a + 0.25,
+              1e-9);
   EXPECT_NEAR(estimate("M83\nG1 X40 E1 F3000\nG1 E-0.8 F1800\nG1 X100 E1 F3000\n"),
               100.0 / 50.0 + 2.0 * 50.0 / a + 0.8 / 30.0, 1e-9);
   // no F: the axis' top speed, 300 mm/s, reached after 15 mm of the 100
