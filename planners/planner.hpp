@@ -69,6 +69,9 @@ struct PlannerInfo {
   // honours the limits' j_max (jerk-limited transitions and ramps); a planner that does not
   // refuses limits with one (check_planner_limits)
   bool honours_jerk_limit = false;
+  // takes a toolpath's exact arcs (PrintPath::arcs: G-code G2/G3); the others get them as
+  // chords within the scenario's chord_tolerance_mm
+  bool consumes_arcs = false;
 };
 
 // every registered planner, in a stable order

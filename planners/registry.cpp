@@ -36,7 +36,7 @@ const std::vector<PlannerInfo>& planner_registry() {
        true},
       {"bezier", "Giberti et al. 2017: lines with Bezier corner blends at constant speed",
        bezier_parameters(), [](const PlannerSpec& spec) { return make_bezier_planner(spec); },
-       false},
+       false, /*consumes_arcs=*/true},
       {"conformal",
        "Shembekar et al. 2018: conformal paths flown by with zone blends, time-optimal under TCP "
        "and joint limits (TOPP-RA), speed and flow control",

@@ -90,6 +90,7 @@ Toolpath apply_order(const Toolpath& toolpath, const OrderResult& result) {
   out.end_mm = toolpath.end_mm;
   out.start_roll_rad = toolpath.start_roll_rad;
   out.end_roll_rad = toolpath.end_roll_rad;
+  out.chord_tolerance_mm = toolpath.chord_tolerance_mm;
   for (size_t k = 0; k < result.order.size(); ++k) {
     const PrintPath& path = toolpath.paths.at(result.order[k]);
     out.paths.push_back(result.reversed[k] ? path.reversed() : path);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -115,6 +116,62 @@ std::vector<size_t> simplify(const std::vector<Vec3>& points, size_t first, size
   return kept;
 }
 
+// A circle in the XY plane through three points at one height (a G17 arc), or nothing when
+// they are (nearly) collinear or not level.
+struct XyCircle {
+  Vec3 centre_mm = Vec3::Zero();
+  double radius_mm = 0.0;
+};
+
+std::optional<XyCircle> circle_through(const Vec3& a, const Vec3& b, const Vec3& c,
+                                       double tolerance_mm) {
+  if (std::abs(b.z() - a.z()) > tolerance_mm || std::abs(c.z() - a.z()) > tolerance_mm)
+    return std::nullopt;
+  // the circumcentre of the triangle in the plane
+  const double bx = b.x() - a.x(), by = b.y() - a.y(), cx = c.x() - a.x(), cy = c.y() - a.y();
+  const double d = 2.0 * (bx * cy - by * cx);
+  const double scale = std::max(bx * bx + by * by, cx * cx + cy * cy);
+  if (std::abs(d) <= 1e-12 * scale) return std::nullopt;
+  const double ux = (cy * (bx * bx + by * by) - by * (cx * cx + cy * cy)) / d;
+  const double uy = (bx * (cx * cx + cy * cy) - cx * (bx * bx + by * by)) / d;
+  XyCircle circle;
+  circle.centre_mm = Vec3(a.x() + ux, a.y() + uy, a.z());
+  circle.radius_mm = std::hypot(ux, uy);
+  return circle;
+}
+
+// The samples [first, last] as one G2/G3 arc: every sample within tolerance of the circle
+// through the first, middle and last sample, level, turning one way through less than a full
+// turn. Returns the circle and the signed sweep (rad, positive counter-clockwise: G3).
+std::optional<std::pair<XyCircle, double>> fit_arc(const std::vector<Vec3>& points, size_t first,
+                                                   size_t last, double tolerance_mm) {
+  constexpr double kMaxRadius_mm = 1e4;  // flatter than this is a line to a printer
+  if (last < first + 2) return std::nullopt;
+  const size_t middle = (first + last) / 2;
+  const std::optional<XyCircle> circle =
+      circle_through(points[first], points[middle], points[last], tolerance_mm);
+  if (!circle || circle->radius_mm > kMaxRadius_mm) return std::nullopt;
+  const Vec3& c = circle->centre_mm;
+  // the angle turned from sample to sample, all one way
+  double sweep = 0.0;
+  for (size_t k = first; k <= last; ++k) {
+    const Vec3& p = points[k];
+    if (std::abs(std::hypot(p.x() - c.x(), p.y() - c.y()) - circle->radius_mm) > tolerance_mm ||
+        std::abs(p.z() - points[first].z()) > tolerance_mm)
+      return std::nullopt;
+    if (k == first) continue;
+    const Vec3& q = points[k - 1];
+    const double turn =
+        std::atan2((q.x() - c.x()) * (p.y() - c.y()) - (q.y() - c.y()) * (p.x() - c.x()),
+                   (q.x() - c.x()) * (p.x() - c.x()) + (q.y() - c.y()) * (p.y() - c.y()));
+    if (k > first + 1 && (turn > 0.0) != (sweep > 0.0) && std::abs(turn) > 1e-12)
+      return std::nullopt;
+    sweep += turn;
+  }
+  if (std::abs(sweep) >= 2.0 * kPi - 1e-6) return std::nullopt;
+  return std::make_pair(*circle, sweep);
+}
+
 // The G-code lines, with the modal position and feed rate written only when they change.
 class GcodeWriter {
  public:
@@ -130,8 +187,13 @@ class GcodeWriter {
       const std::string value = number_text(to[axis], 4);
       if (value != axis_text_[axis]) text += axis_names[axis] + value, axis_text_[axis] = value;
     }
-    // E with at least 3 significant digits (a slow ramp's moves carry very little), so a
-    // print move never reads as E0
+    append_e_and_feed(text, e_mm, feed_mm_min);
+    body_ << text << '\n';
+  }
+
+  // E with at least 3 significant digits (a slow ramp's moves carry very little), so a print
+  // move never reads as E0; F when it changes
+  void append_e_and_feed(std::string& text, double e_mm, double feed_mm_min) {
     if (extrusion_ && e_mm > 0.0) {
       int decimals = 5;
       while (decimals < 10 && e_mm < std::pow(10.0, 2 - decimals)) ++decimals;
@@ -143,6 +205,24 @@ class GcodeWriter {
       const std::string feed = number_text(feed_mm_min, decimals);
       if (feed != feed_text_) text += " F" + feed, feed_text_ = feed;
     }
+  }
+
+  // G2 (clockwise) or G3 (counter-clockwise) in the XY plane to `to` about `centre` (I and J
+  // relative to the start, as G90.1 is not assumed), with F and E as for move()
+  void arc(bool counter_clockwise, const Vec3& from, const Vec3& to, const Vec3& centre,
+           double feed_mm_min, double e_mm) {
+    const std::string i_text = number_text(centre.x() - from.x(), 4);
+    const std::string j_text = number_text(centre.y() - from.y(), 4);
+    std::string text = counter_clockwise ? "G3" : "G2";
+    const char* axis_names[3] = {" X", " Y", " Z"};
+    for (int axis = 0; axis < 3; ++axis) {
+      const std::string value = number_text(to[axis], 4);
+      // an arc's end is always written in the plane, so the reader needs no modal X or Y
+      if (axis < 2 || value != axis_text_[axis]) text += axis_names[axis] + value;
+      axis_text_[axis] = value;
+    }
+    text += " I" + i_text + " J" + j_text;
+    append_e_and_feed(text, e_mm, feed_mm_min);
     body_ << text << '\n';
   }
 
@@ -170,7 +250,7 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
   const double filament_area_mm2 =
       kPi * 0.25 * settings.filament_diameter_mm * settings.filament_diameter_mm;
   GcodeWriter gcode(extrusion);
-  size_t print_moves = 0;
+  size_t print_moves = 0, print_arcs = 0;
   double print_length_mm = 0.0, e_total_mm = 0.0;
   bool open = false;  // aerosol: the shutter code last written
 
@@ -226,9 +306,43 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
         if (!short_run && std::max(high, next) - std::min(low, next) > band_mm_s) break;
         low = std::min(low, next), high = std::max(high, next), ++run_last;
       }
-      for (const size_t to :
-           simplify(samples.position_mm, run_first, run_last, settings.chord_tolerance_mm)) {
+      const std::vector<size_t> kept =
+          simplify(samples.position_mm, run_first, run_last, settings.chord_tolerance_mm);
+      for (size_t next = 0; next < kept.size(); ++next) {
+        const size_t to = kept[next];
         if (to == written) continue;
+        // the longest run of the simplified points from here on that is one arc: a G2/G3
+        // (at least three of the lines it replaces, every sample within the tolerance)
+        size_t arc_end = next;
+        std::optional<std::pair<XyCircle, double>> arc;
+        if (next > 0 && written == kept[next - 1]) {
+          for (size_t end = next + 2; end < kept.size(); ++end) {
+            auto fitted =
+                fit_arc(samples.position_mm, written, kept[end], settings.chord_tolerance_mm);
+            if (!fitted) break;
+            arc = fitted;
+            arc_end = end;
+          }
+        }
+        if (arc) {
+          const size_t arc_to = kept[arc_end];
+          const double length_mm = arc->first.radius_mm * std::abs(arc->second);
+          const double move_s = samples.t_s[arc_to] - samples.t_s[written];
+          if (pending_dwell_s >= 0.0005)
+            gcode.line("G4 P" + number_text(1000.0 * pending_dwell_s, 0) + " ; planned dwell");
+          pending_dwell_s = 0.0;
+          const double e_mm =
+              (samples.volume_mm3[arc_to] - samples.volume_mm3[written]) / filament_area_mm2;
+          gcode.arc(arc->second > 0.0, samples.position_mm[written], samples.position_mm[arc_to],
+                    arc->first.centre_mm, 60.0 * length_mm / move_s, e_mm);
+          written = arc_to;
+          next = arc_end;
+          ++print_moves;
+          ++print_arcs;
+          print_length_mm += length_mm;
+          e_total_mm += e_mm;
+          continue;
+        }
         const double length_mm = (samples.position_mm[to] - samples.position_mm[written]).norm();
         const double move_s = samples.t_s[to] - samples.t_s[written];
         // the nozzle at rest: a dwell; its material goes with the next move
@@ -268,12 +382,13 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
     header << "; process: aerosol, shutter " << settings.open_code << " open / "
            << settings.close_code << " closed\n";
   header << "; planned duration: " << number_text(trajectory.duration_s(), 3) << " s, "
-         << print_moves << " print moves, print length " << number_text(print_length_mm, 3)
-         << " mm";
+         << print_moves << " print moves (" << print_arcs << " of them G2/G3 arcs), print length "
+         << number_text(print_length_mm, 3) << " mm";
   if (extrusion) header << ", E total " << number_text(e_total_mm, 3) << " mm";
   header << '\n'
          << "; every planned sample within " << number_text(settings.chord_tolerance_mm, 4)
-         << " mm of these lines; F = each move's planned average speed\n"
+         << " mm of these lines and arcs (G2/G3 in the XY plane, I and J relative to the "
+            "arc's start); F = each move's planned average speed\n"
          << "G21 ; millimetres\n"
          << "G90 ; absolute positions\n";
   if (extrusion) header << "M83 ; relative extrusion\n";

@@ -78,6 +78,9 @@ struct Toolpath {
   double start_roll_rad = 0.0;
   double end_roll_rad = 0.0;
   std::vector<PrintPath> paths;
+  // the sagitta within which a planner that needs polylines chords the paths' arcs (mm): a
+  // G-code toolpath's `chord_tolerance_mm`
+  double chord_tolerance_mm = 0.01;
 
   ToolOrientation start_orientation() const { return {vertical_tool_axis(), start_roll_rad}; }
   ToolOrientation end_orientation() const { return {vertical_tool_axis(), end_roll_rad}; }

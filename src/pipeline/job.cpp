@@ -152,6 +152,15 @@ PreparedJob prepare_job(const Scenario& scenario) {
   sequencing.lower_bound = scenario.order.method != "as_given";
   job.order = sequence(scenario.toolpath, job.limits, scenario.order, sequencing);
   job.toolpath = apply_order(scenario.toolpath, job.order);
+  // G-code arcs: exact for the planners that consume them, and finely chorded as the path the
+  // metrics measure against (the file's own geometry, not the planners' chords)
+  if (!scenario.exact_toolpath.paths.empty() && !arm) {
+    job.exact_toolpath = apply_order(scenario.exact_toolpath, job.order);
+    const double chord_tolerance_mm =
+        scenario.gcode ? scenario.gcode->chord_tolerance_mm : kReferenceChordTolerance_mm;
+    job.reference_toolpath =
+        job.exact_toolpath.chorded(std::min(kReferenceChordTolerance_mm, chord_tolerance_mm));
+  }
 
   // an arm: its roll at every point and its branch, away from limits, singularities and the part
   if (arm) choose_posture(scenario, *arm, job);
@@ -202,7 +211,10 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
 
   PlannedRun run;
   run.spec = spec;
-  run.trajectory = make_planner(spec)->plan(job.toolpath, job.limits);
+  // exact arcs to a planner that consumes them; chords within the tolerance to the others
+  const PlannerInfo* info = find_planner(spec.name);
+  const bool exact = info && info->consumes_arcs && !job.exact_toolpath.paths.empty();
+  run.trajectory = make_planner(spec)->plan(exact ? job.exact_toolpath : job.toolpath, job.limits);
   // a job far beyond any real print (e.g. a j_max of 1e-9 mm/s^3) would be sampled every
   // millisecond: refuse it before sampling anything
   if (!(run.trajectory.duration_s() <= kMaxJobDuration_s)) {
@@ -229,7 +241,7 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   r.speed_ramps = speed_ramps(run.planned);
   r.planned_velocity_error = velocity_error(run.planned);
   r.planned_velocity_error_steady = velocity_error(run.planned, r.speed_ramps);
-  r.planned_path_error = path_error(run.planned, job.toolpath);
+  r.planned_path_error = path_error(run.planned, job.intended_toolpath());
   OrderStats order;
   order.method = job.scenario.order.method;
   order.refine = job.scenario.order.refine;

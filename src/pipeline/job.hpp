@@ -38,8 +38,21 @@ struct PreparedJob {
   std::optional<ArmPosture> posture;
   TcpLimits limits;  // what every planner must respect (refers to *machine)
   OrderResult order;
-  Toolpath toolpath;  // in print order
+  Toolpath toolpath;  // in print order; G-code arcs as chords within chord_tolerance_mm
+  // a G-code file's arcs (none: both empty): the paths of `toolpath` with their arcs exact,
+  // for the planners that consume them (PlannerInfo::consumes_arcs), and as chords within
+  // 0.001 mm, the intended path that path errors and thickness are measured against
+  Toolpath exact_toolpath;
+  Toolpath reference_toolpath;
+
+  // what the metrics measure against: the file's arcs (finely chorded) when it has any
+  const Toolpath& intended_toolpath() const {
+    return reference_toolpath.paths.empty() ? toolpath : reference_toolpath;
+  }
 };
+
+// the sagitta of the chords the metrics measure G-code arcs by (mm)
+constexpr double kReferenceChordTolerance_mm = 1e-3;
 
 // Throws InputError for an unknown machine, joint limits it cannot honour, an unreachable
 // toolpath, a planner that ignores a jerk limit, ...

@@ -171,15 +171,16 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   run.simulated = recorded_motion(run.record);
   run.planned_at_steps = trajectory_motion_at(trajectory, run.record.t_s);
   run.report = run.plan.report;
-  const Toolpath merged = merge_joined_paths(job.toolpath);
+  const Toolpath& intended = job.intended_toolpath();  // a G-code file's arcs as they are
+  const Toolpath merged = merge_joined_paths(intended);
   const TargetRegion region(merged, deposit.line_width_mm(), deposit.field().cell_mm());
   DepositionMetrics deposited;
   deposited.thickness = thickness_stats(deposit.normal_field(), region, merged);
   deposited.material = split_material(deposit.field(), region, deposit.account());
-  add_simulated_metrics(run.report, run.record, run.simulated, job.toolpath, deposited);
+  add_simulated_metrics(run.report, run.record, run.simulated, intended, deposited);
   // multi-layer and conformal jobs: every metric per layer too
-  if (job.toolpath.layer_count() > 1 || job.part)
-    run.report.layers = layer_reports(job.toolpath, run.plan.planned, run.simulated, deposit);
+  if (intended.layer_count() > 1 || job.part)
+    run.report.layers = layer_reports(intended, run.plan.planned, run.simulated, deposit);
   run.report.actuators = actuator_stats(run.record, job.machine->joint_limits(),
                                         run.simulation->actuator_force_limits());
   // an arm: its posture over the run (limits, singularities, the part, contacts, branch)

@@ -36,6 +36,8 @@ constexpr double kSpeedTolerance = 1e-9;
 constexpr double kMaxSurfaceGridPoints = 2e7;
 // print segments over speed listed before the rest are counted
 constexpr std::size_t kMaxSpeedProblems = 20;
+// an arc's directions, for the feed clamp, come from chords within this sagitta
+constexpr double kClampChordTolerance_mm = 1e-3;
 // a surface toolpath's path problems listed before the rest are counted
 constexpr std::size_t kMaxSurfacePathProblems = 5;
 // a surface toolpath starts and ends this far above the part's highest point (and its layers)
@@ -511,10 +513,14 @@ void Loader::read_toolpath(const Field* field) {
                   "move the part with its paths");
   } else if (f) {
     if (const std::optional<Vec3> offset = read_point(*f, problems_)) {
-      toolpath.start_mm += *offset;
-      toolpath.end_mm += *offset;
-      for (PrintPath& path : toolpath.paths)
-        for (Vec3& point : path.points) point += *offset;
+      for (Toolpath* moved : {&toolpath, &scenario_.exact_toolpath}) {
+        moved->start_mm += *offset;
+        moved->end_mm += *offset;
+        for (PrintPath& path : moved->paths) {
+          for (Vec3& point : path.points) point += *offset;
+          for (EdgeArc& arc : path.arcs) arc.center_mm += *offset;
+        }
+      }
     }
   }
 }
@@ -723,35 +729,30 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
       multi_level_problem(imported, resolved.string(), field.key))
     return;
 
-  // arcs become chords within the tolerance (every planner then gets polylines); each chord
-  // point keeps the line of the move it lies on
-  const double tolerance_mm = settings->chord_tolerance_mm;
-  std::vector<PrintPath> paths;
-  std::vector<std::vector<int>> lines;
-  for (std::size_t i = 0; i < imported.toolpath.paths.size(); ++i) {
-    const PrintPath& path = imported.toolpath.paths[i];
-    if (!path.has_arcs()) {
-      paths.push_back(path);
-      lines.push_back(imported.point_lines[i]);
-      continue;
-    }
-    std::vector<std::size_t> source_point;
-    paths.push_back(path.chorded(tolerance_mm, &source_point));
-    std::vector<int> chord_lines;
-    for (std::size_t k : source_point) chord_lines.push_back(imported.point_lines[i].at(k));
-    lines.push_back(std::move(chord_lines));
-  }
-  for (const std::vector<int>& path_lines : lines)
+  // the paths as the file has them, arcs exact; a move counts once however it is cut later
+  std::vector<PrintPath> exact_paths = imported.toolpath.paths;
+  std::vector<std::vector<int>> exact_lines = imported.point_lines;
+  for (const std::vector<int>& path_lines : exact_lines)
     settings->print_moves += static_cast<int>(distinct_moves(path_lines, 1));
 
   // feed rates above what the machine can do along a move: slowed to it, as firmware does
-  if (settings->feed == "clamp") clamp_feed_rates(paths, lines, *settings);
+  if (settings->feed == "clamp") clamp_feed_rates(exact_paths, exact_lines, *settings);
 
-  for (std::size_t i = 0; i < paths.size(); ++i) {
-    PrintPath& path = paths[i];
-    path.source_index = static_cast<int>(scenario_.toolpath.paths.size());
-    check_path(path, PathOrigin{resolved.string(), field.key, lines[i], true});
-    scenario_.toolpath.paths.push_back(std::move(path));
+  // every path also with its arcs as chords within the tolerance (what planners that need
+  // polylines get, and what the checks see); each chord point keeps the line of its move
+  const bool keeps_arcs = std::any_of(exact_paths.begin(), exact_paths.end(),
+                                      [](const PrintPath& path) { return path.has_arcs(); });
+  const double tolerance_mm = settings->chord_tolerance_mm;
+  for (std::size_t i = 0; i < exact_paths.size(); ++i) {
+    PrintPath& exact = exact_paths[i];
+    exact.source_index = static_cast<int>(scenario_.toolpath.paths.size());
+    std::vector<std::size_t> source_point;
+    PrintPath chorded = exact.chorded(tolerance_mm, &source_point);
+    std::vector<int> chord_lines;
+    for (std::size_t k : source_point) chord_lines.push_back(exact_lines[i].at(k));
+    check_path(chorded, PathOrigin{resolved.string(), field.key, chord_lines, true});
+    scenario_.toolpath.paths.push_back(std::move(chorded));
+    if (keeps_arcs) scenario_.exact_toolpath.paths.push_back(std::move(exact));
   }
 
   // the start (and so the end) defaults to the file's first print point; `offset` then moves
@@ -759,6 +760,9 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   Toolpath& toolpath = scenario_.toolpath;
   if (!start_given) toolpath.start_mm = toolpath.paths.front().points.front();
   if (!end_given) toolpath.end_mm = toolpath.start_mm;
+  scenario_.exact_toolpath.start_mm = toolpath.start_mm;
+  scenario_.exact_toolpath.end_mm = toolpath.end_mm;
+  scenario_.exact_toolpath.chord_tolerance_mm = tolerance_mm;
 }
 
 std::size_t Loader::distinct_moves(const std::vector<int>& point_lines, std::size_t from) {
@@ -824,16 +828,26 @@ void Loader::clamp_feed_rates(std::vector<PrintPath>& paths, std::vector<std::ve
     std::vector<double> edge_speed(path.points.size() - 1, path.speed_mm_s);
     int last_clamped_line = -1;
     for (std::size_t k = 0; k + 1 < path.points.size() && path.speed_mm_s > 0.0; ++k) {
-      const Vec3 step = path.points[k + 1] - path.points[k];
-      const double length_mm = step.norm();
-      if (length_mm <= kJoinTolerance_mm) continue;
-      const MachineLimits limits =
-          tcp_limits_ ? tcp_limits_->along(path.points[k], path.points[k + 1]) : scenario_.limits;
+      // the edge's directions: the line's, or an arc's as fine chords of it
+      std::vector<Vec3> edge_points{path.points[k], path.points[k + 1]};
+      if (!path.arcs.empty() && path.arcs[k].is_arc()) {
+        PrintPath arc_edge;
+        arc_edge.points = edge_points;
+        arc_edge.arcs = {path.arcs[k]};
+        edge_points = arc_edge.chorded(kClampChordTolerance_mm).points;
+      }
       double allowed_mm_s = path.speed_mm_s;
-      for (int axis = 0; axis < 3; ++axis)
-        if (axis_v_max_known_[axis] && std::abs(step[axis]) > 0.0)
-          allowed_mm_s = std::min(allowed_mm_s,
-                                  limits.axes[axis].v_max_mm_s * length_mm / std::abs(step[axis]));
+      for (std::size_t c = 0; c + 1 < edge_points.size(); ++c) {
+        const Vec3 step = edge_points[c + 1] - edge_points[c];
+        const double length_mm = step.norm();
+        if (length_mm <= kJoinTolerance_mm) continue;
+        const MachineLimits limits =
+            tcp_limits_ ? tcp_limits_->along(edge_points[c], edge_points[c + 1]) : scenario_.limits;
+        for (int axis = 0; axis < 3; ++axis)
+          if (axis_v_max_known_[axis] && std::abs(step[axis]) > 0.0)
+            allowed_mm_s = std::min(
+                allowed_mm_s, limits.axes[axis].v_max_mm_s * length_mm / std::abs(step[axis]));
+      }
       if (allowed_mm_s >= path.speed_mm_s) continue;
       edge_speed[k] = allowed_mm_s;
       // a move (a line of the file) counts once, however many chords it has
@@ -856,6 +870,9 @@ void Loader::clamp_feed_rates(std::vector<PrintPath>& paths, std::vector<std::ve
       if (!path.normals.empty())
         piece.normals.assign(path.normals.begin() + static_cast<long>(run_start),
                              path.normals.begin() + static_cast<long>(k) + 1);
+      if (!path.arcs.empty())
+        piece.arcs.assign(path.arcs.begin() + static_cast<long>(run_start),
+                          path.arcs.begin() + static_cast<long>(k));
       piece.speed_mm_s = edge_speed[run_start];
       clamped_paths.push_back(std::move(piece));
       clamped_lines.emplace_back(path_lines.begin() + static_cast<long>(run_start),

@@ -125,7 +125,11 @@ struct Scenario {
   AxisLimits joint_limits;
   int joint_limits_line = 0;  // where `limits.joint` was given, for messages
   ProcessSpec process;
+  // the print paths; a G-code file's arcs are chords within its chord_tolerance_mm here
   Toolpath toolpath;
+  // the same paths (one for one, same start and end) with the G-code file's arcs exact, for
+  // the planners that consume arcs (PlannerInfo::consumes_arcs); empty when no path has arcs
+  Toolpath exact_toolpath;
   // per print path, by its PrintPath::source_index: where it was given
   std::vector<PathSource> path_sources;
   int toolpath_line = 0;  // the `toolpath:` key's line

@@ -166,7 +166,8 @@ TEST(ExportGcode, RoundTripOnEveryShippedPlanarScenario) {
       const GcodeImport import = parse_gcode(in, scenario.name + ".gcode", GcodeOptions{});
       EXPECT_EQ(import.rule,
                 scenario.process.type == "extrusion" ? PrintRule::e : PrintRule::shutter);
-      const Toolpath& imported = import.toolpath;
+      // arcs (G2/G3 written where the plan runs on a circle) as fine chords for the distances
+      const Toolpath imported = import.toolpath.chorded(1e-5);
 
       // print length: the planned motion's against the file's
       const std::vector<std::vector<Vec3>> planned = planned_print_polylines(trajectory);
@@ -205,6 +206,39 @@ TEST(ExportGcode, RoundTripOnEveryShippedPlanarScenario) {
   EXPECT_EQ(exported.size() + skipped.size(), files.size());
   EXPECT_GE(exported.size(), 7u);
   EXPECT_EQ(exported.count("gcode_rounded_square"), 1u);
+}
+
+// Where the plan runs on a circle, the export writes arcs: bezier flies the rounded square's
+// G3 corners exactly (all but each layer's last, where the path ends), so its export has G3
+// moves whose centres are the file's corner centres; lspb_mtt follows the corners' chords,
+// whose samples leave the circle by up to the 0.01 mm chord tolerance, more than the export's
+// 0.005 mm: no arcs.
+TEST(ExportGcode, ArcsWhereThePlanRunsOnACircle) {
+  const Scenario scenario = load_scenario(scenario_path("gcode_rounded_square.yaml"));
+  const PreparedJob job = prepare_job(scenario);
+  GcodeExportJob export_job;
+  export_job.process = "extrusion";
+  const auto exported = [&](const std::string& planner) {
+    for (const PlannerSpec& spec : scenario.planners)
+      if (spec.name == planner)
+        return trajectory_gcode(plan_job(job, spec).trajectory, export_job, GcodeExportSettings{});
+    return std::string();
+  };
+  const std::string bezier = exported("bezier");
+  std::istringstream lines(bezier);
+  int corner_arcs = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("G3 ", 0) != 0) continue;
+    // a corner of radius 3: the centre 3 mm from the start (I, J relative to it). (The last
+    // corner of each layer is flown on chords with small blends between them, which may fit
+    // an arc of another radius within the tolerance, and be written as one.)
+    const double i = std::stod(line.substr(line.find(" I") + 2));
+    const double j = std::stod(line.substr(line.find(" J") + 2));
+    if (std::abs(std::hypot(i, j) - 3.0) <= 1e-3) ++corner_arcs;
+  }
+  EXPECT_GE(corner_arcs, 9) << bezier;  // three exact corners a layer, three layers
+  EXPECT_EQ(bezier.find("\nG2 "), std::string::npos);  // every corner turns left
+  EXPECT_EQ(exported("lspb_mtt").find("\nG3 "), std::string::npos);
 }
 
 // the CLI: the header names the scenario and planner; the same input gives the same bytes

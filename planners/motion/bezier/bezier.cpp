@@ -6,6 +6,8 @@
 #include <optional>
 #include <sstream>
 
+#include <Eigen/Geometry>  // cross products of arcs
+
 #include "core/error.hpp"
 #include "planners/motion/bezier/bezier_curve.hpp"
 #include "planners/motion/bezier/bezier_profile.hpp"
@@ -42,6 +44,7 @@ struct PathNode {
   double cap_mm_s = 0.0;    // before the passes
   bool exact = false;       // the line before ends on a sample here (rest, or lead-in end)
   int corner = -1;          // corner number within the polyline (1-based), -1 if none
+  bool arc = false;         // the blend is one of the path's exact arcs (its corner: the start)
   std::string cap_reason;   // what limits the blend speed, for the warning
 };
 
@@ -64,7 +67,8 @@ double line_accel(const Vec3& dir, const MachineLimits& limits) {
 // |v T_axis| <= v_max and |v^2 kappa N_axis| <= a_max along the curve; at u = 0 and 1
 // the acceleration jumps between two samples, where cubic Hermite interpolation of the
 // samples overshoots a step by up to 4/3, so the ends count 4/3.
-double blend_speed_cap(const BezierBlend& blend, const MachineLimits& limits, std::string& reason) {
+double blend_speed_cap(const BezierBlend& blend, const MachineLimits& limits, std::string& reason,
+                       bool jump_at_start = true, bool jump_at_end = true) {
   constexpr int kIntervals = 256;
   double cap = std::numeric_limits<double>::infinity();
   Vec3 p, d1, d2;
@@ -75,7 +79,8 @@ double blend_speed_cap(const BezierBlend& blend, const MachineLimits& limits, st
     const Vec3 tangent = d1 / speed_u;
     // curvature vector: the normal part of d2p/du2 over |dp/du|^2
     const Vec3 curvature = (d2 - d2.dot(tangent) * tangent) / (speed_u * speed_u);
-    const double hermite_factor = (i == 0 || i == kIntervals) ? 4.0 / 3.0 : 1.0;
+    const bool jump = (i == 0 && jump_at_start) || (i == kIntervals && jump_at_end);
+    const double hermite_factor = jump ? 4.0 / 3.0 : 1.0;
     for (int axis = 0; axis < 3; ++axis) {
       const AxisLimits& lim = limits.axes[axis];
       if (std::abs(tangent[axis]) > 1e-12 && lim.v_max_mm_s / std::abs(tangent[axis]) < cap) {
@@ -96,9 +101,134 @@ std::string corner_name(const PrintPath& path, int corner) {
   return "path " + std::to_string(path.source_index) + " corner " + std::to_string(corner);
 }
 
-PathGeometry build_geometry(const PrintPath& path, const BezierSettings& settings,
-                            const MachineLimits& limits, size_t& next_weight,
-                            std::vector<std::string>& warnings) {
+std::string node_name(const PrintPath& path, const PathNode& node) {
+  return node.arc ? "path " + std::to_string(path.source_index) + " arc from point " +
+                        std::to_string(node.corner)
+                  : corner_name(path, node.corner);
+}
+
+// ---------------------------------------------------------------------------------------
+// exact arcs (G-code G2/G3): a circular arc of sweep phi is the rational quadratic Bezier with
+// its ends as end points, the tangents' intersection as middle point and weight cos(phi / 2)
+// (Piegl & Tiller, The NURBS Book, sec. 7.3), so the blend machinery of eq. (18) traverses it
+// exactly, at constant speed, pieces of at most 90 degrees
+
+// an arc meets its neighbour tangentially when their directions differ by at most this (rad)
+constexpr double kTangentJoin_rad = 2e-3;
+
+// the arc edge's radius vector at its start, in its plane (from the centre at the start's level)
+Vec3 arc_radius(const PrintPath& path, size_t edge) {
+  const EdgeArc& arc = path.arcs[edge];
+  const Vec3 r = path.points[edge] - arc.center_mm;
+  return r - r.dot(arc.axis) * arc.axis;
+}
+
+bool is_arc_edge(const PrintPath& path, size_t edge) {
+  return !path.arcs.empty() && path.arcs[edge].is_arc();
+}
+
+// the unit direction of travel at the start (s = 0) or end (s = 1) of an edge
+Vec3 edge_direction(const PrintPath& path, size_t edge, double s) {
+  if (!is_arc_edge(path, edge)) return (path.points[edge + 1] - path.points[edge]).normalized();
+  const EdgeArc& arc = path.arcs[edge];
+  const Vec3 r = arc_radius(path, edge);
+  const double phi = s * arc.sweep_rad;
+  const Vec3 rise = (path.points[edge + 1] - path.points[edge]).dot(arc.axis) / arc.sweep_rad *
+                    arc.axis;  // a helix climbs along the axis
+  return (-std::sin(phi) * r + std::cos(phi) * arc.axis.cross(r) + rise).normalized();
+}
+
+// the arc edge as blends of at most 90 degrees each (planar arcs only)
+std::vector<BezierBlend> arc_pieces(const PrintPath& path, size_t edge) {
+  const EdgeArc& arc = path.arcs[edge];
+  const Vec3 r = arc_radius(path, edge);
+  const Vec3 centre = path.points[edge] - r;
+  const Vec3 side = arc.axis.cross(r);
+  const int n = std::max(1, static_cast<int>(std::ceil(arc.sweep_rad / (kPi / 2.0) - 1e-9)));
+  const double piece_rad = arc.sweep_rad / n;
+  const auto at = [&](double phi) { return centre + std::cos(phi) * r + std::sin(phi) * side; };
+  std::vector<BezierBlend> pieces;
+  for (int k = 0; k < n; ++k) {
+    const double from = k * piece_rad, mid = (k + 0.5) * piece_rad;
+    BezierBlend piece;
+    piece.entry_mm = k == 0 ? path.points[edge] : at(from);
+    piece.exit_mm = k + 1 == n ? path.points[edge + 1] : at(from + piece_rad);
+    piece.corner_mm =
+        centre + (std::cos(mid) * r + std::sin(mid) * side) / std::cos(0.5 * piece_rad);
+    piece.weight = std::cos(0.5 * piece_rad);
+    pieces.push_back(piece);
+  }
+  return pieces;
+}
+
+// The path as bezier traverses it. An arc stays exact when it is planar, lies inside the path
+// (the path starts and ends at rest on a line: blends keep a constant speed) and meets both
+// neighbours tangentially; every other arc becomes chords within `tolerance_mm`, as for the
+// planners that need polylines. `original_vertex` gets each vertex's index in `path`, -1 for
+// a vertex between chords.
+PrintPath with_traversable_arcs(const PrintPath& path, double tolerance_mm,
+                                std::vector<int>& original_vertex) {
+  const size_t edges = path.points.size() - 1;
+  std::vector<bool> exact(edges, false);
+  if (path.has_arcs() && path.normals.empty() && path.rolls.empty())
+    for (size_t e = 1; e + 1 < edges; ++e)
+      exact[e] = is_arc_edge(path, e) &&
+                 std::abs((path.points[e + 1] - path.points[e]).dot(path.arcs[e].axis)) <= 1e-9;
+  // an edge's direction at a join: an arc kept exact its tangent, a chorded one its chord's
+  const auto chord_direction = [&](size_t edge, bool at_end) {
+    PrintPath single;
+    single.points = {path.points[edge], path.points[edge + 1]};
+    single.arcs = {path.arcs[edge]};
+    const std::vector<Vec3> chords = single.chorded(tolerance_mm).points;
+    return at_end ? (chords.back() - chords[chords.size() - 2]).normalized()
+                  : (chords[1] - chords[0]).normalized();
+  };
+  const auto direction = [&](size_t edge, bool at_end) {
+    if (is_arc_edge(path, edge) && !exact[edge]) return chord_direction(edge, at_end);
+    return edge_direction(path, edge, at_end ? 1.0 : 0.0);
+  };
+  // tangency, until no arc changes (an arc chorded may break its neighbour's tangency)
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t e = 1; e + 1 < edges; ++e) {
+      if (!exact[e]) continue;
+      const double in =
+          std::acos(std::clamp(direction(e - 1, true).dot(direction(e, false)), -1.0, 1.0));
+      const double out =
+          std::acos(std::clamp(direction(e, true).dot(direction(e + 1, false)), -1.0, 1.0));
+      if (in > kTangentJoin_rad || out > kTangentJoin_rad) exact[e] = false, changed = true;
+    }
+  }
+  // the path with the other arcs' chords
+  PrintPath out = path;
+  out.points.assign(1, path.points.front());
+  out.arcs.clear();
+  original_vertex.assign(1, 0);
+  for (size_t e = 0; e < edges; ++e) {
+    if (is_arc_edge(path, e) && !exact[e]) {
+      PrintPath single;
+      single.points = {path.points[e], path.points[e + 1]};
+      single.arcs = {path.arcs[e]};
+      const std::vector<Vec3> chords = single.chorded(tolerance_mm).points;
+      for (size_t c = 1; c + 1 < chords.size(); ++c) {
+        out.points.push_back(chords[c]);
+        out.arcs.push_back(EdgeArc{});
+        original_vertex.push_back(-1);
+      }
+      out.arcs.push_back(EdgeArc{});
+    } else {
+      out.arcs.push_back(exact[e] ? path.arcs[e] : EdgeArc{});
+    }
+    out.points.push_back(path.points[e + 1]);
+    original_vertex.push_back(static_cast<int>(e + 1));
+  }
+  if (!out.has_arcs()) out.arcs.clear();
+  return out;
+}
+
+PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& original_vertex,
+                            const BezierSettings& settings, const MachineLimits& limits,
+                            size_t first_weight, std::vector<std::string>& warnings) {
   const std::vector<Vec3>& points = path.points;
   const size_t edges = points.size() - 1;
   const double print_speed = path.speed_mm_s;
@@ -109,24 +239,33 @@ PathGeometry build_geometry(const PrintPath& path, const BezierSettings& setting
     dirs[i] = (points[i + 1] - points[i]) / lengths[i];
   }
 
-  PathGeometry g;
-  g.nodes.resize(edges + 1);
-  g.nodes.front().exact = true;  // start at rest
-  g.nodes.back().exact = true;   // end at rest
-  for (size_t j = 1; j < edges; ++j) {
-    PathNode& node = g.nodes[j];
-    node.corner = static_cast<int>(j);
-    const double weight =
-        settings.weights.size() == 1 ? settings.weights.front() : settings.weights[next_weight];
-    ++next_weight;
+  // a straight line from a to b along dir (trimmed by the blends below)
+  const auto line_between = [&](const Vec3& a, const Vec3& b, const Vec3& dir) {
+    PathLine line;
+    line.from_mm = a;
+    line.to_mm = b;
+    line.dir = dir;
+    line.accel_mm_s2 = line_accel(dir, limits);
+    line.cap_mm_s = print_speed;
+    return line;
+  };
+
+  // the blended corner at vertex j between straight edges j - 1 and j
+  const auto corner_node = [&](size_t j) {
+    PathNode node;
+    node.corner = original_vertex[j] >= 0 ? original_vertex[j] : static_cast<int>(j);
+    const double weight = settings.weights.size() == 1 ? settings.weights.front()
+                          : original_vertex[j] > 0
+                              ? settings.weights[first_weight + original_vertex[j] - 1]
+                              : 1.0;  // a corner between an arc's chords
     const Vec3& in_dir = dirs[j - 1];
     const Vec3& out_dir = dirs[j];
     // an exact reversal has no blend (its parabola degenerates to a cusp): stop there
     if ((in_dir + out_dir).norm() < 1e-9) {
       node.exact = true;
-      warnings.push_back(corner_name(path, int(j)) +
+      warnings.push_back(corner_name(path, node.corner) +
                          ": reverses direction; stopping at the corner");
-      continue;
+      return node;
     }
     // fillet distance, clipped to half the shorter adjacent line
     const double room = 0.5 * std::min(lengths[j - 1], lengths[j]);
@@ -134,8 +273,8 @@ PathGeometry build_geometry(const PrintPath& path, const BezierSettings& setting
     if (delta > room) {
       delta = room;
       std::ostringstream msg;
-      msg << corner_name(path, int(j)) << ": fillet distance clipped from " << settings.delta_mm
-          << " to " << delta << " mm (half the shorter adjacent line)";
+      msg << corner_name(path, node.corner) << ": fillet distance clipped from "
+          << settings.delta_mm << " to " << delta << " mm (half the shorter adjacent line)";
       warnings.push_back(msg.str());
     }
     BezierBlend blend = BezierBlend::at_corner(points[j], in_dir, out_dir, delta, weight);
@@ -152,27 +291,59 @@ PathGeometry build_geometry(const PrintPath& path, const BezierSettings& setting
     if (blend_extra > stop_extra) {
       node.exact = true;
       std::ostringstream msg;
-      msg << corner_name(path, int(j)) << ": blend would need " << cap << " mm/s (" << reason
+      msg << corner_name(path, node.corner) << ": blend would need " << cap << " mm/s (" << reason
           << "); stopping at the corner is faster";
       warnings.push_back(msg.str());
-      continue;
+      return node;
     }
     node.blend = blend;
     node.blend_length_mm = blend_length;
     node.cap_mm_s = cap;
     node.cap_reason = cap < print_speed ? reason : "";
-  }
+    return node;
+  };
 
-  // lines between the nodes: trimmed by the blends, full edges at stops and path ends
-  g.lines.resize(edges);
-  for (size_t i = 0; i < edges; ++i) {
+  // nodes and lines alternate: a straight edge is a line, a corner between two straight edges
+  // a node (blend or stop), an exact arc one node per piece (zero-length lines between
+  // pieces and between consecutive arcs); the path starts and ends at rest on a line
+  PathGeometry g;
+  g.nodes.emplace_back();
+  g.nodes.back().exact = true;
+  for (size_t e = 0; e < edges; ++e) {
+    if (!is_arc_edge(path, e)) {
+      if (e > 0 && !is_arc_edge(path, e - 1)) g.nodes.push_back(corner_node(e));
+      g.lines.push_back(line_between(points[e], points[e + 1], dirs[e]));
+      continue;
+    }
+    const std::vector<BezierBlend> pieces = arc_pieces(path, e);
+    for (size_t k = 0; k < pieces.size(); ++k) {
+      const BezierBlend& piece = pieces[k];
+      if (k > 0 || is_arc_edge(path, e - 1))
+        g.lines.push_back(line_between(
+            piece.entry_mm, piece.entry_mm,
+            edge_direction(path, e, static_cast<double>(k) / static_cast<double>(pieces.size()))));
+      PathNode node;
+      node.arc = true;
+      node.corner = original_vertex[e];
+      node.blend = piece;
+      node.blend_length_mm = piece.arc_length_mm();
+      // the curvature jumps where the arc meets another curve or a line, not between pieces
+      std::string reason;
+      node.cap_mm_s = std::min(
+          print_speed, blend_speed_cap(piece, limits, reason, k == 0, k + 1 == pieces.size()));
+      node.cap_reason = node.cap_mm_s < print_speed ? reason : "";
+      g.nodes.push_back(node);
+    }
+  }
+  g.nodes.emplace_back();
+  g.nodes.back().exact = true;
+
+  // lines between the nodes: trimmed by the blends (an arc's ends are its lines' ends)
+  for (size_t i = 0; i < g.lines.size(); ++i) {
     PathLine& line = g.lines[i];
-    line.from_mm = g.nodes[i].blend ? g.nodes[i].blend->exit_mm : points[i];
-    line.to_mm = g.nodes[i + 1].blend ? g.nodes[i + 1].blend->entry_mm : points[i + 1];
-    line.dir = dirs[i];
-    line.length_mm = std::max(0.0, (line.to_mm - line.from_mm).dot(dirs[i]));
-    line.accel_mm_s2 = line_accel(dirs[i], limits);
-    line.cap_mm_s = print_speed;
+    if (g.nodes[i].blend) line.from_mm = g.nodes[i].blend->exit_mm;
+    if (g.nodes[i + 1].blend) line.to_mm = g.nodes[i + 1].blend->entry_mm;
+    line.length_mm = std::max(0.0, (line.to_mm - line.from_mm).dot(line.dir));
   }
 
   // lead-in/out: straight extensions of the first and last line, material off; the
@@ -552,8 +723,9 @@ std::unique_ptr<Planner> make_bezier_planner(const PlannerSpec& spec) {
 Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_limits) const {
   const std::string limits_problem = tcp_limits.requested().validate();
   if (!limits_problem.empty()) throw InputError("limits", limits_problem);
-  // degenerate edges, bad speeds and lines too fast for an axis: as for every planner
-  split_into_segments(toolpath, tcp_limits);
+  // degenerate edges, bad speeds and lines too fast for an axis: as for every planner (arcs as
+  // the chords the others get)
+  split_into_segments(toolpath.chorded(toolpath.chord_tolerance_mm), tcp_limits);
 
   // one weight for all corners, or exactly one per corner
   size_t corners = 0;
@@ -581,11 +753,16 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
   std::vector<int> owners;
   std::vector<double> slow_down;
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
-    const PrintPath& path = toolpath.paths[i];
+    // the path with the arcs it can traverse exactly, the others as chords
+    std::vector<int> original_vertex;
+    const PrintPath path =
+        with_traversable_arcs(toolpath.paths[i], toolpath.chord_tolerance_mm, original_vertex);
     // the limits over the path's own box (per path: its blends and ramps are planned together)
     const MachineLimits limits =
         path_limits(path, tcp_limits, settings_.lead_in, settings_.period_s);
-    PathGeometry geometry = build_geometry(path, settings_, limits, next_weight, warnings);
+    PathGeometry geometry =
+        build_geometry(path, original_vertex, settings_, limits, next_weight, warnings);
+    next_weight += toolpath.paths[i].points.size() - 2;
 
     // the samples: Taylor update along the path; blends whose samples, interpolated,
     // exceed a limit are slowed and the path sampled again
@@ -622,7 +799,7 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
     for (const PathNode& node : geometry.nodes) {
       if (!node.blend || node.speed_mm_s >= path.speed_mm_s * (1.0 - 1e-9)) continue;
       std::ostringstream msg;
-      msg << corner_name(path, node.corner) << ": blend slowed to " << node.speed_mm_s
+      msg << node_name(path, node) << ": blend slowed to " << node.speed_mm_s
           << " mm/s (print speed " << path.speed_mm_s << " mm/s; "
           << (node.cap_reason.empty() ? std::string("adjacent lines too short to ramp")
                                       : node.cap_reason)
