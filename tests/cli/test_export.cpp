@@ -236,7 +236,7 @@ TEST(ExportGcode, ArcsWhereThePlanRunsOnACircle) {
     const double j = std::stod(line.substr(line.find(" J") + 2));
     if (std::abs(std::hypot(i, j) - 3.0) <= 1e-3) ++corner_arcs;
   }
-  EXPECT_GE(corner_arcs, 9) << bezier;  // three exact corners a layer, three layers
+  EXPECT_GE(corner_arcs, 9) << bezier;                 // three exact corners a layer, three layers
   EXPECT_EQ(bezier.find("\nG2 "), std::string::npos);  // every corner turns left
   EXPECT_EQ(exported("lspb_mtt").find("\nG3 "), std::string::npos);
 }
