@@ -14,6 +14,7 @@
 #include "deposition/field_io.hpp"
 #include "kinematics/arm6.hpp"
 #include "metrics/run_report.hpp"
+#include "pipeline/deposition_worker.hpp"
 #include "pipeline/progress_line.hpp"
 #include "pipeline/replay.hpp"  // moving pictures
 #include "plots/plots.hpp"
@@ -147,10 +148,12 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   // moving pictures: MuJoCo's whole state sampled for the replay data
   run.states = std::make_shared<StateSamples>(*run.simulation);
   StateSamples& states = *run.states;
+  // (laid down on a worker thread while the simulation goes on, in the same order)
+  DepositionWorker depositing(deposit);
   auto on_step = [&](const StepState& before, const StepState& after) {
     if (before.path_index >= 0) layer = job.toolpath.paths[before.path_index].layer;
     DepositionStep step;
-    if (deposition_step(before, after, job_end_s, step)) deposit.advance(step, layer);
+    if (deposition_step(before, after, job_end_s, step)) depositing.push(step, layer);
     states.on_step(after);
   };
   // the progress line names the run (a compare's order and planner: its label)
@@ -158,6 +161,7 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
                         ProgressLine::style_for_stderr(settings.progress));
   run.record =
       run.simulation->run(trajectory, on_step, [&](double fraction) { progress.update(fraction); });
+  depositing.finish();
   progress.finish();
   run.simulation->set_feedforward_hook({});  // it refers to this function's locals
 
