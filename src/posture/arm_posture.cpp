@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 namespace depotwin {
 
@@ -226,6 +227,7 @@ std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>&
   const double print_step = deg_to_rad(kPrintJointStep_deg);
   const double travel_step = deg_to_rad(kTravelJointStep_deg);
   for (size_t s = 1; s < n; ++s) {
+    throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp)
     const bool travel = stations[s].after_travel;
     for (int k = 0; k < K; ++k) {
       next[k] = kInfinity;
@@ -424,6 +426,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   const auto at = [&](int b, size_t s, int k) { return (static_cast<size_t>(b) * n + s) * K + k; };
   Arm6Branches solved;
   for (size_t s = 0; s < n; ++s) {
+    throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp)
     for (int k = 0; k < K; ++k) {
       if (!arm.branch_solutions(rolled(stations[s], k * step_rad), solved)) continue;
       for (int b = 0; b < kBranches; ++b) {
