@@ -208,9 +208,6 @@ int main(int argc, char** argv) {
   move->add_option("--jmax", jmax, "jerk limits, mm/s^3, 0: none (one per axis, or one for all)");
 
   if (const int status = check_verb(app, argc, argv); status >= 0) return status;
-  // SIGINT and SIGTERM stop the verb: its staging folder removed, its children ended, the
-  // output as it was, exit 130 or 143 (core/interrupt.hpp); set before any thread starts
-  install_interrupt_handlers();
   try {
     try {
       app.parse(argc, argv);
@@ -224,6 +221,11 @@ int main(int argc, char** argv) {
       app.exit(e);
       return kExitBadInput;
     }
+    // the verbs that write: SIGINT and SIGTERM stop them with their staging folder removed,
+    // their children ended, the output as it was, exit 130 or 143 (core/interrupt.hpp); set
+    // before any thread starts. The others (validate, view, ...) write nothing and keep the
+    // signals' default: they end at once.
+    if (*run || *compare || *plan || *export_gcode) install_interrupt_handlers();
     if (*run) return run_verb(run_options);
     if (*compare) return compare_verb(compare_options);
     if (*plan) return plan_verb(plan_options);
