@@ -355,6 +355,7 @@ ArmStats arm_run_stats(const Arm6& arm, const PartClearance* part, const Recorde
   bool in_contact = false;
   double last_clearance = kInfinity;
   for (size_t k = 0; k < record.size(); ++k) {
+    if (k % static_cast<size_t>(stride) == 0) throw_if_interrupted();  // core/interrupt.hpp
     for (int j = 0; j < 6; ++j) q[j] = record.joint(record.joint_position, k, j);
     stats.run.min_joint_margin_deg =
         std::min(stats.run.min_joint_margin_deg, rad_to_deg(arm.joint_margin_rad(q)));
@@ -636,6 +637,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       // measure along the path; where it is too close, every roll of that station
       bool clear = true;
       for (size_t s = 0; s < n; ++s) {
+        throw_if_interrupted();
         measure(s, path[s]);
         if (std::isfinite(ladder.cost[ladder.index(s, path[s])])) continue;
         clear = false;
@@ -826,6 +828,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   double chosen_cost = 0.0;
   Arm6Joints last{};
   for (size_t t = 0; t < n; ++t) {
+    throw_if_interrupted();
     chosen_cost += cost[at(branch, t, chosen[t])];
     if (!arm.branch_solutions(rolled(stations[t], chosen[t] * step_rad), solved)) continue;
     keep_worst(result.chosen, posture_at(arm, part, to_vector(solved[branch])));
@@ -838,6 +841,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     fixed->stats = best_possible_posture();
     const int k = static_cast<int>(std::lround(fixed->roll_deg / settings.roll_step_deg)) % K;
     for (size_t t = 0; t < n; ++t) {
+      throw_if_interrupted();
       if (!arm.branch_solutions(rolled(stations[t], k * step_rad), solved)) continue;
       keep_worst(fixed->stats, posture_at(arm, part, to_vector(solved[fixed->branch])));
       if (t > 0 && !stations[t].after_travel)
