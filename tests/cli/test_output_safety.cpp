@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -274,12 +275,19 @@ void interrupt_trials(int signal_number, const std::string& name, int trials) {
   EXPECT_GE(interrupted, trials / 2);
 }
 
+// trials per signal: 20, or DEPOTWIN_INTERRUPT_TRIALS (fewer under a sanitizer, more on demand)
+int interrupt_trial_count() {
+  const char* text = std::getenv("DEPOTWIN_INTERRUPT_TRIALS");
+  const int count = text != nullptr ? std::atoi(text) : 0;
+  return count > 0 ? count : 20;
+}
+
 TEST(OutputSafety, SigintAtAnyMomentLeavesTheEarlierResultWhole) {
-  interrupt_trials(SIGINT, "safety_sigint", 20);
+  interrupt_trials(SIGINT, "safety_sigint", interrupt_trial_count());
 }
 
 TEST(OutputSafety, SigtermAtAnyMomentLeavesTheEarlierResultWhole) {
-  interrupt_trials(SIGTERM, "safety_sigterm", 20);
+  interrupt_trials(SIGTERM, "safety_sigterm", interrupt_trial_count());
 }
 
 // SIGKILL runs no handler: gnuplot dies with depotwin all the same (the kernel's parent-death
