@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "planners/motion/path_parametrization.hpp"
 
 namespace depotwin {
@@ -692,6 +693,7 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
   Vec3 position = toolpath.start_mm;
   ToolOrientation orientation = toolpath.start_orientation();
   for (size_t index = 0; index < toolpath.paths.size(); ++index) {
+    throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp)
     const PrintPath& path = toolpath.paths[index];
     const std::string name = path_name(path, index);
     validate_path(path, name);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 namespace depotwin {
 
@@ -13,6 +14,8 @@ namespace {
 
 constexpr double kMinGain_s = 1e-9;
 constexpr int kMaxChainNodes = 6;  // or_opt moves chains of at most 3 paths (6 ends)
+// nodes searched between two looks at the interrupt flag
+constexpr long kInterruptCheckNodes = 256;
 
 // The cycle over the path ends as an array with positions, so a stretch can be
 // reversed in place (the shorter side of the cycle is reversed).
@@ -170,7 +173,9 @@ class LocalSearch {
     queue_.assign(n, 0);
     queued_.assign(n, false);
     for (int v = 0; v < n; ++v) push(v);
-    while (count_ > 0) {
+    for (long searched = 0; count_ > 0; ++searched) {
+      // a signal asked to stop (core/interrupt.hpp)
+      if (searched % kInterruptCheckNodes == 0) throw_if_interrupted();
       const int t1 = queue_[head_];
       head_ = (head_ + 1) % n, --count_;
       queued_[t1] = false;

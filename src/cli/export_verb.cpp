@@ -14,7 +14,9 @@
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/interrupt.hpp"
 #include "pipeline/job.hpp"
+#include "report/output_dir.hpp"
 
 #ifndef DEPOTWIN_VERSION
 #define DEPOTWIN_VERSION "unknown"
@@ -418,6 +420,11 @@ void check_out_path(const std::string& out) {
 int export_verb(const ExportOptions& options) {
   check_out_path(options.out);
   const Scenario scenario = load_scenario(options.scenario);
+  // one writer of the file at a time (report/output_dir.hpp); what writers killed outright
+  // left beside it goes
+  const std::string target = std::filesystem::absolute(options.out).lexically_normal().string();
+  OutputLock lock(target, options.out, "export", !options.no_wait);
+  remove_stale_staging(target);
   // 3-axis G-code has no tool axis: a conformal job's tilts would be lost silently
   bool tilted = scenario.surface != nullptr;
   for (const PrintPath& path : scenario.toolpath.paths) tilted = tilted || !path.normals.empty();
@@ -444,8 +451,11 @@ int export_verb(const ExportOptions& options) {
   export_job.flow_mm3_s = scenario.process.flow_mm3_s;
   export_job.bead_width_mm = scenario.process.bead_width_mm;
   export_job.layer_height_mm = scenario.process.layer_height_mm;
-  write_file_atomically(options.out,
-                        trajectory_gcode(planned.trajectory, export_job, options.settings));
+  // a signal that asked to stop leaves the earlier file; the new one is renamed in whole
+  const std::string gcode = trajectory_gcode(planned.trajectory, export_job, options.settings);
+  throw_if_interrupted();
+  write_file_atomically(options.out, gcode);
+  lock.release();
   std::cout << "scenario " << scenario.name << ", planner " << export_job.planner << ": "
             << number_text(planned.trajectory.duration_s(), 3) << " s of planned motion written to "
             << options.out << '\n';

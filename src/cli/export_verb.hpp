@@ -54,6 +54,7 @@ struct ExportOptions {
   std::string planner;  // a run label of the scenario; empty: its only planner
   std::string out;      // the .gcode file
   GcodeExportSettings settings;
+  bool no_wait = false;  // another writer of --out holds its lock: exit 2 instead of waiting
 };
 
 // Plans the scenario with one planner and writes the G-code atomically. InputError (exit 2)

@@ -1,5 +1,6 @@
 // depotwin: the command line. Each verb is a thin wrapper around the pipeline.
-// Exit status: 0 success, 2 bad input (file:line: key: message), 1 internal failure.
+// Exit status: 0 success, 2 bad input (file:line: key: message), 1 internal failure, 130 or 143
+// when SIGINT or SIGTERM stopped it (the output is then as it was before).
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <iostream>
@@ -11,6 +12,7 @@
 #include "cli/move_verb.hpp"
 #include "cli/verbs.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "pipeline/models_dir.hpp"
 #include "viewer/viewer.hpp"  // view
 
@@ -71,6 +73,8 @@ int main(int argc, char** argv) {
   run->add_option("--out", run_options.out, "output directory (default: results/<scenario name>)");
   run->add_flag("--no-render", run_options.no_render, "write no images or plots");
   run->add_flag("--quiet", run_options.quiet, "no progress line");
+  run->add_flag("--no-wait", run_options.no_wait,
+                "exit (status 2) instead of waiting while another depotwin writes --out");
   // ---- moving pictures (src/render/video.hpp) ----
   run->add_flag("--video", run_options.video,
                 "also write run.mp4 in each run folder: the scene over time, the deposit growing");
@@ -92,6 +96,8 @@ int main(int argc, char** argv) {
                       "output directory (default: results/<scenario name>)");
   compare->add_flag("--no-render", compare_options.run.no_render, "write no images or plots");
   compare->add_flag("--quiet", compare_options.run.quiet, "no progress line");
+  compare->add_flag("--no-wait", compare_options.run.no_wait,
+                    "exit (status 2) instead of waiting while another depotwin writes --out");
   // ---- moving pictures (src/render/video.hpp) ----
   compare->add_flag("--video", compare_options.run.video, "also write run.mp4 in each run folder");
   compare
@@ -108,6 +114,8 @@ int main(int argc, char** argv) {
                    "planner(s), comma-separated (default: all of the scenario's)");
   plan->add_option("--out", plan_options.out,
                    "output directory (default: results/<scenario name>)");
+  plan->add_flag("--no-wait", plan_options.no_wait,
+                 "exit (status 2) instead of waiting while another depotwin writes --out");
 
   std::string validate_scenario;
   CLI::App* validate =
@@ -161,6 +169,8 @@ int main(int argc, char** argv) {
                            "aerosol: the shutter-open code (default M3)");
   export_gcode->add_option("--close", export_options.settings.close_code,
                            "aerosol: the shutter-close code (default M5)");
+  export_gcode->add_flag("--no-wait", export_options.no_wait,
+                         "exit (status 2) instead of waiting while another depotwin writes --out");
   // ---- end export ----
 
   // ---- inspect (facts of a G-code file: src/cli/inspect.cpp) ----
@@ -217,6 +227,11 @@ int main(int argc, char** argv) {
       app.exit(e);
       return kExitBadInput;
     }
+    // the verbs that write: SIGINT and SIGTERM stop them with their staging folder removed,
+    // their children ended, the output as it was, exit 130 or 143 (core/interrupt.hpp); set
+    // before any thread starts. The others (validate, view, ...) write nothing and keep the
+    // signals' default: they end at once.
+    if (*run || *compare || *plan || *export_gcode) install_interrupt_handlers();
     if (*run) return run_verb(run_options);
     if (*compare) return compare_verb(compare_options);
     if (*plan) return plan_verb(plan_options);
@@ -242,13 +257,20 @@ int main(int argc, char** argv) {
       std::cout << minimum_time_move_json(request).dump(2) << '\n';
       return kExitOk;
     }
+  } catch (const Interrupted& stop) {
+    // everything was cleaned up while the exception unwound
+    std::cerr << "depotwin: " << stop.what() << "; stopped, the output is as it was\n";
+    return stop.exit_status();
   } catch (const InputError& error) {
     print_problems(error);
     return kExitBadInput;
-  } catch (const InternalError& error) {
-    std::cerr << "internal error: " << error.what() << '\n';
-    return kExitInternal;
   } catch (const std::exception& error) {
+    // a failure while a signal stops the run (a write cut short) is the interrupt's doing
+    if (interrupt_requested()) {
+      std::cerr << "depotwin: " << Interrupted(interrupt_signal()).what()
+                << "; stopped, the output is as it was\n";
+      return Interrupted(interrupt_signal()).exit_status();
+    }
     std::cerr << "internal error: " << error.what() << '\n';
     return kExitInternal;
   }

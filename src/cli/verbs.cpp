@@ -31,7 +31,8 @@ int plan_verb(const RunOptions& options) {
   const Scenario scenario = load_scenario(options.scenario);
   const std::vector<PlannerSpec> planners = selected_planners(scenario, options.planners);
   // the output folder is checked before any planning, and replaced whole at the end
-  OutputFolder out(output_directory(scenario, options.out), "plan", scenario.file);
+  OutputFolder out(output_directory(scenario, options.out), "plan", scenario.file,
+                   !options.no_wait);
   const std::string& directory = out.final_path();
   const PreparedJob job = prepare_job(scenario);
   const std::vector<MetricsReport> reports = write_plans(job, planners, out.path());
@@ -82,7 +83,7 @@ int run_verb(const RunOptions& options) {
   const std::vector<PlannerSpec> planners = selected_planners(scenario, options.planners);
   // the output folder is checked before any planning, and replaced whole at the end; it
   // outlives the writer below, which writes into it
-  OutputFolder out(output_directory(scenario, options.out), "run", scenario.file);
+  OutputFolder out(output_directory(scenario, options.out), "run", scenario.file, !options.no_wait);
   const std::string& directory = out.final_path();
   const PreparedJob job = prepare_job(scenario);
   const RunSettings settings = run_settings(scenario, options);
@@ -119,7 +120,8 @@ int compare_verb(const CompareOptions& options) {
   const std::vector<OrderSpec> orders = parse_order_list(options.orders, scenario.order);
   comparison_cases(scenario, planners, orders);  // refuses runs sharing a label, before any work
   // the output folder is checked before any planning, and replaced whole at the end
-  OutputFolder out(output_directory(scenario, options.run.out), "compare", scenario.file);
+  OutputFolder out(output_directory(scenario, options.run.out), "compare", scenario.file,
+                   !options.run.no_wait);
   const std::string& directory = out.final_path();
   const RunSettings settings = run_settings(scenario, options.run);
   const std::vector<ComparisonRow> rows =

@@ -11,6 +11,8 @@ struct RunOptions {
   std::string out;
   bool no_render = false;
   bool quiet = false;
+  // another writer of --out holds its lock: exit 2 instead of waiting (report/output_dir.hpp)
+  bool no_wait = false;
   // ---- moving pictures: run.mp4 (RunSettings::video) ----
   bool video = false;
   double video_length_s = 30.0;

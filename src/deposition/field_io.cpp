@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/interrupt.hpp"
 #include "core/png.hpp"
 
 namespace depotwin {
@@ -90,6 +91,7 @@ void write_heightmap_csv(const HeightMap& map, const std::string& path, double u
   }
   out << '\n';
   for (int row = 0; row < map.ny; ++row) {
+    throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp)
     const int iy = map.ny - 1 - row;
     std::snprintf(value, sizeof(value), "%.9g", map.origin_y_mm + iy * map.cell_mm);
     out << value;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/interrupt.hpp"
+
 namespace depotwin {
 
 void MotionSamples::reserve(size_t n) {
@@ -178,6 +180,8 @@ PathErrorStats path_error(const MotionSamples& samples, const Toolpath& toolpath
   PathErrorStats stats;
   double sum_sq = 0.0, total_time = 0.0;
   for (size_t k = 0; k < samples.size(); ++k) {
+    // a long path's distances take seconds: a signal that asked to stop ends them
+    if (k % 1024 == 0) throw_if_interrupted();
     const int path = samples.path_index[k];
     if (!samples.depositing[k] || path < 0 || path >= static_cast<int>(toolpath.paths.size()))
       continue;

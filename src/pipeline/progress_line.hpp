@@ -51,6 +51,15 @@ class ProgressLine {
         clock_(std::move(clock)),
         log_period_s_(log_period),
         start_s_(clock_()) {}
+  // a line left open (an exception, an interrupt) ends here, so what follows starts afresh
+  ~ProgressLine() {
+    if (shown_ && style_ == Style::terminal) {
+      std::fputc('\n', out_);
+      std::fflush(out_);
+    }
+  }
+  ProgressLine(const ProgressLine&) = delete;
+  ProgressLine& operator=(const ProgressLine&) = delete;
 
   // the step is `fraction` (0..1) done
   void update(double fraction) {

@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "deposition/deposition_metrics.hpp"
 #include "deposition/field_io.hpp"
 #include "kinematics/arm6.hpp"
@@ -211,6 +212,7 @@ HeightMap field_heightmap(const ThicknessField& field, size_t max_cells) {
 
 void write_run(const PreparedJob& job, const SimulatedRun& run, const std::string& run_directory,
                const RunSettings& settings) {
+  throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp): nothing more to write
   StagedDirectory out(run_directory);
   const ThicknessField& field = run.deposit->normal_field();
   const HeightMap map = field_heightmap(field, kMaxExportCells);  // at most ~4 M cells
@@ -268,7 +270,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
   }
 
   // the plots are waited for (and their errors rethrown) even when this part fails, so no
-  // thread outlives its inputs
+  // thread outlives its inputs; between the stages, a signal that asked to stop ends the write
   try {
     // --- moving pictures: the replay data `depotwin view` reads (always)
     const ReplayData replay =
@@ -287,6 +289,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
       std::cout << line << std::flush;
     }
     // --- end moving pictures
+    throw_if_interrupted();
     write_file_atomically(out.file("metrics.json"), metrics_json_text(run.report));
     write_file_atomically(out.file("trajectory.csv"),
                           planned_and_simulated_csv(run.planned_at_steps, run.simulated));
@@ -298,6 +301,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
     }
 
     // the MuJoCo scene through OSMesa
+    throw_if_interrupted();
     if (settings.render) {
       SceneRenderOptions scene = scene_render_options(job.scenario);
       // on a part, the deposit lies on its surface

@@ -14,6 +14,9 @@
 #include <sstream>
 #include <system_error>
 
+#include "core/child_process.hpp"
+#include "core/interrupt.hpp"
+
 extern char** environ;
 
 namespace depotwin::plots {
@@ -71,6 +74,7 @@ std::string find_gnuplot(const std::string& program) {
 
 std::vector<std::string> run_gnuplot(const std::string& executable, const std::string& script_path,
                                      const std::string& stderr_path) {
+  throw_if_interrupted();  // no new child once a signal has asked to stop
   // stdin and stdout from/to /dev/null, stderr to a file we read afterwards
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -78,28 +82,23 @@ std::vector<std::string> run_gnuplot(const std::string& executable, const std::s
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
   posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, stderr_path.c_str(),
                                    O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::vector<std::string> arguments = {executable, "-d", script_path};
-  std::vector<char*> argv;
-  for (std::string& argument : arguments) argv.push_back(argument.data());
-  argv.push_back(nullptr);
+  const std::vector<std::string> arguments = {executable, "-d", script_path};
   std::vector<std::string> environment = child_environment();
   std::vector<char*> envp;
   for (std::string& entry : environment) envp.push_back(entry.data());
   envp.push_back(nullptr);
 
+  // under depotwin's control: a signal that stops the run ends it (core/child_process.hpp)
   pid_t child = 0;
-  const int spawn_error =
-      ::posix_spawn(&child, executable.c_str(), &actions, nullptr, argv.data(), envp.data());
+  const int spawn_error = spawn_child_process(child, arguments, &actions, envp.data());
   posix_spawn_file_actions_destroy(&actions);
   if (spawn_error == ENOENT) throw GnuplotNotFound();
   if (spawn_error != 0)
     throw InternalError("cannot start " + executable + ": " + std::strerror(spawn_error));
 
-  // wait for it, whatever signals arrive meanwhile
-  int status = 0;
-  while (::waitpid(child, &status, 0) < 0) {
-    if (errno != EINTR) throw InternalError("waiting for gnuplot failed");
-  }
+  // wait for it; killed because a signal stopped the run, it did not fail: the run stops
+  const int status = wait_child_process(child);
+  throw_if_interrupted();
   const std::string messages = read_file(stderr_path);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     const std::string how = WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))

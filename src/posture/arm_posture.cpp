@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 namespace depotwin {
 
@@ -226,6 +227,7 @@ std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>&
   const double print_step = deg_to_rad(kPrintJointStep_deg);
   const double travel_step = deg_to_rad(kTravelJointStep_deg);
   for (size_t s = 1; s < n; ++s) {
+    throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp)
     const bool travel = stations[s].after_travel;
     for (int k = 0; k < K; ++k) {
       next[k] = kInfinity;
@@ -353,6 +355,7 @@ ArmStats arm_run_stats(const Arm6& arm, const PartClearance* part, const Recorde
   bool in_contact = false;
   double last_clearance = kInfinity;
   for (size_t k = 0; k < record.size(); ++k) {
+    if (k % static_cast<size_t>(stride) == 0) throw_if_interrupted();  // core/interrupt.hpp
     for (int j = 0; j < 6; ++j) q[j] = record.joint(record.joint_position, k, j);
     stats.run.min_joint_margin_deg =
         std::min(stats.run.min_joint_margin_deg, rad_to_deg(arm.joint_margin_rad(q)));
@@ -424,6 +427,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   const auto at = [&](int b, size_t s, int k) { return (static_cast<size_t>(b) * n + s) * K + k; };
   Arm6Branches solved;
   for (size_t s = 0; s < n; ++s) {
+    throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp)
     for (int k = 0; k < K; ++k) {
       if (!arm.branch_solutions(rolled(stations[s], k * step_rad), solved)) continue;
       for (int b = 0; b < kBranches; ++b) {
@@ -633,6 +637,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       // measure along the path; where it is too close, every roll of that station
       bool clear = true;
       for (size_t s = 0; s < n; ++s) {
+        throw_if_interrupted();
         measure(s, path[s]);
         if (std::isfinite(ladder.cost[ladder.index(s, path[s])])) continue;
         clear = false;
@@ -823,6 +828,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   double chosen_cost = 0.0;
   Arm6Joints last{};
   for (size_t t = 0; t < n; ++t) {
+    throw_if_interrupted();
     chosen_cost += cost[at(branch, t, chosen[t])];
     if (!arm.branch_solutions(rolled(stations[t], chosen[t] * step_rad), solved)) continue;
     keep_worst(result.chosen, posture_at(arm, part, to_vector(solved[branch])));
@@ -835,6 +841,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     fixed->stats = best_possible_posture();
     const int k = static_cast<int>(std::lround(fixed->roll_deg / settings.roll_step_deg)) % K;
     for (size_t t = 0; t < n; ++t) {
+      throw_if_interrupted();
       if (!arm.branch_solutions(rolled(stations[t], k * step_rad), solved)) continue;
       keep_worst(fixed->stats, posture_at(arm, part, to_vector(solved[fixed->branch])));
       if (t > 0 && !stations[t].after_travel)

@@ -18,13 +18,13 @@
 #include <limits>
 #include <optional>
 
+#include "core/child_process.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/types.hpp"
 #include "render/deposit_mesh.hpp"
 #include "render/scene.hpp"
 #include "sim/mujoco_boundary.hpp"
-
-extern char** environ;
 
 namespace depotwin {
 
@@ -353,15 +353,13 @@ class FfmpegPipe {
         "-r",      rate,        "-i",           "pipe:0",    "-an",   "-c:v",
         "libx264", "-preset",   "veryfast",     "-crf",      quality, "-pix_fmt",
         "yuv420p", "-movflags", "+faststart",   "-f",        "mp4",   output};
-    std::vector<char*> argv;
-    for (std::string& arg : args) argv.push_back(arg.data());
-    argv.push_back(nullptr);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
     posix_spawn_file_actions_adddup2(&actions, log_fd_, STDOUT_FILENO);
     posix_spawn_file_actions_adddup2(&actions, log_fd_, STDERR_FILENO);
-    const int spawned = ::posix_spawnp(&pid_, "ffmpeg", &actions, nullptr, argv.data(), environ);
+    // under depotwin's control: a signal that stops the run ends it (core/child_process.hpp)
+    const int spawned = spawn_child_process(pid_, args, &actions);
     posix_spawn_file_actions_destroy(&actions);
     ::close(fds[0]);
     if (spawned != 0) {
@@ -378,10 +376,11 @@ class FfmpegPipe {
     pthread_sigmask(SIG_BLOCK, &pipe_signal, &saved_mask_);
   }
   ~FfmpegPipe() {
+    // not finished: an error or an interrupt stopped the frames, and the half-written file is
+    // discarded, so ffmpeg is ended rather than left to encode what it has
     if (pid_ > 0) {
       if (write_fd_ >= 0) ::close(write_fd_);
-      int status = 0;
-      ::waitpid(pid_, &status, 0);
+      end_child_process(pid_);
     }
     if (log_fd_ >= 0) ::close(log_fd_);
     restore_signals();
@@ -406,11 +405,10 @@ class FfmpegPipe {
   void finish() {
     ::close(write_fd_);
     write_fd_ = -1;
-    int status = 0;
-    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
-    }
+    const int status = wait_child_process(pid_);
     pid_ = -1;
     restore_signals();
+    throw_if_interrupted();  // killed because a signal stopped the run: it did not fail
     if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
     std::string log;
     char buffer[4096];
@@ -527,6 +525,7 @@ VideoStats write_replay_video(const ReplayData& replay, const std::string& mp4_p
   view_options.closeup = options.closeup;
   view_options.timeline = true;
   for (size_t frame = 0; frame < replay.frame_count(); ++frame) {
+    throw_if_interrupted();
     view.draw(frame, viewport, gl.context(), view_options);
     mjr_readPixels(bottom_up.data(), nullptr, viewport, &gl.context());
     for (int y = 0; y < options.height; ++y)

@@ -1,16 +1,23 @@
 #include "report/output_dir.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <system_error>
+#include <thread>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 namespace depotwin {
 
@@ -80,7 +87,117 @@ fs::path nearest_existing(fs::path path) {
   return path;
 }
 
+// how often a writer waiting for an output's lock tries again
+constexpr std::chrono::milliseconds kLockPollPeriod{100};
+// what a depotwin lock file starts with (a file of that name holding anything else is not ours)
+constexpr const char* kLockTextPrefix = "depotwin lock held by ";
+
+// the lock file's text: who holds it, empty when it cannot be read
+std::string lock_holder_text(int descriptor) {
+  char text[256];
+  const ssize_t size = ::pread(descriptor, text, sizeof text - 1, 0);
+  std::string holder(text, size > 0 ? static_cast<size_t>(size) : 0);
+  while (!holder.empty() && (holder.back() == '\n' || holder.back() == '\r')) holder.pop_back();
+  return holder;
+}
+
+// the pid in `name` when it is `<base><tag><digits>`, else 0
+pid_t staging_pid(const std::string& name, const std::string& base, const std::string& tag) {
+  const std::string prefix = base + tag;
+  if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) return 0;
+  const std::string digits = name.substr(prefix.size());
+  if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return 0;
+  return static_cast<pid_t>(std::stol(digits));
+}
+
 }  // namespace
+
+OutputLock::OutputLock(const std::string& target_path, const std::string& shown_path,
+                       const std::string& verb, bool wait)
+    : lock_path_(target_path + ".lock") {
+  auto refuse = [&](const std::string& why) { throw InputError("--out", shown_path + ": " + why); };
+  const std::string folder = fs::path(target_path).parent_path().string();
+  bool told = false;
+  while (true) {
+    throw_if_interrupted();
+    // O_CLOEXEC: a child process (gnuplot, ffmpeg) never inherits the lock
+    descriptor_ = ::open(lock_path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (descriptor_ < 0) {
+      const int why = errno;
+      if (why == ELOOP || why == EISDIR)
+        refuse(lock_path_ + " is in the way (a link or a folder, not depotwin's lock file)");
+      refuse("cannot write in " + folder + ": " + std::strerror(why));
+    }
+    if (::flock(descriptor_, LOCK_EX | LOCK_NB) == 0) {
+      // the file held must still be the one of that name: a holder removes it before it lets
+      // go, and a waiter that took the lock of the removed file tries again
+      struct stat held {
+      }, named{};
+      if (::fstat(descriptor_, &held) == 0 && ::stat(lock_path_.c_str(), &named) == 0 &&
+          held.st_dev == named.st_dev && held.st_ino == named.st_ino)
+        break;
+      ::close(descriptor_);
+      descriptor_ = -1;
+      continue;
+    }
+    const int why = errno;
+    const std::string holder = lock_holder_text(descriptor_);
+    ::close(descriptor_);
+    descriptor_ = -1;
+    if (why != EWOULDBLOCK && why != EINTR)
+      refuse("cannot lock " + lock_path_ + ": " + std::strerror(why));
+    const std::string who = holder.rfind(kLockTextPrefix, 0) == 0
+                                ? holder.substr(std::strlen(kLockTextPrefix))
+                                : std::string("another depotwin process");
+    if (!wait)
+      refuse("is being written by " + who + " (" + lock_path_ +
+             " is locked); run again when it is done, or without --no-wait to wait for it");
+    if (!told) {
+      std::cerr << "waiting: " << shown_path << " is being written by " << who
+                << "; this run goes on when it is done (--no-wait: exit instead)" << std::endl;
+      told = true;
+    }
+    std::this_thread::sleep_for(kLockPollPeriod);
+  }
+
+  // ours: empty (just made) or a depotwin lock file left by a writer killed outright
+  const std::string text = lock_holder_text(descriptor_);
+  if (!text.empty() && text.rfind(kLockTextPrefix, 0) != 0) {
+    ::close(descriptor_);
+    descriptor_ = -1;
+    refuse(lock_path_ + " exists and is not depotwin's lock file; remove it");
+  }
+  const std::string holder = std::string(kLockTextPrefix) + "pid " + std::to_string(::getpid()) +
+                             " (`depotwin " + verb + "`)\n";
+  if (::ftruncate(descriptor_, 0) != 0 ||
+      ::pwrite(descriptor_, holder.data(), holder.size(), 0) != static_cast<ssize_t>(holder.size()))
+    refuse("cannot write " + lock_path_ + ": " + std::strerror(errno));
+}
+
+void OutputLock::release() {
+  if (descriptor_ < 0) return;
+  // removed while still held, so the next holder makes a fresh one
+  ::unlink(lock_path_.c_str());
+  ::close(descriptor_);
+  descriptor_ = -1;
+}
+
+void remove_stale_staging(const std::string& target_path) {
+  const fs::path target(target_path);
+  const std::string base = target.filename().string();
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(target.parent_path(), error)) {
+    const std::string name = entry.path().filename().string();
+    for (const char* tag : {".partial-", ".old-", ".tmp-"}) {
+      const pid_t pid = staging_pid(name, base, tag);
+      if (pid <= 0 || pid == ::getpid()) continue;
+      // a live process keeps its folder (even a reused pid: then it stays until that ends)
+      if (::kill(pid, 0) == 0 || errno != ESRCH) continue;
+      std::error_code ignored;
+      fs::remove_all(entry.path(), ignored);
+    }
+  }
+}
 
 StagedDirectory::StagedDirectory(std::string final_path) : final_path_(std::move(final_path)) {
   // strip trailing slashes so the staging name sits beside the final directory
@@ -107,7 +224,7 @@ void StagedDirectory::commit() {
 }
 
 OutputFolder::OutputFolder(const std::string& final_path, const std::string& verb,
-                           const std::string& scenario_file)
+                           const std::string& scenario_file, bool wait)
     : final_path_(final_path) {
   auto refuse = [&](const std::string& why) {
     throw InputError("--out", final_path_ + ": " + why);
@@ -123,16 +240,16 @@ OutputFolder::OutputFolder(const std::string& final_path, const std::string& ver
     if (error) refuse("is a symbolic link to nothing");
   }
   if (!target.has_relative_path()) refuse("is the root folder");
-  const fs::file_status status = fs::status(target, error);
 
-  // a file, or a path under a file
-  if (fs::exists(status) && !fs::is_directory(status)) refuse("is a file, not a folder");
-  const fs::path existing = nearest_existing(target.parent_path());
-  if (!fs::is_directory(existing, error))
-    refuse("lies under " + existing.string() + ", which is a file, not a folder");
-
-  // an existing folder: it is replaced whole, so it must be ours and hold nothing we need
-  if (fs::is_directory(status)) {
+  // a file, or a path under a file; an existing folder is replaced whole, so it must be ours
+  // and hold nothing we need (checked again once the lock is ours: DIR may change meanwhile)
+  const auto check_target = [&]() {
+    const fs::file_status status = fs::status(target, error);
+    if (fs::exists(status) && !fs::is_directory(status)) refuse("is a file, not a folder");
+    const fs::path existing = nearest_existing(target.parent_path());
+    if (!fs::is_directory(existing, error))
+      refuse("lies under " + existing.string() + ", which is a file, not a folder");
+    if (!fs::is_directory(status)) return;
     const fs::path canonical = fs::canonical(target, error);
     if (is_within(fs::current_path(error), canonical))
       refuse("holds the current directory; choose a folder of its own for the results");
@@ -146,16 +263,24 @@ OutputFolder::OutputFolder(const std::string& final_path, const std::string& ver
              " marker); it is replaced whole, so choose an empty or new folder, or remove it");
     if (::access(target.c_str(), W_OK | X_OK) != 0)
       refuse(std::string("cannot be replaced: ") + std::strerror(errno));
-  }
+  };
+  check_target();
 
-  // the staging folder beside it is the probe: creating it proves the parent writable (as
-  // root, access(2) says yes even on a read-only mount)
   target_path_ = target.string();
   staging_path_ = staging_name(target_path_);
   fs::create_directories(target.parent_path(), error);
   if (error) refuse("cannot create " + target.parent_path().string() + ": " + error.message());
   if (::access(target.parent_path().c_str(), W_OK | X_OK) != 0)
     refuse("cannot write in " + target.parent_path().string() + ": " + std::strerror(errno));
+
+  // one writer at a time: wait for (or refuse) another; then DIR again, and what writers
+  // killed outright left beside it
+  lock_ = std::make_unique<OutputLock>(target_path_, final_path_, verb, wait);
+  check_target();
+  remove_stale_staging(target_path_);
+
+  // the staging folder beside it is the probe: creating it proves the parent writable (as
+  // root, access(2) says yes even on a read-only mount)
   fs::remove_all(staging_path_, error);
   if (!fs::create_directory(staging_path_, error) || error)
     refuse("cannot write in " + target.parent_path().string() + ": " +
@@ -174,13 +299,17 @@ OutputFolder::OutputFolder(const std::string& final_path, const std::string& ver
 }
 
 OutputFolder::~OutputFolder() {
+  // the staging folder goes before the lock does (lock_ is destroyed after this body)
   if (committed_) return;
   std::error_code ignored;
   fs::remove_all(staging_path_, ignored);
 }
 
 void OutputFolder::commit() {
-  // a folder that appeared meanwhile and is not ours is left alone
+  // the run was asked to stop: DIR keeps its earlier result
+  throw_if_interrupted();
+  // a folder that appeared meanwhile and is not ours is left alone (a writer that takes no
+  // lock: an older depotwin, or another program)
   std::error_code error;
   if (fs::is_directory(fs::symlink_status(target_path_, error)) &&
       !is_depotwin_output(target_path_))
@@ -189,6 +318,7 @@ void OutputFolder::commit() {
                                   "folder; the results were not written");
   replace_directory(staging_path_, target_path_);
   committed_ = true;
+  lock_->release();
 }
 
 }  // namespace depotwin

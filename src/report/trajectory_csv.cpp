@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 namespace depotwin {
 
@@ -18,6 +19,9 @@ void append_planned(std::string& out, const MotionSamples& s, size_t k) {
                 s.path_index[k], s.desired_speed_mm_s[k]);
   out += line;
 }
+
+// rows written between two looks at the interrupt flag
+constexpr size_t kInterruptCheckRows = 4096;
 
 }  // namespace
 
@@ -38,6 +42,8 @@ std::string planned_and_simulated_csv(const MotionSamples& planned,
   std::string out = std::string(kPlannedColumns) + "," + kSimulatedColumns + "\n";
   out.reserve(planned.size() * 200);
   for (size_t k = 0; k < planned.size(); ++k) {
+    // a long job's file takes seconds: a signal that asked to stop ends it (core/interrupt.hpp)
+    if (k % kInterruptCheckRows == 0) throw_if_interrupted();
     append_planned(out, planned, k);
     char line[200];
     const Vec3& p = simulated.position_mm[k];

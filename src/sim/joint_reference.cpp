@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "sim/servo_controller.hpp"
 #include "sim/shutter.hpp"
 
@@ -87,6 +88,9 @@ JointReferences plan_joint_references(const BoundModel& bound, const Trajectory&
   JointVector joints, next_joints;
   TrajectoryCursor plan(trajectory);  // the steps' times only grow
   for (long k = 0, u = 0; k <= steps; ++k) {
+    // inverse kinematics of every step takes seconds on an arm: a signal that asked to stop
+    // ends it (core/interrupt.hpp)
+    if (k % 1024 == 0) throw_if_interrupted();
     const double t = static_cast<double>(k) * dt;
     const TrajectorySample sample = planned_sample(plan, t, duration_s);
     run.deposit_command[k] = sample.depositing ? 1 : 0;

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "sim/closures.hpp"
 #include "sim/joint_reference.hpp"
 #include "sim/model_binding.hpp"
@@ -318,6 +319,8 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
   double max_violation_mm = 0.0;
   Clock::time_point last_progress = wall_start;
   for (long k = 0; k <= steps; ++k) {
+    // a signal asked to stop (SIGINT, SIGTERM): one atomic load per step
+    throw_if_interrupted();
     const double t = run.t_s[k];
     d->time = t;
     mj_step1(m, d);
