@@ -8,10 +8,12 @@ DepositionWorker::DepositionWorker(LayeredDeposit& deposit) : deposit_(deposit) 
 }
 
 DepositionWorker::~DepositionWorker() {
-  // an exception on the simulating side: stop the worker without rethrowing
+  // an exception on the simulating side (an interrupt, a failure): what is still queued is
+  // dropped, and the worker stops without rethrowing
   if (thread_.joinable()) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      queue_.clear();
       done_ = true;
     }
     ready_.notify_one();
