@@ -159,6 +159,51 @@ toolpath: {gcode: {file: arc.gcode, chord_tolerance_mm: 0.01}}
   EXPECT_EQ(s.gcode->rule_applied, "e");
 }
 
+// Arcs stay exact beside their chords (issue 14: "arcs stay exact geometry until planning"):
+// the same paths one for one, the exact ones with the file's arc lengths; `offset` moves the
+// arcs' centres with their points; a feed clamp that splits a path splits its arcs with it.
+TEST_F(ScenarioGcode, ArcsStayExactBesideTheirChords) {
+  write("arc.gcode", "G1 X10 Y0 F600\nG1 X20 Y0 E1\nG3 X30 Y10 I0 J10 E2\nG1 X30 Y30 E3\n");
+  const Scenario s = load_scenario(write("s.yaml", R"(
+machine: cartesian
+limits: {v_max: 50, a_max: 500}
+toolpath: {gcode: {file: arc.gcode, chord_tolerance_mm: 0.01}, offset: [-5, -5, 0]}
+)"));
+  ASSERT_EQ(s.toolpath.paths.size(), 1u);
+  ASSERT_EQ(s.exact_toolpath.paths.size(), 1u);
+  const PrintPath& exact = s.exact_toolpath.paths[0];
+  const PrintPath& chorded = s.toolpath.paths[0];
+  ASSERT_EQ(exact.points.size(), 4u);
+  ASSERT_EQ(exact.arcs.size(), 3u);
+  EXPECT_TRUE(exact.arcs[1].is_arc());
+  EXPECT_NEAR(exact.length_mm(), 10.0 + 5.0 * kPi + 20.0, 1e-9);
+  EXPECT_LT(chorded.length_mm(), exact.length_mm());
+  EXPECT_GT(chorded.points.size(), 4u);
+  // moved by the offset, centre included: (20, 10) - (5, 5)
+  EXPECT_LT((exact.arcs[1].center_mm - Vec3(15, 5, 0)).norm(), 1e-12);
+  EXPECT_LT((exact.points.front() - chorded.points.front()).norm(), 1e-12);
+  EXPECT_LT((exact.points.back() - chorded.points.back()).norm(), 1e-12);
+  EXPECT_LT((s.exact_toolpath.start_mm - s.toolpath.start_mm).norm(), 1e-12);
+  EXPECT_EQ(s.exact_toolpath.chord_tolerance_mm, 0.01);
+
+  // x's v_max 5 mm/s: the lines along x and the arc (it starts along x) are slowed, the last
+  // line along y is not: two paths, the arc kept whole in the first
+  const Scenario clamped = load_scenario(write("c.yaml", R"(
+machine: cartesian
+limits: {v_max: 50, a_max: 500, x: {v_max: 5}}
+toolpath: {gcode: {file: arc.gcode, chord_tolerance_mm: 0.01}}
+)"));
+  ASSERT_EQ(clamped.exact_toolpath.paths.size(), clamped.toolpath.paths.size());
+  double exact_mm = 0.0;
+  for (const PrintPath& path : clamped.exact_toolpath.paths) {
+    EXPECT_EQ(path.arcs.empty() ? path.points.size() - 1 : path.arcs.size(),
+              path.points.size() - 1);
+    exact_mm += path.length_mm();
+  }
+  EXPECT_NEAR(exact_mm, 10.0 + 5.0 * kPi + 20.0, 1e-9);
+  EXPECT_GE(clamped.toolpath.paths.size(), 2u);
+}
+
 // describe shows the keys (the same tables the loader checks)
 TEST(ScenarioGcodeSchema, TheTablesHoldTheGcodeKeys) {
   const SchemaSection& section = schema_section("toolpath.gcode");
