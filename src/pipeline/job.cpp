@@ -10,6 +10,7 @@
 #include "core/file_io.hpp"
 #include "kinematics/arm6.hpp"
 #include "pipeline/models_dir.hpp"
+#include "pipeline/run.hpp"
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
 #include "report/summary_table.hpp"
@@ -202,7 +203,12 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
 
   PlannedRun run;
   run.spec = spec;
-  run.trajectory = make_planner(spec)->plan(job.toolpath, job.limits);
+  // the process the job deposits with, for a planner that predicts the deposit (uniform)
+  PlanningContext context;
+  context.process = std::make_shared<const DepositionSettings>(deposition_settings(job.scenario));
+  if (job.scenario.process.shutter_time_s > 0.0)
+    context.shutter_time_s = job.scenario.process.shutter_time_s;
+  run.trajectory = make_planner(spec)->plan_in_context(job.toolpath, job.limits, context);
   // a job far beyond any real print (e.g. a j_max of 1e-9 mm/s^3) would be sampled every
   // millisecond: refuse it before sampling anything
   if (!(run.trajectory.duration_s() <= kMaxJobDuration_s)) {
@@ -241,6 +247,7 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   // machine's limits), then the planner's
   r.warnings = job.scenario.notes;
   for (const std::string& warning : run.trajectory.warnings()) r.warnings.push_back(warning);
+  r.planner_decisions = run.trajectory.decisions();
   return run;
 }
 
