@@ -17,6 +17,10 @@ constexpr double kWindowSigmas = 8.0;    // window beyond what the candidates ch
 constexpr double kEndClearSigmas = 4.0;  // error cells this far (arc length) from its ends
 constexpr double kMaxTrimShare = 0.3;    // a loop's trim leaves most of the edge printed
 constexpr double kTrimFractions[] = {0.0, 0.25, 0.5, 0.75, 1.0};
+constexpr double kTrimInFractions[] = {0.0, 0.25};
+// slowed corners try the largest blend within the tolerance and smaller ones (slower, nearer
+// the corner)
+constexpr double kSlowBlendShares[] = {1.0, 0.7, 0.5, 0.35, 0.25};
 
 // the steady line's cross-section area (mm^2) at print speed v
 double line_area_mm2(const DepositionSettings& s, double speed_mm_s) {
@@ -187,6 +191,15 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
     }
   }
 
+  // and along the centreline itself (where a line's thickness is measured), every cell
+  const double leg[2] = {(c - a).norm(), (b - c).norm()};
+  for (double arc = kEndClearSigmas * sigma; arc <= total_arc - kEndClearSigmas * sigma; arc += h) {
+    const int edge = arc < leg[0] ? 0 : 1;
+    const Vec3 p = edge == 0 ? Vec3(a + arc * geometry.d_in) : Vec3(c + (arc - leg[0]) * geometry.d_out);
+    const double peak = areas[edge] * peak_per_area;
+    error_mm += std::abs(field.thickness_mm_at(p.x(), p.y()) - peak) / peak * h;
+  }
+
   CornerCandidate candidate;
   candidate.plan = plan;
   candidate.error_mm = error_mm;
@@ -225,8 +238,10 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
       add("blend", plan);
       full_speed_blend = true;
     } else {
-      plan.half_length_mm = g.max_half_length_mm;
-      add("slow", plan);
+      for (const double share : kSlowBlendShares) {
+        plan.half_length_mm = share * g.max_half_length_mm;
+        add("slow", plan);
+      }
     }
   }
   if (!full_speed_blend) {
@@ -236,15 +251,23 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
       const double sigma = model.settings.footprint_sigma_mm();
       const double overlap =
           alpha < 0.5 * kPi ? 2.0 * sigma / std::max(std::sin(alpha), 1e-3) : 0.0;
+      const double edge_in = (chain.points[corner] - chain.points[corner - 1]).norm();
       const double edge_out = (chain.points[corner + 1] - chain.points[corner]).norm();
-      double last_trim = -1.0;
-      for (const double fraction : kTrimFractions) {
-        CornerPlan plan;
-        plan.treatment = CornerTreatment::loop;
-        plan.trim_out_mm = std::min(fraction * overlap, kMaxTrimShare * edge_out);
-        if (plan.trim_out_mm <= last_trim) continue;
-        last_trim = plan.trim_out_mm;
-        add("loop", plan);
+      double last_in = -1.0;
+      for (const double in_fraction : kTrimInFractions) {
+        const double trim_in = std::min(in_fraction * overlap, kMaxTrimShare * edge_in);
+        if (trim_in <= last_in) continue;
+        last_in = trim_in;
+        double last_out = -1.0;
+        for (const double fraction : kTrimFractions) {
+          CornerPlan plan;
+          plan.treatment = CornerTreatment::loop;
+          plan.trim_in_mm = trim_in;
+          plan.trim_out_mm = std::min(fraction * overlap, kMaxTrimShare * edge_out);
+          if (plan.trim_out_mm <= last_out) continue;
+          last_out = plan.trim_out_mm;
+          add("loop", plan);
+        }
       }
     } else {
       CornerPlan plan;
