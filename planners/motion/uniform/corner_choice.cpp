@@ -195,7 +195,8 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
   const double leg[2] = {(c - a).norm(), (b - c).norm()};
   for (double arc = kEndClearSigmas * sigma; arc <= total_arc - kEndClearSigmas * sigma; arc += h) {
     const int edge = arc < leg[0] ? 0 : 1;
-    const Vec3 p = edge == 0 ? Vec3(a + arc * geometry.d_in) : Vec3(c + (arc - leg[0]) * geometry.d_out);
+    const Vec3 p =
+        edge == 0 ? Vec3(a + arc * geometry.d_in) : Vec3(c + (arc - leg[0]) * geometry.d_out);
     const double peak = areas[edge] * peak_per_area;
     error_mm += std::abs(field.thickness_mm_at(p.x(), p.y()) - peak) / peak * h;
   }

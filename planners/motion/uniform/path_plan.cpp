@@ -20,6 +20,9 @@ constexpr double kReversalMarginRad = 1e-6;
 // interpolation of their samples needs (its acceleration error is of order T^2 snap / 12)
 constexpr double kBlendLimitShare = 0.99;
 constexpr const char* kAxisName[3] = {"x", "y", "z"};
+// each half of a blend has at least this many sample periods (shorter than period_s when the
+// blend is short), so its motion is resolved by its own samples
+constexpr int kMinBlendHalfPeriods = 4;
 
 // a straight line's piece of the path from `from` in direction u, timed by the 1-D profile
 PhaseMotion line_motion(const AxisProfile& along, const Vec3& from, const Vec3& u) {
@@ -334,8 +337,8 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
       const double w = v_end[k];
       if (!(w > 0.0)) throw InternalError("uniform: a blend planned at rest");
       const double length = blend.length_mm(), duration = length / w;
-      const size_t half_periods =
-          static_cast<size_t>(std::max(1.0, std::ceil(duration / (2.0 * options.period_s))));
+      const size_t half_periods = static_cast<size_t>(
+          std::max(double(kMinBlendHalfPeriods), std::ceil(duration / (2.0 * options.period_s))));
       const size_t periods = 2 * half_periods;
       const double period = duration / static_cast<double>(periods);
       // two pieces split at the apex: the first half belongs to the incoming edge's path, the
