@@ -113,18 +113,22 @@ double ClothoidBlend::curvature(double s) const {
 }
 
 BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
-  const ClothoidBlend unit(Vec3::Zero(), d_in, d_out, 1.0);
+  // the derivatives depend on the tangent angle and the curvature only (no positions needed):
+  // at half-length 1, psi = phi u^2 and kappa = 2 phi u on the first half (u from the start),
+  // psi = 2 phi - phi u^2 and kappa = 2 phi u on the second (u from the end), kappa' = +-2 phi
+  const double theta = turn_angle(d_in, d_out), phi = 0.5 * theta;
+  const Vec3 e2 = (d_out - d_out.dot(d_in) * d_in).normalized();
   BlendShape shape;
   double curvature_norm = 0.0, third_norm = 0.0;
-  // both halves, the apex from either side (the curvature rate flips there)
   for (int half = 0; half < 2; ++half) {
     for (int k = 0; k <= kShapeSamples; ++k) {
       const double u = static_cast<double>(k) / kShapeSamples;
-      double s = half == 0 ? u : 1.0 + u;
-      if (half == 1 && k == 0) s = std::nextafter(1.0, 2.0);
-      Vec3 p, d1, d2, d3;
-      unit.at(s, p, d1, d2, d3);
-      shape.tangent = shape.tangent.cwiseMax(d1.cwiseAbs());
+      const double psi = half == 0 ? phi * u * u : theta - phi * u * u;
+      const double kappa = 2.0 * phi * u, rate = half == 0 ? 2.0 * phi : -2.0 * phi;
+      const Vec3 t = std::cos(psi) * d_in + std::sin(psi) * e2;
+      const Vec3 normal = -std::sin(psi) * d_in + std::cos(psi) * e2;
+      const Vec3 d2 = kappa * normal, d3 = rate * normal - kappa * kappa * t;
+      shape.tangent = shape.tangent.cwiseMax(t.cwiseAbs());
       shape.curvature = shape.curvature.cwiseMax(d2.cwiseAbs());
       shape.third = shape.third.cwiseMax(d3.cwiseAbs());
       curvature_norm = std::max(curvature_norm, d2.norm());

@@ -12,10 +12,18 @@ namespace depotwin {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kStepS = 0.001;         // the prediction's time step
-constexpr double kWindowSigmas = 8.0;    // window beyond what the candidates change
-constexpr double kEndClearSigmas = 4.0;  // error cells this far (arc length) from its ends
-constexpr double kMaxTrimShare = 0.3;    // a loop's trim leaves most of the edge printed
+// the prediction's steps: at most kStepS, and at most a quarter sigma of travel (the footprint
+// is integrated exactly along each step's chord, so finer steps change nothing measurable)
+constexpr double kStepS = 0.004;
+constexpr double kStepSigmas = 0.25;
+constexpr double kWindowSigmas = 6.0;  // window beyond what the candidates change
+constexpr double kRollSigmas = 6.0;    // pre- and post-rolls (the footprint ends at 5 sigma)
+// error cells this far (arc length) from the window's ends
+constexpr double kEndClearSigmas = 1.0;
+// the prediction's cells: half a sigma (every cell's volume is exact at any size; the error
+// sums compare candidates, which this resolves)
+constexpr double kCellSigmas = 0.5;
+constexpr double kMaxTrimShare = 0.3;  // a loop's trim leaves most of the edge printed
 constexpr double kTrimFractions[] = {0.0, 0.25, 0.5, 0.75, 1.0};
 constexpr double kTrimInFractions[] = {0.0, 0.25};
 // slowed corners try the largest blend within the tolerance and smaller ones (slower, nearer
@@ -91,7 +99,8 @@ void nearest_on_window(const Vec3& a, const Vec3& c, const Vec3& b, const Eigen:
 CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
                                 const CornerGeometry& geometry, const CornerPlan& plan,
                                 const TcpLimits& limits, const PathMotionOptions& options,
-                                const DepositModel& model, double time_weight_mm_s) {
+                                const DepositModel& model, double time_weight_mm_s,
+                                double prune_above_mm) {
   const DepositionSettings& settings = model.settings;
   const double sigma = settings.footprint_sigma_mm();
   const double reach = window_reach_mm(chain, corner, geometry, limits, options, model);
@@ -120,13 +129,24 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
   const Trajectory motion("uniform", planned.pieces);
   const double duration = motion.duration_s();
   const double v_in = window.edge_speed_mm_s[0], v_out = window.edge_speed_mm_s[1];
+  CornerCandidate candidate;
+  candidate.plan = plan;
+  candidate.extra_time_s = duration - ((c - a).norm() / v_in + (b - c).norm() / v_out);
+  candidate.speed_mm_s = planned.corner_speed_mm_s[1];
+  // its time alone costs more than the best so far: no need to predict its deposit
+  if (time_weight_mm_s * candidate.extra_time_s >= prune_above_mm) {
+    candidate.pruned = true;
+    candidate.cost = time_weight_mm_s * candidate.extra_time_s;
+    return candidate;
+  }
 
   // the deposit: a pre-roll at print speed, the window's plan, a post-roll
-  std::unique_ptr<Process> process = make_process(settings, 0.0);
-  const double roll = std::max(kWindowSigmas * sigma, 10.0 * options.lag_s * std::max(v_in, v_out));
+  std::unique_ptr<Process> process = make_process(settings, kCellSigmas * sigma);
+  const double roll = std::max(kRollSigmas * sigma, 6.0 * options.lag_s * std::max(v_in, v_out));
+  const double step_s = std::min(kStepS, kStepSigmas * sigma / std::max(v_in, v_out));
   const auto steady = [&](const Vec3& from, const Vec3& to, double speed, double t0) {
     const double length = (to - from).norm();
-    const int steps = std::max(1, static_cast<int>(std::ceil(length / (speed * kStepS))));
+    const int steps = std::max(1, static_cast<int>(std::ceil(length / (speed * step_s))));
     const double dt = length / speed / steps;
     for (int k = 0; k < steps; ++k) {
       DepositionStep step;
@@ -144,7 +164,7 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
   const double t_pre = roll / v_in;
   steady(a - roll * geometry.d_in, a, v_in, -t_pre);
   const auto closed = closed_spans(motion);
-  const int steps = std::max(1, static_cast<int>(std::ceil(duration / kStepS)));
+  const int steps = std::max(1, static_cast<int>(std::ceil(duration / step_s)));
   const double dt = duration / steps;
   TrajectoryCursor cursor(motion);
   TrajectorySample before = cursor.at(0.0);
@@ -201,12 +221,8 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
     error_mm += std::abs(field.thickness_mm_at(p.x(), p.y()) - peak) / peak * h;
   }
 
-  CornerCandidate candidate;
-  candidate.plan = plan;
   candidate.error_mm = error_mm;
-  candidate.extra_time_s = duration - ((c - a).norm() / v_in + (b - c).norm() / v_out);
   candidate.cost = error_mm + time_weight_mm_s * candidate.extra_time_s;
-  candidate.speed_mm_s = planned.corner_speed_mm_s[1];
   return candidate;
 }
 
@@ -217,11 +233,16 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
   const CornerGeometry& g = geometry[corner];
   const double speed = std::min(chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]);
   std::vector<CornerCandidate> candidates;
+  double best = std::numeric_limits<double>::infinity();
+  // evaluates a candidate (its deposit only when its time alone does not already cost more
+  // than the best so far) and returns its cost
   const auto add = [&](const std::string& name, const CornerPlan& plan) {
     CornerCandidate candidate =
-        evaluate_corner(chain, corner, g, plan, limits, options, model, time_weight_mm_s);
+        evaluate_corner(chain, corner, g, plan, limits, options, model, time_weight_mm_s, best);
     candidate.name = name;
     candidates.push_back(candidate);
+    if (!candidate.pruned) best = std::min(best, candidate.cost);
+    return candidate.cost;
   };
 
   // the blends: the least that keeps the print speed, else the largest within the tolerance
@@ -239,9 +260,13 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
       add("blend", plan);
       full_speed_blend = true;
     } else {
+      // smaller blends while they pay (the cost is unimodal in the size here)
+      double previous = std::numeric_limits<double>::infinity();
       for (const double share : kSlowBlendShares) {
         plan.half_length_mm = share * g.max_half_length_mm;
-        add("slow", plan);
+        const double cost = add("slow", plan);
+        if (cost > previous) break;
+        previous = cost;
       }
     }
   }
@@ -259,7 +284,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
         const double trim_in = std::min(in_fraction * overlap, kMaxTrimShare * edge_in);
         if (trim_in <= last_in) continue;
         last_in = trim_in;
-        double last_out = -1.0;
+        double last_out = -1.0, previous = std::numeric_limits<double>::infinity();
         for (const double fraction : kTrimFractions) {
           CornerPlan plan;
           plan.treatment = CornerTreatment::loop;
@@ -267,7 +292,9 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
           plan.trim_out_mm = std::min(fraction * overlap, kMaxTrimShare * edge_out);
           if (plan.trim_out_mm <= last_out) continue;
           last_out = plan.trim_out_mm;
-          add("loop", plan);
+          const double cost = add("loop", plan);
+          if (cost > previous) break;
+          previous = cost;
         }
       }
     } else {
@@ -280,7 +307,8 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
   CornerDecision decision;
   decision.chosen = candidates.front();
   for (const CornerCandidate& candidate : candidates)
-    if (candidate.cost < decision.chosen.cost) decision.chosen = candidate;
+    if (!candidate.pruned && (decision.chosen.pruned || candidate.cost < decision.chosen.cost))
+      decision.chosen = candidate;
   decision.candidates = std::move(candidates);
   return decision;
 }

@@ -28,6 +28,7 @@
 // candidate is taken.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +53,9 @@ struct CornerCandidate {
   double extra_time_s = 0.0;  // the window's time beyond its length at print speed
   double cost = 0.0;
   double speed_mm_s = 0.0;  // the speed the corner is printed at (loop: the lines' speed)
+  // its time alone costs more than a candidate already evaluated: the deposit was not
+  // predicted (error_mm 0, cost its time's share only)
+  bool pruned = false;
 };
 
 struct CornerDecision {
@@ -67,9 +71,11 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              double time_weight_mm_s);
 
 // The predicted error and extra time of one corner plan (the window and the deposit as above).
+// A plan whose extra time alone costs at least prune_above_mm is not deposited (pruned).
 CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
                                 const CornerGeometry& geometry, const CornerPlan& plan,
                                 const TcpLimits& limits, const PathMotionOptions& options,
-                                const DepositModel& model, double time_weight_mm_s);
+                                const DepositModel& model, double time_weight_mm_s,
+                                double prune_above_mm = std::numeric_limits<double>::infinity());
 
 }  // namespace depotwin
