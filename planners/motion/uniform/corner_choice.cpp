@@ -256,8 +256,13 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
     CornerPlan plan;
     plan.treatment = CornerTreatment::blend;
     if (needed <= g.max_half_length_mm) {
+      // the only candidate: the print speed kept within the tolerance, nothing to weigh it
+      // against (its deposit is not predicted; its time is)
       plan.half_length_mm = std::max(needed, 1e-9 * g.max_half_length_mm);
-      add("blend", plan);
+      CornerCandidate candidate =
+          evaluate_corner(chain, corner, g, plan, limits, options, model, time_weight_mm_s, -kInf);
+      candidate.name = "blend";
+      candidates.push_back(candidate);
       full_speed_blend = true;
     } else {
       // smaller blends while they pay (the cost is unimodal in the size here)

@@ -12,11 +12,12 @@
 //           that evens the overlap of the two lines at a sharp corner (trim_out is searched
 //           over fractions of 2 sigma / sin(alpha), the length over which the lines overlap);
 //   stop    extrusion only: the path comes to rest at the corner (the flow follows the speed).
-// For each, a window of the path around the corner (the two edges, up to what the slowest
-// candidate's speed change needs plus 8 sigma) is planned as the planner will plan it (entering
-// and leaving at print speed), its deposit predicted step by step (1 ms) with pre- and
-// post-rolls at print speed so the window's ends deposit as a continuing line would, and
-// compared with the even deposit the process engineer asks for: on every cell within half a
+// A corner the least blend takes at print speed has that one candidate: its deposit is not
+// predicted. Otherwise, for each candidate, a window of the path around the corner (the two edges,
+// up to what the slowest candidate's speed change needs plus 8 sigma) is planned as the planner
+// will plan it (entering and leaving at print speed), its deposit predicted step by step (1 ms)
+// with pre- and post-rolls at print speed so the window's ends deposit as a continuing line would,
+// and compared with the even deposit the process engineer asks for: on every cell within half a
 // line width of the window's centreline (4 sigma clear of its ends), the steady line's cross
 // section at the cell's distance from the nearest centreline point (the union of the lines:
 // where two lines meet at a sharp corner the target is not their doubled sum). The predicted

@@ -27,9 +27,10 @@ PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerG
   d.figures.push_back({"print_speed_mm_s",
                        std::min(chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]),
                        "mm/s"});
-  d.figures.push_back({"predicted_error_mm", c.error_mm, "mm"});
+  // (a corner blended at print speed had nothing to weigh: its deposit was not predicted)
+  if (!c.pruned) d.figures.push_back({"predicted_error_mm", c.error_mm, "mm"});
   d.figures.push_back({"extra_time_s", c.extra_time_s, "s"});
-  d.figures.push_back({"cost_mm", c.cost, "mm"});
+  if (!c.pruned) d.figures.push_back({"cost_mm", c.cost, "mm"});
   const double deviation = c.plan.treatment == CornerTreatment::blend
                                ? c.plan.half_length_mm * g.deviation_per_length
                                : 0.0;
