@@ -19,6 +19,16 @@
 
 namespace depotwin {
 
+struct DepositionSettings;  // deposition/process.hpp
+
+// What a planner may know of the job besides the toolpath and the limits: the process that
+// deposits (a planner that aims at the deposit predicts it with the project's own model) and
+// the shutter's open/close time. Planners that only plan motion ignore it.
+struct PlanningContext {
+  std::shared_ptr<const DepositionSettings> process;  // null: not known
+  double shutter_time_s = 0.02;                       // aerosol shutter open/close time
+};
+
 // A planner named in a scenario with its parameters: numbers (or lists of numbers), and
 // choices (a word from the parameter's list, e.g. `control: both`).
 struct PlannerSpec {
@@ -59,6 +69,12 @@ class Planner {
   // Every move stays within the limits over its own box (TcpLimits::along, for_transition).
   // Throws InputError when the toolpath cannot be planned within the limits.
   virtual Trajectory plan(const Toolpath& toolpath, const TcpLimits& limits) const = 0;
+  // the same, knowing the job's process (the pipeline calls this one); by default the process
+  // does not matter
+  virtual Trajectory plan_in_context(const Toolpath& toolpath, const TcpLimits& limits,
+                                     const PlanningContext& /*context*/) const {
+    return plan(toolpath, limits);
+  }
 };
 
 struct PlannerInfo {

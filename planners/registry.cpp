@@ -8,6 +8,7 @@
 #include "planners/motion/firmware.hpp"
 #include "planners/motion/lspb_mtt.hpp"
 #include "planners/motion/stop_and_go.hpp"
+#include "planners/motion/uniform/uniform_planner.hpp"
 #include "planners/planner.hpp"
 
 namespace depotwin {
@@ -47,6 +48,13 @@ const std::vector<PlannerInfo>& planner_registry() {
        "(square-corner velocity) trapezoidal look-ahead, material on while printing",
        firmware_parameters(), [](const PlannerSpec& spec) { return make_firmware_planner(spec); },
        false},
+      {"uniform",
+       "beyond the papers: deposit-aware, time-optimal and jerk-limited; clothoid corner blends "
+       "within tolerance_mm, each corner blended, slowed, looped with the shutter closed "
+       "(aerosol) or stopped (extrusion) by the predicted thickness error plus time_weight x "
+       "time, extrusion flow led by the nozzle lag (pressure advance)",
+       uniform_parameters(), [](const PlannerSpec& spec) { return make_uniform_planner(spec); },
+       true, /*consumes_arcs=*/true},
   };
   return registry;
 }

@@ -309,8 +309,10 @@ Trajectory FirmwarePlanner::plan(const Toolpath& toolpath, const TcpLimits& limi
       piece.t_begin_s = t;
       piece.t_end_s = t + 0.5 * tau[k] + t_accel + t_cruise + t_decel + 0.5 * tau[k + 1];
       piece.path_index = s.path_index;
-      piece.depositing = true;          // the flow is on over the whole print move, tied to the
-      piece.flow_follows_speed = true;  // motion as the firmware's E axis is
+      // the flow is on over the whole print move, tied to the motion as the firmware's E axis
+      // is (no pressure advance: led by 0 s)
+      piece.depositing = true;
+      piece.flow_lead_s = 0.0;
       piece.desired_speed_mm_s = s.speed_mm_s;
       piece.motion = std::move(motion);
       piece.tool_axis = segment_tool_axis(s.p0, s.tool0, s.p1, s.tool1);

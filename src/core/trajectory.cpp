@@ -8,8 +8,11 @@
 namespace depotwin {
 
 Trajectory::Trajectory(std::string planner, std::vector<TrajectoryPiece> pieces,
-                       std::vector<std::string> warnings)
-    : planner_(std::move(planner)), pieces_(std::move(pieces)), warnings_(std::move(warnings)) {
+                       std::vector<std::string> warnings, std::vector<PlanDecision> decisions)
+    : planner_(std::move(planner)),
+      pieces_(std::move(pieces)),
+      warnings_(std::move(warnings)),
+      decisions_(std::move(decisions)) {
   // the pieces must tile [0, duration] without gaps
   double t = 0.0;
   for (const TrajectoryPiece& piece : pieces_) {
@@ -149,11 +152,10 @@ void evaluate_tool_axis(const TrajectoryPiece& piece, double tau, const Vec3& po
 
 double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau) {
   if (!piece.depositing) return 0.0;
-  // E tied to the motion: volume per length stays nominal whatever the speed
-  if (piece.flow_follows_speed && piece.desired_speed_mm_s > 0.0) {
-    Vec3 position_mm, velocity_mm_s, acceleration_mm_s2;
-    evaluate_motion(piece, tau, position_mm, velocity_mm_s, acceleration_mm_s2);
-    return velocity_mm_s.norm() / piece.desired_speed_mm_s;
+  if (piece.flow_lead_s >= 0.0) {
+    Vec3 p, v, a;
+    evaluate_motion(piece, tau, p, v, a);
+    return evaluate_flow_fraction(piece, tau, v, a);
   }
   const auto* sampled = std::get_if<SampledMotion>(&piece.motion);
   if (sampled == nullptr || sampled->flow_fraction.empty()) return piece.flow_fraction;
@@ -162,6 +164,17 @@ double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau) {
   double fraction = 0.0;
   if (!sample_interval(*sampled, flow.size(), tau, k, fraction)) return flow.back();
   return flow[k] + fraction * (flow[k + 1] - flow[k]);
+}
+
+double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau, const Vec3& velocity_mm_s,
+                              const Vec3& acceleration_mm_s2) {
+  if (!piece.depositing) return 0.0;
+  if (piece.flow_lead_s < 0.0) return evaluate_flow_fraction(piece, tau);
+  // pressure advance: the speed and its rate of change along the motion, d|v|/dt = v.a / |v|
+  const double speed = velocity_mm_s.norm();
+  const double speed_rate = speed > 0.0 ? velocity_mm_s.dot(acceleration_mm_s2) / speed : 0.0;
+  if (!(piece.desired_speed_mm_s > 0.0)) return 0.0;
+  return std::max(0.0, (speed + piece.flow_lead_s * speed_rate) / piece.desired_speed_mm_s);
 }
 
 namespace {
@@ -188,7 +201,8 @@ TrajectorySample Trajectory::at(double t) const {
                   sample.acceleration_mm_s2);
   evaluate_tool_axis(piece, t - piece.t_begin_s, sample.position_mm, sample.velocity_mm_s,
                      sample.tool_axis, sample.angular_velocity_rad_s, sample.roll_rad);
-  sample.flow_fraction = evaluate_flow_fraction(piece, t - piece.t_begin_s);
+  sample.flow_fraction = evaluate_flow_fraction(piece, t - piece.t_begin_s, sample.velocity_mm_s,
+                                                sample.acceleration_mm_s2);
   return sample;
 }
 
@@ -222,7 +236,8 @@ TrajectorySample TrajectoryCursor::at(double t) {
   }
   evaluate_tool_axis(piece, tau, sample.position_mm, sample.velocity_mm_s, sample.tool_axis,
                      sample.angular_velocity_rad_s, sample.roll_rad);
-  sample.flow_fraction = evaluate_flow_fraction(piece, tau);
+  sample.flow_fraction =
+      evaluate_flow_fraction(piece, tau, sample.velocity_mm_s, sample.acceleration_mm_s2);
   return sample;
 }
 

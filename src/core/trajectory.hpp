@@ -63,9 +63,10 @@ struct TrajectoryPiece {
   // speed (extrusion: 1 = nominal; a planner that slows a path may lower it, SampledMotion
   // may give it per sample). An aerosol stream cannot be modulated: it ignores this.
   double flow_fraction = 1.0;
-  // true: the flow follows the TCP's speed, |v| / desired_speed_mm_s, as a printer's E axis is
-  // tied to its motion (the firmware baseline); flow_fraction is then not read
-  bool flow_follows_speed = false;
+  // >= 0: the commanded flow follows the planned speed instead, led by this time (pressure
+  // advance over an extruder's flow lag tau: fraction (|v| + lead d|v|/dt) / desired speed,
+  // never below 0), so the lagged flow is |v| / desired speed of the nominal; -1: as above
+  double flow_lead_s = -1.0;
   std::variant<PhaseMotion, SampledMotion> motion;
   ToolAxisMotion tool_axis;  // the orientation channel
 };
@@ -88,17 +89,34 @@ struct TrajectorySample {
   Pose pose() const { return Pose(position_mm, tool_axis, roll_rad); }
 };
 
+// A choice a planner made that the report shows (metrics.json "planner.decisions"), e.g. how a
+// corner was taken: where (print path, point index), what kind of place, the choice, and the
+// figures behind it, each with its unit.
+struct PlanFigure {
+  std::string name;
+  double value = 0.0;
+  std::string unit;  // "mm", "s", "deg", "mm/s", "ratio", ...
+};
+struct PlanDecision {
+  int path_index = -1;
+  int point_index = -1;
+  std::string kind;
+  std::string choice;
+  std::vector<PlanFigure> figures;
+};
+
 class Trajectory {
  public:
   Trajectory() = default;
   // pieces must be contiguous in time starting at 0; warnings are carried to metrics.json
   Trajectory(std::string planner, std::vector<TrajectoryPiece> pieces,
-             std::vector<std::string> warnings = {});
+             std::vector<std::string> warnings = {}, std::vector<PlanDecision> decisions = {});
 
   const std::string& planner() const { return planner_; }
   double duration_s() const { return pieces_.empty() ? 0.0 : pieces_.back().t_end_s; }
   const std::vector<TrajectoryPiece>& pieces() const { return pieces_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
+  const std::vector<PlanDecision>& decisions() const { return decisions_; }
 
   // state at time t, clamped to [0, duration]; at a piece boundary the later piece wins
   TrajectorySample at(double t) const;
@@ -113,6 +131,7 @@ class Trajectory {
   std::string planner_;
   std::vector<TrajectoryPiece> pieces_;
   std::vector<std::string> warnings_;
+  std::vector<PlanDecision> decisions_;
 };
 
 // Samples one trajectory at non-decreasing times (a simulation's steps) without searching the
@@ -139,5 +158,8 @@ void evaluate_tool_axis(const TrajectoryPiece& piece, double tau, const Vec3& po
                         double& roll_rad);
 // The commanded flow fraction at local time tau (0 when the piece does not deposit).
 double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau);
+// the same where the motion there is known (velocity and acceleration at tau)
+double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau, const Vec3& velocity_mm_s,
+                              const Vec3& acceleration_mm_s2);
 
 }  // namespace depotwin

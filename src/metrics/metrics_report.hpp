@@ -136,6 +136,8 @@ struct MetricsReport {
   std::optional<ActuatorStats> actuators;
   std::optional<OrderStats> order;
   std::vector<std::string> warnings;
+  // what the planner chose and why (metrics.json "planner"), e.g. uniform's corners
+  std::vector<PlanDecision> planner_decisions;
   std::optional<SimStats> sim;
   std::vector<LayerReport> layers;  // multi-layer and conformal jobs
   std::optional<ArmStats> arm;      // the 6-DOF arm

@@ -10,6 +10,7 @@
 #include "core/file_io.hpp"
 #include "kinematics/arm6.hpp"
 #include "pipeline/models_dir.hpp"
+#include "pipeline/run.hpp"
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
 #include "report/summary_table.hpp"
@@ -214,7 +215,13 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   // exact arcs to a planner that consumes them; chords within the tolerance to the others
   const PlannerInfo* info = find_planner(spec.name);
   const bool exact = info && info->consumes_arcs && !job.exact_toolpath.paths.empty();
-  run.trajectory = make_planner(spec)->plan(exact ? job.exact_toolpath : job.toolpath, job.limits);
+  // the process the job deposits with, for a planner that predicts the deposit (uniform)
+  PlanningContext context;
+  context.process = std::make_shared<const DepositionSettings>(deposition_settings(job.scenario));
+  if (job.scenario.process.shutter_time_s > 0.0)
+    context.shutter_time_s = job.scenario.process.shutter_time_s;
+  run.trajectory = make_planner(spec)->plan_in_context(
+      exact ? job.exact_toolpath : job.toolpath, job.limits, context);
   // a job far beyond any real print (e.g. a j_max of 1e-9 mm/s^3) would be sampled every
   // millisecond: refuse it before sampling anything
   if (!(run.trajectory.duration_s() <= kMaxJobDuration_s)) {
@@ -253,6 +260,7 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   // machine's limits), then the planner's
   r.warnings = job.scenario.notes;
   for (const std::string& warning : run.trajectory.warnings()) r.warnings.push_back(warning);
+  r.planner_decisions = run.trajectory.decisions();
   return run;
 }
 

@@ -253,6 +253,26 @@ Section report_section(const MetricsReport& r) {
     j.section("order", order);
   }
   j.plain("warnings", r.warnings);
+  if (!r.planner_decisions.empty()) {
+    // one object per decision; every decision's figures share one units object
+    Json decisions = Json::array();
+    Json decision_units = Json::object();
+    for (const PlanDecision& d : r.planner_decisions) {
+      Section one;
+      one.integer("path", d.path_index, unit::index)
+          .integer("point", d.point_index, unit::index)
+          .plain("kind", d.kind)
+          .plain("choice", d.choice);
+      for (const PlanFigure& figure : d.figures)
+        one.number(figure.name.c_str(), figure.value, figure.unit.c_str());
+      decisions.push_back(one.values);
+      decision_units.update(one.units);
+    }
+    Section planner;
+    planner.values["decisions"] = decisions;
+    planner.units["decisions"] = decision_units;
+    j.section("planner", planner);
+  }
   if (r.sim) {
     const SimStats& s = *r.sim;
     Section sim;

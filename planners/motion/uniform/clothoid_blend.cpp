@@ -1,0 +1,175 @@
+#include "planners/motion/uniform/clothoid_blend.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Geometry>
+
+#include "core/error.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// samples per half of the unit blend for the per-axis maxima, and the slack added to them
+// (a smooth function sampled every 1/256 is within ~2e-5 of its maximum)
+constexpr int kShapeSamples = 256;
+constexpr double kShapeSlack = 1e-4;
+
+}  // namespace
+
+void clothoid_integrals(double phi, double u, double& x, double& y) {
+  // X = u sum_{k even} (-1)^{k/2} a^k / (k! (2k + 1)), Y = u sum_{k odd} ..., a = phi u^2
+  const double a = phi * u * u;
+  double term = 1.0;  // a^k / k!
+  x = 0.0;
+  y = 0.0;
+  for (int k = 0; k < 40; ++k) {
+    if (k > 0) term *= a / k;
+    const double value = term / (2 * k + 1);
+    if (k % 2 == 0)
+      x += (k % 4 == 0 ? value : -value);
+    else
+      y += (k % 4 == 1 ? value : -value);
+    if (k > 4 && std::abs(term) < 1e-18) break;
+  }
+  x *= u;
+  y *= u;
+}
+
+double ClothoidBlend::turn_angle(const Vec3& d_in, const Vec3& d_out) {
+  return std::atan2(d_in.cross(d_out).norm(), d_in.dot(d_out));
+}
+
+double ClothoidBlend::deviation_per_length(double theta) {
+  double x = 0.0, y = 0.0;
+  clothoid_integrals(0.5 * theta, 1.0, x, y);
+  return y;
+}
+
+double ClothoidBlend::tangent_per_length(double theta) {
+  double x = 0.0, y = 0.0;
+  clothoid_integrals(0.5 * theta, 1.0, x, y);
+  return x + y * std::tan(0.5 * theta);
+}
+
+ClothoidBlend::ClothoidBlend(const Vec3& corner_mm, const Vec3& d_in, const Vec3& d_out,
+                             double half_length_mm)
+    : corner_(corner_mm), d_in_(d_in), d_out_(d_out), half_length_(half_length_mm) {
+  const double theta = turn_angle(d_in, d_out);
+  if (!(theta > 0.0 && theta < kPi) || !(half_length_mm > 0.0))
+    throw InternalError("a clothoid blend needs a turn in (0, pi) and a positive size");
+  phi_ = 0.5 * theta;
+  // the corner's plane: e2 is d_out's part normal to d_in
+  e2_ = (d_out - d_out.dot(d_in) * d_in).normalized();
+  n_out_ = std::cos(theta) * e2_ - std::sin(theta) * d_in;  // d_out turned +90 deg in-plane
+  double x = 0.0, y = 0.0;
+  clothoid_integrals(phi_, 1.0, x, y);
+  tangent_length_ = half_length_ * (x + y * std::tan(phi_));
+  deviation_ = half_length_ * y;
+  start_ = corner_ - tangent_length_ * d_in_;
+  end_ = corner_ + tangent_length_ * d_out_;
+}
+
+void ClothoidBlend::at(double s, Vec3& position, Vec3& d1, Vec3& d2, Vec3& d3) const {
+  const double length = 2.0 * half_length_;
+  s = std::clamp(s, 0.0, length);
+  const double L = half_length_;
+  const bool first = s <= L;
+  // distance from the nearer end, and the tangent angle measured from d_in
+  const double r = first ? s : length - s;
+  const double u = r / L;
+  const double psi = first ? phi_ * u * u : 2.0 * phi_ - phi_ * u * u;
+  const double kappa = 2.0 * phi_ * r / (L * L);
+  const double kappa_rate = (first ? 2.0 : -2.0) * phi_ / (L * L);
+  double x = 0.0, y = 0.0;
+  clothoid_integrals(phi_, u, x, y);
+  if (first)
+    position = start_ + L * (x * d_in_ + y * e2_);
+  else
+    position = end_ - L * x * d_out_ + L * y * n_out_;
+  // t = cos psi e1 + sin psi e2, N = t turned +90 deg, p'' = kappa N, p''' = kappa' N - kappa^2 t
+  const Vec3 t = std::cos(psi) * d_in_ + std::sin(psi) * e2_;
+  const Vec3 normal = -std::sin(psi) * d_in_ + std::cos(psi) * e2_;
+  d1 = t;
+  d2 = kappa * normal;
+  d3 = kappa_rate * normal - kappa * kappa * t;
+  if (s == 0.0) position = start_;
+  if (s == length) position = end_;
+}
+
+Vec3 ClothoidBlend::position(double s) const {
+  Vec3 p, d1, d2, d3;
+  at(s, p, d1, d2, d3);
+  return p;
+}
+
+double ClothoidBlend::curvature(double s) const {
+  Vec3 p, d1, d2, d3;
+  at(s, p, d1, d2, d3);
+  return d2.norm();
+}
+
+BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
+  // the derivatives depend on the tangent angle and the curvature only (no positions needed):
+  // at half-length 1, psi = phi u^2 and kappa = 2 phi u on the first half (u from the start),
+  // psi = 2 phi - phi u^2 and kappa = 2 phi u on the second (u from the end), kappa' = +-2 phi
+  const double theta = turn_angle(d_in, d_out), phi = 0.5 * theta;
+  const Vec3 e2 = (d_out - d_out.dot(d_in) * d_in).normalized();
+  BlendShape shape;
+  double curvature_norm = 0.0, third_norm = 0.0;
+  for (int half = 0; half < 2; ++half) {
+    for (int k = 0; k <= kShapeSamples; ++k) {
+      const double u = static_cast<double>(k) / kShapeSamples;
+      const double psi = half == 0 ? phi * u * u : theta - phi * u * u;
+      const double kappa = 2.0 * phi * u, rate = half == 0 ? 2.0 * phi : -2.0 * phi;
+      const Vec3 t = std::cos(psi) * d_in + std::sin(psi) * e2;
+      const Vec3 normal = -std::sin(psi) * d_in + std::cos(psi) * e2;
+      const Vec3 d2 = kappa * normal, d3 = rate * normal - kappa * kappa * t;
+      shape.tangent = shape.tangent.cwiseMax(t.cwiseAbs());
+      shape.curvature = shape.curvature.cwiseMax(d2.cwiseAbs());
+      shape.third = shape.third.cwiseMax(d3.cwiseAbs());
+      curvature_norm = std::max(curvature_norm, d2.norm());
+      third_norm = std::max(third_norm, d3.norm());
+    }
+  }
+  // what the samples may miss between them
+  shape.tangent.array() += kShapeSlack;
+  shape.curvature.array() += kShapeSlack * curvature_norm;
+  shape.third.array() += kShapeSlack * third_norm;
+  return shape;
+}
+
+double blend_speed_bound(const BlendShape& unit, double half_length_mm,
+                         const MachineLimits& limits) {
+  double bound = kInf;
+  for (int axis = 0; axis < 3; ++axis) {
+    const AxisLimits& limit = limits.axes[axis];
+    if (unit.tangent[axis] > 0.0) bound = std::min(bound, limit.v_max_mm_s / unit.tangent[axis]);
+    // v^2 kappa N_k / L <= a_k, v^3 p'''_k / L^2 <= j_k
+    if (unit.curvature[axis] > 0.0)
+      bound = std::min(bound, std::sqrt(limit.a_max_mm_s2 * half_length_mm / unit.curvature[axis]));
+    if (unit.third[axis] > 0.0 && limit.j_max_mm_s3 > 0.0)
+      bound = std::min(
+          bound, std::cbrt(limit.j_max_mm_s3 * half_length_mm * half_length_mm / unit.third[axis]));
+  }
+  return bound;
+}
+
+double blend_half_length_for_speed(const BlendShape& unit, double speed_mm_s,
+                                   const MachineLimits& limits) {
+  double length = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const AxisLimits& limit = limits.axes[axis];
+    if (speed_mm_s * unit.tangent[axis] > limit.v_max_mm_s * (1 + 1e-12)) return kInf;
+    length = std::max(length, speed_mm_s * speed_mm_s * unit.curvature[axis] / limit.a_max_mm_s2);
+    if (limit.j_max_mm_s3 > 0.0)
+      length = std::max(length,
+                        std::sqrt(std::pow(speed_mm_s, 3) * unit.third[axis] / limit.j_max_mm_s3));
+  }
+  return length;
+}
+
+}  // namespace depotwin

@@ -1,0 +1,321 @@
+#include "planners/motion/uniform/corner_choice.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.hpp"
+#include "deposition/thickness_field.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// the prediction's steps: at most kStepS, and at most a quarter sigma of travel (the footprint
+// is integrated exactly along each step's chord, so finer steps change nothing measurable)
+constexpr double kStepS = 0.004;
+constexpr double kStepSigmas = 0.25;
+constexpr double kWindowSigmas = 6.0;  // window beyond what the candidates change
+constexpr double kRollSigmas = 6.0;    // pre- and post-rolls (the footprint ends at 5 sigma)
+// error cells this far (arc length) from the window's ends
+constexpr double kEndClearSigmas = 1.0;
+// the prediction's cells: half a sigma (every cell's volume is exact at any size; the error
+// sums compare candidates, which this resolves)
+constexpr double kCellSigmas = 0.5;
+constexpr double kMaxTrimShare = 0.3;  // a loop's trim leaves most of the edge printed
+constexpr double kTrimFractions[] = {0.0, 0.25, 0.5, 0.75, 1.0};
+constexpr double kTrimInFractions[] = {0.0, 0.25};
+// slowed corners try the largest blend within the tolerance and smaller ones (slower, nearer
+// the corner)
+constexpr double kSlowBlendShares[] = {1.0, 0.7, 0.5, 0.35, 0.25};
+
+// the steady line's cross-section area (mm^2) at print speed v
+double line_area_mm2(const DepositionSettings& s, double speed_mm_s) {
+  if (s.type == ProcessType::aerosol) return s.aerosol_flow_mm3_s() / speed_mm_s;
+  if (s.flow_mm3_s > 0.0) return s.flow_mm3_s / speed_mm_s;
+  return s.bead_width_mm * s.layer_height_mm;
+}
+
+// how far on each side of the corner the window reaches: the slowest candidate's speed
+// change (to rest), the largest blend or trim, and kWindowSigmas
+double window_reach_mm(const PrintChain& chain, size_t corner, const CornerGeometry& g,
+                       const TcpLimits& limits, const PathMotionOptions& options,
+                       const DepositModel& model) {
+  const double sigma = model.settings.footprint_sigma_mm();
+  double reach = 0.0;
+  for (const size_t e : {corner - 1, corner}) {
+    const Vec3& a = chain.points[e];
+    const Vec3& b = chain.points[e + 1];
+    const LineLimits line = line_limits((b - a).normalized(), limits.along(a, b),
+                                        chain.edge_speed_mm_s[e], options.lag_s);
+    reach = std::max(reach, speed_change_distance(line.v_max_mm_s, 0.0, line));
+    reach = std::max(reach, kMaxTrimShare * (b - a).norm());
+  }
+  return reach + g.max_half_length_mm * g.tangent_per_length + kWindowSigmas * sigma;
+}
+
+// the time spans of a plan with the material off (a loop)
+std::vector<std::pair<double, double>> closed_spans(const Trajectory& plan) {
+  std::vector<std::pair<double, double>> spans;
+  for (const TrajectoryPiece& piece : plan.pieces())
+    if (!piece.depositing) spans.emplace_back(piece.t_begin_s, piece.t_end_s);
+  return spans;
+}
+
+// the ideal blade's open fraction (sim/shutter.hpp for print intervals and gaps longer than its
+// time): the share of [t, t + T] with the material on
+double open_fraction(const std::vector<std::pair<double, double>>& closed, double t,
+                     double time_s) {
+  double blocked = 0.0;
+  for (const auto& [a, b] : closed)
+    blocked += std::max(0.0, std::min(b, t + time_s) - std::max(a, t));
+  return std::clamp(1.0 - blocked / time_s, 0.0, 1.0);
+}
+
+// nearest point of the polyline a - c - b to p: distance and arc length from a
+void nearest_on_window(const Vec3& a, const Vec3& c, const Vec3& b, const Eigen::Vector2d& p,
+                       double& distance, double& arc, int& edge) {
+  distance = kInf;
+  double start = 0.0;
+  const Vec3 ends[3] = {a, c, b};
+  for (int e = 0; e < 2; ++e) {
+    const Eigen::Vector2d p0 = ends[e].head<2>(), p1 = ends[e + 1].head<2>();
+    const Eigen::Vector2d d = p1 - p0;
+    const double length = d.norm();
+    const double f = length > 0.0 ? std::clamp((p - p0).dot(d) / (length * length), 0.0, 1.0) : 0.0;
+    const double dist = (p0 + f * d - p).norm();
+    if (dist < distance) {
+      distance = dist;
+      arc = start + f * length;
+      edge = e;
+    }
+    start += length;
+  }
+}
+
+}  // namespace
+
+CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
+                                const CornerGeometry& geometry, const CornerPlan& plan,
+                                const TcpLimits& limits, const PathMotionOptions& options,
+                                const DepositModel& model, double time_weight_mm_s,
+                                double prune_above_mm) {
+  const DepositionSettings& settings = model.settings;
+  const double sigma = settings.footprint_sigma_mm();
+  const double reach = window_reach_mm(chain, corner, geometry, limits, options, model);
+
+  // the window: the two edges around the corner, cut at `reach`
+  PrintChain window;
+  const Vec3& c = chain.points[corner];
+  const double edge_in = (c - chain.points[corner - 1]).norm();
+  const double edge_out = (chain.points[corner + 1] - c).norm();
+  const Vec3 a = edge_in <= reach ? chain.points[corner - 1] : Vec3(c - reach * geometry.d_in);
+  const Vec3 b = edge_out <= reach ? chain.points[corner + 1] : Vec3(c + reach * geometry.d_out);
+  window.points = {a, c, b};
+  window.orientations.assign(3, ToolOrientation{});
+  window.edge_speed_mm_s = {chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]};
+  window.edge_path = {0, 0};
+  window.edge_source = {chain.edge_source[corner - 1], chain.edge_source[corner]};
+  window.point_path = {0, 0, 0};
+  window.point_index = {0, 1, 2};
+  std::vector<CornerGeometry> window_geometry = corner_geometry(window.points, kInf);
+  std::vector<CornerPlan> plans(3);
+  plans[1] = plan;
+  PathMotionOptions window_options = options;
+  window_options.enter_at_speed = window_options.leave_at_speed = true;
+  const PlannedPath planned =
+      plan_chain(window, window_geometry, plans, limits, window_options, 0.0);
+  const Trajectory motion("uniform", planned.pieces);
+  const double duration = motion.duration_s();
+  const double v_in = window.edge_speed_mm_s[0], v_out = window.edge_speed_mm_s[1];
+  CornerCandidate candidate;
+  candidate.plan = plan;
+  candidate.extra_time_s = duration - ((c - a).norm() / v_in + (b - c).norm() / v_out);
+  candidate.speed_mm_s = planned.corner_speed_mm_s[1];
+  // its time alone costs more than the best so far: no need to predict its deposit
+  if (time_weight_mm_s * candidate.extra_time_s >= prune_above_mm) {
+    candidate.pruned = true;
+    candidate.cost = time_weight_mm_s * candidate.extra_time_s;
+    return candidate;
+  }
+
+  // the deposit: a pre-roll at print speed, the window's plan, a post-roll
+  std::unique_ptr<Process> process = make_process(settings, kCellSigmas * sigma);
+  const double roll = std::max(kRollSigmas * sigma, 6.0 * options.lag_s * std::max(v_in, v_out));
+  const double step_s = std::min(kStepS, kStepSigmas * sigma / std::max(v_in, v_out));
+  const auto steady = [&](const Vec3& from, const Vec3& to, double speed, double t0) {
+    const double length = (to - from).norm();
+    const int steps = std::max(1, static_cast<int>(std::ceil(length / (speed * step_s))));
+    const double dt = length / speed / steps;
+    for (int k = 0; k < steps; ++k) {
+      DepositionStep step;
+      step.t0_s = t0 + k * dt;
+      step.t1_s = t0 + (k + 1) * dt;
+      step.p0_mm = from + (to - from) * (static_cast<double>(k) / steps);
+      step.p1_mm = from + (to - from) * (static_cast<double>(k + 1) / steps);
+      step.open0 = step.open1 = 1.0;
+      step.flow_command = 1.0;
+      step.desired_speed_mm_s = speed;
+      process->advance(step);
+    }
+    return t0 + length / speed;
+  };
+  const double t_pre = roll / v_in;
+  steady(a - roll * geometry.d_in, a, v_in, -t_pre);
+  const auto closed = closed_spans(motion);
+  const int steps = std::max(1, static_cast<int>(std::ceil(duration / step_s)));
+  const double dt = duration / steps;
+  TrajectoryCursor cursor(motion);
+  TrajectorySample before = cursor.at(0.0);
+  for (int k = 0; k < steps; ++k) {
+    const double t0 = k * dt, t1 = k + 1 == steps ? duration : (k + 1) * dt;
+    const TrajectorySample after = cursor.at(t1);
+    DepositionStep step;
+    step.t0_s = t0;
+    step.t1_s = t1;
+    step.p0_mm = before.position_mm;
+    step.p1_mm = after.position_mm;
+    step.open0 = open_fraction(closed, t0, model.shutter_time_s);
+    step.open1 = open_fraction(closed, t1, model.shutter_time_s);
+    step.flow_command = before.depositing ? before.flow_fraction : 0.0;
+    step.desired_speed_mm_s = before.desired_speed_mm_s;
+    process->advance(step);
+    before = after;
+  }
+  steady(b, b + roll * geometry.d_out, v_out, duration);
+  const ThicknessField& field = process->field();
+
+  // the error against the even deposit over the window's target cells
+  const double h = field.cell_mm();
+  const double r = 0.5 * settings.resolved_line_width_mm();
+  const double total_arc = (c - a).norm() + (b - c).norm();
+  const double peak_per_area = 1.0 / (sigma * std::sqrt(2.0 * kPi));
+  const double areas[2] = {line_area_mm2(settings, v_in), line_area_mm2(settings, v_out)};
+  const Vec3 lo = a.cwiseMin(b).cwiseMin(c) - Vec3::Constant(r + h);
+  const Vec3 hi = a.cwiseMax(b).cwiseMax(c) + Vec3::Constant(r + h);
+  double error_mm = 0.0;
+  for (int iy = static_cast<int>(std::floor(lo.y() / h));
+       iy <= static_cast<int>(std::ceil(hi.y() / h)); ++iy) {
+    for (int ix = static_cast<int>(std::floor(lo.x() / h));
+         ix <= static_cast<int>(std::ceil(hi.x() / h)); ++ix) {
+      double distance = 0.0, arc = 0.0;
+      int edge = 0;
+      nearest_on_window(a, c, b, Eigen::Vector2d(ix * h, iy * h), distance, arc, edge);
+      if (distance > r || arc < kEndClearSigmas * sigma ||
+          arc > total_arc - kEndClearSigmas * sigma)
+        continue;
+      const double target =
+          areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma));
+      error_mm += std::abs(field.cell_thickness_mm(ix, iy) - target) * h * h / areas[edge];
+    }
+  }
+
+  // and along the centreline itself (where a line's thickness is measured), every cell
+  const double leg[2] = {(c - a).norm(), (b - c).norm()};
+  for (double arc = kEndClearSigmas * sigma; arc <= total_arc - kEndClearSigmas * sigma; arc += h) {
+    const int edge = arc < leg[0] ? 0 : 1;
+    const Vec3 p =
+        edge == 0 ? Vec3(a + arc * geometry.d_in) : Vec3(c + (arc - leg[0]) * geometry.d_out);
+    const double peak = areas[edge] * peak_per_area;
+    error_mm += std::abs(field.thickness_mm_at(p.x(), p.y()) - peak) / peak * h;
+  }
+
+  candidate.error_mm = error_mm;
+  candidate.cost = error_mm + time_weight_mm_s * candidate.extra_time_s;
+  return candidate;
+}
+
+CornerDecision choose_corner(const PrintChain& chain, size_t corner,
+                             const std::vector<CornerGeometry>& geometry, const TcpLimits& limits,
+                             const PathMotionOptions& options, const DepositModel& model,
+                             double time_weight_mm_s) {
+  const CornerGeometry& g = geometry[corner];
+  const double speed = std::min(chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]);
+  std::vector<CornerCandidate> candidates;
+  double best = std::numeric_limits<double>::infinity();
+  // evaluates a candidate (its deposit only when its time alone does not already cost more
+  // than the best so far) and returns its cost
+  const auto add = [&](const std::string& name, const CornerPlan& plan) {
+    CornerCandidate candidate =
+        evaluate_corner(chain, corner, g, plan, limits, options, model, time_weight_mm_s, best);
+    candidate.name = name;
+    candidates.push_back(candidate);
+    if (!candidate.pruned) best = std::min(best, candidate.cost);
+    return candidate.cost;
+  };
+
+  // the blends: the least that keeps the print speed, else the largest within the tolerance
+  bool full_speed_blend = false;
+  if (g.max_half_length_mm > 0.0) {
+    const double tangent_max = g.max_half_length_mm * g.tangent_per_length;
+    const Vec3 p0 = g.point - tangent_max * g.d_in, p1 = g.point + tangent_max * g.d_out;
+    const MachineLimits box = blend_limits(
+        limits.over(p0.cwiseMin(p1).cwiseMin(g.point), p0.cwiseMax(p1).cwiseMax(g.point)));
+    const double needed = blend_half_length_for_speed(g.shape, speed, box);
+    CornerPlan plan;
+    plan.treatment = CornerTreatment::blend;
+    if (needed <= g.max_half_length_mm) {
+      // the only candidate: the print speed kept within the tolerance, nothing to weigh it
+      // against (its deposit is not predicted; its time is)
+      plan.half_length_mm = std::max(needed, 1e-9 * g.max_half_length_mm);
+      CornerCandidate candidate =
+          evaluate_corner(chain, corner, g, plan, limits, options, model, time_weight_mm_s, -kInf);
+      candidate.name = "blend";
+      candidates.push_back(candidate);
+      full_speed_blend = true;
+    } else {
+      // smaller blends while they pay (the cost is unimodal in the size here)
+      double previous = std::numeric_limits<double>::infinity();
+      for (const double share : kSlowBlendShares) {
+        plan.half_length_mm = share * g.max_half_length_mm;
+        const double cost = add("slow", plan);
+        if (cost > previous) break;
+        previous = cost;
+      }
+    }
+  }
+  if (!full_speed_blend) {
+    if (model.aerosol()) {
+      // loops, printing resuming past the overlap of the two lines at a sharp corner
+      const double alpha = deg_to_rad(g.interior_deg);
+      const double sigma = model.settings.footprint_sigma_mm();
+      const double overlap =
+          alpha < 0.5 * kPi ? 2.0 * sigma / std::max(std::sin(alpha), 1e-3) : 0.0;
+      const double edge_in = (chain.points[corner] - chain.points[corner - 1]).norm();
+      const double edge_out = (chain.points[corner + 1] - chain.points[corner]).norm();
+      double last_in = -1.0;
+      for (const double in_fraction : kTrimInFractions) {
+        const double trim_in = std::min(in_fraction * overlap, kMaxTrimShare * edge_in);
+        if (trim_in <= last_in) continue;
+        last_in = trim_in;
+        double last_out = -1.0, previous = std::numeric_limits<double>::infinity();
+        for (const double fraction : kTrimFractions) {
+          CornerPlan plan;
+          plan.treatment = CornerTreatment::loop;
+          plan.trim_in_mm = trim_in;
+          plan.trim_out_mm = std::min(fraction * overlap, kMaxTrimShare * edge_out);
+          if (plan.trim_out_mm <= last_out) continue;
+          last_out = plan.trim_out_mm;
+          const double cost = add("loop", plan);
+          if (cost > previous) break;
+          previous = cost;
+        }
+      }
+    } else {
+      CornerPlan plan;
+      plan.treatment = CornerTreatment::stop;
+      add("stop", plan);
+    }
+  }
+  if (candidates.empty()) throw InternalError("uniform: a corner without candidates");
+  CornerDecision decision;
+  decision.chosen = candidates.front();
+  for (const CornerCandidate& candidate : candidates)
+    if (!candidate.pruned && (decision.chosen.pruned || candidate.cost < decision.chosen.cost))
+      decision.chosen = candidate;
+  decision.candidates = std::move(candidates);
+  return decision;
+}
+
+}  // namespace depotwin

@@ -1,0 +1,82 @@
+// How `uniform` takes each corner, chosen by predicting the deposit with the project's own
+// deposition model (deposition/process.hpp: the Gaussian footprint integrated along the
+// nozzle's chords, the aerosol shutter's open fraction, the extruder's flow lag).
+//
+// Candidates at a corner of interior angle alpha (the joint angle, 180 deg straight on):
+//   blend   the least clothoid blend that keeps the print speed (constant-speed blend), when it
+//           fits the tolerance and the room on the edges;
+//   slow    the largest blend within the tolerance, at the lower constant speed its curvature
+//           allows (a slowed corner: the lines slow down to it and speed up after it);
+//   loop    aerosol only: the shutter closes, the nozzle loops with the shutter closed and the
+//           next line resumes at print speed; printing resumes trim_out past the corner, where
+//           that evens the overlap of the two lines at a sharp corner (trim_out is searched
+//           over fractions of 2 sigma / sin(alpha), the length over which the lines overlap);
+//   stop    extrusion only: the path comes to rest at the corner (the flow follows the speed).
+// A corner the least blend takes at print speed has that one candidate: its deposit is not
+// predicted. Otherwise, for each candidate, a window of the path around the corner (the two edges,
+// up to what the slowest candidate's speed change needs plus 8 sigma) is planned as the planner
+// will plan it (entering and leaving at print speed), its deposit predicted step by step (1 ms)
+// with pre- and post-rolls at print speed so the window's ends deposit as a continuing line would,
+// and compared with the even deposit the process engineer asks for: on every cell within half a
+// line width of the window's centreline (4 sigma clear of its ends), the steady line's cross
+// section at the cell's distance from the nearest centreline point (the union of the lines:
+// where two lines meet at a sharp corner the target is not their doubled sum). The predicted
+// thickness error is
+//   E = sum |T - T*| cell^2 / A_line   (mm: the length of line whose material is misplaced;
+//                                        A_line the steady line's cross-section area)
+// and the cost E + time_weight * (window time - window length / print speed): time_weight is
+// in mm/s, the length of misplaced line one second of extra time is worth. The cheapest
+// candidate is taken.
+#pragma once
+
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/limits.hpp"
+#include "deposition/process.hpp"
+#include "planners/motion/uniform/path_plan.hpp"
+
+namespace depotwin {
+
+// the process as the planner predicts it
+struct DepositModel {
+  DepositionSettings settings;
+  double shutter_time_s = 0.02;
+  bool aerosol() const { return settings.type == ProcessType::aerosol; }
+};
+
+struct CornerCandidate {
+  std::string name;  // blend, slow, loop, stop
+  CornerPlan plan;
+  double error_mm = 0.0;      // predicted thickness error over the window
+  double extra_time_s = 0.0;  // the window's time beyond its length at print speed
+  double cost = 0.0;
+  double speed_mm_s = 0.0;  // the speed the corner is printed at (loop: the lines' speed)
+  // its time alone costs more than a candidate already evaluated: the deposit was not
+  // predicted (error_mm 0, cost its time's share only)
+  bool pruned = false;
+};
+
+struct CornerDecision {
+  CornerCandidate chosen;
+  std::vector<CornerCandidate> candidates;  // every one evaluated, the chosen among them
+};
+
+// The treatment of interior point `corner` of the chain (geometry: corner_geometry of its
+// points), its candidates evaluated as above. `limits` must carry jerk limits.
+CornerDecision choose_corner(const PrintChain& chain, size_t corner,
+                             const std::vector<CornerGeometry>& geometry, const TcpLimits& limits,
+                             const PathMotionOptions& options, const DepositModel& model,
+                             double time_weight_mm_s);
+
+// The predicted error and extra time of one corner plan (the window and the deposit as above).
+// A plan whose extra time alone costs at least prune_above_mm is not deposited (pruned).
+CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
+                                const CornerGeometry& geometry, const CornerPlan& plan,
+                                const TcpLimits& limits, const PathMotionOptions& options,
+                                const DepositModel& model, double time_weight_mm_s,
+                                double prune_above_mm = std::numeric_limits<double>::infinity());
+
+}  // namespace depotwin

@@ -1,0 +1,391 @@
+#include "planners/motion/uniform/path_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "planners/motion/transition.hpp"
+
+namespace depotwin {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// turns below this are straight on (no blend); above pi minus it, a reversal (no blend fits)
+constexpr double kStraightTurnRad = 1e-10;
+constexpr double kReversalMarginRad = 1e-6;
+// blends keep this share of the acceleration and jerk limits: the slack the cubic Hermite
+// interpolation of their samples needs (its acceleration error is of order T^2 snap / 12)
+constexpr double kBlendLimitShare = 0.99;
+constexpr const char* kAxisName[3] = {"x", "y", "z"};
+// each half of a blend has at least this many sample periods (shorter than period_s when the
+// blend is short), so its motion is resolved by its own samples
+constexpr int kMinBlendHalfPeriods = 4;
+
+// a straight line's piece of the path from `from` in direction u, timed by the 1-D profile
+PhaseMotion line_motion(const AxisProfile& along, const Vec3& from, const Vec3& u) {
+  PhaseMotion motion;
+  for (int axis = 0; axis < 3; ++axis) {
+    AxisProfile scaled(from[axis], u[axis] * along.v_start(), u[axis] * along.a_start());
+    for (const Phase& phase : along.phases()) {
+      if (phase.jerk == 0.0)
+        scaled.append(phase.duration_s, u[axis] * phase.a0);
+      else
+        scaled.append_jerk(phase.duration_s, u[axis] * phase.jerk);
+    }
+    motion.axes[axis] = std::move(scaled);
+  }
+  return motion;
+}
+
+// the box of a blend: it lies in the triangle of its ends and the corner
+void blend_box(const ClothoidBlend& blend, Vec3& lo, Vec3& hi) {
+  lo = blend.start_mm().cwiseMin(blend.end_mm()).cwiseMin(blend.corner_mm());
+  hi = blend.start_mm().cwiseMax(blend.end_mm()).cwiseMax(blend.corner_mm());
+}
+
+}  // namespace
+
+MachineLimits blend_limits(MachineLimits limits) {
+  for (AxisLimits& axis : limits.axes) {
+    axis.a_max_mm_s2 *= kBlendLimitShare;
+    axis.j_max_mm_s3 *= kBlendLimitShare;
+  }
+  return limits;
+}
+
+ToolOrientation PrintChain::edge_orientation(size_t e, double fraction) const {
+  const ToolOrientation& a = orientations[e];
+  const ToolOrientation& b = orientations[e + 1];
+  if (fraction <= 0.0) return a;
+  if (fraction >= 1.0) return b;
+  return {slerp_axis(a.axis, b.axis, fraction), a.roll_rad + fraction * (b.roll_rad - a.roll_rad)};
+}
+
+ToolOrientation PrintChain::orientation_near_corner(size_t corner, const Vec3& p) const {
+  // the nearer of the two edges meeting at the corner, at the projection's fraction
+  double best = kInf;
+  ToolOrientation result = orientations[corner];
+  for (const size_t e : {corner - 1, corner}) {
+    const Vec3 edge = points[e + 1] - points[e];
+    const double f = std::clamp((p - points[e]).dot(edge) / edge.squaredNorm(), 0.0, 1.0);
+    const double d = (points[e] + f * edge - p).squaredNorm();
+    if (d < best) {
+      best = d;
+      result = edge_orientation(e, f);
+    }
+  }
+  return result;
+}
+
+std::vector<PrintChain> print_chains(const Toolpath& toolpath) {
+  std::vector<PrintChain> chains;
+  for (size_t index = 0; index < toolpath.paths.size(); ++index) {
+    const PrintPath& path = toolpath.paths[index];
+    const std::string name = "toolpath path " + std::to_string(path.source_index);
+    if (path.points.size() < 2) throw InputError(name, "a print path needs at least two points");
+    if (!(path.speed_mm_s > 0.0) || !std::isfinite(path.speed_mm_s))
+      throw InputError(name, "print speed must be positive");
+    if (!path.normals.empty() && path.normals.size() != path.points.size())
+      throw InputError(name, "needs one normal per point");
+    if (!path.rolls.empty() && path.rolls.size() != path.points.size())
+      throw InputError(name, "needs one roll per point");
+    for (size_t i = 0; i < path.points.size(); ++i) {
+      if (!path.points[i].allFinite())
+        throw InputError(name, "point " + std::to_string(i) + " is not finite");
+      if (i > 0 && !((path.points[i] - path.points[i - 1]).norm() > kJoinTolerance_mm))
+        throw InputError(name, "segment " + std::to_string(i - 1) + " has zero length");
+    }
+    // a path whose start is the previous one's end goes on printing through the joint
+    const bool joined =
+        !chains.empty() &&
+        (chains.back().points.back() - path.points.front()).norm() <= kJoinTolerance_mm;
+    if (!joined) {
+      chains.emplace_back();
+      PrintChain& chain = chains.back();
+      chain.points.push_back(path.points.front());
+      chain.orientations.push_back(path.orientation(0));
+      chain.point_path.push_back(static_cast<int>(index));
+      chain.point_index.push_back(0);
+    }
+    PrintChain& chain = chains.back();
+    chain.oriented = chain.oriented || !path.normals.empty() || !path.rolls.empty();
+    for (size_t i = 1; i < path.points.size(); ++i) {
+      chain.points.push_back(path.points[i]);
+      chain.orientations.push_back(path.orientation(i));
+      chain.edge_speed_mm_s.push_back(path.speed_mm_s);
+      chain.edge_path.push_back(static_cast<int>(index));
+      chain.edge_source.push_back(path.source_index);
+      chain.point_path.push_back(static_cast<int>(index));
+      chain.point_index.push_back(static_cast<int>(i));
+    }
+  }
+  return chains;
+}
+
+const char* corner_treatment_name(CornerTreatment treatment) {
+  switch (treatment) {
+    case CornerTreatment::straight:
+      return "straight";
+    case CornerTreatment::blend:
+      return "blend";
+    case CornerTreatment::loop:
+      return "loop";
+    case CornerTreatment::stop:
+      return "stop";
+  }
+  return "?";
+}
+
+LineLimits line_limits(const Vec3& u, const MachineLimits& limits, double speed_cap, double lag_s) {
+  LineLimits line;
+  line.v_max_mm_s = speed_cap;
+  line.a_max_mm_s2 = kInf;
+  line.j_max_mm_s3 = kInf;
+  line.lag_s = lag_s;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double c = std::abs(u[axis]);
+    if (c < 1e-15) continue;
+    const AxisLimits& limit = limits.axes[axis];
+    line.v_max_mm_s = std::min(line.v_max_mm_s, limit.v_max_mm_s / c);
+    line.a_max_mm_s2 = std::min(line.a_max_mm_s2, limit.a_max_mm_s2 / c);
+    line.j_max_mm_s3 = std::min(line.j_max_mm_s3, limit.j_max_mm_s3 / c);
+  }
+  return line;
+}
+
+TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s) {
+  const auto fill = [jerk_ramp_s](MachineLimits m) {
+    for (AxisLimits& axis : m.axes)
+      if (!(axis.j_max_mm_s3 > 0.0)) axis.j_max_mm_s3 = axis.a_max_mm_s2 / jerk_ramp_s;
+    return m;
+  };
+  if (limits.uniform()) return TcpLimits(fill(limits.requested()));
+  return TcpLimits(fill(limits.requested()), [limits, fill](const Vec3& lo, const Vec3& hi) {
+    return fill(limits.over(lo, hi));
+  });
+}
+
+std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm) {
+  const size_t n = points.size();
+  std::vector<CornerGeometry> corners(n);
+  for (size_t i = 0; i < n; ++i) corners[i].point = points[i];
+  for (size_t i = 1; i + 1 < n; ++i) {
+    CornerGeometry& c = corners[i];
+    const Vec3 in = points[i] - points[i - 1], out = points[i + 1] - points[i];
+    c.d_in = in.normalized();
+    c.d_out = out.normalized();
+    c.turn_rad = ClothoidBlend::turn_angle(c.d_in, c.d_out);
+    c.interior_deg = 180.0 - rad_to_deg(c.turn_rad);
+    if (c.turn_rad <= kStraightTurnRad || c.turn_rad >= kPi - kReversalMarginRad) continue;
+    c.tangent_per_length = ClothoidBlend::tangent_per_length(c.turn_rad);
+    c.deviation_per_length = ClothoidBlend::deviation_per_length(c.turn_rad);
+    c.shape = ClothoidBlend::unit_shape(c.d_in, c.d_out);
+    // within the tolerance, and leaving each adjacent edge at least half for its other end
+    const double room = 0.5 * std::min(in.norm(), out.norm());
+    c.max_half_length_mm =
+        std::min(tolerance_mm / c.deviation_per_length, room / c.tangent_per_length);
+  }
+  return corners;
+}
+
+PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry>& geometry,
+                       const std::vector<CornerPlan>& corners, const TcpLimits& limits,
+                       const PathMotionOptions& options, double t_begin_s) {
+  const size_t n = chain.points.size();
+  const size_t edges = n - 1;
+
+  // the trimmed lines: each edge loses the blend's tangent (or the loop's trim) at its ends
+  struct Line {
+    Vec3 from, to, u;
+    double length = 0.0;
+    LineLimits limits;
+  };
+  std::vector<Line> lines(edges);
+  std::vector<ClothoidBlend> blends(n);
+  for (size_t e = 0; e < edges; ++e) {
+    const Vec3& p0 = chain.points[e];
+    const Vec3& p1 = chain.points[e + 1];
+    const double speed = chain.edge_speed_mm_s[e];
+    const std::string where = "toolpath path " + std::to_string(chain.edge_source[e]);
+    Line& line = lines[e];
+    const double edge_length = (p1 - p0).norm();
+    line.u = (p1 - p0) / edge_length;
+    // the print speed must be possible along the whole edge
+    const MachineLimits edge_limits = limits.along(p0, p1);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (std::abs(speed * line.u[axis]) > edge_limits.axes[axis].v_max_mm_s * (1 + 1e-12)) {
+        std::ostringstream msg;
+        msg << "segment " << e << " needs " << std::abs(speed * line.u[axis]) << " mm/s on axis "
+            << kAxisName[axis] << " at print speed " << speed << " mm/s, above v_max "
+            << edge_limits.axes[axis].v_max_mm_s;
+        throw InputError(where, msg.str());
+      }
+    }
+    double trim0 = 0.0, trim1 = 0.0;
+    if (e > 0) {
+      const CornerPlan& c = corners[e];
+      if (c.treatment == CornerTreatment::blend)
+        trim0 = c.half_length_mm * geometry[e].tangent_per_length;
+      if (c.treatment == CornerTreatment::loop) trim0 = c.trim_out_mm;
+    }
+    if (e + 1 < edges) {
+      const CornerPlan& c = corners[e + 1];
+      if (c.treatment == CornerTreatment::blend)
+        trim1 = c.half_length_mm * geometry[e + 1].tangent_per_length;
+      if (c.treatment == CornerTreatment::loop) trim1 = c.trim_in_mm;
+    }
+    line.length = std::max(0.0, edge_length - trim0 - trim1);
+    line.from = p0 + trim0 * line.u;
+    line.to = p1 - trim1 * line.u;
+    if (trim0 + trim1 >= edge_length) line.to = line.from;
+    const MachineLimits box =
+        line.length > 0.0 ? limits.along(line.from, line.to) : limits.along(p0, p1);
+    line.limits = line_limits(line.u, box, speed, options.lag_s);
+  }
+  for (size_t i = 1; i + 1 < n; ++i)
+    if (corners[i].treatment == CornerTreatment::blend)
+      blends[i] = ClothoidBlend(chain.points[i], geometry[i].d_in, geometry[i].d_out,
+                                corners[i].half_length_mm);
+
+  // node caps: node k sits before line k (k = edges: after the last line); a loop splits the
+  // node into the end of one run and the start of the next
+  std::vector<double> cap_before(edges + 1, 0.0), cap_after(edges + 1, 0.0);
+  std::vector<char> split(edges + 1, 0);
+  cap_before[0] = options.enter_at_speed ? lines[0].limits.v_max_mm_s : 0.0;
+  cap_after[edges] = options.leave_at_speed ? lines[edges - 1].limits.v_max_mm_s : 0.0;
+  PlannedPath planned;
+  planned.corner_speed_mm_s.assign(n, 0.0);
+  for (size_t k = 1; k < edges; ++k) {
+    const CornerPlan& c = corners[k];
+    const double both = std::min(lines[k - 1].limits.v_max_mm_s, lines[k].limits.v_max_mm_s);
+    double cap = both;
+    if (c.treatment == CornerTreatment::blend) {
+      Vec3 lo, hi;
+      blend_box(blends[k], lo, hi);
+      cap = std::min(cap, blend_speed_bound(geometry[k].shape, c.half_length_mm,
+                                            blend_limits(limits.over(lo, hi))));
+    }
+    if (c.treatment == CornerTreatment::stop) cap = 0.0;
+    if (c.treatment == CornerTreatment::loop) {
+      split[k] = 1;
+      cap_after[k] = lines[k - 1].limits.v_max_mm_s;
+      cap_before[k] = lines[k].limits.v_max_mm_s;
+    } else {
+      cap_after[k] = cap_before[k] = cap;
+    }
+  }
+
+  // look-ahead: backward then forward over the lines (speed[k]: line k's start, end[k]: end)
+  std::vector<double> v_start(edges), v_end(edges);
+  for (size_t k = 0; k < edges; ++k) {
+    v_start[k] = cap_before[k];
+    v_end[k] = cap_after[k + 1];
+  }
+  for (size_t k = edges; k-- > 0;) {
+    // the node after line k joins v_end[k] and v_start[k + 1] unless split
+    if (k + 1 < edges && !split[k + 1]) v_end[k] = std::min(v_end[k], v_start[k + 1]);
+    v_start[k] = std::min(
+        v_start[k], reachable_speed(v_end[k], lines[k].length, v_start[k], lines[k].limits, true));
+  }
+  for (size_t k = 0; k < edges; ++k) {
+    if (k > 0 && !split[k]) v_start[k] = std::min(v_start[k], v_end[k - 1]);
+    v_end[k] = std::min(
+        v_end[k], reachable_speed(v_start[k], lines[k].length, v_end[k], lines[k].limits, false));
+  }
+  // one speed per joined node (the forward pass may have lowered an end below its next start)
+  for (size_t k = 0; k + 1 < edges; ++k)
+    if (!split[k + 1]) v_start[k + 1] = v_end[k] = std::min(v_end[k], v_start[k + 1]);
+
+  // the pieces
+  double t = t_begin_s;
+  const double lead = options.flow_follows_speed ? options.lag_s : -1.0;
+  const auto base_piece = [&](double duration, size_t edge) {
+    TrajectoryPiece piece;
+    piece.t_begin_s = t;
+    piece.t_end_s = t + duration;
+    piece.path_index = chain.edge_path[edge];
+    piece.depositing = true;
+    piece.desired_speed_mm_s = chain.edge_speed_mm_s[edge];
+    piece.flow_lead_s = lead;
+    return piece;
+  };
+  for (size_t k = 0; k < edges; ++k) {
+    const Line& line = lines[k];
+    // the line
+    if (line.length > 0.0) {
+      const AxisProfile along = line_profile(line.length, v_start[k], v_end[k], line.limits);
+      const double duration = along.duration_s();
+      if (duration > 0.0) {
+        TrajectoryPiece piece = base_piece(duration, k);
+        piece.motion = line_motion(along, line.from, line.u);
+        piece.tool_axis = segment_tool_axis(chain.points[k], chain.orientations[k],
+                                            chain.points[k + 1], chain.orientations[k + 1]);
+        planned.pieces.push_back(std::move(piece));
+        t += duration;
+      }
+    }
+    if (k + 1 == edges) break;
+    // the corner after it
+    const size_t i = k + 1;
+    const CornerPlan& c = corners[i];
+    planned.corner_speed_mm_s[i] = std::min(v_end[k], v_start[k + 1]);
+    if (c.treatment == CornerTreatment::blend) {
+      const ClothoidBlend& blend = blends[i];
+      const double w = v_end[k];
+      if (!(w > 0.0)) throw InternalError("uniform: a blend planned at rest");
+      const double length = blend.length_mm(), duration = length / w;
+      const size_t half_periods = static_cast<size_t>(
+          std::max(double(kMinBlendHalfPeriods), std::ceil(duration / (2.0 * options.period_s))));
+      const size_t periods = 2 * half_periods;
+      const double period = duration / static_cast<double>(periods);
+      // two pieces split at the apex: the first half belongs to the incoming edge's path, the
+      // second to the outgoing one's (they differ where two paths join at the corner)
+      for (int half = 0; half < 2; ++half) {
+        SampledMotion motion;
+        motion.period_s = period;
+        for (size_t m = half * half_periods; m <= (half + 1) * half_periods; ++m) {
+          const double s = m == periods ? length : length * static_cast<double>(m) / periods;
+          Vec3 p, d1, d2, d3;
+          blend.at(s, p, d1, d2, d3);
+          motion.position_mm.push_back(p);
+          motion.velocity_mm_s.push_back(w * d1);
+          if (chain.oriented) {
+            const ToolOrientation o = chain.orientation_near_corner(i, p);
+            motion.tool_axis.push_back(o.axis);
+            motion.roll_rad.push_back(o.roll_rad);
+          }
+        }
+        TrajectoryPiece piece = base_piece(static_cast<double>(half_periods) * period, k + half);
+        if (chain.oriented) {
+          piece.tool_axis.begin = motion.tool_axis.front();
+          piece.tool_axis.end = motion.tool_axis.back();
+          piece.tool_axis.roll_begin = motion.roll_rad.front();
+          piece.tool_axis.roll_end = motion.roll_rad.back();
+        }
+        piece.motion = std::move(motion);
+        planned.pieces.push_back(std::move(piece));
+        t = planned.pieces.back().t_end_s;
+      }
+    } else if (c.treatment == CornerTreatment::loop) {
+      // shutter closed: from the end of this line to the start of the next, at their speeds
+      const Line& next = lines[k + 1];
+      const double edge_in = (chain.points[i] - chain.points[i - 1]).norm();
+      const double edge_out = (chain.points[i + 1] - chain.points[i]).norm();
+      TrajectoryPiece loop =
+          transition_piece(t, line.to, v_end[k] * line.u, next.from, v_start[k + 1] * next.u,
+                           limits, chain.edge_orientation(k, 1.0 - c.trim_in_mm / edge_in),
+                           chain.edge_orientation(k + 1, c.trim_out_mm / edge_out));
+      t = loop.t_end_s;
+      planned.pieces.push_back(std::move(loop));
+    }
+  }
+  planned.start_velocity = v_start.front() * lines.front().u;
+  planned.end_velocity = v_end.back() * lines.back().u;
+  planned.t_end_s = t;
+  return planned;
+}
+
+}  // namespace depotwin

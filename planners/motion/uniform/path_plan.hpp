@@ -1,0 +1,135 @@
+// One print path planned by `uniform`, once each corner's treatment is chosen
+// (corner_choice.hpp chooses it): its geometry, its jerk-limited time law and its trajectory
+// pieces.
+//
+// Geometry. The polyline's edges, trimmed at each corner by the corner's treatment:
+//   straight  collinear edges: no corner;
+//   blend     a clothoid pair (clothoid_blend.hpp) traversed at constant speed; the edges lose
+//             its tangent length;
+//   loop      (aerosol) the shutter closes `trim_in` before the corner, the nozzle loops with
+//             the shutter closed (a jerk-limited synchronised move, motion/sync.hpp, leaving
+//             and entering at the lines' velocities) and printing resumes `trim_out` after the
+//             corner;
+//   stop      the path comes to rest at the corner (a reversal an extruder cannot loop).
+//
+// Time law. Speed changes happen on the straight lines only; every curved section (blend) is
+// traversed at one constant speed, its "node" speed. Between two nodes a line runs the
+// time-optimal jerk-limited profile of line_profile.hpp (zero acceleration at both ends), so
+// the acceleration is continuous everywhere: a line meets a blend where the blend's curvature
+// (and so its acceleration) is 0. Each node's speed is capped by its section's limits
+// (blend_speed_bound over the blend's box), the print speed and the adjacent lines' caps; a
+// backward and a forward pass (the classic look-ahead) lower the caps to what the lines can
+// reach (reachable_speed), which makes every line's profile feasible and the whole law the
+// fastest jerk-limited one of this family. Per-axis limits map exactly onto a line:
+// v <= v_k / |u_k|, a <= a_k / |u_k|, j <= j_k / |u_k| for its direction u, over the line's box
+// (TcpLimits::along: a machine's joint limits mapped where the line is).
+//
+// Pieces. A line is a PhaseMotion (per axis p0_k + u_k s(t): constant-jerk phases, exact); a
+// blend is a SampledMotion at constant speed (samples of the exact clothoid; an even number of
+// equal periods no longer than period_s, so the apex, where the curvature rate flips, falls
+// on a sample); a loop is a transition piece (not depositing). With a flow lag (extrusion) the
+// pieces' commanded flow leads the planned speed (TrajectoryPiece::flow_lead_s).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/limits.hpp"
+#include "core/toolpath.hpp"
+#include "core/trajectory.hpp"
+#include "planners/motion/uniform/clothoid_blend.hpp"
+#include "planners/motion/uniform/line_profile.hpp"
+
+namespace depotwin {
+
+enum class CornerTreatment { straight, blend, loop, stop };
+const char* corner_treatment_name(CornerTreatment treatment);
+
+// How one interior point of a path is taken.
+struct CornerPlan {
+  CornerTreatment treatment = CornerTreatment::straight;
+  double half_length_mm = 0.0;  // blend: the clothoids' half-length
+  double trim_in_mm = 0.0;      // loop: printing stops this far before the corner
+  double trim_out_mm = 0.0;     // loop: and resumes this far after it
+};
+
+// What is printed in one go: consecutive print paths joined end to start (one path, or several
+// whose ends touch, e.g. a polyline given as separate segments), as one polyline whose edges
+// keep their own path's index and speed.
+struct PrintChain {
+  std::vector<Vec3> points;
+  std::vector<ToolOrientation> orientations;  // per point
+  std::vector<double> edge_speed_mm_s;        // per edge: its path's print speed
+  std::vector<int> edge_path;                 // per edge: index into Toolpath::paths
+  std::vector<int> edge_source;               // per edge: the path's source index (messages)
+  // per point: the print path and the point index within it where the point ends an edge
+  // (the first point: the first path's point 0)
+  std::vector<int> point_path, point_index;
+  bool oriented = false;  // some path has normals or rolls: the tool axis is carried
+
+  size_t edges() const { return points.empty() ? 0 : points.size() - 1; }
+  // the orientation at a fraction of edge e (slerp of the axes, rolls linear)
+  ToolOrientation edge_orientation(size_t e, double fraction) const;
+  // the orientation at the point of edges e and e + 1 nearest to p (a blend's sample)
+  ToolOrientation orientation_near_corner(size_t corner, const Vec3& p) const;
+};
+// the chains of a toolpath: runs of consecutive paths whose ends join (kJoinTolerance_mm);
+// InputError for a path with fewer than two points, a zero-length edge, a bad speed or
+// non-finite points
+std::vector<PrintChain> print_chains(const Toolpath& toolpath);
+
+// How the path's ends are taken and how the flow is commanded.
+struct PathMotionOptions {
+  bool enter_at_speed = false;      // starts at print speed (aerosol: a transition brings it)
+  bool leave_at_speed = false;      // ends at print speed
+  double lag_s = 0.0;               // extruder flow lag: the deceleration rule and the flow lead
+  bool flow_follows_speed = false;  // pieces carry flow_lead_s = lag_s
+  double period_s = 0.001;          // longest sample period of a blend
+};
+
+// A corner's geometry (interior points only): its directions, turn and blend shape.
+struct CornerGeometry {
+  Vec3 point = Vec3::Zero();
+  Vec3 d_in = Vec3::UnitX(), d_out = Vec3::UnitX();
+  double turn_rad = 0.0;              // 0: straight on, pi: a reversal
+  double interior_deg = 180.0;        // the joint angle: 180 - turn
+  double tangent_per_length = 0.0;    // T / L of a clothoid pair at this turn
+  double deviation_per_length = 0.0;  // deviation / L
+  BlendShape shape;                   // per-axis maxima at half-length 1
+  double max_half_length_mm = 0.0;    // tolerance and room on the adjacent edges
+};
+// every point's corner geometry (index = point index; ends are straight placeholders),
+// with the largest blend within tolerance_mm that leaves each adjacent edge at least half for
+// its other end
+std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm);
+
+// A planned print path: pieces from t_begin, and its boundary velocities.
+struct PlannedPath {
+  std::vector<TrajectoryPiece> pieces;
+  Vec3 start_velocity = Vec3::Zero(), end_velocity = Vec3::Zero();
+  double t_end_s = 0.0;
+  // per corner (point index), the constant speed it was taken at (blends), or the line speeds
+  // into and out of it (loops, straights, stops: the lower)
+  std::vector<double> corner_speed_mm_s;
+};
+
+// The limits a planner needs with a jerk limit on every axis: the user's where given, else
+// a_max / jerk_ramp_s (the acceleration ramps up in jerk_ramp_s).
+TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s);
+
+// Plans a chain from t_begin with the corners as given (one per point; ends ignored). `limits`
+// must carry jerk limits (with_jerk_limits). InputError when a print speed exceeds an axis'
+// limit along its edge.
+PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry>& geometry,
+                       const std::vector<CornerPlan>& corners, const TcpLimits& limits,
+                       const PathMotionOptions& options, double t_begin_s);
+
+// the limits blends are held to: kBlendLimitShare of the acceleration and jerk limits (the
+// slack the cubic interpolation of a blend's samples needs)
+MachineLimits blend_limits(MachineLimits limits);
+
+// the straight line's limits along direction u (unit) under per-axis limits, capped at speed
+LineLimits line_limits(const Vec3& u, const MachineLimits& limits, double speed_cap_mm_s,
+                       double lag_s);
+
+}  // namespace depotwin

@@ -1,0 +1,183 @@
+#include "planners/motion/uniform/uniform_planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "planners/motion/transition.hpp"
+
+namespace depotwin {
+
+namespace {
+
+// arcs become chords within this share of the tolerance before their corners are blended
+constexpr double kArcChordShare = 0.1;
+
+PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerGeometry& g,
+                           const CornerDecision& decision) {
+  const CornerCandidate& c = decision.chosen;
+  PlanDecision d;
+  d.path_index = chain.point_path[corner];
+  d.point_index = chain.point_index[corner];
+  d.kind = "corner";
+  d.choice = c.name;
+  d.figures.push_back({"interior_angle_deg", g.interior_deg, "deg"});
+  d.figures.push_back({"speed_mm_s", c.speed_mm_s, "mm/s"});
+  d.figures.push_back({"print_speed_mm_s",
+                       std::min(chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]),
+                       "mm/s"});
+  // (a corner blended at print speed had nothing to weigh: its deposit was not predicted)
+  if (!c.pruned) d.figures.push_back({"predicted_error_mm", c.error_mm, "mm"});
+  d.figures.push_back({"extra_time_s", c.extra_time_s, "s"});
+  if (!c.pruned) d.figures.push_back({"cost_mm", c.cost, "mm"});
+  const double deviation = c.plan.treatment == CornerTreatment::blend
+                               ? c.plan.half_length_mm * g.deviation_per_length
+                               : 0.0;
+  d.figures.push_back({"deviation_mm", deviation, "mm"});
+  d.figures.push_back({"trim_out_mm", c.plan.trim_out_mm, "mm"});
+  // the best of each other kind, for comparison
+  int pruned = 0;
+  for (const char* kind : {"blend", "slow", "loop", "stop"}) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const CornerCandidate& other : decision.candidates)
+      if (other.name == kind && !other.pruned) best = std::min(best, other.cost);
+    if (std::isfinite(best)) d.figures.push_back({std::string(kind) + "_cost_mm", best, "mm"});
+  }
+  // candidates whose extra time alone cost more than the chosen one's total
+  for (const CornerCandidate& other : decision.candidates) pruned += other.pruned ? 1 : 0;
+  d.figures.push_back({"candidates", static_cast<double>(decision.candidates.size()), "count"});
+  d.figures.push_back({"pruned_by_time", static_cast<double>(pruned), "count"});
+  return d;
+}
+
+}  // namespace
+
+Trajectory UniformPlanner::plan(const Toolpath& toolpath, const TcpLimits& limits) const {
+  return plan_in_context(toolpath, limits, PlanningContext{});
+}
+
+Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLimits& limits,
+                                           const PlanningContext& context) const {
+  const std::string limits_problem = limits.requested().validate();
+  if (!limits_problem.empty()) throw InputError("limits", limits_problem);
+  DepositModel model;
+  if (context.process) model.settings = *context.process;
+  model.shutter_time_s = context.shutter_time_s;
+  const bool aerosol = model.aerosol();
+  const TcpLimits jerk_limits = with_jerk_limits(limits, settings_.jerk_ramp_s);
+
+  PathMotionOptions options;
+  options.enter_at_speed = options.leave_at_speed = aerosol;
+  options.lag_s = aerosol ? 0.0 : model.settings.tau_s;
+  options.flow_follows_speed = !aerosol;
+  options.period_s = settings_.period_s;
+
+  // arcs as fine chords (their corners are blended like any other)
+  Toolpath chorded = toolpath;
+  for (PrintPath& path : chorded.paths)
+    if (path.has_arcs()) path = path.chorded(kArcChordShare * settings_.tolerance_mm);
+
+  std::vector<TrajectoryPiece> pieces;
+  std::vector<PlanDecision> decisions;
+  double t = 0.0;
+  Vec3 position = toolpath.start_mm, velocity = Vec3::Zero();
+  ToolOrientation orientation = toolpath.start_orientation();
+  const auto add_transition = [&](const Vec3& to, const Vec3& to_velocity,
+                                  const ToolOrientation& to_orientation) {
+    if ((to - position).norm() <= 1e-12 && (to_velocity - velocity).norm() <= 1e-12) return;
+    pieces.push_back(transition_piece(t, position, velocity, to, to_velocity, jerk_limits,
+                                      orientation, to_orientation));
+    t = pieces.back().t_end_s;
+  };
+  for (const PrintChain& chain : print_chains(chorded)) {
+    // each corner's treatment, by the predicted deposit
+    const std::vector<CornerGeometry> geometry =
+        corner_geometry(chain.points, settings_.tolerance_mm);
+    std::vector<CornerPlan> corners(chain.points.size());
+    for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
+      if (geometry[i].turn_rad <= 0.0 ||
+          (geometry[i].max_half_length_mm <= 0.0 && geometry[i].turn_rad < 0.5 * kPi))
+        continue;  // straight on
+      const CornerDecision decision = choose_corner(chain, i, geometry, jerk_limits, options, model,
+                                                    settings_.time_weight_mm_s);
+      corners[i] = decision.chosen.plan;
+      decisions.push_back(corner_report(chain, i, geometry[i], decision));
+    }
+    // planned from 0, then placed after the transition that brings the nozzle to its start
+    PlannedPath planned = plan_chain(chain, geometry, corners, jerk_limits, options, 0.0);
+    add_transition(chain.points.front(), planned.start_velocity, chain.orientations.front());
+    for (TrajectoryPiece& piece : planned.pieces) {
+      piece.t_begin_s += t;
+      piece.t_end_s += t;
+      pieces.push_back(std::move(piece));
+    }
+    t += planned.t_end_s;
+    position = chain.points.back();
+    velocity = planned.end_velocity;
+    orientation = chain.orientations.back();
+  }
+  add_transition(toolpath.end_mm, Vec3::Zero(), toolpath.end_orientation());
+  if (pieces.empty()) {
+    // nothing to print and nowhere to go: at rest at the start
+    pieces.push_back(transition_piece(0.0, position, velocity, position, velocity, jerk_limits,
+                                      orientation, orientation));
+  }
+  return Trajectory("uniform", std::move(pieces), {}, std::move(decisions));
+}
+
+std::vector<PlannerParameter> uniform_parameters() {
+  return {
+      {"tolerance_mm",
+       0.05,
+       1e-4,
+       10.0,
+       "corners are blended within this distance of the polyline (LinuxCNC's G64 P): the blended "
+       "path never leaves the band",
+       false,
+       {},
+       "mm"},
+      {"time_weight",
+       1.0,
+       0.0,
+       1e6,
+       "what a second of extra time is worth in mm of misplaced line when a corner's treatment "
+       "is chosen (cost = predicted thickness error + time_weight x extra time); 0: the deposit "
+       "alone decides",
+       false,
+       {},
+       "mm/s"},
+      {"jerk_ramp_s",
+       0.01,
+       1e-4,
+       1.0,
+       "without a j_max in the limits, each axis' jerk limit is a_max / jerk_ramp_s (the "
+       "acceleration ramps up in this time)",
+       false,
+       {},
+       "s"},
+      {"period_s",
+       0.001,
+       1e-5,
+       0.01,
+       "longest sample period of a blend (its samples are the exact clothoid)",
+       false,
+       {},
+       "s"},
+  };
+}
+
+UniformSettings uniform_settings(const PlannerSpec& spec) {
+  UniformSettings settings;
+  settings.tolerance_mm = spec.get("tolerance_mm", settings.tolerance_mm);
+  settings.time_weight_mm_s = spec.get("time_weight", settings.time_weight_mm_s);
+  settings.jerk_ramp_s = spec.get("jerk_ramp_s", settings.jerk_ramp_s);
+  settings.period_s = spec.get("period_s", settings.period_s);
+  return settings;
+}
+
+std::unique_ptr<Planner> make_uniform_planner(const PlannerSpec& spec) {
+  return std::make_unique<UniformPlanner>(uniform_settings(spec));
+}
+
+}  // namespace depotwin

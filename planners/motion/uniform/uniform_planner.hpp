@@ -1,0 +1,59 @@
+// `uniform`: beyond the papers, a planner that aims at the deposit itself, time-optimal and
+// jerk-limited (issue 16). Every planner from the papers controls the motion and hopes the
+// deposit follows; this one predicts the deposit with the project's own model and chooses
+// what the motion alone cannot.
+//
+//  - Path: corners blended within `tolerance_mm` by clothoid pairs (clothoid_blend.hpp): the
+//    curvature is continuous, so a constant-speed blend has a continuous acceleration.
+//  - Time law: jerk-limited and time-optimal for its family (path_plan.hpp): speed changes on
+//    the straight lines (exact per-axis limits along each line's direction, over its box, so a
+//    machine's joint limits come mapped where the line is), constant speed on every blend, a
+//    look-ahead that makes every line's profile feasible; j_max from the limits, else
+//    a_max / `jerk_ramp_s` on each axis.
+//  - Deposition coupling (corner_choice.hpp): per corner, a constant-speed blend, a slowed
+//    corner, a shutter-closed loop (aerosol) or a stop (extrusion), by the predicted thickness
+//    error over the target region plus `time_weight` times the time; extrusion's commanded flow
+//    leads the planned speed by the flow lag (pressure advance), and its decelerations stay
+//    within what the lagging flow can follow (line_profile.hpp).
+//  - Transitions between print paths: jerk-limited synchronised minimum-time moves with the
+//    material off; aerosol paths are entered and left at print speed (the stream cannot be
+//    modulated, so a path's start ramp would thicken it), extrusion paths at rest.
+// Joined paths (a path starting where the previous one ended) are printed in one go, their
+// joint a corner like any other. Arcs (PrintPath::arcs) are chorded within a tenth of the
+// tolerance first, and the chords' corners blended.
+//
+// Without a PlanningContext (Planner::plan) the process is the aerosol default.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "planners/motion/uniform/corner_choice.hpp"
+#include "planners/planner.hpp"
+
+namespace depotwin {
+
+struct UniformSettings {
+  double tolerance_mm = 0.05;     // the blended path stays this close to the polyline
+  double time_weight_mm_s = 1.0;  // a second of extra time is worth this many mm of misplaced line
+  double jerk_ramp_s = 0.01;      // without j_max: the acceleration ramps up in this time
+  double period_s = 0.001;        // longest sample period of a blend
+};
+
+class UniformPlanner : public Planner {
+ public:
+  explicit UniformPlanner(UniformSettings settings) : settings_(settings) {}
+  Trajectory plan(const Toolpath& toolpath, const TcpLimits& limits) const override;
+  Trajectory plan_in_context(const Toolpath& toolpath, const TcpLimits& limits,
+                             const PlanningContext& context) const override;
+  const UniformSettings& settings() const { return settings_; }
+
+ private:
+  UniformSettings settings_;
+};
+
+std::vector<PlannerParameter> uniform_parameters();
+UniformSettings uniform_settings(const PlannerSpec& spec);
+std::unique_ptr<Planner> make_uniform_planner(const PlannerSpec& spec);
+
+}  // namespace depotwin

@@ -1,0 +1,207 @@
+// `uniform`'s time law: the 1-D jerk-limited line profiles against the analytic double-S of
+// motion/jerk.hpp, the extruder's deceleration rule, and whole plans checked joint by joint
+// by finite differences of the planned motion (the XY stage's joints and the linear delta's
+// carriages through their inverse kinematics).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "kinematics/linear_delta.hpp"
+#include "kinematics/xy_stage.hpp"
+#include "motion/jerk.hpp"
+#include "planners/motion/uniform/line_profile.hpp"
+#include "planners/motion/uniform/uniform_planner.hpp"
+
+namespace depotwin {
+namespace {
+
+// Without a flow lag a line's profile is the time-optimal double-S of motion/jerk.hpp (the
+// `depotwin move --jmax` code path) from v0 to v1 over its length: same duration, same
+// state at every time.
+TEST(UniformLineProfile, EqualsTheAnalyticDoubleS) {
+  struct Case {
+    double length, v0, v1, v_max, a_max, j_max;
+  };
+  for (const Case& c :
+       {Case{10.0, 0.0, 0.0, 3.0, 30.0, 300.0}, Case{0.2, 0.0, 0.0, 3.0, 30.0, 300.0},
+        Case{5.0, 3.0, 1.0, 4.0, 30.0, 3000.0}, Case{2.0, 0.5, 2.5, 3.0, 50.0, 900.0},
+        Case{30.0, 20.0, 0.0, 20.0, 1500.0, 150000.0}}) {
+    SCOPED_TRACE(testing::Message() << "L " << c.length << " v0 " << c.v0 << " v1 " << c.v1);
+    const LineLimits limits{c.v_max, c.a_max, c.j_max, 0.0};
+    const AxisProfile ours = line_profile(c.length, c.v0, c.v1, limits);
+    const AxisProfile analytic =
+        jerk_min_time_move(AxisBoundary{0.0, c.length, c.v0, c.v1}, c.v_max, c.a_max, c.j_max);
+    ASSERT_NEAR(ours.duration_s(), analytic.duration_s(), 1e-9 * analytic.duration_s());
+    for (int k = 0; k <= 200; ++k) {
+      const double t = analytic.duration_s() * k / 200.0;
+      const AxisState a = ours.at(t), b = analytic.at(t);
+      EXPECT_NEAR(a.q, b.q, 1e-9 * c.length) << "t " << t;
+      EXPECT_NEAR(a.v, b.v, 1e-7 * c.v_max) << "t " << t;
+      EXPECT_NEAR(a.a, b.a, 1e-6 * c.a_max) << "t " << t;
+    }
+    EXPECT_NEAR(ours.q_end(), c.length, 1e-12 * c.length);
+    EXPECT_NEAR(ours.v_end(), c.v1, 1e-12 * c.v_max);
+  }
+}
+
+// reachable_speed is the largest speed whose change fits the length, and never above the cap
+TEST(UniformLineProfile, ReachableSpeedFitsTheLengthExactly) {
+  const LineLimits limits{5.0, 30.0, 500.0, 0.0};
+  for (const double length : {0.01, 0.1, 0.4, 3.0}) {
+    const double v = reachable_speed(0.5, length, 5.0, limits, true);
+    if (v < 5.0) {
+      EXPECT_NEAR(speed_change_distance(v, 0.5, limits), length, 1e-9 * length);
+    } else {
+      EXPECT_LE(speed_change_distance(v, 0.5, limits), length);
+    }
+    // accelerating towards the end: the same distance by symmetry of the S-curve
+    EXPECT_NEAR(reachable_speed(0.5, length, 5.0, limits, false), v, 1e-9);
+  }
+  EXPECT_EQ(reachable_speed(2.0, 0.0, 5.0, limits, true), 2.0);  // nothing to change on
+}
+
+// With an extruder's flow lag tau, a deceleration never falls faster than v / tau (down to 2 %
+// of its starting speed), so a flow that leads the speed by tau never goes negative there;
+// accelerations are not held back.
+TEST(UniformLineProfile, DecelerationsFollowTheFlowLag) {
+  const double tau = 0.05;
+  const LineLimits limits{20.0, 1500.0, 150000.0, tau};
+  const AxisProfile stop = line_profile(30.0, 0.0, 0.0, limits);
+  EXPECT_NEAR(stop.q_end(), 30.0, 1e-9);
+  bool accelerated_fast = false;
+  for (int k = 0; k <= 20000; ++k) {
+    const double t = stop.duration_s() * k / 20000.0;
+    const AxisState s = stop.at(t);
+    if (s.a < 0.0 && s.v > 0.02 * 20.0) {
+      EXPECT_GE(s.a, -s.v / tau * (1 + 1e-9)) << "t " << t << " v " << s.v;
+    }
+    if (s.a > 20.0 / tau) accelerated_fast = true;
+    ASSERT_GE(s.v, -1e-9);
+  }
+  EXPECT_TRUE(accelerated_fast);
+  // duration and distance of the staged change agree with its phases
+  AxisProfile change(0.0, 20.0, 0.0);
+  append_speed_change(change, 20.0, 1.0, limits);
+  EXPECT_NEAR(change.duration_s(), speed_change_duration(20.0, 1.0, limits), 1e-12);
+  EXPECT_NEAR(change.q_end(), speed_change_distance(20.0, 1.0, limits), 1e-9);
+  EXPECT_NEAR(change.v_end(), 1.0, 1e-9);
+}
+
+// A zig-zag with corners from 160 to 10 degrees (every treatment occurs), planned for aerosol
+// and for extrusion, sampled every millisecond.
+Toolpath zig_zag(double speed_mm_s) {
+  Toolpath toolpath;
+  toolpath.start_mm = Vec3(-5, -5, 0);
+  toolpath.end_mm = Vec3(5, -5, 0);
+  PrintPath path;
+  path.speed_mm_s = speed_mm_s;
+  Vec3 p(-10, 0, 0);
+  double heading_deg = 15.0;
+  path.points.push_back(p);
+  int k = 0;
+  for (const double joint_deg : {160.0, 120.0, 90.0, 60.0, 30.0, 10.0}) {
+    p += 3.0 * Vec3(std::cos(deg_to_rad(heading_deg)), std::sin(deg_to_rad(heading_deg)), 0.0);
+    path.points.push_back(p);
+    heading_deg += (k++ % 2 == 0 ? 1.0 : -1.0) * (180.0 - joint_deg);
+  }
+  p += 3.0 * Vec3(std::cos(deg_to_rad(heading_deg)), std::sin(deg_to_rad(heading_deg)), 0.0);
+  path.points.push_back(p);
+  toolpath.paths.push_back(path);
+  PrintPath line;  // and an isolated line
+  line.speed_mm_s = speed_mm_s;
+  line.points = {Vec3(0, -3, 0), Vec3(6, -2, 0)};
+  line.source_index = 1;
+  toolpath.paths.push_back(line);
+  return toolpath;
+}
+
+// Every joint's speed, acceleration (and, where the machine's joints are its axes, jerk) by
+// finite differences of the joint positions the machine's inverse kinematics gives along the
+// plan every millisecond. A third difference over dt^3 is a weighted mean of the jerk over
+// three periods, so it cannot exceed the largest jerk; the slack covers the cubic
+// interpolation of the blends' samples.
+void expect_joint_limits(const Trajectory& plan, const Machine& machine, const JointLimit& joint,
+                         bool check_jerk) {
+  const double dt = 0.001;
+  std::vector<JointVector> q;
+  for (double t = 0.0; t <= plan.duration_s(); t += dt) {
+    JointVector joints;
+    ASSERT_TRUE(machine.inverse(Pose(plan.at(t).position_mm), joints)) << "t " << t;
+    q.push_back(joints);
+  }
+  double peak_v = 0.0, peak_a = 0.0, peak_j = 0.0;
+  for (size_t k = 0; k + 3 < q.size(); ++k) {
+    for (size_t j = 0; j < q[k].size(); ++j) {
+      peak_v = std::max(peak_v, std::abs(q[k + 1][j] - q[k][j]) / dt);
+      peak_a = std::max(peak_a, std::abs(q[k + 2][j] - 2 * q[k + 1][j] + q[k][j]) / (dt * dt));
+      peak_j =
+          std::max(peak_j, std::abs(q[k + 3][j] - 3 * q[k + 2][j] + 3 * q[k + 1][j] - q[k][j]) /
+                               (dt * dt * dt));
+    }
+  }
+  EXPECT_LE(peak_v, joint.v_max * (1 + 1e-6));
+  EXPECT_LE(peak_a, joint.a_max * (1 + 1e-3));
+  if (check_jerk) {
+    EXPECT_LE(peak_j, joint.j_max * (1 + 1e-2));
+  }
+  // the limits are used: the plan is not slack
+  EXPECT_GT(peak_a, 0.5 * joint.a_max);
+}
+
+TEST(UniformTimeLaw, XyStageJointsWithinSpeedAccelerationAndJerk) {
+  const std::unique_ptr<Machine> stage = make_xy_stage();
+  const MachineLimits limits = MachineLimits::uniform(4.0, 30.0, 600.0);
+  JointLimit joint;
+  joint.v_max = 4.0;
+  joint.a_max = 30.0;
+  joint.j_max = 600.0;
+  for (const ProcessType type : {ProcessType::aerosol, ProcessType::extrusion}) {
+    SCOPED_TRACE(process_type_name(type));
+    PlanningContext context;
+    DepositionSettings process;
+    process.type = type;
+    context.process = std::make_shared<const DepositionSettings>(process);
+    const UniformPlanner planner{UniformSettings{}};
+    const Trajectory plan = planner.plan_in_context(zig_zag(3.0), limits, context);
+    expect_joint_limits(plan, *stage, joint, true);
+  }
+}
+
+TEST(UniformTimeLaw, DeltaCarriagesWithinTheirLimits) {
+  LinearDelta delta;
+  ASSERT_EQ(delta.set_joint_limits(AxisLimits{200.0, 3000.0, 0.0}), "");
+  const TcpLimits limits = delta.tcp_limits(MachineLimits::uniform(100.0, 1500.0, 60000.0));
+  Toolpath toolpath = zig_zag(20.0);
+  PlanningContext context;
+  DepositionSettings extrusion;
+  extrusion.type = ProcessType::extrusion;
+  extrusion.bead_width_mm = 0.45;
+  context.process = std::make_shared<const DepositionSettings>(extrusion);
+  const Trajectory plan =
+      UniformPlanner{UniformSettings{}}.plan_in_context(toolpath, limits, context);
+  JointLimit carriage = delta.joint_limits().front();
+  // the planner holds the TCP limits the machine maps over each move's box; the carriages stay
+  // within theirs (jerk: the delta has no carriage jerk limit)
+  std::vector<JointVector> q;
+  const double dt = 0.001;
+  double peak_v = 0.0, peak_a = 0.0;
+  JointVector previous, before;
+  for (double t = 0.0; t <= plan.duration_s(); t += dt) {
+    JointVector joints;
+    ASSERT_TRUE(delta.inverse(Pose(plan.at(t).position_mm), joints));
+    if (!previous.empty())
+      for (size_t j = 0; j < 3; ++j)
+        peak_v = std::max(peak_v, std::abs(joints[j] - previous[j]) / dt);
+    if (!before.empty())
+      for (size_t j = 0; j < 3; ++j)
+        peak_a = std::max(peak_a, std::abs(joints[j] - 2 * previous[j] + before[j]) / (dt * dt));
+    before = previous;
+    previous = joints;
+  }
+  EXPECT_LE(peak_v, carriage.v_max);
+  EXPECT_LE(peak_a, carriage.a_max);
+  EXPECT_GT(peak_v, 0.0);
+}
+
+}  // namespace
+}  // namespace depotwin
