@@ -11,6 +11,10 @@
 #include <iterator>
 #include <sstream>
 
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
 #include "core/error.hpp"
 
 namespace depotwin {
@@ -110,6 +114,21 @@ std::optional<Code> code_of(const std::string& text) {
   return Code{upper(text[0]), static_cast<int>(std::lround(number * 10.0))};
 }
 
+// Ask for 2 MB pages over a large buffer not yet written (Linux transparent huge pages in
+// `madvise` mode): a 10^6-line file's moves take ~140 MB, and first touching them 4 kB at a
+// time costs more than parsing them. Only advice: nothing changes where it is not honoured.
+void advise_huge_pages(void* data, std::size_t bytes) {
+#ifdef __linux__
+  constexpr std::uintptr_t kHugePage = 2u << 20;
+  const auto begin = (reinterpret_cast<std::uintptr_t>(data) + kHugePage - 1) & ~(kHugePage - 1);
+  const auto end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHugePage - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
+
 // the parser's state: modal settings and the position reached so far
 class GcodeParser {
  public:
@@ -122,6 +141,11 @@ class GcodeParser {
 
   void line(const char* begin, const char* end, int line_number);
   GcodeProgram finish(int n_lines);
+  // room for up to n moves at once (untouched room costs no memory until written)
+  void reserve_moves(std::size_t n) {
+    program_.moves.reserve(n);
+    advise_huge_pages(program_.moves.data(), n * sizeof(GcodeMove));
+  }
 
  private:
   void problem(int line_number, const std::string& message);
@@ -664,6 +688,10 @@ GcodeProgram parse_gcode_program(const std::string& text, const std::string& fil
   const char* end = p + text.size();
   // a UTF-8 byte order mark is not part of the first command
   if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) p += 3;
+  // at most one move per line: one reservation instead of a copy at every doubling (capped:
+  // beyond 2^23 moves the vector grows as usual)
+  const auto n_lines = static_cast<std::size_t>(std::count(p, end, '\n')) + 1;
+  parser.reserve_moves(std::min<std::size_t>(n_lines, std::size_t{1} << 23));
   int line_number = 0;
   while (p < end) {
     const char* line_end = static_cast<const char*>(std::memchr(p, '\n', end - p));
