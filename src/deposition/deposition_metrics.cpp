@@ -113,7 +113,9 @@ TargetRegion::TargetRegion(const Toolpath& toolpath, double line_width_mm, doubl
       const int iy_hi = static_cast<int>(std::ceil((std::max(ay, by) + r) / h));
       for (int iy = iy_lo; iy <= iy_hi; ++iy) {
         const double y = iy * h;
-        const Interval row = capsule_row(ax, ay, bx, by, ex, ey, length, r, y);
+        // (the row's interval with the same tolerance as the test below: a row exactly r
+        // from the centreline, rounded a hair beyond it, keeps its cells)
+        const Interval row = capsule_row(ax, ay, bx, by, ex, ey, length, std::sqrt(r2), y);
         if (row.empty()) continue;
         const int ix_lo = static_cast<int>(std::floor(row.lo / h)) - 1;
         const int ix_hi = static_cast<int>(std::ceil(row.hi / h)) + 1;

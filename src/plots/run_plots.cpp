@@ -397,8 +397,18 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
     s += format("set label %zu %s at screen 0.5,%.4f center font \",10\" tc rgb \"#404040\"\n",
                 950 + i, style::quoted(notes[i]).c_str(), 0.075 - 0.04 * i);
 
-  // one colour and key entry per line when few; one shared colour and entry when many
-  const bool few = data.profiles.size() <= 8;
+  // one colour and key entry per line when few; one shared colour and entry when many, on the
+  // first line drawn, naming the paths' range
+  int first_path = std::numeric_limits<int>::max(), last_path = std::numeric_limits<int>::min();
+  size_t drawn = 0;
+  for (size_t i = 0; i < data.profiles.size(); ++i) {
+    if (data.profiles[i].point_count() == 0) continue;
+    ++drawn;
+    first_path = std::min(first_path, input.profiles[i].path_index);
+    last_path = std::max(last_path, input.profiles[i].path_index);
+  }
+  const bool few = drawn <= 8;
+  bool shared_entry_given = false;
   std::vector<std::string> elements;
   // the reference lines first, so the profiles are drawn over them
   if (input.target_thickness_um > 0.0)
@@ -412,9 +422,10 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
   for (size_t i = 0; i < data.profiles.size(); ++i) {
     if (data.profiles[i].point_count() == 0) continue;
     const int path = input.profiles[i].path_index;
-    std::string title = few ? format("title 'path %d'", path)
-                            : (i == 0 ? format("title 'paths 0-%zu'", data.profiles.size() - 1)
-                                      : std::string("notitle"));
+    std::string title = few                   ? format("title 'path %d'", path)
+                        : !shared_entry_given ? format("title 'paths %d-%d'", first_path, last_path)
+                                              : std::string("notitle");
+    shared_entry_given = true;
     elements.push_back(
         job.data_file(format("profile_%zu.dat", i), format_curve(data.profiles[i])) + " " +
         line_style(few ? style::series_colour(i) : style::kPlannedColour, 1.5) + " " + title);

@@ -209,7 +209,35 @@ TEST(Aerosol, MaterialIsConservedThroughShutterTransitions) {
   EXPECT_NEAR(m.on_target_mm3 + m.overspray_mm3 + m.captured_mm3, emitted, 1e-6 * emitted);
   EXPECT_NEAR(process.field().total_volume_mm3(), process.account().landed_mm3, 1e-12 * emitted);
   EXPECT_GT(m.overspray_mm3, 0.0);  // the Gaussian tail beyond +-2 sigma
-  EXPECT_NEAR(m.fraction, (m.overspray_mm3 + m.captured_mm3) / emitted, 1e-12);
+
+  // the waste, from an account of its own: the material that landed farther than half a line
+  // width from both centrelines, summed over the deposit's cells themselves, plus Q x the
+  // closed time above, over Q x 5 s
+  const double r = 0.5 * process.line_width_mm();
+  const double area = kCell * kCell;
+  const FieldBounds bounds = process.field().bounds();
+  ASSERT_FALSE(bounds.empty);
+  double outside_mm3 = 0.0, landed_mm3 = 0.0;
+  for (long iy = std::lround(bounds.y_lo_mm / kCell); iy <= std::lround(bounds.y_hi_mm / kCell);
+       ++iy)
+    for (long ix = std::lround(bounds.x_lo_mm / kCell); ix <= std::lround(bounds.x_hi_mm / kCell);
+         ++ix) {
+      const double volume = process.field().cell_thickness_mm(ix, iy) * area;
+      const double x = ix * kCell, y = iy * kCell;
+      // distance to the segments (0, 0)-(6, 0) and (0, 1)-(6, 1)
+      const double along = std::max(0.0, std::max(x - 6.0, -x));
+      const double d = std::min(std::hypot(along, y), std::hypot(along, y - 1.0));
+      landed_mm3 += volume;
+      if (d > r + 1e-9) outside_mm3 += volume;
+    }
+  EXPECT_NEAR(landed_mm3, emitted - q * closed_time, 1e-6 * emitted);
+  // the Gaussian tails on both sides of 12 mm of line: the cells within r = 2 sigma are on
+  // target, so on the lattice the band ends half a cell beyond r, erfc((r + h / 2) / (sigma
+  // sqrt 2)) = 3.4 % (the line's ends add little)
+  EXPECT_NEAR(outside_mm3 / landed_mm3, std::erfc((r + 0.5 * kCell) / (kSigma * std::sqrt(2.0))),
+              0.002);
+  EXPECT_NEAR(m.fraction, (outside_mm3 + q * closed_time) / emitted, 1e-9);
+  EXPECT_NEAR(m.overspray_mm3, outside_mm3, 1e-9 * emitted);
 }
 
 TEST(Aerosol, BadSettingsAreInputErrors) {

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <set>
 
+#include "gnuplot_capture.hpp"
 #include "plot_fixture.hpp"
 #include "plots/plots.hpp"
 #include "plots/style.hpp"
@@ -129,14 +131,77 @@ TEST(RunPlots, NothingDepositedStillRendersEveryFrame) {
     expect_png(file, plots::style::kRunPlotWidth_px, plots::style::kRunPlotHeight_px);
 }
 
-TEST(RunPlots, ManyLinesShareOneProfileKeyEntry) {
-  const auto f = make_plot_fixture(testing_support::raster_toolpath(12), 0.3, false);
-  const std::string directory = output_directory("many_lines");
+// thickness_profile.png's key, read from the script gnuplot ran: the two reference lines
+// (target, centreline mean) and the profiles; `expected` titles per profile element ("" for
+// notitle) and whether they share one colour. Each profile's data file holds that line's
+// profile, point for point (the fixture's profiles are below the decimation budget).
+void expect_profile_key(const testing_support::PlotFixture& fixture,
+                        const plots::RunPlotInput& input, const std::string& name,
+                        const std::vector<std::string>& expected, bool one_colour) {
+  SCOPED_TRACE(name);
+  const std::string directory = output_directory(name);
+  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
   const auto result =
-      plots::render_run_plots(f.input("12 lines"), directory, {RunPlot::thickness_profile});
+      plots::render_run_plots(input, directory + "/plot", {RunPlot::thickness_profile}, options);
   EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
   ASSERT_EQ(result.files.size(), 1u);
   expect_png(result.files[0], plots::style::kRunPlotWidth_px, plots::style::kRunPlotHeight_px);
+
+  const std::vector<std::string> elements = testing_support::plot_elements(
+      testing_support::png_section(capture.script(), "thickness_profile.png"));
+  ASSERT_EQ(elements.size(), 2 + expected.size()) << capture.script();
+  EXPECT_EQ(testing_support::key_title(elements[0]), "target 10 µm");
+  EXPECT_EQ(testing_support::key_title(elements[1]).rfind("centreline mean ", 0), 0u);
+  std::vector<std::string> titles, colours;
+  for (size_t e = 2; e < elements.size(); ++e) {
+    titles.push_back(testing_support::key_title(elements[e]));
+    colours.push_back(testing_support::line_colour(elements[e]));
+    // the data: the profile it names, every point
+    const std::string file = testing_support::data_file_name(elements[e]);
+    ASSERT_EQ(file.rfind("profile_", 0), 0u) << elements[e];
+    const size_t index = std::stoul(file.substr(8));
+    ASSERT_LT(index, fixture.profiles.size());
+    const auto& profile = fixture.profiles[index];
+    const auto rows = testing_support::read_rows(capture.folder + "/" + file);
+    ASSERT_EQ(rows.size(), profile.arc_length_mm.size()) << file;
+    for (size_t k = 0; k < rows.size(); ++k) {
+      ASSERT_EQ(rows[k].size(), 2u);
+      EXPECT_NEAR(rows[k][0], profile.arc_length_mm[k], 1e-6) << file << " row " << k;
+      EXPECT_NEAR(rows[k][1], profile.thickness_um[k], 1e-5 * profile.thickness_um[k] + 1e-9)
+          << file << " row " << k;
+    }
+  }
+  EXPECT_EQ(titles, expected);
+  const std::set<std::string> distinct(colours.begin(), colours.end());
+  EXPECT_EQ(distinct.size(), one_colour ? 1u : colours.size());
+  EXPECT_EQ(distinct.count(""), 0u);
+}
+
+// Past eight lines the profiles share one colour and one key entry, "paths first-last", not
+// one entry each (that would fill the key and hide the plot); eight or fewer get an entry
+// and a colour each. The shared entry stays when the first line has no profile (it goes on
+// the first line drawn, naming the paths drawn).
+TEST(RunPlots, ManyLinesShareOneProfileKeyEntry) {
+  const auto many = make_plot_fixture(testing_support::raster_toolpath(12), 0.3, false);
+  std::vector<std::string> shared(12, "");
+  shared[0] = "paths 0-11";
+  expect_profile_key(many, many.input("12 lines"), "many_lines", shared, true);
+
+  const auto few = make_plot_fixture(testing_support::raster_toolpath(8), 0.3, false);
+  std::vector<std::string> each;
+  for (int i = 0; i < 8; ++i) each.push_back("path " + std::to_string(i));
+  expect_profile_key(few, few.input("8 lines"), "eight_lines", each, false);
+
+  // nine lines drawn of ten, the first without a profile
+  auto gap = make_plot_fixture(testing_support::raster_toolpath(10), 0.3, false);
+  gap.profiles[0].arc_length_mm.clear();
+  gap.profiles[0].thickness_um.clear();
+  std::vector<std::string> after_gap(9, "");
+  after_gap[0] = "paths 1-9";
+  expect_profile_key(gap, gap.input("10 lines, the first empty"), "first_line_empty", after_gap,
+                     true);
 }
 
 TEST(Comparison, OneColumnPerPlannerOnASharedScale) {

@@ -1,5 +1,6 @@
-// The scene render: a PNG of the requested size that shows something, with the deposit
-// visible on the substrate (a printed line changes the middle of the picture, nothing else).
+// The scene render: a PNG of the requested size showing the machine in the state a run left
+// it, the deposit where it lies in the colour bar's colours (pixels read where MuJoCo's
+// cameras project known points), framed so that machine, nozzle and deposit fit their panels.
 #include <gtest/gtest.h>
 #include <stb_image.h>
 #include <unistd.h>
@@ -50,6 +51,10 @@ HeightMap deposit_grid(bool with_line) {
   return map;
 }
 
+// the deposit mesh's light on a flat crest (render/deposit_mesh.cpp): 0.7 ambient plus 0.3
+// diffuse from a light 30 degrees off the substrate's normal
+const double kDepositLight = 0.7 + 0.3 * std::cos(30.0 * kPi / 180.0);
+
 // render options for an image of this size, the rest default
 SceneRenderOptions sized(int width, int height) {
   SceneRenderOptions options;
@@ -62,31 +67,152 @@ std::string temp_path(const std::string& name) {
   return ::testing::TempDir() + "depotwin_" + std::to_string(::getpid()) + "_" + name;
 }
 
-TEST(Scene, WritesAPngOfTheRequestedSizeThatIsNotBlank) {
+// a panel of a layout as MuJoCo's viewport (framebuffer pixels, bottom-up, no supersampling)
+mjrRect viewport_of(const PixelRect& panel, int image_height) {
+  return {panel.x, image_height - panel.y - panel.height, panel.width, panel.height};
+}
+
+// the GL camera mjv_updateScene makes of a free camera (the one mjr_render projects with)
+mjvGLCamera gl_camera(const mjModel& model, const mjData& data, const FreeCamera& free) {
+  mjvScene scene;
+  mjv_defaultScene(&scene);
+  mjv_makeScene(&model, &scene, 4 * model.ngeom + 64);
+  DataPtr copy = copy_data(model, data);
+  mjvOption visual_options;
+  mjv_defaultOption(&visual_options);
+  mjvPerturb perturb;
+  mjv_defaultPerturb(&perturb);
+  mjvCamera view;
+  mjv_defaultCamera(&view);
+  set_free_camera(free, view);
+  mjv_updateScene(&model, copy.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene);
+  const mjvGLCamera camera = mjv_averageCamera(scene.camera, scene.camera + 1);
+  mjv_freeScene(&scene);
+  return camera;
+}
+
+// the world point (m) of a substrate-frame point (mm)
+Vec3 on_substrate(const mjModel& model, const mjData& data, const Vec3& local_mm) {
+  const int body = mj_name2id(&model, mjOBJ_BODY, "substrate");
+  Vec3 world;
+  for (int row = 0; row < 3; ++row) {
+    world[row] = data.xpos[3 * body + row];
+    for (int col = 0; col < 3; ++col)
+      world[row] += data.xmat[9 * body + 3 * row + col] * 1e-3 * local_mm[col];
+  }
+  return world;
+}
+
+// the GL camera of the model's own camera `name` (mjCAMERA_FIXED) at this state
+mjvGLCamera model_gl_camera(const mjModel& model, const mjData& data, const char* name) {
+  mjvScene scene;
+  mjv_defaultScene(&scene);
+  mjv_makeScene(&model, &scene, 4 * model.ngeom + 64);
+  DataPtr copy = copy_data(model, data);
+  mjvOption visual_options;
+  mjv_defaultOption(&visual_options);
+  mjvPerturb perturb;
+  mjv_defaultPerturb(&perturb);
+  mjvCamera view;
+  mjv_defaultCamera(&view);
+  view.type = mjCAMERA_FIXED;
+  view.fixedcamid = mj_name2id(&model, mjOBJ_CAMERA, name);
+  mjv_updateScene(&model, copy.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene);
+  const mjvGLCamera camera = mjv_averageCamera(scene.camera, scene.camera + 1);
+  mjv_freeScene(&scene);
+  return camera;
+}
+
+// where a world point shows in the image: column and row from the top-left corner (the
+// viewport's pixels are counted from its bottom)
+std::optional<Eigen::Vector2d> image_pixel(const mjvGLCamera& camera, const mjrRect& viewport,
+                                           int image_height, const Vec3& world_m) {
+  const auto pixel = project_to_viewport(camera, viewport, world_m);
+  if (!pixel) return std::nullopt;
+  return Eigen::Vector2d(pixel->x(), image_height - pixel->y());
+}
+
+// the RGB of the image pixel at (column, row)
+Eigen::Vector3d rgb_at(const std::vector<unsigned char>& rgb, int width, double column,
+                       double row) {
+  const size_t i =
+      3 * (static_cast<size_t>(std::floor(row)) * width + static_cast<size_t>(std::floor(column)));
+  return Eigen::Vector3d(rgb[i], rgb[i + 1], rgb[i + 2]);
+}
+
+// viridis at a value in [0, 1] in 0..255 per channel
+Eigen::Vector3d viridis_255(double value) {
+  float colour[3];
+  viridis(value, colour);
+  return 255.0 * Eigen::Vector3d(colour[0], colour[1], colour[2]);
+}
+
+// scene.png is the scene at the requested size: its pixels are the render's, and the render
+// shows the deposit where it lies in the colour bar's colours (the line's crest, projected
+// through the close-up's camera, has the bar's top colour, lit from above: 0.7 ambient + 0.3
+// cos 30 deg diffuse; bare substrate 2 mm beside it does not), the bar runs from the bottom of
+// viridis to its top, and the nozzle lies inside the machine view
+TEST(Scene, WritesAPngOfTheRequestedSizeShowingTheDepositInItsColours) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
   const std::string path = temp_path("scene.png");
   SceneRenderOptions options;  // 640 x 480
-  render_scene_png(simulation, deposit_grid(true), path, options);
+  const HeightMap deposit = deposit_grid(true);
+  render_scene_png(simulation, deposit, path, options);
 
   int width = 0, height = 0, channels = 0;
   unsigned char* pixels = stbi_load(path.c_str(), &width, &height, &channels, 3);
   ASSERT_NE(pixels, nullptr);
   EXPECT_EQ(width, 640);
   EXPECT_EQ(height, 480);
-  // grey-level variance well above a blank (single colour) picture's 0
-  double sum = 0.0, sum_squares = 0.0;
-  const long count = static_cast<long>(width) * height;
-  for (long i = 0; i < count; ++i) {
-    const double grey = (pixels[3 * i] + pixels[3 * i + 1] + pixels[3 * i + 2]) / 3.0;
-    sum += grey;
-    sum_squares += grey * grey;
-  }
+  const std::vector<unsigned char> png(pixels, pixels + 3 * static_cast<size_t>(width) * height);
   stbi_image_free(pixels);
-  const double mean = sum / count;
-  const double variance = sum_squares / count - mean * mean;
-  std::printf("scene.png grey mean %.1f, variance %.1f\n", mean, variance);
-  EXPECT_GT(variance, 100.0);
+  EXPECT_TRUE(png == render_scene_rgb(simulation, deposit, options)) << "not the render";
+
+  const mjModel& model = SimulationAccess::model(simulation);
+  const mjData& data = SimulationAccess::data(simulation);
+  const SceneFraming framing = frame_scene(model, data, deposit, options);
+  const SceneLayout layout = scene_layout(options);
+  // the crest of the line, at the drawn relief, and bare substrate 2 mm beside it
+  const mjvGLCamera closeup = gl_camera(model, data, framing.closeup);
+  const mjrRect closeup_viewport = viewport_of(layout.closeup, height);
+  const double lit = kDepositLight;
+  // (clear of the nozzle, which stands over x = 0 and shows in front of the crest there)
+  for (double x : {-6.0, -3.0, 3.0, 6.0}) {
+    const auto crest = image_pixel(closeup, closeup_viewport, height,
+                                   on_substrate(model, data, Vec3(x, 0.0, framing.relief_mm)));
+    ASSERT_TRUE(crest);
+    const Eigen::Vector3d colour = rgb_at(png, width, crest->x(), crest->y());
+    std::printf("crest at x = %.0f mm: pixel (%.0f, %.0f) = (%.0f, %.0f, %.0f)\n", x, crest->x(),
+                crest->y(), colour[0], colour[1], colour[2]);
+    EXPECT_LT((colour - lit * viridis_255(1.0)).cwiseAbs().maxCoeff(), 25.0) << "x " << x;
+    const auto beside =
+        image_pixel(closeup, closeup_viewport, height, on_substrate(model, data, Vec3(x, 2, 0)));
+    ASSERT_TRUE(beside);
+    const Eigen::Vector3d bare = rgb_at(png, width, beside->x(), beside->y());
+    EXPECT_GT((bare - lit * viridis_255(1.0)).cwiseAbs().maxCoeff(), 60.0) << "x " << x;
+  }
+  // the colour bar: viridis' bottom and top colours both in the strip
+  long bottom = 0, top = 0;
+  for (int row = layout.strip.y; row < layout.strip.y + layout.strip.height; ++row)
+    for (int column = 0; column < width; ++column) {
+      const Eigen::Vector3d colour = rgb_at(png, width, column, row);
+      bottom += (colour - viridis_255(0.0)).cwiseAbs().maxCoeff() <= 4.0;
+      top += (colour - viridis_255(1.0)).cwiseAbs().maxCoeff() <= 4.0;
+    }
+  EXPECT_GT(bottom, 10);
+  EXPECT_GT(top, 10);
+  // the nozzle in the machine view
+  const int nozzle = mj_name2id(&model, mjOBJ_SITE, "nozzle");
+  const Vec3 nozzle_world(data.site_xpos[3 * nozzle], data.site_xpos[3 * nozzle + 1],
+                          data.site_xpos[3 * nozzle + 2]);
+  const auto tip = image_pixel(gl_camera(model, data, framing.whole),
+                               viewport_of(layout.whole, height), height, nozzle_world);
+  ASSERT_TRUE(tip);
+  EXPECT_GE(tip->x(), layout.whole.x);
+  EXPECT_LE(tip->x(), layout.whole.x + layout.whole.width);
+  EXPECT_GE(tip->y(), layout.whole.y);
+  EXPECT_LE(tip->y(), layout.whole.y + layout.whole.height);
   // written through a temporary file that is gone afterwards
   for (const auto& entry : fs::directory_iterator(fs::path(path).parent_path()))
     EXPECT_EQ(entry.path().string().find(path + ".tmp"), std::string::npos) << entry.path();
@@ -148,21 +274,68 @@ TEST(Scene, APrintedLineChangesTheCloseUpOnly) {
   EXPECT_EQ(render_scene_rgb(simulation, deposit_grid(true), options), printed);
 }
 
+// the mean (column, row) of the pixels that differ clearly between two renders, and their count
+std::pair<Eigen::Vector2d, long> changed_centroid(const std::vector<unsigned char>& a,
+                                                  const std::vector<unsigned char>& b, int width) {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  long changed = 0;
+  for (size_t i = 0; i < a.size(); i += 3) {
+    int difference = 0;
+    for (int c = 0; c < 3; ++c) difference = std::max(difference, std::abs(a[i + c] - b[i + c]));
+    if (difference <= 40) continue;
+    ++changed;
+    sum += Eigen::Vector2d(static_cast<double>(i / 3 % width), static_cast<double>(i / 3 / width));
+  }
+  return {changed > 0 ? Eigen::Vector2d(sum / changed) : sum, changed};
+}
+
+// From render_cam as placed in the MJCF, the render shows the machine as the run left it: the
+// stage carried the plate 8 mm along x under the fixed nozzle (the print ends at x = 8 mm on
+// the plate, it started at the home pose, x = 0), so the deposit (drawn with and without, at
+// the same state) appears where the plate's centre projects after the run, not before
 TEST(Scene, RendersTheStateAfterARunFromTheModelCamera) {
   const auto machine = make_xy_stage();
   Simulation simulation(xy_stage_model(), *machine);
-  const auto print =
-      straight_print(Vec3(-8, 0, 0), Vec3(1, 0, 0), 3.0, 16.0, MachineLimits::uniform(4, 30));
-  simulation.run(print.trajectory);
   SceneRenderOptions options = sized(320, 240);
   options.frame_deposit = false;  // render_cam as placed in the MJCF, the machine view alone
   options.closeup = false;
   options.overlays = false;
-  const auto before = render_scene_rgb(simulation, deposit_grid(false), options);
-  const auto after = render_scene_rgb(simulation, deposit_grid(true), options);
-  long changed = 0;
-  for (size_t i = 0; i < after.size(); ++i) changed += std::abs(after[i] - before[i]) > 40;
-  EXPECT_GT(changed, 50);
+  const mjModel& model = SimulationAccess::model(simulation);
+  const mjData& data = SimulationAccess::data(simulation);
+  const mjrRect viewport = {0, 0, 320, 240};
+  const auto centre_now = [&] {
+    const auto pixel = image_pixel(model_gl_camera(model, data, "render_cam"), viewport, 240,
+                                   on_substrate(model, data, Vec3::Zero()));
+    EXPECT_TRUE(pixel);
+    return pixel ? *pixel : Eigen::Vector2d(-1e9, -1e9);
+  };
+  const auto deposit_centroid = [&] {
+    const auto [centroid, changed] =
+        changed_centroid(render_scene_rgb(simulation, deposit_grid(false), options),
+                         render_scene_rgb(simulation, deposit_grid(true), options), 320);
+    EXPECT_GT(changed, 50);
+    return centroid;
+  };
+  const Eigen::Vector2d before_centre = centre_now();
+  const Eigen::Vector2d before_deposit = deposit_centroid();
+
+  const auto print =
+      straight_print(Vec3(-8, 0, 0), Vec3(1, 0, 0), 3.0, 16.0, MachineLimits::uniform(4, 30));
+  simulation.run(print.trajectory);
+  const Eigen::Vector2d after_centre = centre_now();
+  const Eigen::Vector2d after_deposit = deposit_centroid();
+  std::printf(
+      "plate centre in the picture: (%.1f, %.1f) before, (%.1f, %.1f) after; deposit "
+      "(%.1f, %.1f) before, (%.1f, %.1f) after\n",
+      before_centre.x(), before_centre.y(), after_centre.x(), after_centre.y(), before_deposit.x(),
+      before_deposit.y(), after_deposit.x(), after_deposit.y());
+  // the plate moved clearly in the picture, and the deposit with it (its centroid within a
+  // quarter of the move of the plate's centre: perspective shifts it a little)
+  const double moved_px = (after_centre - before_centre).norm();
+  ASSERT_GT(moved_px, 20.0);
+  EXPECT_LT((before_deposit - before_centre).norm(), 0.25 * moved_px);
+  EXPECT_LT((after_deposit - after_centre).norm(), 0.25 * moved_px);
+  EXPECT_GT((after_deposit - before_centre).norm(), 0.75 * moved_px);
 }
 
 // A renderer that keeps its contexts (prepared on a background thread, then reused, rebuilt
@@ -251,42 +424,6 @@ TEST(Scene, NoViewShowsTheEmptyBackground) {
       black += rgb[i] < 8 && rgb[i + 1] < 8 && rgb[i + 2] < 8;
     EXPECT_EQ(black, 0) << (framed ? "framed" : "render_cam");
   }
-}
-
-// a panel of a layout as MuJoCo's viewport (framebuffer pixels, bottom-up, no supersampling)
-mjrRect viewport_of(const PixelRect& panel, int image_height) {
-  return {panel.x, image_height - panel.y - panel.height, panel.width, panel.height};
-}
-
-// the GL camera mjv_updateScene makes of a free camera (the one mjr_render projects with)
-mjvGLCamera gl_camera(const mjModel& model, const mjData& data, const FreeCamera& free) {
-  mjvScene scene;
-  mjv_defaultScene(&scene);
-  mjv_makeScene(&model, &scene, 4 * model.ngeom + 64);
-  DataPtr copy = copy_data(model, data);
-  mjvOption visual_options;
-  mjv_defaultOption(&visual_options);
-  mjvPerturb perturb;
-  mjv_defaultPerturb(&perturb);
-  mjvCamera view;
-  mjv_defaultCamera(&view);
-  set_free_camera(free, view);
-  mjv_updateScene(&model, copy.get(), &visual_options, &perturb, &view, mjCAT_ALL, &scene);
-  const mjvGLCamera camera = mjv_averageCamera(scene.camera, scene.camera + 1);
-  mjv_freeScene(&scene);
-  return camera;
-}
-
-// the world point (m) of a substrate-frame point (mm)
-Vec3 on_substrate(const mjModel& model, const mjData& data, const Vec3& local_mm) {
-  const int body = mj_name2id(&model, mjOBJ_BODY, "substrate");
-  Vec3 world;
-  for (int row = 0; row < 3; ++row) {
-    world[row] = data.xpos[3 * body + row];
-    for (int col = 0; col < 3; ++col)
-      world[row] += data.xmat[9 * body + 3 * row + col] * 1e-3 * local_mm[col];
-  }
-  return world;
 }
 
 // Framing of deposit_grid(true): in the machine view every geom's centre, the nozzle and the
@@ -567,11 +704,63 @@ void render_arm_scene(const ArmScene& scene, const HeightMap& map, const std::st
                                 SimulationAccess::data(*scene.simulation), map, options);
   const auto rgb = render_scene_rgb(*scene.simulation, map, options);
   EXPECT_EQ(render_scene_rgb(*scene.simulation, map, options), rgb);
-  // the deposit shows: the picture without it (the same views) differs
+  // the deposit shows where it lies: against the picture without it (the same views), the
+  // changed pixels of the close-up (framed on the deposit) centre on it, and those of the
+  // machine view centre where the deposit's middle on the part projects
   const auto bare = render_scene_rgb(*scene.simulation, HeightMap{}, options);
-  long changed = 0;
-  for (size_t i = 0; i < rgb.size(); ++i) changed += std::abs(rgb[i] - bare[i]) > 40;
-  EXPECT_GT(changed, 2000) << name;
+  const mjModel& model = SimulationAccess::model(*scene.simulation);
+  const mjData& data = SimulationAccess::data(*scene.simulation);
+  const SceneLayout layout = scene_layout(options);
+  Eigen::Vector2d closeup_sum = Eigen::Vector2d::Zero(), whole_sum = Eigen::Vector2d::Zero();
+  long closeup_changed = 0, whole_changed = 0;
+  for (size_t i = 0; i < rgb.size(); i += 3) {
+    int difference = 0;
+    for (int c = 0; c < 3; ++c)
+      difference = std::max(difference, std::abs(rgb[i + c] - bare[i + c]));
+    if (difference <= 40) continue;
+    const Eigen::Vector2d pixel(static_cast<double>(i / 3 % 640), static_cast<double>(i / 3 / 640));
+    if (pixel.y() >= layout.strip.y) continue;  // the colour bar's values
+    if (pixel.x() >= layout.closeup.x) {
+      closeup_sum += pixel;
+      ++closeup_changed;
+    } else {
+      whole_sum += pixel;
+      ++whole_changed;
+    }
+  }
+  ASSERT_GT(closeup_changed, 2000) << name;
+  ASSERT_GT(whole_changed, 20) << name;
+  const Eigen::Vector2d closeup_centroid = closeup_sum / closeup_changed;
+  EXPECT_NEAR(closeup_centroid.x(), layout.closeup.x + 0.5 * layout.closeup.width,
+              0.15 * layout.closeup.width)
+      << name;
+  EXPECT_NEAR(closeup_centroid.y(), layout.closeup.y + 0.5 * layout.closeup.height,
+              0.15 * layout.closeup.height)
+      << name;
+  const double middle_x = map.origin_x_mm + 0.5 * (map.nx - 1) * map.cell_mm;
+  const double middle_y = map.origin_y_mm + 0.5 * (map.ny - 1) * map.cell_mm;
+  const std::optional<double> middle_z = projector->height_at(middle_x, middle_y);
+  ASSERT_TRUE(middle_z) << name;
+  const mjvGLCamera whole_camera = gl_camera(model, data, options.framing->whole);
+  const auto middle = image_pixel(whole_camera, viewport_of(layout.whole, 480), 480,
+                                  on_substrate(model, data, Vec3(middle_x, middle_y, *middle_z)));
+  ASSERT_TRUE(middle) << name;
+  const Eigen::Vector2d whole_centroid = whole_sum / whole_changed;
+  std::printf(
+      "[ %s ] deposit: close-up centroid (%.0f, %.0f); machine view centroid (%.0f, %.0f), "
+      "the part's middle at (%.0f, %.0f)\n",
+      name.c_str(), closeup_centroid.x(), closeup_centroid.y(), whole_centroid.x(),
+      whole_centroid.y(), middle->x(), middle->y());
+  EXPECT_LT((whole_centroid - *middle).norm(), 0.1 * layout.whole.width) << name;
+  // the nozzle, which the arm holds above the part, is in the machine view
+  const int nozzle = mj_name2id(&model, mjOBJ_SITE, "nozzle");
+  const auto tip = image_pixel(whole_camera, viewport_of(layout.whole, 480), 480,
+                               Vec3(data.site_xpos[3 * nozzle], data.site_xpos[3 * nozzle + 1],
+                                    data.site_xpos[3 * nozzle + 2]));
+  ASSERT_TRUE(tip) << name;
+  EXPECT_TRUE(tip->x() >= layout.whole.x && tip->x() <= layout.whole.x + layout.whole.width &&
+              tip->y() >= layout.whole.y && tip->y() <= layout.whole.y + layout.whole.height)
+      << name;
   // looking down on the part, the floor fills the view: none of the empty background's black
   long black = 0;
   for (size_t i = 0; i < rgb.size(); i += 3)

@@ -145,6 +145,66 @@ TEST(MetricsJson, PlannedAndSimulatedFiguresHaveTheirOwnNames) {
   EXPECT_TRUE(run["layers"][0].contains("velocity_error_steady"));
 }
 
+// the contract of docs/ARCHITECTURE.md ("metrics.json"): every key under its name, holding the
+// report's value (the fixture's own numbers, not the writer's), with its unit
+TEST(MetricsJson, ContractKeysHoldTheReportsValues) {
+  const Json j = Json::parse(metrics_json_text(simulated_report()));
+  EXPECT_EQ(j["scenario"], "fixture");
+  EXPECT_EQ(j["machine"], "xy_stage");
+  EXPECT_EQ(j["planner"], "lspb_mtt");
+  EXPECT_EQ(j["sequencer"], "as_given");
+  const auto expect_section = [&](const char* section, const std::vector<const char*>& keys,
+                                  const std::vector<double>& values, const char* unit) {
+    ASSERT_TRUE(j.contains(section)) << section;
+    for (size_t k = 0; k < keys.size(); ++k) {
+      ASSERT_TRUE(j[section].contains(keys[k])) << section << "." << keys[k];
+      EXPECT_DOUBLE_EQ(j[section][keys[k]].get<double>(), values[k]) << section << "." << keys[k];
+      if (unit) {
+        EXPECT_EQ(j["units"][section][keys[k]], unit) << section << "." << keys[k];
+      }
+    }
+  };
+  expect_section("time_s", {"total", "print", "transition"}, {19.0, 11.0, 8.0}, "s");
+  const std::vector<const char*> velocity_keys = {"max_rel", "rms_rel", "p95_rel",
+                                                  "frac_len_over_1pct"};
+  expect_section("velocity_error", velocity_keys, {0.61, 0.05, 0.1, 0.02}, "fraction");
+  expect_section("planned_velocity_error", velocity_keys, {0.6, 0.05, 0.1, 0.02}, "fraction");
+  expect_section("path_error_mm", {"max", "rms"}, {0.05, 0.01}, "mm");
+  expect_section("thickness", {"mean_um", "cv", "line_cv", "min_rel", "max_rel"},
+                 {1.2, 0.5, 0.08, 0.1, 1.9}, nullptr);
+  EXPECT_EQ(j["units"]["thickness"]["mean_um"], "µm");
+  expect_section("waste", {"fraction", "shutter_captured", "overspray"}, {0.45, 0.4, 0.05},
+                 "fraction");
+  expect_section("waste", {"closed_time_s"}, {8.0}, "s");
+  expect_section("material_mm3", {"emitted", "on_target", "overspray", "captured"},
+                 {10.0, 5.5, 0.5, 4.0}, "mm^3");
+  // emitted = the sum of the other three, as the contract says of the fixture's volumes
+  const Json& material = j["material_mm3"];
+  EXPECT_DOUBLE_EQ(material["emitted"].get<double>(), material["on_target"].get<double>() +
+                                                          material["overspray"].get<double>() +
+                                                          material["captured"].get<double>());
+  for (const char* key : {"peak_vel", "peak_acc", "peak_force"}) {
+    ASSERT_TRUE(j["actuators"].contains(key)) << key;
+    EXPECT_EQ(j["actuators"][key], (Json{1.0, 2.0})) << key;
+  }
+  EXPECT_EQ(j["actuators"]["limit_violations"], 0);
+  EXPECT_EQ(j["order"]["method"], "as_given");
+  EXPECT_TRUE(j["order"]["refine"].is_null());
+  EXPECT_EQ(j["order"]["cost_model"], "machine");
+  EXPECT_DOUBLE_EQ(j["order"]["cost_s"].get<double>(), 19.0);
+  EXPECT_DOUBLE_EQ(j["order"]["lower_bound_s"].get<double>(), 18.0);
+  EXPECT_TRUE(j["warnings"].is_array());
+  EXPECT_EQ(j["sim"]["steps"], 19000);
+  EXPECT_DOUBLE_EQ(j["sim"]["timestep_s"].get<double>(), 0.001);
+  EXPECT_DOUBLE_EQ(j["sim"]["wall_s"].get<double>(), 0.1);
+  EXPECT_DOUBLE_EQ(j["sim"]["realtime_factor"].get<double>(), 190.0);
+  EXPECT_EQ(j["units"]["sim"]["timestep_s"], "s");
+  // a warning the run gave is written as given
+  MetricsReport warned = simulated_report();
+  warned.warnings = {"path 3: lengthened"};
+  EXPECT_EQ(Json::parse(metrics_json_text(warned))["warnings"], (Json{"path 3: lengthened"}));
+}
+
 TEST(MetricsJson, OrderRefineIsNullWithoutOne) {
   MetricsReport r = planned_report();
   EXPECT_TRUE(Json::parse(metrics_json_text(r))["order"]["refine"].is_null());

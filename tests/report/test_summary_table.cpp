@@ -2,6 +2,7 @@
 // have the same columns under the same names, in the same order.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -105,6 +106,92 @@ TEST(SummaryTable, PlannedAndSimulatedColumnsAreNamedApart) {
   EXPECT_NE(summary_console(run).find("planned_vel_err_steady_max_pct      0.38\n"),
             std::string::npos)
       << summary_console(run);
+}
+
+// ... and the same values: every cell of every row reads the same in comparison.csv (full
+// precision), comparison.json and, rounded to the column's digits, on the console and in
+// markdown; a figure a run lacks is empty in csv, null in json and a dash on the console and
+// in markdown. The percent columns are the report's fractions times 100.
+TEST(SummaryTable, SameValuesInEveryFormat) {
+  std::vector<MetricsReport> reports{report("lspb_mtt", true), report("stop_and_go", true)};
+  reports[1].planner = "stop_and_go";
+  reports[1].time.total_s = 20.25;
+  reports[1].velocity_error->max_rel = 1.0;
+  reports[1].thickness.reset();  // no deposit figures for this run
+  const std::string csv = summary_csv(reports);
+  const nlohmann::ordered_json json = summary_json(reports);
+  const std::vector<std::string> names = csv_names(csv);
+  const std::vector<SummaryColumn> columns = summary_columns_for(reports);
+  ASSERT_EQ(columns.size(), names.size());
+
+  // csv rows and markdown rows (after the header and the rule)
+  std::vector<std::vector<std::string>> csv_rows, md_rows;
+  {
+    std::stringstream in(csv);
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) csv_rows.push_back(split(line, ','));
+    std::stringstream md(summary_markdown(reports));
+    std::getline(md, line);
+    std::getline(md, line);
+    while (std::getline(md, line)) {
+      std::vector<std::string> cells;
+      for (const std::string& cell : split(line, '|'))
+        if (!trim(cell).empty() || !cells.empty()) cells.push_back(trim(cell));
+      if (!cells.empty() && cells.back().empty()) cells.pop_back();
+      md_rows.push_back(cells);
+    }
+  }
+  // console: one line per column: name, then one value per run
+  std::vector<std::vector<std::string>> console_lines;
+  {
+    std::stringstream in(summary_console(reports));
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '-') continue;
+      std::stringstream words(line);
+      std::vector<std::string> cells;
+      std::string word;
+      while (words >> word) cells.push_back(word);
+      console_lines.push_back(cells);
+    }
+  }
+  ASSERT_EQ(csv_rows.size(), 2u);
+  ASSERT_EQ(md_rows.size(), 2u);
+  ASSERT_EQ(console_lines.size(), names.size());
+  for (size_t run = 0; run < 2; ++run) {
+    for (size_t c = 0; c < names.size(); ++c) {
+      SCOPED_TRACE(names[c] + " of run " + std::to_string(run));
+      const SummaryCell cell = columns[c].cell(reports[run]);
+      const nlohmann::ordered_json& value = json["rows"][run][names[c]];
+      const std::string& in_csv = csv_rows[run].at(c);
+      const std::string& in_md = md_rows[run].at(c);
+      const std::string& on_console = console_lines[c].at(run + 1);
+      if (cell.is_text) {
+        EXPECT_EQ(value, cell.text);
+        EXPECT_EQ(in_csv, cell.text);
+        EXPECT_EQ(in_md, cell.text);
+        EXPECT_EQ(on_console, cell.text);
+      } else if (!cell.number) {
+        EXPECT_TRUE(value.is_null());
+        EXPECT_EQ(in_csv, "");
+        EXPECT_EQ(in_md, "-");
+        EXPECT_EQ(on_console, "-");
+      } else {
+        const double v = *cell.number;
+        EXPECT_NEAR(value.get<double>(), v, 1e-12 * std::abs(v));
+        EXPECT_NEAR(std::stod(in_csv), v, 1e-5 * std::abs(v));
+        const double step = std::pow(10.0, -columns[c].digits);
+        EXPECT_NEAR(std::stod(in_md), v, 0.5 * step + 1e-12);
+        EXPECT_NEAR(std::stod(on_console), v, 0.5 * step + 1e-12);
+      }
+    }
+  }
+  // the percent columns are the fractions x 100, the times the report's seconds
+  EXPECT_DOUBLE_EQ(json["rows"][1]["sim_vel_err_max_pct"].get<double>(), 100.0);
+  EXPECT_DOUBLE_EQ(json["rows"][1]["time_s"].get<double>(), 20.25);
+  EXPECT_DOUBLE_EQ(json["rows"][0]["waste_pct"].get<double>(), 45.7);
+  EXPECT_TRUE(json["rows"][1]["thickness_cv"].is_null());
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include "planners/planner.hpp"
 #include "scenario/scenario.hpp"
 #include "scenario_test_util.hpp"
+#include "toolpath/random_segments.hpp"
 
 namespace depotwin {
 namespace {
@@ -296,30 +297,62 @@ TEST_F(ScenarioLoad, PlannerParametersFromTheRegistry) {
                  "is outside");
 }
 
+// every key of random_segments reaches the generator: the loaded paths are the instance
+// make_random_segments gives for those values (n, bed, length, seed, speed), moved by the
+// offset; and, independently of the generator, they are 6 segments of 10 to 40 mm at 2 mm/s
+// inside the 100 x 80 mm bed, which the offset centres on the origin
 TEST_F(ScenarioLoad, RandomSegmentsKeysAreParsed) {
-  // the generator may not exist yet; when it does, the instance has n paths at the speed
   const std::string path = write("r.yaml", R"(
 toolpath:
   random_segments: {n: 6, bed: [100, 80], length: [10, 40], seed: 3, speed: 2}
   offset: [-50, -40]
 limits: {v_max: 4, a_max: 30}
 )");
-  try {
-    const Scenario s = load_scenario(path);
-    ASSERT_EQ(s.toolpath.paths.size(), 6u);
-    for (const PrintPath& p : s.toolpath.paths) {
-      EXPECT_EQ(p.speed_mm_s, 2.0);
-      EXPECT_GE(p.length_mm(), 10.0 - 1e-9);
-      EXPECT_LE(p.length_mm(), 40.0 + 1e-9);
-    }
-  } catch (const InputError& e) {
-    // only the generator's own complaint, with this file and the random_segments line
-    for (const Problem& p : e.problems()) {
-      EXPECT_EQ(p.file, path);
-      EXPECT_EQ(p.line, 2) << p.str();
-      EXPECT_EQ(p.key, "toolpath.random_segments") << p.str();
+  const Scenario s = load_scenario(path);
+  ASSERT_EQ(s.toolpath.paths.size(), 6u);
+  for (const PrintPath& p : s.toolpath.paths) {
+    EXPECT_EQ(p.speed_mm_s, 2.0);
+    ASSERT_EQ(p.points.size(), 2u);
+    EXPECT_GE(p.length_mm(), 10.0 - 1e-9);
+    EXPECT_LE(p.length_mm(), 40.0 + 1e-9);
+    for (const Vec3& point : p.points) {
+      EXPECT_LE(std::abs(point.x()), 50.0 + 1e-9);
+      EXPECT_LE(std::abs(point.y()), 40.0 + 1e-9);
+      EXPECT_EQ(point.z(), 0.0);
     }
   }
+
+  // the same instance as the generator's for these values, offset
+  RandomSegmentsSpec spec;
+  spec.count = 6;
+  spec.bed_x_mm = 100.0;
+  spec.bed_y_mm = 80.0;
+  spec.length_min_mm = 10.0;
+  spec.length_max_mm = 40.0;
+  spec.seed = 3;
+  spec.speed_mm_s = 2.0;
+  const Vec3 offset(-50.0, -40.0, 0.0);
+  const Toolpath expected = make_random_segments(spec);
+  ASSERT_EQ(expected.paths.size(), s.toolpath.paths.size());
+  for (size_t i = 0; i < expected.paths.size(); ++i)
+    for (size_t k = 0; k < 2; ++k)
+      expect_point(s.toolpath.paths[i].points[k], expected.paths[i].points[k].x() + offset.x(),
+                   expected.paths[i].points[k].y() + offset.y(), 0.0);
+  // no start or end given: the instance's, offset
+  expect_point(s.toolpath.start_mm, expected.start_mm.x() + offset.x(),
+               expected.start_mm.y() + offset.y(), 0.0);
+  expect_point(s.toolpath.end_mm, expected.end_mm.x() + offset.x(),
+               expected.end_mm.y() + offset.y(), 0.0);
+
+  // another seed is another instance (the seed is read, not defaulted)
+  const Scenario other = load_scenario(write("r4.yaml", R"(
+toolpath:
+  random_segments: {n: 6, bed: [100, 80], length: [10, 40], seed: 4, speed: 2}
+  offset: [-50, -40]
+limits: {v_max: 4, a_max: 30}
+)"));
+  ASSERT_EQ(other.toolpath.paths.size(), 6u);
+  EXPECT_NE(other.toolpath.paths[0].points[0], s.toolpath.paths[0].points[0]);
 }
 
 }  // namespace

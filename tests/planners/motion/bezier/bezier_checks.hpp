@@ -30,8 +30,9 @@ inline Toolpath single_path(std::vector<Vec3> points, double speed_mm_s) {
   return toolpath;
 }
 
-// The four-point path of the paper's Fig. 3 kind: three lines, two corners (one turning
-// left by 135 degrees, one right by 90), lines long enough to reach full speed.
+// The four-point path of the paper's Fig. 3 kind: three lines, two corners (the first
+// turning left by 135 degrees, the second right by 135: (1, 0) -> (-1, 1)/sqrt 2 -> (1, 0)),
+// lines long enough to reach full speed.
 inline std::vector<Vec3> four_point_path() {
   return {Vec3(0, 0, 0), Vec3(30, 0, 0), Vec3(10, 20, 0), Vec3(40, 20, 0)};
 }

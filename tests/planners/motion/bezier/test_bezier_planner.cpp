@@ -2,6 +2,7 @@
 // closed forms and the project's planner contract.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -90,23 +91,68 @@ TEST(BezierPlanner, LineTooFastForAnAxisIsAnInputError) {
 
 // Sec. 4.1 / Fig. 4: four points, two curves, 5, 10 and 20 mm/s, delta 0.45 mm (the value of
 // the paper's application, Sec. 6.2), T_s = 1 ms. The paper reports at most 0.14, 0.27 and
-// 0.22 % speed variation over the central part; the corners of this path turn by 90 degrees.
+// 0.22 % speed variation over the central part (and "always smaller than 0.3 %") without
+// giving its points. Measured where the variation is largest: both corners of
+// four_point_path turn by 135 degrees, the sharpest of these tests.
+//
+// At 5 and 10 mm/s the variation there is below the paper's figures. At 20 mm/s no plan at
+// constant speed can be: the measure is the chord between samples over T_s, and a chord of
+// s = v T_s = 0.02 mm across the blend's apex, of curvature kappa = cos(phi/2) / (delta
+// sin^2(phi/2)) = 14.0 / mm (legs delta, phi = 45 degrees between them), falls short of its
+// arc by (kappa s)^2 / 24 = 0.33 %, above the paper's 0.22 %: the paper's corners must have
+// been gentler. There the variation is at least that geometric shortfall, and at most the
+// paper's 10 mm/s figure carried to twice the step by the update's (v T)^2 law
+// (SpeedVariationGrowsWithTheSquareOfTheStep): 4 x 0.27 = 1.08 %. On 90-degree corners
+// (apex curvature 3.1 / mm) all three figures hold.
 TEST(BezierPlanner, SpeedVariationOnAFourPointPathIsBelowThePapers) {
-  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(30, 0, 0), Vec3(30, 20, 0),
-                                    Vec3(60, 20, 0)};
-  const std::vector<std::pair<double, double>> paper = {
-      {5.0, 0.0014}, {10.0, 0.0027}, {20.0, 0.0022}};
-  for (const auto& [speed, paper_variation] : paper) {
-    const Trajectory trajectory = planner_with(0.45).plan(single_path(points, speed), kUnbound);
+  struct Case {
+    double speed_mm_s, paper_rel;
+  };
+  const Case paper[] = {{5.0, 0.0014}, {10.0, 0.0027}, {20.0, 0.0022}};
+  const double delta_mm = 0.45, period_s = 0.001;
+  // the apex curvature of a blend whose legs meet at phi (180 degrees minus the turn)
+  const auto apex_curvature = [&](double turn_deg) {
+    const double half_phi = deg_to_rad(180.0 - turn_deg) / 2.0;
+    return std::cos(half_phi) / (delta_mm * std::sin(half_phi) * std::sin(half_phi));
+  };
+  const auto measure = [&](const std::vector<Vec3>& points, double speed) {
+    double length_mm = 0.0;
+    for (size_t i = 0; i + 1 < points.size(); ++i) length_mm += (points[i + 1] - points[i]).norm();
+    const Trajectory trajectory = planner_with(delta_mm).plan(single_path(points, speed), kUnbound);
     EXPECT_TRUE(trajectory.warnings().empty());
     const auto pieces = printing_pieces(trajectory);
-    ASSERT_EQ(pieces.size(), 1u);
+    EXPECT_EQ(pieces.size(), 1u);
     const SpeedVariation variation = speed_variation(sampled(*pieces[0]), speed);
     // the central part is nearly the whole path (ramps of v/a are a few samples)
-    EXPECT_GT(variation.central_samples, 0.98 * 80.0 / speed / 0.001);
-    EXPECT_LT(variation.max_rel, paper_variation) << speed << " mm/s";
-    std::printf("[ speed variation ] %4.0f mm/s: %.4f %% (paper %.2f %%)\n", speed,
-                100 * variation.max_rel, 100 * paper_variation);
+    EXPECT_GT(variation.central_samples, 0.98 * length_mm / speed / period_s);
+    return variation.max_rel;
+  };
+
+  double at_10 = 0.0;
+  for (const Case& c : paper) {
+    const double sharp = measure(four_point_path(), c.speed_mm_s);
+    const double step_mm = c.speed_mm_s * period_s;
+    const double shortfall = std::pow(apex_curvature(135.0) * step_mm, 2) / 24.0;
+    std::printf(
+        "[ speed variation, 135-degree corners ] %4.0f mm/s: %.4f %% (paper %.2f %%, "
+        "chord shortfall at the apex %.4f %%)\n",
+        c.speed_mm_s, 100 * sharp, 100 * c.paper_rel, 100 * shortfall);
+    EXPECT_GE(sharp, shortfall) << c.speed_mm_s << " mm/s";
+    if (shortfall < c.paper_rel) {
+      EXPECT_LT(sharp, c.paper_rel) << c.speed_mm_s << " mm/s";
+    } else {
+      EXPECT_LT(sharp, 4.0 * paper[1].paper_rel) << c.speed_mm_s << " mm/s";
+    }
+    if (c.speed_mm_s == 10.0) at_10 = sharp;
+  }
+  EXPECT_GT(at_10, 0.5 * paper[1].paper_rel);  // the sharp corners are a real test at 10 mm/s
+  // the three figures on 90-degree corners
+  for (const Case& c : paper) {
+    const double right =
+        measure({Vec3(0, 0, 0), Vec3(30, 0, 0), Vec3(30, 20, 0), Vec3(60, 20, 0)}, c.speed_mm_s);
+    std::printf("[ speed variation, 90-degree corners ] %4.0f mm/s: %.4f %% (paper %.2f %%)\n",
+                c.speed_mm_s, 100 * right, 100 * c.paper_rel);
+    EXPECT_LT(right, c.paper_rel) << c.speed_mm_s << " mm/s";
   }
 }
 
