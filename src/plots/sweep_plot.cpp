@@ -139,13 +139,19 @@ PlotResult render_sweep_summary(const SweepPlotInput& input, const std::string& 
   const double panel_w = 1.0 / static_cast<double>(panel_columns);
   const double panel_h = static_cast<double>(kPanelHeight_px) / height_px;
   const double top = 1.0 - static_cast<double>(kTitleBand_px) / height_px;
+  // the key once, across the top under the title: a coloured dot and name per curve
   bool key_drawn = false;
-  // the key once, across the top under the title
   const auto key = [&]() -> std::string {
     if (input.curves.size() < 2 || key_drawn) return "unset key\n";
     key_drawn = true;
-    return format("set key at screen 0.5,%.4f center top horizontal noopaque nobox\n",
-                  1.0 - 0.45 * kTitleBand_px / height_px);
+    std::string labels = "unset key\n";
+    const double spacing = 210.0 / width_px;
+    const double first = 0.5 - 0.5 * spacing * static_cast<double>(input.curves.size() - 1);
+    for (std::size_t c = 0; c < input.curves.size(); ++c)
+      labels += format("set label %zu %s at screen %.4f,%.4f center tc rgb \"%s\"\n", 990 + c,
+                       style::quoted("● " + input.curves[c]).c_str(), first + spacing * c,
+                       1.0 - 0.62 * kTitleBand_px / height_px, style::series_colour(c));
+    return labels;
   };
   const auto curve_title = [&](std::size_t c) {
     return input.curves.empty() ? std::string("notitle")
@@ -194,7 +200,7 @@ PlotResult render_sweep_summary(const SweepPlotInput& input, const std::string& 
             curve_title(c));
       }
       s += plot_command(elements);
-      s += "set xtics autofreq norotate\n";
+      s += "set xtics autofreq norotate\nunset label\n";
     }
   }
 
@@ -228,7 +234,7 @@ PlotResult render_sweep_summary(const SweepPlotInput& input, const std::string& 
           points_file +
           format(" using (column(%zu) * %.10g):(column(1) == %zu ? column(%zu) * %.10g : NaN)",
                  y_column(px), input.metrics[px].scale, c, y_column(py), input.metrics[py].scale) +
-          " with points pt 7 ps 0.6 lc rgb \"" + style::series_colour(c) + "\" notitle");
+          " with points pt 7 ps 0.9 lc rgb \"" + style::series_colour(c) + "\" notitle");
     elements.push_back(front_file + " using 1:2 with steps lw 1.5 dt 2 lc rgb \"#303030\" notitle");
     elements.push_back(front_file +
                        " using 1:2 with points pt 6 ps 1.6 lw 1.5 lc rgb \"#000000\" title "

@@ -140,7 +140,11 @@ std::string set_value(YAML::Node root, const std::vector<KeyStep>& steps, const 
         return walked + " is " + what_is(current) + " in the base scenario, not a map: override " +
                walked + " as a whole";
       if (last) {
-        current[step.name] = value;
+        // null (~) removes the key, e.g. toolpath.segments before toolpath.polylines is set
+        if (value.IsNull())
+          current.remove(step.name);
+        else
+          current[step.name] = value;
         return "";
       }
       YAML::Node child = current[step.name];
@@ -161,6 +165,9 @@ std::string set_value(YAML::Node root, const std::vector<KeyStep>& steps, const 
                                    : "") +
                ")";
       if (last) {
+        if (value.IsNull())
+          return walked + "[" + std::to_string(step.index) +
+                 "]: a list entry cannot be removed (~); override the whole list";
         current[static_cast<std::size_t>(step.index)] = value;
         return "";
       }

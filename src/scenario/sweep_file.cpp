@@ -273,12 +273,9 @@ class SweepReader {
     for (const std::string& key : keys_in(field)) {
       const Field* entry = view.find(key);
       if (entry == nullptr || !claim_key(key, entry->key_line, "set")) continue;
-      if (!entry->node.IsDefined() || entry->node.IsNull()) {
-        problems_.add(entry->key_line, entry->key, "an empty value");
-        continue;
-      }
-      spec_.fixed.push_back(
-          ScenarioOverride{key, flow_text(entry->node), spec_.file, entry->key_line});
+      // ~ (null) removes the key from the base scenario
+      const std::string value = entry->node.IsNull() ? "~" : flow_text(entry->node);
+      spec_.fixed.push_back(ScenarioOverride{key, value, spec_.file, entry->key_line});
     }
   }
 

@@ -73,7 +73,7 @@ std::string slurm_script(const Sweep& sweep, const EmitOptions& options) {
   s += "#SBATCH --output=" + logs + "/merge.log\n";
   s += sweep_command(options, "--merge --quiet") + "\n";
   s += "SBATCH\n)\n";
-  s += "echo \"" + name + ": submitted array job(s) ${arrays//:/ } (" + std::to_string(count) +
+  s += "echo \"" + name + ": submitted array job(s)${arrays//:/ } (" + std::to_string(count) +
        " tasks) and merge job ${merge%%;*}; results in " + options.out + "\"\n";
   return s;
 }
