@@ -321,6 +321,16 @@ ResolvedScenario resolve_scenario(const std::string& path, const std::string& te
       if (gcode && gcode.IsMap()) add_file(gcode["file"]);
       if (toolpath["surface"] && toolpath["surface"].IsMap()) add_file(toolpath["surface"]["file"]);
     }
+    // the planners it runs, by run label
+    const YAML::Node planners = tree["planners"];
+    if (planners && planners.IsSequence()) {
+      resolved.planners.emplace();
+      std::string label, name;
+      for (std::size_t i = 0; i < planners.size(); ++i) {
+        planner_names(planners[i], label, name);
+        resolved.planners->push_back(label.empty() ? name : label);
+      }
+    }
   }
   return resolved;
 }

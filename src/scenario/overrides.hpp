@@ -15,6 +15,7 @@
 // indices refer to the base scenario's list.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct ResolvedScenario {
   // files the scenario reads besides itself (G-code, STL, MJCF model), resolved against the
   // scenario file's directory, in the order the tree names them
   std::vector<std::string> input_files;
+  // the run label (label:, else name) of each `planners` entry; nothing when the tree has no
+  // `planners` (the loader's default planners run)
+  std::optional<std::vector<std::string>> planners;
 };
 
 // Applies the overrides to the tree of `text` (the scenario file at `path`, which names it in

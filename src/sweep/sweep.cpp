@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "core/error.hpp"
@@ -168,21 +169,33 @@ void Sweep::validate_all(int threads, bool progress) const {
     for (std::uint64_t i = next++; i < count; i = next++) {
       const SweepTask one = task(i);
       std::vector<Problem>& found = problems[static_cast<std::size_t>(i)];
+      // a task runs one planner: the base's only one, or the one `planner` chooses (counted
+      // in the overridden tree, so it is said even when the scenario has other problems)
+      std::optional<std::vector<std::string>> planners;
+      try {
+        planners = resolve_scenario(spec_.base, base_text_, one.overrides).planners;
+      } catch (const InputError&) {
+        // the load below lists the same problems
+      }
       try {
         const Scenario scenario = load_task(one);
-        // a task runs one planner: the base's only one, or the one `planner` chooses
-        if (scenario.planners.size() != 1) {
-          std::string names;
+        if (!planners) {
+          planners.emplace();
           for (const PlannerSpec& planner : scenario.planners)
-            names += (names.empty() ? "" : ", ") + planner.run_label();
-          found.push_back(Problem{spec_.file, spec_.base_line, "base",
-                                  "the scenario lists " + std::to_string(scenario.planners.size()) +
-                                      " planners (" + names +
-                                      ") and a task runs one: sweep planner: in grid: (or "
-                                      "choose one under set:)"});
+            planners->push_back(planner.run_label());
         }
       } catch (const InputError& error) {
         found = error.problems();
+      }
+      if (planners && planners->size() != 1) {
+        std::string names;
+        for (const std::string& name : *planners) names += (names.empty() ? "" : ", ") + name;
+        found.insert(found.begin(),
+                     Problem{spec_.file, spec_.base_line, "base",
+                             "the scenario lists " + std::to_string(planners->size()) +
+                                 " planners (" + names +
+                                 ") and a task runs one: sweep planner: in grid: (or choose one "
+                                 "under set:)"});
       }
       ++done;
     }
