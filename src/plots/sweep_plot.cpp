@@ -19,6 +19,8 @@ constexpr int kPanelHeight_px = 280;
 constexpr int kParetoHeight_px = 380;
 constexpr int kParetoMaxWidth_px = 920;
 constexpr int kTitleBand_px = 70;
+// the most tasks drawn as dots (cairo draws each; thousands more add time, not information)
+constexpr std::size_t kMaxDots = 2500;
 
 // a value in a data file: "?" for none (`set datafile missing`)
 std::string value_text(double value) {
@@ -87,9 +89,13 @@ PlotResult render_sweep_summary(const SweepPlotInput& input, const std::string& 
       png_path.find('/') == std::string::npos ? "." : png_path.substr(0, png_path.rfind('/'));
   PlotJob job(directory, options);
 
-  // every point: its curve, its x per parameter, its y per metric
+  // the points drawn as dots, evenly thinned to at most kMaxDots (the means and the front use
+  // every point): its curve, its x per parameter, its y per metric
+  std::vector<std::size_t> dots;
+  for (std::size_t k = 0; k < std::min(points, kMaxDots); ++k)
+    dots.push_back(points <= kMaxDots ? k : k * points / kMaxDots);
   std::string text;
-  for (std::size_t i = 0; i < points; ++i) {
+  for (const std::size_t i : dots) {
     text += std::to_string(input.curve[i]);
     for (const auto& values : input.x) text += " " + value_text(values[i]);
     for (const auto& values : input.y) text += " " + value_text(values[i]);
@@ -134,8 +140,10 @@ PlotResult render_sweep_summary(const SweepPlotInput& input, const std::string& 
   job.begin_png(png_path, width_px, height_px);
   std::string& s = job.script();
   s += "set datafile missing \"?\"\n";
-  s += "set multiplot title " + style::quoted(input.title) + " font \"" + style::title_font() +
-       "\"\n";
+  const std::string title =
+      input.title + (dots.size() < points ? format(" (dots: %zu of %zu tasks)", dots.size(), points)
+                                          : std::string());
+  s += "set multiplot title " + style::quoted(title) + " font \"" + style::title_font() + "\"\n";
   const double panel_w = 1.0 / static_cast<double>(panel_columns);
   const double panel_h = static_cast<double>(kPanelHeight_px) / height_px;
   const double top = 1.0 - static_cast<double>(kTitleBand_px) / height_px;

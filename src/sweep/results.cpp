@@ -48,35 +48,104 @@ struct TaskRow {
   std::vector<MetricValue> metrics;
 };
 
-// metrics.json's scalars by dotted path, with the unit at the same path of its units block
-void flatten(const Json& value, const Json* units, const std::string& path,
-             std::vector<MetricValue>& out) {
-  if (value.is_object()) {
-    for (const auto& [key, child] : value.items()) {
-      if (path.empty() && key == "units") continue;
-      const Json* child_units =
-          units && units->is_object() && units->contains(key) ? &(*units)[key] : nullptr;
-      flatten(child, child_units, path.empty() ? key : path + "." + key, out);
+// metrics.json's scalars by dotted path, read as a stream (no document built: a merge reads
+// thousands); lists are left out but for `warnings`, counted; the `units` block is skipped
+class MetricsReader : public nlohmann::json_sax<Json> {
+ public:
+  explicit MetricsReader(std::vector<MetricValue>& out) : out_(out) {}
+
+  bool null() override { return scalar(std::monostate{}); }
+  bool boolean(bool value) override { return scalar(static_cast<long long>(value ? 1 : 0)); }
+  bool number_integer(number_integer_t value) override {
+    return scalar(static_cast<long long>(value));
+  }
+  bool number_unsigned(number_unsigned_t value) override {
+    return scalar(static_cast<long long>(value));
+  }
+  bool number_float(number_float_t value, const string_t&) override {
+    return scalar(static_cast<double>(value));
+  }
+  bool string(string_t& value) override { return scalar(value); }
+  bool binary(binary_t&) override { return scalar(std::monostate{}); }
+  bool key(string_t& name) override {
+    key_ = name;
+    return true;
+  }
+  bool start_object(std::size_t) override {
+    // the document itself, a section, or something inside a list or the units (skipped)
+    if (stack_.empty()) {
+      stack_.push_back(Frame{});
+      return true;
     }
-    return;
+    const Frame& parent = stack_.back();
+    Frame frame;
+    frame.skip = parent.skip || parent.list || (stack_.size() == 1 && key_ == "units");
+    frame.path = frame.skip ? "" : child_path();
+    if (parent.list) ++stack_.back().count;
+    stack_.push_back(frame);
+    return true;
   }
-  const std::string unit = units && units->is_string() ? units->get<std::string>() : "";
-  if (value.is_array()) {
-    // lists (per joint, per layer) are not scalars; the warnings are counted
-    if (path == "warnings")
-      out.push_back(MetricValue{path, static_cast<long long>(value.size()), "count"});
-    return;
+  bool end_object() override {
+    stack_.pop_back();
+    return true;
   }
-  if (value.is_boolean())
-    out.push_back(MetricValue{path, static_cast<long long>(value.get<bool>() ? 1 : 0), unit});
-  else if (value.is_number_integer())
-    out.push_back(MetricValue{path, value.get<long long>(), unit});
-  else if (value.is_number())
-    out.push_back(MetricValue{path, value.get<double>(), unit});
-  else if (value.is_string())
-    out.push_back(MetricValue{path, value.get<std::string>(), unit});
-  else
-    out.push_back(MetricValue{path, std::monostate{}, unit});
+  bool start_array(std::size_t) override {
+    const Frame& parent = stack_.back();
+    Frame frame;
+    frame.list = true;
+    frame.skip = parent.skip || parent.list;
+    frame.path = frame.skip ? "" : child_path();
+    if (parent.list) ++stack_.back().count;
+    stack_.push_back(frame);
+    return true;
+  }
+  bool end_array() override {
+    const Frame frame = stack_.back();
+    stack_.pop_back();
+    if (!frame.skip && frame.path == "warnings")
+      out_.push_back(MetricValue{frame.path, static_cast<long long>(frame.count), "count"});
+    return true;
+  }
+  bool parse_error(std::size_t position, const std::string&,
+                   const nlohmann::detail::exception& error) override {
+    throw std::runtime_error("at byte " + std::to_string(position) + ": " + error.what());
+  }
+
+ private:
+  struct Frame {
+    bool list = false;  // an array: its entries are counted, not read
+    bool skip = false;  // inside a list or the units block
+    std::string path;   // its dotted path
+    std::size_t count = 0;
+  };
+  std::string child_path() const {
+    const std::string& parent = stack_.back().path;
+    return parent.empty() ? key_ : parent + "." + key_;
+  }
+  bool scalar(ResultCell value) {
+    Frame& parent = stack_.back();
+    if (parent.list) {
+      ++parent.count;
+      return true;
+    }
+    if (!parent.skip) out_.push_back(MetricValue{child_path(), std::move(value), ""});
+    return true;
+  }
+
+  std::vector<MetricValue>& out_;
+  std::vector<Frame> stack_;
+  std::string key_;
+};
+
+// the unit of every scalar: metrics.json's units block (the same shape as the report)
+void collect_units(const Json& units, const std::string& path,
+                   std::map<std::string, std::string>& out) {
+  if (units.is_object()) {
+    for (const auto& [key, child] : units.items())
+      collect_units(child, path.empty() ? key : path + "." + key, out);
+  } else if (units.is_string()) {
+    out[path] = units.get<std::string>();
+  }
 }
 
 std::string read_file(const std::string& path, bool& found) {
@@ -130,8 +199,8 @@ TaskRow read_task_row(const Sweep& sweep, std::uint64_t index) {
   const std::string text = read_file(folder + "/" + record->run + "/metrics.json", found);
   try {
     if (!found) throw std::runtime_error("no metrics.json");
-    const Json metrics = Json::parse(text);
-    flatten(metrics, metrics.contains("units") ? &metrics["units"] : nullptr, "", row.metrics);
+    MetricsReader reader(row.metrics);
+    Json::sax_parse(text, &reader);
   } catch (const std::exception& error) {
     row.status = "missing";
     row.error = "its metrics.json cannot be read (" + std::string(error.what()) + "): run it again";
@@ -175,6 +244,22 @@ ResultsTable collect_results(const Sweep& sweep, int threads) {
   read();
   for (std::thread& helper : helpers) helper.join();
 
+  // the metrics' units, from the first task that ran
+  std::map<std::string, std::string> units;
+  for (std::uint64_t i = 0; i < count && units.empty(); ++i) {
+    if (rows[static_cast<std::size_t>(i)].status != "ok") continue;
+    const std::optional<TaskRecord> record = read_task_record(sweep.task_folder(i));
+    bool found = false;
+    const std::string text = read_file(
+        sweep.task_folder(i) + "/" + (record ? record->run : "") + "/metrics.json", found);
+    try {
+      const Json metrics = Json::parse(text);
+      if (metrics.contains("units")) collect_units(metrics["units"], "", units);
+    } catch (const std::exception&) {
+      // no units: the columns say none
+    }
+  }
+
   // the columns: task, parameters, status, then every metric in order of first appearance
   ResultsTable table;
   table.columns.push_back(ResultColumn{"task", "task", "INTEGER", "index"});
@@ -193,7 +278,8 @@ ResultsTable collect_results(const Sweep& sweep, int threads) {
   for (const TaskRow& row : rows)
     for (const MetricValue& metric : row.metrics)
       if (metric_column.emplace(metric.name, table.columns.size()).second)
-        table.columns.push_back(ResultColumn{metric.name, "metric", "", metric.unit});
+        table.columns.push_back(ResultColumn{
+            metric.name, "metric", "", metric.unit.empty() ? units[metric.name] : metric.unit});
 
   // the rows
   const std::size_t width = table.columns.size();

@@ -42,6 +42,20 @@ Sweep::Sweep(const std::string& sweep_file, const std::string& out)
   for (const SweepParameter& parameter : spec_.zip) parameter_keys_.push_back(parameter.key);
   // folder names sort in task order: at least four digits, more for larger sweeps
   folder_digits_ = std::max<int>(4, static_cast<int>(std::to_string(size() - 1).size()));
+  // the files every task reads, hashed once, unless a parameter can name other ones (the
+  // machine's model, a G-code file, a part's STL)
+  const auto names_files = [](const std::string& key) {
+    for (const char* prefix : {"machine", "toolpath.gcode", "toolpath.surface"})
+      if (key.compare(0, std::string(prefix).size(), prefix) == 0) return true;
+    return key == "toolpath";
+  };
+  if (std::none_of(parameter_keys_.begin(), parameter_keys_.end(), names_files)) {
+    try {
+      shared_input_files_ = input_file_hashes(spec_.fixed);
+    } catch (const InputError&) {
+      // a set: override that does not fit: every task says so when it is checked
+    }
+  }
 }
 
 SweepTask Sweep::task(std::uint64_t index) const {
@@ -122,15 +136,26 @@ std::string file_hash(const std::string& path) {
 
 }  // namespace
 
+std::vector<std::string> Sweep::input_file_hashes(
+    const std::vector<ScenarioOverride>& overrides) const {
+  std::vector<std::string> hashes;
+  for (const std::string& file : resolve_scenario(spec_.base, base_text_, overrides).input_files)
+    hashes.push_back(file_hash(file));
+  return hashes;
+}
+
 std::string Sweep::input_hash(const SweepTask& task) const {
-  const ResolvedScenario resolved = resolve_scenario(spec_.base, base_text_, task.overrides);
+  // what the task's scenario is made of: the base's text and the overrides (which determine
+  // its tree), the bytes of the files it reads, `keep:` and the depotwin version
   Fnv1a64 hash;
   hash.add(std::string("depotwin ") + sweep_depotwin_version()).add("keep " + spec_.keep);
-  hash.add(resolved.text);
+  hash.add(base_text_);
   for (const ScenarioOverride& override_ : task.overrides)
     hash.add(override_.key + "=" + override_.value_yaml);
   // the files' bytes, not their paths: a task's hash is the same from any working directory
-  for (const std::string& file : resolved.input_files) hash.add(file_hash(file));
+  for (const std::string& file :
+       shared_input_files_ ? *shared_input_files_ : input_file_hashes(task.overrides))
+    hash.add(file);
   return hash.hex();
 }
 
@@ -169,23 +194,21 @@ void Sweep::validate_all(int threads, bool progress) const {
     for (std::uint64_t i = next++; i < count; i = next++) {
       const SweepTask one = task(i);
       std::vector<Problem>& found = problems[static_cast<std::size_t>(i)];
-      // a task runs one planner: the base's only one, or the one `planner` chooses (counted
-      // in the overridden tree, so it is said even when the scenario has other problems)
+      // a task runs one planner: the base's only one, or the one `planner` chooses (when the
+      // scenario has other problems, counted in the overridden tree, so it is still said)
       std::optional<std::vector<std::string>> planners;
       try {
-        planners = resolve_scenario(spec_.base, base_text_, one.overrides).planners;
-      } catch (const InputError&) {
-        // the load below lists the same problems
-      }
-      try {
         const Scenario scenario = load_task(one);
-        if (!planners) {
-          planners.emplace();
-          for (const PlannerSpec& planner : scenario.planners)
-            planners->push_back(planner.run_label());
-        }
+        planners.emplace();
+        for (const PlannerSpec& planner : scenario.planners)
+          planners->push_back(planner.run_label());
       } catch (const InputError& error) {
         found = error.problems();
+        try {
+          planners = resolve_scenario(spec_.base, base_text_, one.overrides).planners;
+        } catch (const InputError&) {
+          // the same problems as the load's
+        }
       }
       if (planners && planners->size() != 1) {
         std::string names;

@@ -8,12 +8,15 @@
 // error and wall time) and, for a task that ran, DIR/tasks/<i>/<run>/metrics.json (with
 // `keep: all`, everything `depotwin run --no-render` writes there).
 //
-// A task's input hash covers the overridden scenario text, the files it reads (G-code, STL,
-// MJCF: their bytes), the overrides, `keep:` and the depotwin version; a task whose folder
-// holds an `ok` result with the same hash is up to date and is skipped unless forced.
+// A task's input hash covers what its scenario is made of: the base scenario's text and the
+// overrides (`set:` and the task's parameters), which determine the overridden scenario, the
+// bytes of the files it reads (G-code, STL, MJCF), `keep:` and the depotwin version. A task
+// whose folder holds an `ok` result with the same hash is up to date and is skipped unless
+// forced; any edit of the base file (a comment too) makes every task new.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -78,6 +81,9 @@ class Sweep {
   std::string out_;
   std::vector<std::string> parameter_keys_;
   int folder_digits_ = 4;
+  // the hashes of the files the scenario reads when every task reads the same ones
+  std::optional<std::vector<std::string>> shared_input_files_;
+  std::vector<std::string> input_file_hashes(const std::vector<ScenarioOverride>& overrides) const;
 };
 
 // a task index from `--task` text: a whole number, or `env` (SLURM_ARRAY_TASK_ID plus
