@@ -118,19 +118,23 @@ Scenario Sweep::load_task(const SweepTask& task) const {
 
 namespace {
 
-// the bytes of the files a scenario reads, hashed once per process
+// the bytes of the files a scenario reads, hashed once per process and version of the file
 std::string file_hash(const std::string& path) {
   static std::mutex mutex;
-  static std::map<std::string, std::string> known;
+  static std::map<std::string, std::string> known;  // path|mtime|size -> hash
+  std::error_code error;
+  if (!fs::is_regular_file(path, error)) return "missing";
+  const std::string version =
+      path + "|" +
+      std::to_string(fs::last_write_time(path, error).time_since_epoch().count()) + "|" +
+      std::to_string(fs::file_size(path, error));
   {
     const std::lock_guard<std::mutex> lock(mutex);
-    if (const auto found = known.find(path); found != known.end()) return found->second;
+    if (const auto found = known.find(version); found != known.end()) return found->second;
   }
-  std::string hash = "missing";
-  std::error_code error;
-  if (fs::is_regular_file(path, error)) hash = Fnv1a64().add(read_text_file(path)).hex();
+  const std::string hash = Fnv1a64().add(read_text_file(path)).hex();
   const std::lock_guard<std::mutex> lock(mutex);
-  known[path] = hash;
+  known[version] = hash;
   return hash;
 }
 

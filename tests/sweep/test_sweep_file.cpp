@@ -268,6 +268,16 @@ TEST(ScenarioOverrides, HashesFollowTheInputsNotTheWorkingDirectory) {
   changed.replace(changed.find("a_max: 30"), 9, "a_max: 31");
   write_text(dir, "base.yaml", changed);
   EXPECT_NE(Sweep(file, "").input_hash(Sweep(file, "").task(0)), hash_0);
+
+  // a file the scenario reads: its bytes count
+  std::string with_model = fig7;
+  with_model.replace(with_model.find("machine: xy_stage"), 17,
+                     "machine: {model: stage.xml, kinematics: xy_stage}");
+  write_text(dir, "base.yaml", with_model);
+  write_text(dir, "stage.xml", "<mujoco model=\"one\"/>\n");
+  const std::string model_one = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+  write_text(dir, "stage.xml", "<mujoco model=\"two, longer\"/>\n");
+  EXPECT_NE(Sweep(file, "").input_hash(Sweep(file, "").task(0)), model_one);
 }
 
 TEST(SweepTasks, ValidateAllListsEachProblemOnceWithTheTasksItConcerns) {
