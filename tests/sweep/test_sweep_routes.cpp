@@ -138,6 +138,11 @@ TEST_F(SweepRoutes, LocalWorkersRecordEveryTaskAndCountTheFailuresInTheExitStatu
   }
   // the shipped scenario's figure: lspb_mtt at 3 mm/s takes 19.355 s (README)
   EXPECT_NEAR(std::stod(table[1].at("time_s.total")), 19.355, 5e-4);
+  // keep: metrics (the default): the run's folder holds metrics.json alone
+  std::vector<std::string> kept;
+  for (const auto& entry : fs::directory_iterator(dir_ + "/local/tasks/0001/lspb_mtt"))
+    kept.push_back(entry.path().filename().string());
+  EXPECT_EQ(kept, (std::vector<std::string>{"metrics.json"}));
 }
 
 TEST_F(SweepRoutes, ATaskIsTheRunOfTheSameScenario) {
@@ -223,6 +228,20 @@ TEST_F(SweepRoutes, OneTaskByIndexOrSchedulerAndTheMergeListsWhatIsMissing) {
   EXPECT_EQ(table[5].at("status"), "failed");
 }
 
+TEST_F(SweepRoutes, KeepAllKeepsWhatRunNoRenderWrites) {
+  const std::string sweep = write_text(dir_, "keep_all.yaml", R"(base: base.yaml
+keep: all
+grid:
+  planner: [stop_and_go]
+)");
+  const std::string out = dir_ + "/keep_all";
+  const CliResult r = depotwin("sweep " + sweep + " --task 0 --quiet --out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* file :
+       {"metrics.json", "trajectory.csv", "thickness.csv", "thickness_field.png", "replay.json"})
+    EXPECT_TRUE(fs::is_regular_file(out + "/tasks/0000/stop_and_go/" + file)) << file;
+}
+
 TEST_F(SweepRoutes, BadInputExitsTwoAndWritesNothing) {
   const std::string bad = write_text(dir_, "bad.yaml", R"(base: base.yaml
 grid:
@@ -284,6 +303,13 @@ TEST_F(SweepRoutes, ASlurmArrayGivesTheSameTable) {
     if (started.status != 0)
       GTEST_SKIP() << "no local Slurm: scripts/slurm-local.sh start said:\n" << started.output;
   }
+  // what this test started is stopped however it ends
+  struct StopAtEnd {
+    bool active;
+    ~StopAtEnd() {
+      if (active) slurm_local("stop");
+    }
+  } stop_at_end{!was_running};
   ASSERT_EQ(local().status, 104) << local().output;
   const std::string out = dir_ + "/slurm";
   const CliResult emitted = depotwin("sweep " + sweep_ + " --emit slurm -j 2 --quiet --out " + out);
@@ -293,18 +319,16 @@ TEST_F(SweepRoutes, ASlurmArrayGivesTheSameTable) {
   const CliResult submitted = shell("timeout 60 bash " + script);
   ASSERT_EQ(submitted.status, 0) << submitted.output;
   // "... and merge job N; ...": wait (at most 3 minutes) until the merge has run
-  const size_t at = submitted.output.find("merge job ");
-  ASSERT_NE(at, std::string::npos) << submitted.output;
-  const std::string merge_job =
-      submitted.output.substr(at + 10, submitted.output.find(';', at) - at - 10);
+  ASSERT_NE(submitted.output.find("(8 tasks) and merge job "), std::string::npos)
+      << submitted.output;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(3);
   std::string queue;
   do {
     std::this_thread::sleep_for(std::chrono::seconds(1));
-    queue = shell("squeue -h -n fig7_routes,fig7_routes-merge -o '%i %j %T %r'").output;
+    queue = shell("timeout 10 squeue -h -n fig7_routes,fig7_routes-merge -o '%i %j %T %r'").output;
   } while (!queue.empty() && std::chrono::steady_clock::now() < deadline);
-  if (!queue.empty()) shell("scancel " + merge_job);
-  if (!was_running) slurm_local("stop");
+  if (!queue.empty())
+    shell("timeout 10 scancel --name=fig7_routes; timeout 10 scancel --name=fig7_routes-merge");
   ASSERT_TRUE(queue.empty()) << "Slurm jobs still queued after 3 minutes:\n" << queue;
   ASSERT_TRUE(fs::exists(out + "/results.csv")) << read_text(out + "/logs/merge.log");
   EXPECT_EQ(table_without_wall_times(out + "/results.csv"),
