@@ -9,7 +9,7 @@
 //                            share of the merge. overhead_share = overhead / run (target <= 2 %).
 //                            A worker's start-up (exec of depotwin, once per worker, not per
 //                            task) is reported beside it.
-//   BM_LocalThroughput       `sweep -j 1` against `sweep -j 2` on 8 thompson_fig7 tasks
+//   BM_LocalThroughput       `sweep -j 1` against `sweep -j 2` on 16 thompson_fig7 tasks
 //                            (--force, alternately, medians): speedup = t(-j 1) / t(-j 2)
 //                            (target >= 1.8 on 2 idle cores); the load average is reported.
 //   BM_List10000             `depotwin sweep --list` of a 10,000-task sweep (every task's
@@ -195,7 +195,7 @@ BENCHMARK(BM_SweepOverheadPerTask)->Unit(benchmark::kMillisecond)->Iterations(5)
 
 void BM_LocalThroughput(benchmark::State& state) {
   const fs::path dir = scratch("throughput");
-  const std::string file = fig7_sweep(dir, "[1.5, 2, 2.5, 3]");
+  const std::string file = fig7_sweep(dir, "[1.25, 1.5, 1.75, 2, 2.25, 2.5, 2.75, 3]");
   const std::string out = (dir / "out").string();
   report_load(state, "load_average_before");
   std::vector<double> one, two;
