@@ -46,11 +46,11 @@ std::string slurm_script(const Sweep& sweep, const EmitOptions& options) {
     s += "\n# tasks " + std::to_string(first) + ".." + std::to_string(first + size - 1) + "\n";
     s += "job=$(sbatch --parsable <<'SBATCH'\n";
     s += "#!/bin/bash\n";
-    s += "#SBATCH --job-name=" + name + "\n";
+    s += "#SBATCH --job-name=" + shell_quoted(name) + "\n";
     s += "#SBATCH --array=0-" + std::to_string(size - 1) + "%" +
          std::to_string(std::max(1, options.max_running)) + "\n";
     s += "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n";
-    s += "#SBATCH --output=" + logs + "/slurm-%A_%a.log\n";
+    s += "#SBATCH --output=" + shell_quoted(logs + "/slurm-%A_%a.log") + "\n";
     s += "export DEPOTWIN_SWEEP_TASK_OFFSET=" + std::to_string(first) + "\n";
     s += "# each task's output in its own log, named by its task index\n";
     s += "exec >" + shell_quoted(logs) + "/task-$((SLURM_ARRAY_TASK_ID + " + std::to_string(first) +
@@ -68,9 +68,9 @@ std::string slurm_script(const Sweep& sweep, const EmitOptions& options) {
   s += "merge=$(sbatch --parsable --dependency=\"afterok$arrays\" --kill-on-invalid-dep=yes "
        "<<'SBATCH'\n";
   s += "#!/bin/bash\n";
-  s += "#SBATCH --job-name=" + name + "-merge\n";
+  s += "#SBATCH --job-name=" + shell_quoted(name + "-merge") + "\n";
   s += "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n";
-  s += "#SBATCH --output=" + logs + "/merge.log\n";
+  s += "#SBATCH --output=" + shell_quoted(logs + "/merge.log") + "\n";
   s += sweep_command(options, "--merge --quiet") + "\n";
   s += "SBATCH\n)\n";
   s += "echo \"" + name + ": submitted array job(s)${arrays//:/ } (" + std::to_string(count) +
