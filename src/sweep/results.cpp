@@ -1,5 +1,6 @@
 #include "sweep/results.hpp"
 
+#include <fcntl.h>
 #include <sqlite3.h>
 #include <unistd.h>
 
@@ -148,12 +149,17 @@ void collect_units(const Json& units, const std::string& path,
   }
 }
 
+// a whole file in one read (a merge reads two per task)
 std::string read_file(const std::string& path, bool& found) {
-  std::ifstream in(path, std::ios::binary);
-  found = static_cast<bool>(in);
-  std::stringstream text;
-  if (found) text << in.rdbuf();
-  return text.str();
+  std::string text;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  found = fd >= 0;
+  if (!found) return text;
+  char buffer[16384];
+  for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) > 0;)
+    text.append(buffer, static_cast<std::size_t>(n));
+  ::close(fd);
+  return text;
 }
 
 TaskRow read_task_row(const Sweep& sweep, std::uint64_t index) {
@@ -454,6 +460,7 @@ std::string cell_text(const ResultCell& cell) {
 
 std::string results_csv(const ResultsTable& table) {
   std::string csv;
+  csv.reserve(table.rows.size() * table.columns.size() * 12 + 4096);
   for (std::size_t k = 0; k < table.columns.size(); ++k)
     csv += (k == 0 ? "" : ",") + csv_field(table.columns[k].name);
   csv += '\n';

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
+#include <iterator>
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
@@ -32,12 +32,11 @@ std::string task_record_json(const TaskRecord& record) {
 }
 
 std::optional<TaskRecord> read_task_record(const std::string& folder) {
-  std::ifstream in(folder + "/task.json");
+  std::ifstream in(folder + "/task.json", std::ios::binary);
   if (!in) return std::nullopt;
-  std::stringstream text;
-  text << in.rdbuf();
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   try {
-    const nlohmann::ordered_json json = nlohmann::ordered_json::parse(text.str());
+    const nlohmann::ordered_json json = nlohmann::ordered_json::parse(text);
     TaskRecord record;
     record.index = json.at("index").get<std::uint64_t>();
     for (const auto& [key, value] : json.at("parameters").items())
