@@ -64,7 +64,7 @@ class ProgressLine {
       const int length = std::fprintf(out_, "\r%s %3.0f %% (%.1f s)%s", label_.c_str(),
                                       100.0 * fraction, elapsed, tail.c_str());
       if (length < last_length_) std::fprintf(out_, "%*s", last_length_ - length, "");
-      last_length_ = length;
+      last_length_ = std::max(length, last_length_);  // what the terminal line now shows
     } else {
       // the first line after one period, then one per period
       if (elapsed < last_log_s_ + log_period_s_) return;

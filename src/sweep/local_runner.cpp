@@ -32,6 +32,8 @@ namespace {
 
 // the worker reports on this descriptor
 constexpr int kReportFd = 3;
+// characters of the progress bar
+constexpr std::size_t kBarWidth = 24;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -231,8 +233,11 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
     const std::uint64_t done = summary.ran;
     const double eta =
         done > 0 ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : NAN;
-    line.update(static_cast<double>(done) / static_cast<double>(total),
-                std::to_string(done) + "/" + std::to_string(total) + " tasks" +
+    const double fraction = static_cast<double>(done) / static_cast<double>(total);
+    const std::size_t filled = static_cast<std::size_t>(fraction * kBarWidth);
+    line.update(fraction,
+                "[" + std::string(filled, '#') + std::string(kBarWidth - filled, '.') + "] " +
+                    std::to_string(done) + "/" + std::to_string(total) + " tasks" +
                     (summary.failed > 0 ? ", " + std::to_string(summary.failed) + " failed" : "") +
                     ", ETA " + duration_text(eta));
   }
