@@ -35,6 +35,12 @@ constexpr int kReportFd = 3;
 // characters of the progress bar
 constexpr std::size_t kBarWidth = 24;
 
+// the signal (SIGINT, SIGTERM) that asked the local run to stop, 0 while none has
+volatile sig_atomic_t g_stop_signal = 0;
+extern "C" void record_stop_signal(int signal_number) {
+  if (g_stop_signal == 0) g_stop_signal = signal_number;
+}
+
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -138,6 +144,15 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
   }, previous{};
   ignore.sa_handler = SIG_IGN;
   ::sigaction(SIGPIPE, &ignore, &previous);
+  // Ctrl-C or a kill: recorded here (the workers ignore SIGINT), the workers ended, then the
+  // signal's own action
+  struct sigaction stop {
+  }, previous_int{}, previous_term{};
+  stop.sa_handler = record_stop_signal;
+  sigemptyset(&stop.sa_mask);
+  g_stop_signal = 0;
+  ::sigaction(SIGINT, &stop, &previous_int);
+  ::sigaction(SIGTERM, &stop, &previous_term);
 
   std::deque<std::uint64_t> queue(tasks.begin(), tasks.end());
   std::vector<Worker> workers;
@@ -175,7 +190,7 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
     give_next(workers.back());
   }
 
-  while (true) {
+  while (g_stop_signal == 0) {
     std::vector<pollfd> polled;
     std::vector<std::size_t> owner;
     for (std::size_t k = 0; k < workers.size(); ++k)
@@ -241,8 +256,25 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
                     (summary.failed > 0 ? ", " + std::to_string(summary.failed) + " failed" : "") +
                     ", ETA " + duration_text(eta));
   }
-  line.finish();
+  if (g_stop_signal == 0) line.finish();
   ::sigaction(SIGPIPE, &previous, nullptr);
+  ::sigaction(SIGINT, &previous_int, nullptr);
+  ::sigaction(SIGTERM, &previous_term, nullptr);
+  if (const int signal_number = g_stop_signal; signal_number != 0) {
+    // stopped: the workers end at once (their tasks' folders stay as they were: an unfinished
+    // task is not recorded and runs again next time), then this process by the signal
+    for (Worker& worker : workers)
+      if (worker.report_fd >= 0) {
+        ::kill(worker.pid, SIGKILL);
+        ::waitpid(worker.pid, nullptr, 0);
+      }
+    std::fprintf(stderr, "\nsweep %s: stopped by %s after %llu of %llu tasks\n",
+                 sweep.spec().name.c_str(), strsignal(signal_number),
+                 static_cast<unsigned long long>(summary.ran),
+                 static_cast<unsigned long long>(total));
+    ::signal(signal_number, SIG_DFL);
+    ::raise(signal_number);
+  }
   summary.wall_s = now_s() - start_s;
   return summary;
 }
@@ -250,6 +282,8 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
 int sweep_worker(const Sweep& sweep) {
   if (::fcntl(kReportFd, F_GETFD) == -1)
     throw InputError("--worker", "is for depotwin's own worker processes (sweep -j)");
+  // Ctrl-C reaches the whole process group: the parent decides, and ends its workers
+  ::signal(SIGINT, SIG_IGN);
   std::string text;
   while (std::getline(std::cin, text)) {
     const std::uint64_t index = std::stoull(text);

@@ -3,8 +3,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <iterator>
+#include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
@@ -116,7 +116,15 @@ TaskRecord run_task(const Sweep& sweep, const SweepTask& task, const std::string
     record.run = planner.run_label();
   } catch (const InputError& error) {
     record.error = problems_text(error);
-  } catch (const std::exception& error) {
+  } catch (const std::runtime_error& error) {
+    // InternalError, a library's error; other exceptions (a request to stop) are not the
+    // task's failure and leave its folder as it was
+    record.error = std::string("internal error: ") + error.what();
+  } catch (const std::logic_error& error) {
+    record.error = std::string("internal error: ") + error.what();
+  } catch (const std::bad_alloc&) {
+    record.error = "internal error: out of memory";
+  } catch (const nlohmann::json::exception& error) {
     record.error = std::string("internal error: ") + error.what();
   }
   record.wall_s = seconds_since(start);
