@@ -10,6 +10,8 @@
 # env:   DEPOTWIN_BUILD_DIR (default <repo>/build; built with scripts/build.sh when the
 #        depotwin binary is missing)
 #        DEPOTWIN_RENDER_SCENARIOS: scenario names to render (space-separated; default: all)
+#        DEPOTWIN_RENDER_SWEEPS: parameter studies of scenarios/sweeps/ whose summary.png goes
+#        to OUTDIR/sweeps/<name>/ (space-separated; default: corner_study; "none": none)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out_dir="${1:-$root/renders}"
@@ -96,6 +98,25 @@ for scenario_file in "${scenario_files[@]}"; do
   size=$(du -sk "$target" | cut -f1)
   printf 'render-examples: %-20s %d runs, %2d files, %5d KiB, %3d s\n' "$name" "${#runs[@]}" \
     "$files" "$size" "$((SECONDS - start_s))"
+done
+
+# parameter studies: the sweep run on every core, its summary.png kept
+for name in ${DEPOTWIN_RENDER_SWEEPS:-corner_study}; do
+  [[ "$name" == none ]] && continue
+  start_s=$SECONDS
+  raw="$work_dir/sweeps/$name"
+  (cd "$root" && "$depotwin" sweep "scenarios/sweeps/$name.yaml" --out "$raw" --quiet \
+    -j "$(nproc)" >"$work_dir/sweep-$name.log" 2>&1) || {
+    cat "$work_dir/sweep-$name.log" >&2
+    echo "render-examples: depotwin sweep failed for $name" >&2
+    exit 1
+  }
+  target="$out_dir/sweeps/$name"
+  rm -rf "$target"
+  mkdir -p "$target"
+  cp "$raw/summary.png" "$target/"
+  printf 'render-examples: %-20s sweep, summary.png, %5d KiB, %3d s\n' "$name" \
+    "$(du -sk "$target" | cut -f1)" "$((SECONDS - start_s))"
 done
 
 echo "render-examples: $(du -sh "$out_dir" | cut -f1) in $out_dir"

@@ -20,6 +20,9 @@ packages=(
   ffmpeg                                 # run.mp4 (render/video: raw frames piped to its H.264 encoder)
   libglfw3-dev                           # the `view` window (viewer/)
   xvfb xauth                             # the viewer's screenshot test runs under xvfb-run
+  libsqlite3-dev                         # sweep results (results.sqlite)
+  parallel                               # sweeps through GNU parallel (sweep --emit parallel)
+  slurmctld slurmd slurm-client munge    # sweeps on Slurm arrays; scripts/slurm-local.sh
 )
 
 missing=()

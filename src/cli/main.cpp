@@ -10,6 +10,7 @@
 #include "cli/export_verb.hpp"  // export
 #include "cli/inspect.hpp"      // inspect
 #include "cli/move_verb.hpp"
+#include "cli/sweep_verb.hpp"  // sweep
 #include "cli/verbs.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
@@ -193,6 +194,11 @@ int main(int argc, char** argv) {
                       "deviation) or klipper (square-corner velocity); default marlin");
   // ---- end inspect ----
 
+  // ---- sweep (parameter studies: src/cli/sweep_verb.cpp, src/sweep/) ----
+  SweepOptions sweep_options;
+  CLI::App* sweep = add_sweep_verb(app, sweep_options);
+  // ---- end sweep ----
+
   // positions give the axes, one value each; a velocity or limit list has one value per
   // axis, or one value for every axis
   std::string q0, q1, v0, v1, vmax, amax, jmax;
@@ -239,6 +245,7 @@ int main(int argc, char** argv) {
     if (*view) return view_verb(view_options);                              // view
     if (*describe) return describe_verb(describe_topic, describe_as_json);  // describe
     if (*export_gcode) return export_verb(export_options);                  // export
+    if (*sweep) return sweep_verb(sweep_options);                           // sweep
     // inspect
     if (*inspect) {
       inspect_options.rule = *print_rule_from_name(inspect_rule);

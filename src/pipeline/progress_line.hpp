@@ -4,6 +4,7 @@
 // clutter. Either way a closing "<label> done in 12.3 s" line once anything was shown.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -61,18 +62,24 @@ class ProgressLine {
   ProgressLine(const ProgressLine&) = delete;
   ProgressLine& operator=(const ProgressLine&) = delete;
 
-  // the step is `fraction` (0..1) done
-  void update(double fraction) {
+  // the step is `fraction` (0..1) done; `detail` follows the time (e.g. "12/27 tasks, ETA 5 s")
+  void update(double fraction, const std::string& detail = "") {
     if (style_ == Style::off) return;
     const double elapsed = clock_() - start_s_;
+    const std::string tail = detail.empty() ? "" : " " + detail;
     if (style_ == Style::terminal) {
       if (elapsed < kTerminalDelay_s) return;
-      std::fprintf(out_, "\r%s %3.0f %% (%.1f s)", label_.c_str(), 100.0 * fraction, elapsed);
+      // spaces over what a longer line before left
+      const int length = std::fprintf(out_, "\r%s %3.0f %% (%.1f s)%s", label_.c_str(),
+                                      100.0 * fraction, elapsed, tail.c_str());
+      if (length < last_length_) std::fprintf(out_, "%*s", last_length_ - length, "");
+      last_length_ = std::max(length, last_length_);  // what the terminal line now shows
     } else {
       // the first line after one period, then one per period
       if (elapsed < last_log_s_ + log_period_s_) return;
       last_log_s_ = elapsed;
-      std::fprintf(out_, "%s %3.0f %% (%.1f s)\n", label_.c_str(), 100.0 * fraction, elapsed);
+      std::fprintf(out_, "%s %3.0f %% (%.1f s)%s\n", label_.c_str(), 100.0 * fraction, elapsed,
+                   tail.c_str());
     }
     std::fflush(out_);
     shown_ = true;
@@ -82,10 +89,13 @@ class ProgressLine {
   void finish() {
     if (!shown_) return;
     const double elapsed = clock_() - start_s_;
-    if (style_ == Style::terminal)
-      std::fprintf(out_, "\r%s done in %.1f s        \n", label_.c_str(), elapsed);
-    else
+    if (style_ == Style::terminal) {
+      // spaces over the rest of the last line
+      const int length = std::fprintf(out_, "\r%s done in %.1f s", label_.c_str(), elapsed);
+      std::fprintf(out_, "%*s\n", std::max(8, last_length_ - length), "");
+    } else {
       std::fprintf(out_, "%s done in %.1f s\n", label_.c_str(), elapsed);
+    }
     std::fflush(out_);
     shown_ = false;
   }
@@ -98,6 +108,7 @@ class ProgressLine {
   double log_period_s_;
   double start_s_;
   double last_log_s_ = 0.0;  // elapsed time of the last log line (0: none yet)
+  int last_length_ = 0;      // characters of the last terminal line
   bool shown_ = false;
 };
 

@@ -11,6 +11,8 @@
 #include <Eigen/Geometry>
 
 #include "kinematics/machine.hpp"
+#include "scenario/override_tree.hpp"
+#include "scenario/overrides.hpp"
 #include "scenario/schema.hpp"
 #include "scenario/yaml_reader.hpp"
 #include "toolpath/gcode.hpp"
@@ -108,6 +110,12 @@ class Loader {
   }
 
   Scenario load();
+  // a sweep's task: the file's text given (not read), and overrides applied to its tree
+  // before it is read (scenario/overrides.hpp)
+  void set_source(const std::string* text, const std::vector<ScenarioOverride>* overrides) {
+    text_ = text;
+    overrides_ = overrides;
+  }
 
  private:
   bool read_document(YAML::Node& root);
@@ -158,6 +166,8 @@ class Loader {
   ProblemList problems_;
   Scenario scenario_;
   fs::path relative_dir_;
+  const std::string* text_ = nullptr;                         // given text, else the file's
+  const std::vector<ScenarioOverride>* overrides_ = nullptr;  // applied to the tree
   // per TCP axis: its v_max is usable, so print speeds are checked against it
   std::array<bool, 3> axis_v_max_known_{true, true, true};
   bool joint_limits_bad_ = false;  // `limits.joint` given but unusable
@@ -171,6 +181,9 @@ class Loader {
 Scenario Loader::load() {
   YAML::Node root;
   if (!read_document(root)) throw InputError(problems_.problems());
+  // a sweep task's overrides (an override the tree cannot take is a problem at its own line,
+  // and the rest of the scenario is still read)
+  if (overrides_ != nullptr) apply_overrides(root, *overrides_, problems_.problems());
 
   // the top level: every key optional except the toolpath
   const MapView top(Field{root, "", 1, 1}, keys_of(""), problems_);
@@ -203,8 +216,9 @@ Scenario Loader::load() {
       problems_.add_problem(std::move(problem));
   if (problems_.empty()) return scenario_;
 
-  // scenario-file problems in line order, then those of imported files
+  // scenario-file problems in line order, then those of imported files (and of overrides)
   std::vector<Problem>& list = problems_.problems();
+  if (overrides_ != nullptr) attribute_to_overrides(list, *overrides_);
   const std::string& file = problems_.file();
   std::stable_sort(list.begin(), list.end(), [&](const Problem& a, const Problem& b) {
     const bool a_other = a.file != file, b_other = b.file != file;
@@ -215,45 +229,34 @@ Scenario Loader::load() {
 }
 
 bool Loader::read_document(YAML::Node& root) {
-  // the file itself
-  const fs::path file_path(problems_.file());
-  std::error_code error;
-  if (!fs::exists(file_path, error)) {
-    problems_.add(0, "", "scenario file not found");
-    return false;
-  }
-  if (fs::is_directory(file_path, error)) {
-    problems_.add(0, "", "is a directory, expected a scenario .yaml file");
-    return false;
-  }
-  std::ifstream in(file_path);
-  std::stringstream text;
-  text << in.rdbuf();
-  if (!in) {
-    problems_.add(0, "", "cannot read the scenario file");
-    return false;
+  // the text given, else the file itself
+  std::string text;
+  if (text_ != nullptr) {
+    text = *text_;
+  } else {
+    const fs::path file_path(problems_.file());
+    std::error_code error;
+    if (!fs::exists(file_path, error)) {
+      problems_.add(0, "", "scenario file not found");
+      return false;
+    }
+    if (fs::is_directory(file_path, error)) {
+      problems_.add(0, "", "is a directory, expected a scenario .yaml file");
+      return false;
+    }
+    std::ifstream in(file_path);
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    if (!in) {
+      problems_.add(0, "", "cannot read the scenario file");
+      return false;
+    }
+    text = buffer.str();
   }
   // exactly one YAML document
-  std::vector<YAML::Node> documents;
-  try {
-    documents = YAML::LoadAll(text.str());
-  } catch (const YAML::ParserException& e) {
-    problems_.add(e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
-    return false;
-  } catch (const YAML::Exception& e) {
-    problems_.add(0, "", std::string("malformed YAML: ") + e.what());
-    return false;
-  }
-  if (documents.empty() || documents.front().IsNull()) {
-    problems_.add(1, "", "the file holds no settings: expected a map with at least `toolpath:`");
-    return false;
-  }
-  if (documents.size() > 1) {
-    problems_.add(line_of(documents[1]), "",
-                  "more than one YAML document (---): a scenario file holds one");
-    return false;
-  }
-  root = documents.front();
+  std::optional<YAML::Node> document = parse_scenario_text(text, problems_);
+  if (!document) return false;
+  root = *document;
   return true;
 }
 
@@ -1559,6 +1562,13 @@ std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine&
 
 Scenario load_scenario(const std::string& path) {
   return Loader(path).load();
+}
+
+Scenario load_scenario(const std::string& path, const std::string& text,
+                       const std::vector<ScenarioOverride>& overrides) {
+  Loader loader(path);
+  loader.set_source(&text, &overrides);
+  return loader.load();
 }
 
 std::vector<Problem> validate_scenario_file(const std::string& path) {

@@ -51,6 +51,22 @@ TEST(ProgressLine, TerminalRewritesOneLineAfterASecond) {
             "\rjob/lspb_mtt: simulating done in 3.0 s        \n");
 }
 
+// a detail after the time (a sweep's tasks and ETA); a shorter line blanks what a longer one left
+TEST(ProgressLine, DetailFollowsTheTimeAndShorterLinesAreBlankedOut) {
+  Capture c(ProgressLine::Style::terminal);
+  c.now_s = 101.5;
+  c.line.update(0.5, "2/4 tasks, ETA 12 s");
+  c.now_s = 102.0;
+  c.line.update(0.75, "3/4");
+  c.now_s = 103.0;
+  c.line.finish();
+  const std::string first = "\rjob/lspb_mtt: simulating  50 % (1.5 s) 2/4 tasks, ETA 12 s";
+  const std::string second = "\rjob/lspb_mtt: simulating  75 % (2.0 s) 3/4";
+  const std::string done = "\rjob/lspb_mtt: simulating done in 3.0 s";
+  EXPECT_EQ(c.text(), first + second + std::string(first.size() - second.size(), ' ') + done +
+                          std::string(first.size() - done.size(), ' ') + "\n");
+}
+
 TEST(ProgressLine, LogPrintsAPlainLinePerPeriod) {
   Capture c(ProgressLine::Style::log, 5.0);
   for (int k = 1; k <= 48; ++k) c.at(100.0 + 0.25 * k, k / 48.0);  // every 0.25 s, 12 s

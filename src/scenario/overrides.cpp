@@ -1,0 +1,338 @@
+// Scenario overrides: the YAML tree of a scenario edited before it is loaded
+// (scenario/overrides.hpp).
+#include "scenario/overrides.hpp"
+
+#include <cctype>
+#include <filesystem>
+
+#include "scenario/override_tree.hpp"
+
+namespace depotwin {
+
+namespace scenario_detail {
+
+std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemList& problems) {
+  // exactly one YAML document
+  std::vector<YAML::Node> documents;
+  try {
+    documents = YAML::LoadAll(text);
+  } catch (const YAML::ParserException& e) {
+    problems.add(e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
+    return std::nullopt;
+  } catch (const YAML::Exception& e) {
+    problems.add(0, "", std::string("malformed YAML: ") + e.what());
+    return std::nullopt;
+  }
+  if (documents.empty() || documents.front().IsNull()) {
+    problems.add(1, "", "the file holds no settings: expected a map with at least `toolpath:`");
+    return std::nullopt;
+  }
+  if (documents.size() > 1) {
+    problems.add(line_of(documents[1]), "",
+                 "more than one YAML document (---): a scenario file holds one");
+    return std::nullopt;
+  }
+  return documents.front();
+}
+
+std::optional<std::vector<KeyStep>> parse_override_key(const std::string& key, std::string& why) {
+  std::vector<KeyStep> steps;
+  const auto is_name_char = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
+  };
+  std::size_t at = 0;
+  if (key.empty()) {
+    why = "an empty key";
+    return std::nullopt;
+  }
+  while (at < key.size()) {
+    // a name ...
+    const std::size_t begin = at;
+    while (at < key.size() && is_name_char(key[at])) ++at;
+    if (at == begin) {
+      why = "expected a key name at character " + std::to_string(begin + 1) +
+            " (keys are names joined by dots, with [index] for list entries: planners[0].delta)";
+      return std::nullopt;
+    }
+    steps.push_back(KeyStep{key.substr(begin, at - begin), -1});
+    // ... with list indices after it ...
+    while (at < key.size() && key[at] == '[') {
+      const std::size_t digits = at + 1;
+      std::size_t close = digits;
+      while (close < key.size() && std::isdigit(static_cast<unsigned char>(key[close]))) ++close;
+      if (close == digits || close >= key.size() || key[close] != ']' || close - digits > 9) {
+        why = "a list index is [N] with N a whole number from 0 (character " +
+              std::to_string(at + 1) + ")";
+        return std::nullopt;
+      }
+      steps.push_back(KeyStep{"", std::stoll(key.substr(digits, close - digits))});
+      at = close + 1;
+    }
+    // ... then a dot and the next name, or the end
+    if (at == key.size()) break;
+    if (key[at] != '.' || at + 1 == key.size()) {
+      why = "unexpected '" + std::string(1, key[at]) + "' at character " + std::to_string(at + 1) +
+            " (keys are names joined by dots, with [index] for list entries: planners[0].delta)";
+      return std::nullopt;
+    }
+    ++at;
+  }
+  return steps;
+}
+
+std::string flow_text(const YAML::Node& node) {
+  if (node.IsScalar()) return node.Scalar();
+  YAML::Emitter out;
+  out.SetMapFormat(YAML::Flow);
+  out.SetSeqFormat(YAML::Flow);
+  out << node;
+  return out.c_str();
+}
+
+namespace {
+
+// the dotted text of the first `count` steps (`planners[0]`)
+std::string key_text(const std::vector<KeyStep>& steps, std::size_t count) {
+  std::string text;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (steps[i].name.empty())
+      text += "[" + std::to_string(steps[i].index) + "]";
+    else
+      text += (text.empty() ? "" : ".") + steps[i].name;
+  }
+  return text;
+}
+
+// The key a scalar stands for where the schema also takes a map: a planner name
+// (`planners[i]`: {name: X}), an order (`order`: {method: X}), a G-code file
+// (`toolpath.gcode`: {file: X}); empty where there is none.
+std::string map_form_key(const std::vector<KeyStep>& steps, std::size_t count) {
+  if (count == 2 && steps[0].name == "planners" && steps[1].name.empty()) return "name";
+  if (count == 1 && steps[0].name == "order") return "method";
+  if (count == 2 && steps[0].name == "toolpath" && steps[1].name == "gcode") return "file";
+  return "";
+}
+
+// what a node holds, for messages
+std::string what_is(const YAML::Node& node) {
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a map";
+  if (node.IsScalar()) return "'" + node.Scalar() + "'";
+  return "nothing";
+}
+
+// Sets `steps` in `root` to `value`; "" or what went wrong.
+std::string set_value(YAML::Node root, const std::vector<KeyStep>& steps, const YAML::Node& value) {
+  YAML::Node current;
+  current.reset(root);
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const KeyStep& step = steps[i];
+    const bool last = i + 1 == steps.size();
+    const std::string walked = key_text(steps, i);
+    if (!step.name.empty()) {
+      // a map key: a scalar with a map form becomes that map, e.g. a planner name {name: X}
+      if (current.IsScalar() && !map_form_key(steps, i).empty()) {
+        YAML::Node as_map(YAML::NodeType::Map);
+        as_map[map_form_key(steps, i)] = current.Scalar();
+        current = as_map;  // replaces the node in the tree
+      }
+      if (!current.IsMap())
+        return walked + " is " + what_is(current) + " in the base scenario, not a map: override " +
+               walked + " as a whole";
+      if (last) {
+        // null (~) removes the key, e.g. toolpath.segments before toolpath.polylines is set
+        if (value.IsNull())
+          current.remove(step.name);
+        else
+          current[step.name] = value;
+        return "";
+      }
+      YAML::Node child = current[step.name];
+      if (!child.IsDefined() || child.IsNull()) {
+        current[step.name] = YAML::Node(YAML::NodeType::Map);
+        child.reset(current[step.name]);
+      }
+      current.reset(child);
+    } else {
+      // a list entry that exists
+      if (!current.IsSequence())
+        return walked + " is " + what_is(current) + " in the base scenario, not a list";
+      if (step.index >= static_cast<long long>(current.size()))
+        return walked + " has " + std::to_string(current.size()) +
+               (current.size() == 1 ? " entry" : " entries") + " in the base scenario (" + walked +
+               "[0]" +
+               (current.size() > 1 ? ".." + walked + "[" + std::to_string(current.size() - 1) + "]"
+                                   : "") +
+               ")";
+      if (last) {
+        if (value.IsNull())
+          return walked + "[" + std::to_string(step.index) +
+                 "]: a list entry cannot be removed (~); override the whole list";
+        current[static_cast<std::size_t>(step.index)] = value;
+        return "";
+      }
+      YAML::Node child = current[static_cast<std::size_t>(step.index)];
+      current.reset(child);
+    }
+  }
+  return "";
+}
+
+// a planner entry's run label and name (`lspb_mtt`, `{name: conformal, label: control_none}`)
+void planner_names(const YAML::Node& entry, std::string& label, std::string& name) {
+  label.clear();
+  name.clear();
+  if (entry.IsScalar()) {
+    name = entry.Scalar();
+  } else if (entry.IsMap()) {
+    if (entry["name"] && entry["name"].IsScalar()) name = entry["name"].Scalar();
+    if (entry["label"] && entry["label"].IsScalar()) label = entry["label"].Scalar();
+  }
+}
+
+// `planner`: keeps one planner of the scenario (by run label, then by name), or names another
+std::string select_planner(YAML::Node root, const YAML::Node& value) {
+  const YAML::Node& const_root = root;
+  const YAML::Node planners = const_root["planners"];
+  YAML::Node chosen = value;
+  if (value.IsScalar() && planners && planners.IsSequence()) {
+    const std::string wanted = value.Scalar();
+    std::vector<std::size_t> by_label, by_name;
+    std::string label, name;
+    for (std::size_t i = 0; i < planners.size(); ++i) {
+      planner_names(planners[i], label, name);
+      if (label == wanted) by_label.push_back(i);
+      if (name == wanted) by_name.push_back(i);
+    }
+    const std::vector<std::size_t>& found = by_label.empty() ? by_name : by_label;
+    if (found.size() > 1) {
+      std::string labels;
+      for (const std::size_t i : found) {
+        planner_names(planners[i], label, name);
+        labels += (labels.empty() ? "" : ", ") + (label.empty() ? name : label);
+      }
+      return "'" + wanted + "' matches " + std::to_string(found.size()) +
+             " planners of the base scenario (" + labels + "): name one by its label";
+    }
+    if (found.size() == 1) chosen = YAML::Clone(planners[found.front()]);
+  }
+  YAML::Node list(YAML::NodeType::Sequence);
+  list.push_back(chosen);
+  root["planners"] = list;
+  return "";
+}
+
+bool starts_with(const std::string& text, const std::string& prefix) {
+  return text.compare(0, prefix.size(), prefix) == 0;
+}
+
+}  // namespace
+
+void apply_overrides(YAML::Node root, const std::vector<ScenarioOverride>& overrides,
+                     std::vector<Problem>& problems) {
+  if (!root.IsMap()) return;  // the loader says what the file should be
+  const auto apply = [&](const ScenarioOverride& override_) {
+    const auto problem = [&](const std::string& message) {
+      problems.push_back(Problem{override_.file, override_.line, override_.key, message});
+    };
+    YAML::Node value;
+    try {
+      value = YAML::Load(override_.value_yaml);
+    } catch (const YAML::Exception& e) {
+      problem(std::string("malformed value: ") + e.what());
+      return;
+    }
+    if (override_.key == "planner") {
+      const std::string why = select_planner(root, value);
+      if (!why.empty()) problem(why);
+      return;
+    }
+    std::string why;
+    const std::optional<std::vector<KeyStep>> steps = parse_override_key(override_.key, why);
+    if (!steps) {
+      problem(why);
+      return;
+    }
+    why = set_value(root, *steps, value);
+    if (!why.empty()) problem(why);
+  };
+  // every override in order, `planner` last (planners[i] names the base scenario's list)
+  for (const ScenarioOverride& override_ : overrides)
+    if (override_.key != "planner") apply(override_);
+  for (const ScenarioOverride& override_ : overrides)
+    if (override_.key == "planner") apply(override_);
+}
+
+void attribute_to_overrides(std::vector<Problem>& problems,
+                            const std::vector<ScenarioOverride>& overrides) {
+  for (Problem& problem : problems) {
+    const ScenarioOverride* owner = nullptr;
+    std::size_t owner_length = 0;
+    for (const ScenarioOverride& override_ : overrides) {
+      const std::string key = override_.key == "planner" ? "planners" : override_.key;
+      const bool under = problem.key == key || starts_with(problem.key, key + ".") ||
+                         starts_with(problem.key, key + "[");
+      // the most specific override wins (limits.x.v_max over limits)
+      if (under && key.size() >= owner_length) {
+        owner = &override_;
+        owner_length = key.size();
+      }
+    }
+    if (owner == nullptr) continue;
+    problem.file = owner->file;
+    problem.line = owner->line;
+  }
+}
+
+}  // namespace scenario_detail
+
+std::string override_key_problem(const std::string& key) {
+  if (key == "planner") return "";
+  std::string why;
+  return scenario_detail::parse_override_key(key, why) ? "" : why;
+}
+
+ResolvedScenario resolve_scenario(const std::string& path, const std::string& text,
+                                  const std::vector<ScenarioOverride>& overrides) {
+  using namespace scenario_detail;
+  ProblemList problems(path);
+  std::optional<YAML::Node> root = parse_scenario_text(text, problems);
+  if (!root) throw InputError(problems.problems());
+  apply_overrides(*root, overrides, problems.problems());
+  if (!problems.empty()) throw InputError(problems.problems());
+
+  ResolvedScenario resolved;
+  YAML::Emitter out;
+  out << *root;
+  resolved.text = out.c_str();
+  // the files it reads: an MJCF model, a G-code file, a part's STL
+  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
+  const auto add_file = [&](const YAML::Node& node) {
+    if (node && node.IsScalar())
+      resolved.input_files.push_back((directory / node.Scalar()).lexically_normal().string());
+  };
+  const YAML::Node& tree = *root;
+  if (tree.IsMap()) {
+    if (tree["machine"] && tree["machine"].IsMap()) add_file(tree["machine"]["model"]);
+    const YAML::Node toolpath = tree["toolpath"];
+    if (toolpath && toolpath.IsMap()) {
+      const YAML::Node gcode = toolpath["gcode"];
+      if (gcode && gcode.IsScalar()) add_file(gcode);
+      if (gcode && gcode.IsMap()) add_file(gcode["file"]);
+      if (toolpath["surface"] && toolpath["surface"].IsMap()) add_file(toolpath["surface"]["file"]);
+    }
+    // the planners it runs, by run label
+    const YAML::Node planners = tree["planners"];
+    if (planners && planners.IsSequence()) {
+      resolved.planners.emplace();
+      std::string label, name;
+      for (std::size_t i = 0; i < planners.size(); ++i) {
+        planner_names(planners[i], label, name);
+        resolved.planners->push_back(label.empty() ? name : label);
+      }
+    }
+  }
+  return resolved;
+}
+
+}  // namespace depotwin
