@@ -33,8 +33,8 @@ struct OrderResult {
 // knobs for benchmarks and tests; the defaults are what scenarios get
 struct SequencerOptions {
   int neighbors = 12;  // candidate list length per path end (local search)
-  // the lower bound is exact at any N but costs ~0.6 s at N = 10^4 and ~30 s at 10^5;
-  // above this many paths (or when false) lower_bound_s is NaN
+  // the lower bound is exact at any N but its cost grows faster than the sequencers' (see
+  // bench_ordering); above lower_bound_max_paths paths (or when false) lower_bound_s is NaN
   bool lower_bound = true;
   int lower_bound_max_paths = 20000;
 };

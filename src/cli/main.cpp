@@ -18,6 +18,11 @@ using namespace depotwin;
 
 namespace {
 
+// --max-memory on the scenario verbs (pipeline/job_check.hpp)
+const char* const kMaxMemoryHelp =
+    "refuse a job estimated to need more memory than this, before any work: bytes or K, M, G, T "
+    "(powers of 1024), e.g. 16G (default 8G)";
+
 void print_problems(const InputError& error) {
   for (const Problem& problem : error.problems()) std::cerr << "error: " << problem.str() << '\n';
 }
@@ -71,6 +76,7 @@ int main(int argc, char** argv) {
   run->add_option("--out", run_options.out, "output directory (default: results/<scenario name>)");
   run->add_flag("--no-render", run_options.no_render, "write no images or plots");
   run->add_flag("--quiet", run_options.quiet, "no progress line");
+  run->add_option("--max-memory", run_options.max_memory, kMaxMemoryHelp);
   // ---- moving pictures (src/render/video.hpp) ----
   run->add_flag("--video", run_options.video,
                 "also write run.mp4 in each run folder: the scene over time, the deposit growing");
@@ -92,6 +98,7 @@ int main(int argc, char** argv) {
                       "output directory (default: results/<scenario name>)");
   compare->add_flag("--no-render", compare_options.run.no_render, "write no images or plots");
   compare->add_flag("--quiet", compare_options.run.quiet, "no progress line");
+  compare->add_option("--max-memory", compare_options.run.max_memory, kMaxMemoryHelp);
   // ---- moving pictures (src/render/video.hpp) ----
   compare->add_flag("--video", compare_options.run.video, "also write run.mp4 in each run folder");
   compare
@@ -108,11 +115,15 @@ int main(int argc, char** argv) {
                    "planner(s), comma-separated (default: all of the scenario's)");
   plan->add_option("--out", plan_options.out,
                    "output directory (default: results/<scenario name>)");
+  plan->add_option("--max-memory", plan_options.max_memory, kMaxMemoryHelp);
 
-  std::string validate_scenario;
-  CLI::App* validate =
-      app.add_subcommand("validate", "load and check a scenario; explain every problem");
+  std::string validate_scenario, validate_max_memory;
+  CLI::App* validate = app.add_subcommand(
+      "validate",
+      "every check `run` makes before it simulates (the file, the MJCF model, the plans, the "
+      "job's size); lists every problem");
   validate->add_option("scenario", validate_scenario, "scenario YAML file")->required();
+  validate->add_option("--max-memory", validate_max_memory, kMaxMemoryHelp);
 
   // ---- view (a finished run replayed in a window: src/viewer/viewer.cpp) ----
   ViewOptions view_options;
@@ -214,7 +225,7 @@ int main(int argc, char** argv) {
     if (*run) return run_verb(run_options);
     if (*compare) return compare_verb(compare_options);
     if (*plan) return plan_verb(plan_options);
-    if (*validate) return validate_verb(validate_scenario);
+    if (*validate) return validate_verb(validate_scenario, validate_max_memory);
     if (*view) return view_verb(view_options);                              // view
     if (*describe) return describe_verb(describe_topic, describe_as_json);  // describe
     if (*export_gcode) return export_verb(export_options);                  // export

@@ -11,6 +11,7 @@ struct RunOptions {
   std::string out;
   bool no_render = false;
   bool quiet = false;
+  std::string max_memory;  // --max-memory (pipeline/job_check.hpp); empty: the default
   // ---- moving pictures: run.mp4 (RunSettings::video) ----
   bool video = false;
   double video_length_s = 30.0;
@@ -25,6 +26,6 @@ struct CompareOptions {
 int run_verb(const RunOptions& options);
 int compare_verb(const CompareOptions& options);
 int plan_verb(const RunOptions& options);
-int validate_verb(const std::string& scenario);
+int validate_verb(const std::string& scenario, const std::string& max_memory = {});
 
 }  // namespace depotwin

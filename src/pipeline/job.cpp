@@ -25,8 +25,10 @@ namespace {
 constexpr double kSamplePeriod_s = 0.001;  // trajectory.csv and planned metrics
 // at most this many unreachable points are listed (the rest counted)
 constexpr size_t kMaxNamedPoints = 20;
-// the longest job planned, sampled and simulated (at 1 ms, about 14 M samples)
-constexpr double kMaxJobDuration_s = 4.0 * 3600.0;
+// the most 1 ms samples a plan may have at all (pipeline/job_check.hpp refuses far smaller
+// jobs against sim.max_steps and --max-memory before they are planned for a verb; this guards
+// the sample count's integer conversion for every caller)
+constexpr double kMaxPlanSamples = 1e12;
 
 // The machine named in the scenario, from the registry (the loader checked the name), and the
 // MJCF it is simulated in: the scenario's own model file, else the machine's shipped one.
@@ -111,7 +113,7 @@ void choose_posture(const Scenario& scenario, Arm6& arm, PreparedJob& job) {
 
 }  // namespace
 
-PreparedJob prepare_job(const Scenario& scenario) {
+PreparedJob prepare_job(const Scenario& scenario, const PrepareOptions& options) {
   PreparedJob job;
   job.scenario = scenario;
   job.machine = machine_for(scenario, job.model_path);
@@ -149,7 +151,7 @@ PreparedJob prepare_job(const Scenario& scenario) {
   // (the lower bound, every pair of path ends, only where an order is searched for: the given
   // order's job never needs it, and a hatched part has hundreds of paths)
   SequencerOptions sequencing;
-  sequencing.lower_bound = scenario.order.method != "as_given";
+  sequencing.lower_bound = options.lower_bound && scenario.order.method != "as_given";
   job.order = sequence(scenario.toolpath, job.limits, scenario.order, sequencing);
   job.toolpath = apply_order(scenario.toolpath, job.order);
 
@@ -193,26 +195,30 @@ std::string output_directory(const Scenario& scenario, const std::string& reques
   return requested.empty() ? (fs::path("results") / scenario.name).string() : requested;
 }
 
-PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
+Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec) {
   // a jerk limit in force (the user's, or the joints' mapped) must be honoured
   Vec3 lo, hi;
   job.toolpath.bounds(lo, hi);
   const std::string ignored = check_planner_limits(spec, job.limits.over(lo, hi));
-  if (!ignored.empty()) throw InputError(job.scenario.file, spec.line, "planners", ignored);
+  const int line = spec.line > 0 ? spec.line : job.scenario.line_of("planners");
+  if (!ignored.empty()) throw InputError(job.scenario.file, line, "planners", ignored);
+  Trajectory trajectory = make_planner(spec)->plan(job.toolpath, job.limits);
+  // a plan far beyond any real print (e.g. a j_max of 1e-300 mm/s^3) cannot be sampled
+  if (!(trajectory.duration_s() / kSamplePeriod_s <= kMaxPlanSamples)) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "the %s plan lasts %.4g s: far too long to sample every ms; check the print "
+                  "speeds and the limits (v_max, a_max, j_max)",
+                  spec.name.c_str(), trajectory.duration_s());
+    throw InputError(job.scenario.file, line, "planners", text);
+  }
+  return trajectory;
+}
 
+PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   PlannedRun run;
   run.spec = spec;
-  run.trajectory = make_planner(spec)->plan(job.toolpath, job.limits);
-  // a job far beyond any real print (e.g. a j_max of 1e-9 mm/s^3) would be sampled every
-  // millisecond: refuse it before sampling anything
-  if (!(run.trajectory.duration_s() <= kMaxJobDuration_s)) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "the %s plan lasts %.4g s, beyond the %.0f h a job may last here; check the "
-                  "print speeds and the limits (v_max, a_max, j_max)",
-                  spec.name.c_str(), run.trajectory.duration_s(), kMaxJobDuration_s / 3600.0);
-    throw InputError(job.scenario.file, spec.line, "planners", text);
-  }
+  run.trajectory = plan_trajectory(job, spec);
   run.planned = sample_trajectory(run.trajectory, kSamplePeriod_s);
 
   MetricsReport& r = run.report;
