@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cstdio>
+#include <cstdlib>
 #include <system_error>
 
 namespace depotwin {
@@ -13,7 +14,11 @@ std::optional<double> parse_double(const std::string& text) {
   if (*first == '+') ++first;
   double value = 0.0;
   const auto [end, error] = std::from_chars(first, last, value);
-  if (error != std::errc() || end != last) return std::nullopt;
+  if (end != last) return std::nullopt;
+  // beyond the doubles (1e400, 1e-400): what strtod makes of it, +-inf or (nearly) 0, so the
+  // caller can say "not finite" or "out of range" instead of "not a number"
+  if (error == std::errc::result_out_of_range) return std::strtod(text.c_str(), nullptr);
+  if (error != std::errc()) return std::nullopt;
   return value;
 }
 

@@ -9,7 +9,8 @@
 
 namespace depotwin {
 
-// the whole text as a double (inf and nan included), or nothing
+// the whole text as a double (inf and nan included; beyond the doubles: +-inf, or 0 and the
+// subnormals for tiny ones), or nothing
 std::optional<double> parse_double(const std::string& text);
 
 // a number as messages print it: at most 6 significant digits (%.6g: 3, 0.25, 1e-05, 1e+300)

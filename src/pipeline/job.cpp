@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
@@ -71,6 +72,15 @@ std::vector<Problem> at_toolpath(const Scenario& scenario, const std::vector<Nam
     p.file = scenario.file;
     p.line = scenario.surface ? scenario.surface->line : scenario.toolpath_line;
     p.key = scenario.surface ? "toolpath.surface" : "toolpath";
+    // the start and the end at their own keys and lines (where given)
+    for (const auto& [name, key, line] :
+         {std::tuple<const char*, const char*, int>{"the start ", "toolpath.start",
+                                                    scenario.start_line},
+          std::tuple<const char*, const char*, int>{"the end ", "toolpath.end", scenario.end_line}})
+      if (p.message.rfind(name, 0) == 0) {
+        p.key = key;
+        if (line > 0) p.line = line;
+      }
   }
   return problems;
 }

@@ -146,7 +146,11 @@ std::optional<double> read_number(const Field& field, ProblemList& problems, con
   }
   if (!std::isfinite(*value)) {
     problems.add(field.line, field.key,
-                 "must be a finite number, got " + printable_text(text) + " (beyond 1.8e308)");
+                 "must be a finite number, got " +
+                     // digits beyond the doubles are not echoed (hundreds of them)
+                     (text.find_first_of("0123456789") == std::string::npos
+                          ? printable_text(text)
+                          : std::string(*value < 0 ? "-" : "") + "a number beyond 1.8e+308"));
     return std::nullopt;
   }
   if (!range.contains(*value)) {
@@ -177,8 +181,13 @@ std::optional<std::uint64_t> read_seed(const Field& field, ProblemList& problems
   const char* last = text.data() + text.size();
   const auto [end, error] = std::from_chars(text.data(), last, value);
   if (!node.IsScalar() || is_quoted(node) || text.empty() || error != std::errc() || end != last) {
-    problems.add(field.line, field.key,
-                 "expected a whole number >= 0 (a random seed), got " + describe(node));
+    // a number is named by its value (never hundreds of digits), anything else as written
+    const std::optional<double> number =
+        node.IsScalar() && !is_quoted(node) ? parse_double(text) : std::nullopt;
+    const std::string got = !number                  ? describe(node)
+                            : std::isfinite(*number) ? format_number(*number)
+                                                     : "a number beyond 1.8e+308";
+    problems.add(field.line, field.key, "expected a whole number >= 0 (a random seed), got " + got);
     return std::nullopt;
   }
   return value;
