@@ -78,10 +78,11 @@ int validate_verb(const std::string& path, const std::string& max_memory) {
             << ", " << scenario.toolpath.paths.size() << " print paths, "
             << scenario.planners.size() << " planner(s)\n";
   if (longest != runs.end())
-    std::cout << "  run: longest " << longest->label << ", " << message_number(longest->duration_s)
-              << " s, " << message_number(longest->steps) << " physics steps (sim.max_steps "
-              << message_number(static_cast<double>(scenario.sim.max_steps))
-              << "); the runs' data about " << format_bytes(memory_bytes) << " (--max-memory "
+    std::cout << "  `run` would take: the longest plan " << longest->label << " "
+              << message_number(longest->duration_s) << " s, " << message_number(longest->steps)
+              << " physics steps (sim.max_steps "
+              << message_number(static_cast<double>(scenario.sim.max_steps)) << "); about "
+              << format_bytes(memory_bytes) << " for the runs' data (--max-memory "
               << format_bytes(budget.max_memory_bytes) << ")\n";
   return kExitOk;
 }

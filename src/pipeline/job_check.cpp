@@ -177,9 +177,9 @@ std::string size_driver(const Scenario& scenario, const RunEstimate& run, bool m
     return "sim.timestep_s";
   if (run.print_s >= 0.5 * run.duration_s)
     return scenario.key_lines.count("toolpath.speed") ? "toolpath.speed" : "toolpath";
-  for (const char* key : {"limits.a_max", "limits.j_max", "limits"})
-    if (scenario.key_lines.count(key)) return key;
-  return "limits";
+  // a jerk limit in force lengthens every move most; else the accelerations
+  if (scenario.limits.jerk_limited()) return "limits.j_max";
+  return "limits.a_max";
 }
 
 // what a run's duration is made of, for messages
@@ -230,8 +230,10 @@ std::string format_bytes(double bytes) {
   const double mib = bytes / (1024.0 * 1024.0);
   if (mib < 1024.0)
     std::snprintf(text, sizeof text, "%.0f MB", mib);
-  else
+  else if (mib < 1024.0 * 1024.0)
     std::snprintf(text, sizeof text, "%.3g GB", mib / 1024.0);
+  else
+    std::snprintf(text, sizeof text, "%.3g TB", mib / (1024.0 * 1024.0));
   return text;
 }
 

@@ -14,6 +14,7 @@
 #include "core/input_ranges.hpp"
 #include "core/number_text.hpp"
 #include "kinematics/machine.hpp"
+#include "scenario/lifted_list.hpp"
 #include "scenario/schema.hpp"
 #include "scenario/yaml_reader.hpp"
 #include "toolpath/gcode.hpp"
@@ -192,6 +193,8 @@ class Loader {
   bool joint_limits_bad_ = false;  // `limits.joint` given but unusable
   // the machine named (when known) and its TCP limits per move, for the speed and reach checks
   std::unique_ptr<Machine> machine_;
+  // a long segments list read without yaml-cpp (scenario/lifted_list.hpp)
+  std::optional<LiftedSegments> lifted_;
   std::optional<TcpLimits> tcp_limits_;
   std::size_t speed_problems_ = 0;  // print segments over speed, listed up to a count
   bool speed_missing_ = false;      // reported once, not per path
@@ -263,10 +266,12 @@ bool Loader::read_document(YAML::Node& root) {
     problems_.add(0, "", "cannot read the scenario file");
     return false;
   }
-  // exactly one YAML document
+  // exactly one YAML document; a long segments list is read apart (lifted_list.hpp)
+  std::string yaml = text.str();
+  lifted_ = lift_segments(yaml);
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(text.str());
+    documents = YAML::LoadAll(yaml);
   } catch (const YAML::ParserException& e) {
     problems_.add(e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
     return false;
@@ -580,6 +585,30 @@ std::optional<std::vector<Vec3>> Loader::read_points(const Field& field, std::ve
 
 void Loader::read_segments(const Field& field, const std::optional<double>& default_speed) {
   const std::size_t first_path = scenario_.toolpath.paths.size();
+  // a list read apart: every entry already a valid pair of points, each on its own line
+  if (lifted_ && lifted_->key_line == field.key_line) {
+    if (!default_speed && !speed_missing_) {
+      problems_.add(field.key_line, "toolpath.speed",
+                    "missing: the print speed of the segments (mm/s)");
+      speed_missing_ = true;
+    }
+    scenario_.toolpath.paths.reserve(lifted_->segments.size());
+    scenario_.path_sources.reserve(lifted_->segments.size());
+    for (std::size_t i = 0; i < lifted_->segments.size(); ++i) {
+      PrintPath path;
+      path.points = {lifted_->segments[i][0], lifted_->segments[i][1]};
+      path.speed_mm_s = default_speed.value_or(0.0);
+      path.source_index = static_cast<int>(i);
+      const int line = lifted_->lines[i];
+      check_path(
+          path,
+          PathOrigin{
+              problems_.file(), field.key + "[" + std::to_string(i) + "]", {line, line}, false});
+      scenario_.toolpath.paths.push_back(std::move(path));
+    }
+    check_repeated_paths(first_path, "segment");
+    return;
+  }
   if (!expect_list(field, problems_, "a list of segments [[x, y], [x, y]]")) return;
   if (field.node.size() == 0) {
     problems_.add(field.line, field.key, "is empty: give at least one segment");
