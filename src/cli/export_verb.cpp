@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "pipeline/job.hpp"
+#include "pipeline/job_check.hpp"
 
 #ifndef DEPOTWIN_VERSION
 #define DEPOTWIN_VERSION "unknown"
@@ -302,7 +303,8 @@ void check_out_path(const std::string& out) {
 
 int export_verb(const ExportOptions& options) {
   check_out_path(options.out);
-  const Scenario scenario = load_scenario(options.scenario);
+  // every check before any work (pipeline/job_check.hpp): one run, planned and sampled only
+  const Scenario scenario = check_scenario(options.scenario, JobBudget{}, 1, false);
   // 3-axis G-code has no tool axis: a conformal job's tilts would be lost silently
   bool tilted = scenario.surface != nullptr;
   for (const PrintPath& path : scenario.toolpath.paths) tilted = tilted || !path.normals.empty();
@@ -317,7 +319,7 @@ int export_verb(const ExportOptions& options) {
       labels += (labels.empty() ? "" : ", ") + spec.run_label();
     throw InputError("--planner", "export writes one planner's motion; choose one of " + labels);
   }
-  const PreparedJob job = prepare_job(scenario);
+  const PreparedJob job = prepare_checked_job(scenario, planners, JobBudget{}, false, false);
   const PlannedRun planned = plan_job(job, planners.front());
 
   GcodeExportJob export_job;
