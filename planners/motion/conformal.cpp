@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "core/number_text.hpp"
 #include "planners/motion/path_parametrization.hpp"
 
 namespace depotwin {
@@ -267,7 +268,12 @@ PathGrid polyline_grid(const std::vector<Piece>& pieces, double ds, double speed
   for (size_t index = 0; index < pieces.size(); ++index) {
     const Piece& piece = pieces[index];
     const int minimum = piece.is_blend ? kBlendMinIntervals : kLineMinIntervals;
-    const int steps = std::max(minimum, static_cast<int>(std::ceil(piece.length / ds - 1e-9)));
+    const double intervals = std::ceil(piece.length / ds - 1e-9);
+    if (!(intervals <= 1e8))
+      throw InputError("planners",
+                       "conformal: a piece of " + message_number(piece.length) +
+                           " mm would need more than 1e8 grid steps of ds_mm; raise ds_mm");
+    const int steps = std::max(minimum, static_cast<int>(intervals));
     const double step = piece.length / steps;
     sigmas.clear();
     for (int j = 0; j < steps; ++j) sigmas.push_back(piece.length * j / steps);

@@ -75,6 +75,7 @@ Trajectory LspbMttPlanner::plan(const Toolpath& toolpath, const TcpLimits& limit
   assign_boundary_velocities(segments);
 
   std::vector<TrajectoryPiece> pieces;
+  pieces.reserve(2 * segments.size() + 1);  // a transition before each segment, one to the end
   std::vector<std::string> warnings;
   double t = 0.0;
   Vec3 position = toolpath.start_mm;

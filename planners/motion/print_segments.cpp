@@ -10,7 +10,11 @@ namespace depotwin {
 std::vector<PrintSegment> split_into_segments(const Toolpath& toolpath,
                                               const TcpLimits& tcp_limits) {
   static const char* kAxis[3] = {"x", "y", "z"};
+  // sized once: a toolpath may have 10^5 segments
   std::vector<PrintSegment> segments;
+  size_t count = 0;
+  for (const PrintPath& path : toolpath.paths) count += path.points.size() - 1;
+  segments.reserve(count);
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
     const PrintPath& path = toolpath.paths[i];
     const std::string where = "toolpath path " + std::to_string(path.source_index);

@@ -43,6 +43,7 @@ AxisProfile scaled(const AxisProfile& along, double q0, double u) {
 Trajectory StopAndGoPlanner::plan(const Toolpath& toolpath, const TcpLimits& limits) const {
   const std::vector<PrintSegment> segments = split_into_segments(toolpath, limits);
   std::vector<TrajectoryPiece> pieces;
+  pieces.reserve(2 * segments.size() + 1);  // a transition before each segment, one to the end
   double t = 0.0;
   Vec3 position = toolpath.start_mm;
   ToolOrientation tool = toolpath.start_orientation();

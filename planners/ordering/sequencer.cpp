@@ -79,8 +79,12 @@ OrderResult sequence(const Toolpath& toolpath, const TcpLimits& limits, const Or
 
   result.cost_s = cost.order_cost(result);
   result.print_time_s = cost.print_time_s();
+  // the matching lower bound only when asked for and within its size limit (it grows faster
+  // than the sequencers: seconds at 10^4 paths)
+  const bool bound = options.lower_bound &&
+                     static_cast<long>(toolpath.paths.size()) <= options.lower_bound_max_paths;
   result.lower_bound_s =
-      options.lower_bound ? matching_lower_bound(cost) : std::numeric_limits<double>::quiet_NaN();
+      bound ? matching_lower_bound(cost) : std::numeric_limits<double>::quiet_NaN();
   return result;
 }
 

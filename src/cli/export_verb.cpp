@@ -16,6 +16,7 @@
 #include "core/file_io.hpp"
 #include "core/interrupt.hpp"
 #include "pipeline/job.hpp"
+#include "pipeline/job_check.hpp"
 #include "report/output_dir.hpp"
 
 #ifndef DEPOTWIN_VERSION
@@ -419,7 +420,8 @@ void check_out_path(const std::string& out) {
 
 int export_verb(const ExportOptions& options) {
   check_out_path(options.out);
-  const Scenario scenario = load_scenario(options.scenario);
+  // every check before any work (pipeline/job_check.hpp): one run, planned and sampled only
+  const Scenario scenario = check_scenario(options.scenario, JobBudget{}, 1, false);
   // one writer of the file at a time (report/output_dir.hpp); what writers killed outright
   // left beside it goes
   const std::string target = std::filesystem::absolute(options.out).lexically_normal().string();
@@ -439,7 +441,7 @@ int export_verb(const ExportOptions& options) {
       labels += (labels.empty() ? "" : ", ") + spec.run_label();
     throw InputError("--planner", "export writes one planner's motion; choose one of " + labels);
   }
-  const PreparedJob job = prepare_job(scenario);
+  const PreparedJob job = prepare_checked_job(scenario, planners, JobBudget{}, false, false);
   const PlannedRun planned = plan_job(job, planners.front());
 
   GcodeExportJob export_job;

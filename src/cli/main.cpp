@@ -21,6 +21,11 @@ using namespace depotwin;
 
 namespace {
 
+// --max-memory on the scenario verbs (pipeline/job_check.hpp)
+const char* const kMaxMemoryHelp =
+    "refuse a job estimated to need more memory than this, before any work: bytes or K, M, G, T "
+    "(powers of 1024), e.g. 16G (default 8G)";
+
 void print_problems(const InputError& error) {
   for (const Problem& problem : error.problems()) std::cerr << "error: " << problem.str() << '\n';
 }
@@ -76,6 +81,7 @@ int main(int argc, char** argv) {
   run->add_flag("--quiet", run_options.quiet, "no progress line");
   run->add_flag("--no-wait", run_options.no_wait,
                 "exit (status 2) instead of waiting while another depotwin writes --out");
+  run->add_option("--max-memory", run_options.max_memory, kMaxMemoryHelp);
   // ---- moving pictures (src/render/video.hpp) ----
   run->add_flag("--video", run_options.video,
                 "also write run.mp4 in each run folder: the scene over time, the deposit growing");
@@ -99,6 +105,7 @@ int main(int argc, char** argv) {
   compare->add_flag("--quiet", compare_options.run.quiet, "no progress line");
   compare->add_flag("--no-wait", compare_options.run.no_wait,
                     "exit (status 2) instead of waiting while another depotwin writes --out");
+  compare->add_option("--max-memory", compare_options.run.max_memory, kMaxMemoryHelp);
   // ---- moving pictures (src/render/video.hpp) ----
   compare->add_flag("--video", compare_options.run.video, "also write run.mp4 in each run folder");
   compare
@@ -117,11 +124,15 @@ int main(int argc, char** argv) {
                    "output directory (default: results/<scenario name>)");
   plan->add_flag("--no-wait", plan_options.no_wait,
                  "exit (status 2) instead of waiting while another depotwin writes --out");
+  plan->add_option("--max-memory", plan_options.max_memory, kMaxMemoryHelp);
 
-  std::string validate_scenario;
-  CLI::App* validate =
-      app.add_subcommand("validate", "load and check a scenario; explain every problem");
+  std::string validate_scenario, validate_max_memory;
+  CLI::App* validate = app.add_subcommand(
+      "validate",
+      "every check `run` makes before it simulates (the file, the MJCF model, the plans, the "
+      "job's size); lists every problem");
   validate->add_option("scenario", validate_scenario, "scenario YAML file")->required();
+  validate->add_option("--max-memory", validate_max_memory, kMaxMemoryHelp);
 
   // ---- view (a finished run replayed in a window: src/viewer/viewer.cpp) ----
   ViewOptions view_options;
@@ -241,7 +252,7 @@ int main(int argc, char** argv) {
     if (*run) return run_verb(run_options);
     if (*compare) return compare_verb(compare_options);
     if (*plan) return plan_verb(plan_options);
-    if (*validate) return validate_verb(validate_scenario);
+    if (*validate) return validate_verb(validate_scenario, validate_max_memory);
     if (*view) return view_verb(view_options);                              // view
     if (*describe) return describe_verb(describe_topic, describe_as_json);  // describe
     if (*export_gcode) return export_verb(export_options);                  // export

@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/input_ranges.hpp"
+#include "core/number_text.hpp"
 #include "motion/sync.hpp"
 
 namespace depotwin {
@@ -15,11 +17,12 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
   std::stringstream stream(text);
   std::string item;
   while (std::getline(stream, item, ',')) {
-    char* end = nullptr;
-    const double value = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(value))
-      throw InputError(option, "'" + item + "' is not a finite number (expected e.g. 0,5.5)");
-    values.push_back(value);
+    // the whole item as a number, whatever the locale
+    const std::optional<double> value = parse_double(item);
+    if (!value || !std::isfinite(*value))
+      throw InputError(
+          option, "'" + printable_text(item) + "' is not a finite number (expected e.g. 0,5.5)");
+    values.push_back(*value);
   }
   if (values.empty()) throw InputError(option, "no value given");
   return values;
@@ -83,7 +86,13 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
   }
   if (!problems.empty()) throw InputError(problems);
 
-  // per axis: limits and boundary velocities, then the synchronised move
+  // per axis: limits and boundary velocities within the ranges a scenario accepts
+  // (core/input_ranges.hpp), then the synchronised move
+  namespace ranges = input_ranges;
+  const auto within = [](double value, double lo, double hi) { return value >= lo && value <= hi; };
+  const auto range_text = [](double lo, double hi) {
+    return "in [" + message_number(lo) + ", " + message_number(hi) + "]";
+  };
   std::vector<AxisMove> moves(axes);
   for (size_t i = 0; i < axes; ++i) {
     AxisMove& m = moves[i];
@@ -91,15 +100,37 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
                               value_for_axis(request.v0, i), value_for_axis(request.v1, i)};
     m.v_max = value_for_axis(request.v_max, i);
     m.a_max = value_for_axis(request.a_max, i);
-    const std::string axis = " of axis " + std::to_string(i);
-    if (!(m.v_max > 0.0)) problems.push_back({"", 0, "--vmax", "must be > 0" + axis});
-    if (!(m.a_max > 0.0)) problems.push_back({"", 0, "--amax", "must be > 0" + axis});
-    if (m.v_max > 0.0 && std::abs(m.boundary.v0) > m.v_max)
-      problems.push_back({"", 0, "--v0", "|v0| exceeds v_max" + axis});
-    if (m.v_max > 0.0 && std::abs(m.boundary.v1) > m.v_max)
-      problems.push_back({"", 0, "--v1", "|v1| exceeds v_max" + axis});
-    if (!request.j_max.empty() && !(value_for_axis(request.j_max, i) >= 0.0))
-      problems.push_back({"", 0, "--jmax", "must be >= 0 (0: no jerk limit)" + axis});
+    const std::string axis = " (axis " + std::to_string(i) + ")";
+    const auto got = [&](double value) { return ", got " + message_number(value) + axis; };
+    for (const auto& [name, q] : {std::pair<const char*, double>{"--q0", m.boundary.q0},
+                                  std::pair<const char*, double>{"--q1", m.boundary.q1}})
+      if (!within(q, -ranges::kMaxCoordinate_mm, ranges::kMaxCoordinate_mm))
+        problems.push_back({"", 0, name,
+                            "must be " +
+                                range_text(-ranges::kMaxCoordinate_mm, ranges::kMaxCoordinate_mm) +
+                                " mm" + got(q)});
+    const bool v_ok = within(m.v_max, ranges::kMinLimit, ranges::kMaxSpeed_mm_s);
+    if (!v_ok)
+      problems.push_back({"", 0, "--vmax",
+                          "must be " + range_text(ranges::kMinLimit, ranges::kMaxSpeed_mm_s) +
+                              " mm/s" + got(m.v_max)});
+    if (!within(m.a_max, ranges::kMinLimit, ranges::kMaxAcceleration_mm_s2))
+      problems.push_back({"", 0, "--amax",
+                          "must be " +
+                              range_text(ranges::kMinLimit, ranges::kMaxAcceleration_mm_s2) +
+                              " mm/s^2" + got(m.a_max)});
+    if (v_ok && std::abs(m.boundary.v0) > m.v_max)
+      problems.push_back({"", 0, "--v0", "|v0| exceeds v_max" + got(m.boundary.v0)});
+    if (v_ok && std::abs(m.boundary.v1) > m.v_max)
+      problems.push_back({"", 0, "--v1", "|v1| exceeds v_max" + got(m.boundary.v1)});
+    if (!request.j_max.empty()) {
+      const double j_max = value_for_axis(request.j_max, i);
+      if (!(j_max == 0.0 || within(j_max, ranges::kMinLimit, ranges::kMaxJerk_mm_s3)))
+        problems.push_back({"", 0, "--jmax",
+                            "must be 0 (no jerk limit) or " +
+                                range_text(ranges::kMinLimit, ranges::kMaxJerk_mm_s3) + " mm/s^3" +
+                                got(j_max)});
+    }
   }
   if (!problems.empty()) throw InputError(problems);
   // the jerk limits (0: none); "j_max" is reported once any axis has one

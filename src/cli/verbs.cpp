@@ -1,11 +1,14 @@
 #include "cli/verbs.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
 #include "core/error.hpp"
+#include "core/number_text.hpp"
 #include "pipeline/compare.hpp"
 #include "pipeline/job.hpp"
+#include "pipeline/job_check.hpp"
 #include "pipeline/run.hpp"
 #include "render/scene.hpp"
 #include "report/output_dir.hpp"
@@ -25,16 +28,25 @@ std::vector<PlannerSpec> selected_planners(const Scenario& scenario, const std::
   return planners;
 }
 
+// --max-memory, or the default budget
+JobBudget job_budget(const std::string& max_memory) {
+  JobBudget budget;
+  if (!max_memory.empty()) budget.max_memory_bytes = parse_memory_size(max_memory);
+  return budget;
+}
+
 }  // namespace
 
 int plan_verb(const RunOptions& options) {
-  const Scenario scenario = load_scenario(options.scenario);
+  // every check before any work (pipeline/job_check.hpp), the same as validate's
+  const JobBudget budget = job_budget(options.max_memory);
+  const Scenario scenario = check_scenario(options.scenario, budget, 0, false);
   const std::vector<PlannerSpec> planners = selected_planners(scenario, options.planners);
   // the output folder is checked before any planning, and replaced whole at the end
   OutputFolder out(output_directory(scenario, options.out), "plan", scenario.file,
                    !options.no_wait);
   const std::string& directory = out.final_path();
-  const PreparedJob job = prepare_job(scenario);
+  const PreparedJob job = prepare_checked_job(scenario, planners, budget, false, true);
   const std::vector<MetricsReport> reports = write_plans(job, planners, out.path());
   out.commit();
   std::cout << "scenario " << scenario.name << " (" << scenario.file << "), machine "
@@ -49,12 +61,30 @@ int plan_verb(const RunOptions& options) {
   return kExitOk;
 }
 
-int validate_verb(const std::string& path) {
-  const Scenario scenario = load_scenario(path);
-  const PreparedJob job = prepare_job(scenario);
+int validate_verb(const std::string& path, const std::string& max_memory) {
+  // every check `run` makes before it simulates, made the same way (pipeline/job_check.hpp);
+  // no lower bound of the print order (a report shows it, validate does not)
+  const JobBudget budget = job_budget(max_memory);
+  const Scenario scenario = check_scenario(path, budget);
+  std::vector<RunEstimate> runs;
+  const PreparedJob job =
+      prepare_checked_job(scenario, scenario.planners, budget, true, false, &runs);
+  // what `run` would take: the longest run, and the memory of all of them
+  const auto longest = std::max_element(
+      runs.begin(), runs.end(),
+      [](const RunEstimate& a, const RunEstimate& b) { return a.steps < b.steps; });
+  double memory_bytes = 0.0;
+  for (const RunEstimate& run : runs) memory_bytes += run.memory_bytes;
   std::cout << path << ": ok — scenario " << scenario.name << ", machine " << job.machine->name()
             << ", " << scenario.toolpath.paths.size() << " print paths, "
             << scenario.planners.size() << " planner(s)\n";
+  if (longest != runs.end())
+    std::cout << "  `run` would take: the longest plan " << longest->label << " "
+              << message_number(longest->duration_s) << " s, " << message_number(longest->steps)
+              << " physics steps (sim.max_steps "
+              << message_number(static_cast<double>(scenario.sim.max_steps)) << "); about "
+              << format_bytes(memory_bytes) << " for the runs' data (--max-memory "
+              << format_bytes(budget.max_memory_bytes) << ")\n";
   return kExitOk;
 }
 
@@ -79,13 +109,15 @@ RunSettings run_settings(const Scenario& scenario, const RunOptions& options) {
 }  // namespace
 
 int run_verb(const RunOptions& options) {
-  const Scenario scenario = load_scenario(options.scenario);
+  // every check before any work (pipeline/job_check.hpp), the same as validate's
+  const JobBudget budget = job_budget(options.max_memory);
+  const Scenario scenario = check_scenario(options.scenario, budget);
   const std::vector<PlannerSpec> planners = selected_planners(scenario, options.planners);
   // the output folder is checked before any planning, and replaced whole at the end; it
   // outlives the writer below, which writes into it
   OutputFolder out(output_directory(scenario, options.out), "run", scenario.file, !options.no_wait);
   const std::string& directory = out.final_path();
-  const PreparedJob job = prepare_job(scenario);
+  const PreparedJob job = prepare_checked_job(scenario, planners, budget, true, true);
   const RunSettings settings = run_settings(scenario, options);
   if (settings.scene_renderer)
     settings.scene_renderer->prepare(job.model_path, scene_render_options(scenario),
@@ -114,7 +146,10 @@ int run_verb(const RunOptions& options) {
 }
 
 int compare_verb(const CompareOptions& options) {
-  const Scenario scenario = load_scenario(options.run.scenario);
+  // every check before any work (pipeline/job_check.hpp), the same as validate's; each case
+  // is prepared and planned in compare_runs before the first simulates
+  const JobBudget budget = job_budget(options.run.max_memory);
+  const Scenario scenario = check_scenario(options.run.scenario, budget);
   const std::vector<PlannerSpec> planners =
       selected_planners(scenario, options.run.planners, "--planners");
   const std::vector<OrderSpec> orders = parse_order_list(options.orders, scenario.order);
@@ -125,7 +160,7 @@ int compare_verb(const CompareOptions& options) {
   const std::string& directory = out.final_path();
   const RunSettings settings = run_settings(scenario, options.run);
   const std::vector<ComparisonRow> rows =
-      compare_runs(scenario, planners, orders, out.path(), settings);
+      compare_runs(scenario, planners, orders, out.path(), settings, &budget);
   out.commit();
   std::vector<MetricsReport> reports;
   for (const ComparisonRow& row : rows) reports.push_back(row.report);

@@ -13,6 +13,7 @@ struct RunOptions {
   bool quiet = false;
   // another writer of --out holds its lock: exit 2 instead of waiting (report/output_dir.hpp)
   bool no_wait = false;
+  std::string max_memory;  // --max-memory (pipeline/job_check.hpp); empty: the default
   // ---- moving pictures: run.mp4 (RunSettings::video) ----
   bool video = false;
   double video_length_s = 30.0;
@@ -27,6 +28,6 @@ struct CompareOptions {
 int run_verb(const RunOptions& options);
 int compare_verb(const CompareOptions& options);
 int plan_verb(const RunOptions& options);
-int validate_verb(const std::string& scenario);
+int validate_verb(const std::string& scenario, const std::string& max_memory = {});
 
 }  // namespace depotwin

@@ -1,6 +1,8 @@
 #include "core/number_text.hpp"
 
 #include <charconv>
+#include <cstdio>
+#include <cstdlib>
 #include <system_error>
 
 namespace depotwin {
@@ -12,8 +14,78 @@ std::optional<double> parse_double(const std::string& text) {
   if (*first == '+') ++first;
   double value = 0.0;
   const auto [end, error] = std::from_chars(first, last, value);
-  if (error != std::errc() || end != last) return std::nullopt;
+  if (end != last) return std::nullopt;
+  // beyond the doubles (1e400, 1e-400): what strtod makes of it, +-inf or (nearly) 0, so the
+  // caller can say "not finite" or "out of range" instead of "not a number"
+  if (error == std::errc::result_out_of_range) return std::strtod(text.c_str(), nullptr);
+  if (error != std::errc()) return std::nullopt;
   return value;
+}
+
+std::string message_number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+namespace {
+
+// the length of the well-formed UTF-8 sequence of a printable code point (>= U+00A0) at
+// `at`, or 0
+std::size_t printable_utf8_length(const std::string& text, std::size_t at) {
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+  const unsigned char lead = byte(at);
+  std::size_t length = 0;
+  unsigned int code_point = 0;
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    length = 2;
+    code_point = lead & 0x1Fu;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    length = 3;
+    code_point = lead & 0x0Fu;
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    length = 4;
+    code_point = lead & 0x07u;
+  } else {
+    return 0;
+  }
+  if (at + length > text.size()) return 0;
+  for (std::size_t i = 1; i < length; ++i) {
+    if ((byte(at + i) & 0xC0u) != 0x80u) return 0;
+    code_point = (code_point << 6) | (byte(at + i) & 0x3Fu);
+  }
+  // overlong forms, surrogates, beyond U+10FFFF and the C1 controls are not printed as such
+  const unsigned int smallest[5] = {0, 0, 0x80, 0x800, 0x10000};
+  if (code_point < smallest[length] || code_point < 0xA0 ||
+      (code_point >= 0xD800 && code_point <= 0xDFFF) || code_point > 0x10FFFF)
+    return 0;
+  return length;
+}
+
+}  // namespace
+
+std::string printable_text(const std::string& text, std::size_t max_chars) {
+  static const char* kHex = "0123456789ABCDEF";
+  std::string out;
+  std::size_t chars = 0;
+  std::size_t at = 0;
+  while (at < text.size() && chars < max_chars) {
+    const auto byte = static_cast<unsigned char>(text[at]);
+    if (byte >= 0x20 && byte < 0x7F) {
+      out += text[at++];
+    } else if (const std::size_t length = printable_utf8_length(text, at); length > 0) {
+      out.append(text, at, length);
+      at += length;
+    } else {
+      out += "\\x";
+      out += kHex[byte >> 4];
+      out += kHex[byte & 15];
+      ++at;
+    }
+    ++chars;
+  }
+  if (at < text.size()) out += "...";
+  return out;
 }
 
 }  // namespace depotwin

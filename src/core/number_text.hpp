@@ -1,13 +1,24 @@
-// Numbers in text files (scenarios, G-code): the whole text as a double, independent of the
-// locale (std::from_chars), with an optional leading '+'.
+// Numbers and text in messages and text files: the whole text as a double, independent of the
+// locale (std::from_chars), with an optional leading '+'; a number as a message prints it
+// (%.6g, never hundreds of digits); a user's text made safe to print on a terminal.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 
 namespace depotwin {
 
-// the whole text as a double (inf and nan included), or nothing
+// the whole text as a double (inf and nan included; beyond the doubles: +-inf, or 0 and the
+// subnormals for tiny ones), or nothing
 std::optional<double> parse_double(const std::string& text);
+
+// a number as messages print it: at most 6 significant digits (%.6g: 3, 0.25, 1e-05, 1e+300)
+std::string message_number(double value);
+
+// a user's text (a YAML value, a key, a G-code word) as messages echo it: printable ASCII and
+// well-formed UTF-8 kept, every other byte (control bytes, escape sequences, broken UTF-8) as
+// \xNN, cut after max_chars characters with "..."
+std::string printable_text(const std::string& text, std::size_t max_chars = 40);
 
 }  // namespace depotwin

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/input_ranges.hpp"
 
 namespace depotwin {
 
@@ -14,8 +15,9 @@ namespace {
 constexpr double kMmPerUm = 1e-3;
 // footprint sigma per cell: coarser than one cell per sigma aliases the Gaussian, finer than
 // 64 cells per sigma makes a step touch ~400k cells
-constexpr double kMaxCellSigmas = 1.0;
-constexpr double kMinCellSigmas = 1.0 / 64.0;
+// (one source with the scenario schema: core/input_ranges.hpp)
+constexpr double kMaxCellSigmas = input_ranges::kMaxCellSigmas;
+constexpr double kMinCellSigmas = input_ranges::kMinCellSigmas;
 // once the ooze after a stop falls below this fraction of the largest commanded flow, its
 // remaining tail (Q tau) is put down in that step and the flow snaps to zero
 constexpr double kOozeCutoff = 1e-12;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace depotwin {
 
@@ -60,6 +61,34 @@ ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointL
     stats.peak_acc_over_plan.push_back(plan_a > 0.0 ? a / plan_a : 0.0);
   }
   return stats;
+}
+
+std::vector<std::string> actuator_limit_warnings(const ActuatorStats& stats) {
+  std::vector<std::string> warnings;
+  const auto number = [](double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", value);
+    return std::string(text);
+  };
+  for (std::size_t j = 0; j < stats.joint_names.size(); ++j) {
+    const bool hinge = stats.revolute[j];
+    // the same comparisons as limit_violations, in the units the report gives
+    const struct {
+      const char* what;
+      double peak, limit;
+      const char* unit;
+    } quantities[] = {
+        {"speed", stats.peak_vel[j], stats.limit_vel[j], hinge ? "deg/s" : "mm/s"},
+        {"acceleration", stats.peak_acc[j], stats.limit_acc[j], hinge ? "deg/s^2" : "mm/s^2"},
+        {"actuator force", stats.peak_force[j], stats.limit_force[j], hinge ? "N m" : "N"},
+    };
+    for (const auto& q : quantities)
+      if (q.limit > 0.0 && q.peak > q.limit)
+        warnings.push_back("joint " + stats.joint_names[j] + ": peak " + q.what + " " +
+                           number(q.peak) + " " + q.unit + " above its limit " + number(q.limit) +
+                           " " + q.unit + " in the simulation");
+  }
+  return warnings;
 }
 
 namespace {

@@ -27,6 +27,11 @@ MotionSamples trajectory_motion_at(const Trajectory& trajectory, const std::vect
 ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointLimit>& limits,
                              const std::vector<double>& force_limits);
 
+// One line per joint and quantity whose simulated peak exceeds its limit (speed, acceleration,
+// actuator force), for metrics.json's warnings: "joint y: peak speed 733 mm/s above its
+// limit 200 mm/s in the simulation"
+std::vector<std::string> actuator_limit_warnings(const ActuatorStats& stats);
+
 // Adds to a planned report (plan_job's) what the simulation scored: the simulated velocity
 // error (whole and steady: outside the plan's ramps, report.speed_ramps) and path error,
 // thickness, material and waste from the deposit, and the simulation's own statistics.

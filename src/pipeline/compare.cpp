@@ -105,7 +105,8 @@ plots::ComparisonColumn sheet_column(const std::string& label, const SimulatedRu
 std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
                                         const std::vector<PlannerSpec>& planners,
                                         const std::vector<OrderSpec>& orders,
-                                        const std::string& directory, const RunSettings& settings) {
+                                        const std::string& directory, const RunSettings& settings,
+                                        const JobBudget* budget) {
   const std::vector<ComparisonCase> cases = comparison_cases(scenario, planners, orders);
   std::vector<ComparisonRow> rows;
   std::vector<SimulatedRun> runs;
@@ -115,19 +116,40 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
   // references into runs and jobs, so neither may reallocate
   runs.reserve(cases.size());
   jobs.reserve(cases.size());
-  BackgroundRunWriter writer;
+  // every case prepared (and with a budget planned and sized) before the first simulates
+  std::vector<Problem> problems;
+  std::vector<RunEstimate> estimates;
   for (const ComparisonCase& c : cases) {
     Scenario variant = scenario;
     variant.order = c.order;
-    jobs.push_back(prepare_job(variant));
+    try {
+      jobs.push_back(prepare_job(variant));
+    } catch (const InputError& e) {
+      const std::vector<Problem> found = scenario.located(e.problems());
+      problems.insert(problems.end(), found.begin(), found.end());
+      continue;
+    }
+    if (!budget) continue;
+    const std::vector<RunEstimate> sized = check_runs(jobs.back(), {c.planner}, true, problems);
+    estimates.insert(estimates.end(), sized.begin(), sized.end());
+  }
+  if (budget && problems.empty()) problems = size_problems(scenario, estimates, *budget);
+  if (!problems.empty()) {
+    sort_problems(problems, scenario.file);
+    throw InputError(std::move(problems));
+  }
+  BackgroundRunWriter writer;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const ComparisonCase& c = cases[i];
+    const PreparedJob& job = jobs[i];
     if (settings.scene_renderer)
-      settings.scene_renderer->prepare(jobs.back().model_path, scene_render_options(variant),
-                                       jobs.back().model_text);
-    runs.push_back(simulate_job(jobs.back(), c.planner, settings));
+      settings.scene_renderer->prepare(job.model_path, scene_render_options(job.scenario),
+                                       job.model_text);
+    runs.push_back(simulate_job(job, c.planner, settings));
     SimulatedRun& run = runs.back();
     run.report.planner = c.planner.name;
     run.report.label = c.label;
-    writer.submit(jobs.back(), run, (fs::path(directory) / c.label).string(), settings);
+    writer.submit(job, run, (fs::path(directory) / c.label).string(), settings);
     rows.push_back({c.label, run.report});
   }
   writer.wait();

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/job_check.hpp"
 #include "pipeline/run.hpp"
 
 namespace depotwin {
@@ -32,11 +33,14 @@ std::vector<ComparisonCase> comparison_cases(const Scenario& scenario,
                                              const std::vector<OrderSpec>& orders);
 
 // Run comparison_cases(...) and write DIR/<label>/... plus DIR/comparison.*. Returns the rows
-// in order.
+// in order. Every case is prepared (its order, the arm's posture) and, with a budget, planned
+// and sized against sim.max_steps and the budget (all runs together, as they are kept) before
+// the first one simulates: every problem of every case in one InputError.
 std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
                                         const std::vector<PlannerSpec>& planners,
                                         const std::vector<OrderSpec>& orders,
-                                        const std::string& directory, const RunSettings& settings);
+                                        const std::string& directory, const RunSettings& settings,
+                                        const JobBudget* budget = nullptr);
 
 // "christofides+three_opt" -> {method christofides, refine three_opt}; InputError for unknown names
 OrderSpec parse_order_label(const std::string& label, const OrderSpec& defaults);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
@@ -26,8 +27,10 @@ namespace {
 constexpr double kSamplePeriod_s = 0.001;  // trajectory.csv and planned metrics
 // at most this many unreachable points are listed (the rest counted)
 constexpr size_t kMaxNamedPoints = 20;
-// the longest job planned, sampled and simulated (at 1 ms, about 14 M samples)
-constexpr double kMaxJobDuration_s = 4.0 * 3600.0;
+// the most 1 ms samples a plan may have at all (pipeline/job_check.hpp refuses far smaller
+// jobs against sim.max_steps and --max-memory before they are planned for a verb; this guards
+// the sample count's integer conversion for every caller)
+constexpr double kMaxPlanSamples = 1e12;
 
 // The machine named in the scenario, from the registry (the loader checked the name), and the
 // MJCF it is simulated in: the scenario's own model file, else the machine's shipped one.
@@ -70,6 +73,15 @@ std::vector<Problem> at_toolpath(const Scenario& scenario, const std::vector<Nam
     p.file = scenario.file;
     p.line = scenario.surface ? scenario.surface->line : scenario.toolpath_line;
     p.key = scenario.surface ? "toolpath.surface" : "toolpath";
+    // the start and the end at their own keys and lines (where given)
+    for (const auto& [name, key, line] :
+         {std::tuple<const char*, const char*, int>{"the start ", "toolpath.start",
+                                                    scenario.start_line},
+          std::tuple<const char*, const char*, int>{"the end ", "toolpath.end", scenario.end_line}})
+      if (p.message.rfind(name, 0) == 0) {
+        p.key = key;
+        if (line > 0) p.line = line;
+      }
   }
   return problems;
 }
@@ -112,7 +124,7 @@ void choose_posture(const Scenario& scenario, Arm6& arm, PreparedJob& job) {
 
 }  // namespace
 
-PreparedJob prepare_job(const Scenario& scenario) {
+PreparedJob prepare_job(const Scenario& scenario, const PrepareOptions& options) {
   PreparedJob job;
   job.scenario = scenario;
   job.machine = machine_for(scenario, job.model_path);
@@ -150,7 +162,7 @@ PreparedJob prepare_job(const Scenario& scenario) {
   // (the lower bound, every pair of path ends, only where an order is searched for: the given
   // order's job never needs it, and a hatched part has hundreds of paths)
   SequencerOptions sequencing;
-  sequencing.lower_bound = scenario.order.method != "as_given";
+  sequencing.lower_bound = options.lower_bound && scenario.order.method != "as_given";
   job.order = sequence(scenario.toolpath, job.limits, scenario.order, sequencing);
   job.toolpath = apply_order(scenario.toolpath, job.order);
   // G-code arcs: exact for the planners that consume them, and finely chorded as the path the
@@ -203,15 +215,13 @@ std::string output_directory(const Scenario& scenario, const std::string& reques
   return requested.empty() ? (fs::path("results") / scenario.name).string() : requested;
 }
 
-PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
+Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec) {
   // a jerk limit in force (the user's, or the joints' mapped) must be honoured
   Vec3 lo, hi;
   job.toolpath.bounds(lo, hi);
   const std::string ignored = check_planner_limits(spec, job.limits.over(lo, hi));
-  if (!ignored.empty()) throw InputError(job.scenario.file, spec.line, "planners", ignored);
-
-  PlannedRun run;
-  run.spec = spec;
+  const int line = spec.line > 0 ? spec.line : job.scenario.line_of("planners");
+  if (!ignored.empty()) throw InputError(job.scenario.file, line, "planners", ignored);
   // exact arcs to a planner that consumes them; chords within the tolerance to the others
   const PlannerInfo* info = find_planner(spec.name);
   const bool exact = info && info->consumes_arcs && !job.exact_toolpath.paths.empty();
@@ -220,18 +230,24 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   context.process = std::make_shared<const DepositionSettings>(deposition_settings(job.scenario));
   if (job.scenario.process.shutter_time_s > 0.0)
     context.shutter_time_s = job.scenario.process.shutter_time_s;
-  run.trajectory = make_planner(spec)->plan_in_context(
+  Trajectory trajectory = make_planner(spec)->plan_in_context(
       exact ? job.exact_toolpath : job.toolpath, job.limits, context);
-  // a job far beyond any real print (e.g. a j_max of 1e-9 mm/s^3) would be sampled every
-  // millisecond: refuse it before sampling anything
-  if (!(run.trajectory.duration_s() <= kMaxJobDuration_s)) {
-    char text[200];
+  // a plan far beyond any real print (e.g. a j_max of 1e-300 mm/s^3) cannot be sampled
+  if (!(trajectory.duration_s() / kSamplePeriod_s <= kMaxPlanSamples)) {
+    char text[240];
     std::snprintf(text, sizeof text,
-                  "the %s plan lasts %.4g s, beyond the %.0f h a job may last here; check the "
-                  "print speeds and the limits (v_max, a_max, j_max)",
-                  spec.name.c_str(), run.trajectory.duration_s(), kMaxJobDuration_s / 3600.0);
-    throw InputError(job.scenario.file, spec.line, "planners", text);
+                  "the %s plan lasts %.4g s: far too long to sample every ms; check the print "
+                  "speeds and the limits (v_max, a_max, j_max)",
+                  spec.name.c_str(), trajectory.duration_s());
+    throw InputError(job.scenario.file, line, "planners", text);
   }
+  return trajectory;
+}
+
+PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
+  PlannedRun run;
+  run.spec = spec;
+  run.trajectory = plan_trajectory(job, spec);
   run.planned = sample_trajectory(run.trajectory, kSamplePeriod_s);
 
   MetricsReport& r = run.report;

@@ -53,10 +53,16 @@ struct PreparedJob {
 
 // the sagitta of the chords the metrics measure G-code arcs by (mm)
 constexpr double kReferenceChordTolerance_mm = 1e-3;
+// What a job is prepared for: the print order's lower bound (every pair of path ends matched,
+// LEMON) is computed only when a report shows it and an order is searched for (as_given
+// never needs it), and only up to SequencerOptions::lower_bound_max_paths paths.
+struct PrepareOptions {
+  bool lower_bound = true;
+};
 
 // Throws InputError for an unknown machine, joint limits it cannot honour, an unreachable
 // toolpath, a planner that ignores a jerk limit, ...
-PreparedJob prepare_job(const Scenario& scenario);
+PreparedJob prepare_job(const Scenario& scenario, const PrepareOptions& options = {});
 
 // the planners to run: all of the scenario's, or those named (comma list); InputError
 // for a name the scenario does not list
@@ -73,6 +79,9 @@ struct PlannedRun {
   MetricsReport report;   // planned metrics only
 };
 PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec);
+// the planner's trajectory alone (plan_job's first step): InputError for a jerk limit the
+// planner ignores, a toolpath it cannot plan, or a plan too long to sample at all
+Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec);
 
 // `depotwin plan`: DIR/<planner>/metrics.json and trajectory.csv per planner; returns the
 // reports in planner order

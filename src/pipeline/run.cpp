@@ -188,6 +188,9 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
     run.report.layers = layer_reports(intended, run.plan.planned, run.simulated, deposit);
   run.report.actuators = actuator_stats(run.record, job.machine->joint_limits(),
                                         run.simulation->actuator_force_limits());
+  // a joint beyond its limits is said in the warnings, not only counted
+  for (std::string& warning : actuator_limit_warnings(*run.report.actuators))
+    run.report.warnings.push_back(std::move(warning));
   // an arm: its posture over the run (limits, singularities, the part, contacts, branch)
   if (const auto* arm = dynamic_cast<const Arm6*>(job.machine.get()); arm && job.posture)
     run.report.arm =

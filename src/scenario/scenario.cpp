@@ -9,10 +9,14 @@
 #include <sstream>
 
 #include <Eigen/Geometry>
+#include <unordered_map>
 
+#include "core/input_ranges.hpp"
+#include "core/number_text.hpp"
 #include "kinematics/machine.hpp"
 #include "scenario/override_tree.hpp"
 #include "scenario/overrides.hpp"
+#include "scenario/lifted_list.hpp"
 #include "scenario/schema.hpp"
 #include "scenario/yaml_reader.hpp"
 #include "toolpath/gcode.hpp"
@@ -44,6 +48,29 @@ constexpr double kClampChordTolerance_mm = 1e-3;
 constexpr std::size_t kMaxSurfacePathProblems = 5;
 // a surface toolpath starts and ends this far above the part's highest point (and its layers)
 constexpr double kSurfaceClearance_mm = 20.0;
+// the longest `name:` or planner `label:` (each names a folder; file systems allow 255 bytes)
+constexpr std::size_t kMaxFolderNameBytes = 100;
+// repeated print paths listed before the rest are counted
+constexpr std::size_t kMaxRepeatProblems = 20;
+
+// "" when `name` can name a results folder, else why not
+std::string folder_name_problem(const std::string& name) {
+  const std::string shown = "'" + printable_text(name) + "'";
+  if (name.empty()) return "is empty: it names the results folder";
+  if (name.size() > kMaxFolderNameBytes)
+    return shown + " is " + std::to_string(name.size()) +
+           " bytes long: it names a folder, at most " + std::to_string(kMaxFolderNameBytes);
+  if (std::any_of(name.begin(), name.end(), [](char c) {
+        const auto byte = static_cast<unsigned char>(c);
+        return byte < 0x20 || byte == 0x7F;
+      }))
+    return shown +
+           " holds a control character (newline, tab, escape, ...): it names a folder, so "
+           "give printable text";
+  if (name.find_first_of("/\\") != std::string::npos || name == "." || name == "..")
+    return shown + " cannot name a results folder (no '/', '\\', '.' or '..')";
+  return "";
+}
 
 std::string join(const std::vector<std::string>& names, const std::string& separator = ", ") {
   std::string text;
@@ -109,7 +136,7 @@ class Loader {
     scenario_.planners = {PlannerSpec{"lspb_mtt", {}, 0}, PlannerSpec{"stop_and_go", {}, 0}};
   }
 
-  Scenario load();
+  ScenarioReading read();
   // a sweep's task: the file's text given (not read), and overrides applied to its tree
   // before it is read (scenario/overrides.hpp)
   void set_source(const std::string* text, const std::vector<ScenarioOverride>* overrides) {
@@ -150,6 +177,11 @@ class Loader {
                     bool start_given, bool end_given);
   std::optional<std::vector<Vec3>> read_points(const Field& field, std::vector<int>& lines);
   void check_path(const PrintPath& path, const PathOrigin& origin);
+  // a print path given twice (the same points, either way round) is refused: `paths` from
+  // `first` on, as the file gives them under `key` (segments or polylines)
+  void check_repeated_paths(std::size_t first, const std::string& kind);
+  // cross-checks of settings read from different sections (sim against process)
+  void check_settings();
   void read_arm(const Field& field);
   void read_order(const Field& field);
   bool read_order_name(const Field& field, OrderSpec& order);
@@ -173,20 +205,28 @@ class Loader {
   bool joint_limits_bad_ = false;  // `limits.joint` given but unusable
   // the machine named (when known) and its TCP limits per move, for the speed and reach checks
   std::unique_ptr<Machine> machine_;
+  // a long segments list read without yaml-cpp (scenario/lifted_list.hpp)
+  std::optional<LiftedSegments> lifted_;
   std::optional<TcpLimits> tcp_limits_;
   std::size_t speed_problems_ = 0;  // print segments over speed, listed up to a count
   bool speed_missing_ = false;      // reported once, not per path
 };
 
-Scenario Loader::load() {
+ScenarioReading Loader::read() {
+  ScenarioReading reading;
   YAML::Node root;
-  if (!read_document(root)) throw InputError(problems_.problems());
+  if (!read_document(root)) {
+    reading.problems = std::move(problems_.problems());
+    reading.scenario = std::move(scenario_);
+    return reading;
+  }
   // a sweep task's overrides (an override the tree cannot take is a problem at its own line,
   // and the rest of the scenario is still read)
   if (overrides_ != nullptr) apply_overrides(root, *overrides_, problems_.problems());
 
   // the top level: every key optional except the toolpath
   const MapView top(Field{root, "", 1, 1}, keys_of(""), problems_);
+  reading.document_read = top.is_map();
   if (top.is_map()) {
     if (const Field* f = top.find("name")) read_name(*f);
     if (const Field* f = top.find("machine")) read_machine(*f);
@@ -199,6 +239,7 @@ Scenario Loader::load() {
     if (const Field* f = top.find("planners")) read_planners(*f);
     if (const Field* f = top.find("sim")) read_sim(*f);
     if (const Field* f = top.find("outputs")) read_outputs(*f);
+    check_settings();
   }
   // `arm:` belongs to an arm
   if (scenario_.arm && scenario_.machine != "arm6")
@@ -214,18 +255,13 @@ Scenario Loader::load() {
   if (machine_ && scenario_.machine != "arm6")
     for (Problem& problem : unreachable_points(scenario_, *machine_))
       problems_.add_problem(std::move(problem));
-  if (problems_.empty()) return scenario_;
-
-  // scenario-file problems in line order, then those of imported files (and of overrides)
-  std::vector<Problem>& list = problems_.problems();
-  if (overrides_ != nullptr) attribute_to_overrides(list, *overrides_);
-  const std::string& file = problems_.file();
-  std::stable_sort(list.begin(), list.end(), [&](const Problem& a, const Problem& b) {
-    const bool a_other = a.file != file, b_other = b.file != file;
-    if (a_other != b_other) return !a_other;
-    return !a_other && a.line < b.line;
-  });
-  throw InputError(list);
+  scenario_.key_lines = problems_.key_lines();
+  reading.problems = std::move(problems_.problems());
+  // problems under an overridden key belong to the sweep file's override
+  if (overrides_ != nullptr) attribute_to_overrides(reading.problems, *overrides_);
+  sort_problems(reading.problems, problems_.file());
+  reading.scenario = std::move(scenario_);
+  return reading;
 }
 
 bool Loader::read_document(YAML::Node& root) {
@@ -253,7 +289,9 @@ bool Loader::read_document(YAML::Node& root) {
     }
     text = buffer.str();
   }
-  // exactly one YAML document
+  // a long segments list is read apart (lifted_list.hpp), unless overrides may edit it in the
+  // tree; then exactly one YAML document
+  if (overrides_ == nullptr) lifted_ = lift_segments(text);
   std::optional<YAML::Node> document = parse_scenario_text(text, problems_);
   if (!document) return false;
   root = *document;
@@ -263,10 +301,10 @@ bool Loader::read_document(YAML::Node& root) {
 void Loader::read_name(const Field& field) {
   const std::optional<std::string> name = read_string(field, problems_);
   if (!name) return;
-  // it names the results folder
-  if (name->find_first_of("/\\") != std::string::npos || *name == "." || *name == "..") {
-    problems_.add(field.line, field.key,
-                  "'" + *name + "' cannot name a results folder (no '/', '\\', '.' or '..')");
+  // it names the results folder: refused rather than changed, so the folder is the name
+  const std::string problem = folder_name_problem(*name);
+  if (!problem.empty()) {
+    problems_.add(field.line, field.key, problem);
     return;
   }
   scenario_.name = *name;
@@ -334,9 +372,16 @@ bool Loader::read_axis_limits(const MapView& view, const std::string& section, A
   if (const Field* f = view.find("a_max"))
     axis.a_max_mm_s2 =
         read_number(*f, problems_, range_of(section, "a_max")).value_or(axis.a_max_mm_s2);
-  if (const Field* f = view.find("j_max"))
-    axis.j_max_mm_s3 =
-        read_number(*f, problems_, range_of(section, "j_max")).value_or(axis.j_max_mm_s3);
+  if (const Field* f = view.find("j_max")) {
+    const std::optional<double> j_max = read_number(*f, problems_, range_of(section, "j_max"));
+    // 0 is "no jerk limit"; a tiny one makes phases of 1e+300 s
+    if (j_max && *j_max > 0.0 && *j_max < input_ranges::kMinLimit)
+      problems_.add(f->line, f->key,
+                    "must be 0 (no jerk limit) or at least " +
+                        format_number(input_ranges::kMinLimit) + ", got " + format_number(*j_max));
+    else if (j_max)
+      axis.j_max_mm_s3 = *j_max;
+  }
   return v_max_ok;
 }
 
@@ -549,6 +594,31 @@ std::optional<std::vector<Vec3>> Loader::read_points(const Field& field, std::ve
 }
 
 void Loader::read_segments(const Field& field, const std::optional<double>& default_speed) {
+  const std::size_t first_path = scenario_.toolpath.paths.size();
+  // a list read apart: every entry already a valid pair of points, each on its own line
+  if (lifted_ && lifted_->key_line == field.key_line) {
+    if (!default_speed && !speed_missing_) {
+      problems_.add(field.key_line, "toolpath.speed",
+                    "missing: the print speed of the segments (mm/s)");
+      speed_missing_ = true;
+    }
+    scenario_.toolpath.paths.reserve(lifted_->segments.size());
+    scenario_.path_sources.reserve(lifted_->segments.size());
+    for (std::size_t i = 0; i < lifted_->segments.size(); ++i) {
+      PrintPath path;
+      path.points = {lifted_->segments[i][0], lifted_->segments[i][1]};
+      path.speed_mm_s = default_speed.value_or(0.0);
+      path.source_index = static_cast<int>(i);
+      const int line = lifted_->lines[i];
+      check_path(
+          path,
+          PathOrigin{
+              problems_.file(), field.key + "[" + std::to_string(i) + "]", {line, line}, false});
+      scenario_.toolpath.paths.push_back(std::move(path));
+    }
+    check_repeated_paths(first_path, "segment");
+    return;
+  }
   if (!expect_list(field, problems_, "a list of segments [[x, y], [x, y]]")) return;
   if (field.node.size() == 0) {
     problems_.add(field.line, field.key, "is empty: give at least one segment");
@@ -580,9 +650,11 @@ void Loader::read_segments(const Field& field, const std::optional<double>& defa
     check_path(path, PathOrigin{problems_.file(), item.key, lines, false});
     scenario_.toolpath.paths.push_back(std::move(path));
   }
+  check_repeated_paths(first_path, "segment");
 }
 
 void Loader::read_polylines(const Field& field, const std::optional<double>& default_speed) {
+  const std::size_t first_path = scenario_.toolpath.paths.size();
   if (!expect_list(field, problems_, "a list of polylines")) return;
   if (field.node.size() == 0) {
     problems_.add(field.line, field.key, "is empty: give at least one polyline");
@@ -625,6 +697,67 @@ void Loader::read_polylines(const Field& field, const std::optional<double>& def
     check_path(path, PathOrigin{problems_.file(), item.key, lines, true});
     scenario_.toolpath.paths.push_back(std::move(path));
   }
+  check_repeated_paths(first_path, "polyline");
+}
+
+void Loader::check_repeated_paths(std::size_t first, const std::string& kind) {
+  // a hash of each path's points (in the direction that sorts first), then exact comparison
+  // among equal hashes: linear in the number of points
+  const std::vector<PrintPath>& paths = scenario_.toolpath.paths;
+  const auto canonical_reversed = [](const PrintPath& path) {
+    const std::vector<Vec3>& p = path.points;
+    for (std::size_t i = 0, j = p.size() - 1; i < p.size(); ++i, --j) {
+      for (int axis = 0; axis < 3; ++axis) {
+        if (p[i][axis] != p[j][axis]) return p[j][axis] < p[i][axis];
+      }
+    }
+    return false;
+  };
+  const auto point_at = [](const PrintPath& path, bool reversed, std::size_t k) -> const Vec3& {
+    return reversed ? path.points[path.points.size() - 1 - k] : path.points[k];
+  };
+  const auto hash_of = [&](const PrintPath& path, bool reversed) {
+    std::size_t hash = path.points.size();
+    for (std::size_t k = 0; k < path.points.size(); ++k)
+      for (int axis = 0; axis < 3; ++axis)
+        hash = hash * 1000003u ^ std::hash<double>{}(point_at(path, reversed, k)[axis] + 0.0);
+    return hash;
+  };
+  std::unordered_multimap<std::size_t, std::size_t> seen;  // hash -> index into paths
+  std::size_t repeats = 0;
+  for (std::size_t i = first; i < paths.size(); ++i) {
+    const PrintPath& path = paths[i];
+    const bool reversed = canonical_reversed(path);
+    const std::size_t hash = hash_of(path, reversed);
+    const auto [begin, end] = seen.equal_range(hash);
+    const auto same = std::find_if(begin, end, [&](const auto& entry) {
+      const PrintPath& other = paths[entry.second];
+      if (other.points.size() != path.points.size()) return false;
+      const bool other_reversed = canonical_reversed(other);
+      for (std::size_t k = 0; k < path.points.size(); ++k)
+        if (point_at(other, other_reversed, k) != point_at(path, reversed, k)) return false;
+      return true;
+    });
+    if (same == end) {
+      seen.emplace(hash, i);
+      continue;
+    }
+    if (++repeats > kMaxRepeatProblems) continue;
+    const PathSource& source = scenario_.path_sources[static_cast<std::size_t>(path.source_index)];
+    const PathSource& earlier =
+        scenario_.path_sources[static_cast<std::size_t>(paths[same->second].source_index)];
+    problems_.add(
+        source.point_lines.empty() ? 0 : source.point_lines.front(), source.key,
+        "repeats " + earlier.key + " (the same points" +
+            (path.points.front() == paths[same->second].points.front() ? "" : ", reversed") +
+            "): every " + kind +
+            " is printed once; for a thicker line raise process.flow_mm3_s or lower "
+            "the speed");
+  }
+  if (repeats > kMaxRepeatProblems)
+    problems_.add(scenario_.toolpath_line, "toolpath",
+                  "... and " + std::to_string(repeats - kMaxRepeatProblems) + " more repeated " +
+                      kind + "s (the first " + std::to_string(kMaxRepeatProblems) + " are listed)");
 }
 
 void Loader::read_gcode_file(const Field& field, const std::optional<double>& default_speed,
@@ -905,14 +1038,15 @@ void Loader::read_random_segments(const Field& field, const std::optional<double
     spec.count =
         static_cast<int>(read_integer(*f, problems_, min_of(section, "n"), max_of(section, "n"))
                              .value_or(spec.count));
+  const Range size_range{0.0, false, input_ranges::kMaxCoordinate_mm, true};
   if (const Field* f = view.find("bed")) {
-    if (const auto bed = read_numbers(*f, problems_, 2, Range::positive())) {
+    if (const auto bed = read_numbers(*f, problems_, 2, size_range)) {
       spec.bed_x_mm = (*bed)[0];
       spec.bed_y_mm = (*bed)[1];
     }
   }
   if (const Field* f = view.find("length")) {
-    if (const auto length = read_numbers(*f, problems_, 2, Range::positive())) {
+    if (const auto length = read_numbers(*f, problems_, 2, size_range)) {
       if ((*length)[0] > (*length)[1])
         problems_.add(f->line, f->key,
                       "expected [min, max] with min <= max, got [" + format_number((*length)[0]) +
@@ -996,9 +1130,10 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
   if (const Field* f = view.find("offset"))
     surface->offset_mm = read_point(*f, problems_).value_or(Vec3::Zero());
   if (const Field* f = view.find("rotation")) {
+    const Range turn = Range::closed(-360.0, 360.0);
     if (f->node.IsScalar()) {
-      surface->rotation_deg.z() = read_number(*f, problems_).value_or(0.0);
-    } else if (const auto angles = read_numbers(*f, problems_, 3, Range{})) {
+      surface->rotation_deg.z() = read_number(*f, problems_, turn).value_or(0.0);
+    } else if (const auto angles = read_numbers(*f, problems_, 3, turn)) {
       surface->rotation_deg = Vec3((*angles)[0], (*angles)[1], (*angles)[2]);
     }
   }
@@ -1012,7 +1147,8 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
       if (f->node.size() == 0) problems_.add(f->line, f->key, "is empty: give at least one angle");
       std::vector<double> angles;
       for (std::size_t i = 0; i < f->node.size(); ++i)
-        if (const std::optional<double> angle = read_number(f->item(i), problems_))
+        if (const std::optional<double> angle =
+                read_number(f->item(i), problems_, Range::closed(-360.0, 360.0)))
           angles.push_back(*angle);
       if (!angles.empty()) surface->angles_deg = angles;
     }
@@ -1369,10 +1505,11 @@ void Loader::read_planners(const Field& field) {
       if (key == "label") {
         const std::optional<std::string> label = read_string(*parameter, problems_);
         if (!label) continue;
-        if (label->empty() || label->find_first_of("/\\ \t") != std::string::npos ||
-            *label == "." || *label == "..")
-          problems_.add(parameter->line, parameter->key,
-                        "'" + *label + "' cannot name a results folder (no spaces, '/' or '\\')");
+        std::string problem = folder_name_problem(*label);
+        if (problem.empty() && label->find(' ') != std::string::npos)
+          problem = "'" + printable_text(*label) + "' cannot name a run (no spaces)";
+        if (!problem.empty())
+          problems_.add(parameter->line, parameter->key, problem);
         else
           spec.label = *label;
         continue;
@@ -1460,6 +1597,51 @@ void Loader::read_sim(const Field& field) {
   read("cell_mm", sim.cell_mm);
   read("kp_scale", sim.kp_scale);
   read("settle_s", sim.settle_s);
+  if (const Field* f = view.find("max_steps"))
+    sim.max_steps =
+        read_integer(*f, problems_, min_of("sim", "max_steps"), max_of("sim", "max_steps"))
+            .value_or(sim.max_steps);
+}
+
+void Loader::check_settings() {
+  const SimSpec& sim = scenario_.sim;
+  const ProcessSpec& process = scenario_.process;
+  const std::map<std::string, int>& lines = problems_.key_lines();
+  const auto line_of = [&](const std::string& key) {
+    const auto found = lines.find(key);
+    return found == lines.end() ? 0 : found->second;
+  };
+  // the deposition grid against the footprint it samples (deposition/process.cpp enforces the
+  // same bounds): sigma / 64 .. sigma
+  const int cell_line = line_of("sim.cell_mm");
+  if (cell_line > 0 && sim.cell_mm > 0.0) {
+    const bool aerosol = process.type == "aerosol";
+    const double sigma_mm = aerosol ? process.sigma_mm : 0.25 * process.bead_width_mm;
+    const double lo_mm = input_ranges::kMinCellSigmas * sigma_mm;
+    const double hi_mm = input_ranges::kMaxCellSigmas * sigma_mm;
+    if (sim.cell_mm < lo_mm * (1.0 - 1e-12) || sim.cell_mm > hi_mm * (1.0 + 1e-12))
+      problems_.add(cell_line, "sim.cell_mm",
+                    "must be 0 (the default) or between sigma / 64 = " + format_number(lo_mm) +
+                        " and sigma = " + format_number(hi_mm) + " mm of the footprint (" +
+                        (aerosol ? "process.sigma_mm" : "process.bead_width_mm / 4") + "), got " +
+                        format_number(sim.cell_mm));
+  }
+  // the servo loop's stability: kp dt^2 (sim/servo_controller: an explicit loop)
+  const double stiffness =
+      sim.kp_scale * std::pow(sim.timestep_s / input_ranges::kReferenceTimestep_s, 2);
+  if (stiffness > input_ranges::kMaxServoStiffnessPerStep * (1.0 + 1e-12)) {
+    const int kp_line = line_of("sim.kp_scale");
+    const int step_line = line_of("sim.timestep_s");
+    problems_.add(step_line > 0 ? step_line : kp_line,
+                  step_line > 0 ? "sim.timestep_s" : "sim.kp_scale",
+                  "timestep_s " + format_number(sim.timestep_s) + " s with kp_scale " +
+                      format_number(sim.kp_scale) +
+                      " makes the servos unstable: kp_scale * "
+                      "(timestep_s / 1 ms)^2 = " +
+                      format_number(stiffness) + ", at most " +
+                      format_number(input_ranges::kMaxServoStiffnessPerStep) +
+                      " (lower sim.timestep_s or sim.kp_scale)");
+  }
 }
 
 void Loader::read_outputs(const Field& field) {
@@ -1560,15 +1742,57 @@ std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine&
   return problems;
 }
 
+int Scenario::line_of(const std::string& key) const {
+  // the key itself, else its nearest given parent, else the top of the file
+  for (std::string k = key; !k.empty();) {
+    const auto found = key_lines.find(k);
+    if (found != key_lines.end()) return found->second;
+    const std::size_t dot = k.rfind('.');
+    if (dot == std::string::npos) break;
+    k.resize(dot);
+  }
+  return 1;
+}
+
+Problem Scenario::problem_at(const std::string& key, const std::string& message) const {
+  return Problem{file, line_of(key), key, message};
+}
+
+std::vector<Problem> Scenario::located(std::vector<Problem> problems) const {
+  for (Problem& p : problems) {
+    if (!p.file.empty()) continue;
+    p.file = file;
+    p.line = line_of(p.key);
+  }
+  return problems;
+}
+
+void sort_problems(std::vector<Problem>& problems, const std::string& scenario_file) {
+  // scenario-file problems in line order, then those of other files as found
+  std::stable_sort(problems.begin(), problems.end(), [&](const Problem& a, const Problem& b) {
+    const bool a_other = a.file != scenario_file, b_other = b.file != scenario_file;
+    if (a_other != b_other) return !a_other;
+    return !a_other && a.line < b.line;
+  });
+}
+
+ScenarioReading read_scenario(const std::string& path) {
+  return Loader(path).read();
+}
+
 Scenario load_scenario(const std::string& path) {
-  return Loader(path).load();
+  ScenarioReading reading = read_scenario(path);
+  if (!reading.problems.empty()) throw InputError(std::move(reading.problems));
+  return std::move(reading.scenario);
 }
 
 Scenario load_scenario(const std::string& path, const std::string& text,
                        const std::vector<ScenarioOverride>& overrides) {
   Loader loader(path);
   loader.set_source(&text, &overrides);
-  return loader.load();
+  ScenarioReading reading = loader.read();
+  if (!reading.problems.empty()) throw InputError(std::move(reading.problems));
+  return std::move(reading.scenario);
 }
 
 std::vector<Problem> validate_scenario_file(const std::string& path) {

@@ -24,8 +24,10 @@ namespace depotwin {
 // `process:` — how material leaves the nozzle.
 struct ProcessSpec {
   std::string type = "aerosol";  // aerosol | extrusion
-  // aerosol: continuous stream from job start to job end, Gaussian footprint
-  double flow_mm3_s = 0.0;       // 0: derived from the target thickness (see README)
+  // aerosol: continuous stream from job start to job end, Gaussian footprint; its flow, 0:
+  // derived from the target thickness (see README). Extrusion: a fixed nominal flow (a
+  // constant-rate extruder), 0: speed x bead width x layer height
+  double flow_mm3_s = 0.0;
   double sigma_mm = 0.1;         // footprint standard deviation
   double line_width_mm = 0.0;    // 0: 4 sigma (aerosol) or bead width (extrusion)
   double shutter_time_s = 0.02;  // flap open/close time
@@ -43,6 +45,9 @@ struct SimSpec {
   double cell_mm = 0.0;             // 0: sigma / 4 (aerosol) or bead width / 8 (extrusion)
   double kp_scale = 1.0;            // multiply the model's default servo gains
   double settle_s = 0.0;            // extra simulated time after the trajectory ends
+  // the most physics steps a run may take (core/input_ranges.hpp): a job needing more is
+  // refused before anything is allocated (pipeline/job_check.hpp)
+  long long max_steps = 10000000;
 };
 
 // `outputs:` — what a run writes besides metrics.
@@ -154,6 +159,18 @@ struct Scenario {
   std::vector<PlannerSpec> planners;
   SimSpec sim;
   OutputSpec outputs;
+  // the line of every map key the file gives outside lists ("sim.timestep_s", "limits.a_max",
+  // "toolpath.speed", ...), for problems found after loading that name a key
+  std::map<std::string, int> key_lines;
+
+  // the line of a key as given, else of its nearest given parent ("sim.settle_s" -> "sim"),
+  // else the top of the file (1)
+  int line_of(const std::string& key) const;
+  // a problem found after loading, placed in this file at its key's line
+  Problem problem_at(const std::string& key, const std::string& message) const;
+  // problems without a file (e.g. thrown by a downstream check that names only a key) placed
+  // in this file at their key's line
+  std::vector<Problem> located(std::vector<Problem> problems) const;
 };
 
 // The problem `message` about point `point` (0-based, as given in the file) of the print path
@@ -181,8 +198,23 @@ std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine&
 // against its directory. Full schema and defaults: src/scenario/SCHEMA.md.
 Scenario load_scenario(const std::string& path);
 
+// What a scenario file says and every problem the loader found in it, without throwing: the
+// scenario holds what could be read (defaults where a value was bad), so checks made after
+// loading (pipeline/job_check.hpp: the MJCF model, the job's size) can add their problems to
+// the same list. Problems are in the order load_scenario reports them.
+struct ScenarioReading {
+  Scenario scenario;
+  std::vector<Problem> problems;
+  bool document_read = false;  // false: not even a YAML map (nothing else can be checked)
+};
+ScenarioReading read_scenario(const std::string& path);
+
 // For `depotwin validate`: every problem load_scenario would report, or an empty list
 // when the file loads. Never throws InputError.
 std::vector<Problem> validate_scenario_file(const std::string& path);
+
+// The problems in the order every verb reports them: the scenario file's by line, then those
+// of other files (an imported G-code file, an MJCF model) in the order found.
+void sort_problems(std::vector<Problem>& problems, const std::string& scenario_file);
 
 }  // namespace depotwin

@@ -3,10 +3,13 @@
 // key gets.
 #include "scenario/schema.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
+#include "core/input_ranges.hpp"
+#include "core/number_text.hpp"
 #include "kinematics/machine.hpp"
 #include "planners/ordering/sequencer.hpp"
 #include "scenario/scenario.hpp"
@@ -40,9 +43,7 @@ std::string ValueRange::text() const {
 }
 
 std::string format_number(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
+  return message_number(value);
 }
 
 std::string SchemaKey::accepted() const {
@@ -68,6 +69,13 @@ const SchemaKey& SchemaSection::key(const std::string& name) const {
 }
 
 namespace {
+
+namespace ranges = input_ranges;
+
+// (0, max]: a positive quantity with a sane ceiling
+ValueRange positive_up_to(double max) {
+  return {0.0, false, max, true};
+}
 
 // a number with its unit, range and default
 SchemaKey number(const std::string& name, const std::string& unit, const ValueRange& range,
@@ -132,7 +140,8 @@ std::vector<SchemaSection> make_schema() {
       {"",
        "a scenario file: one YAML map; every key optional except toolpath",
        {other("name", "text", "", "the file's stem",
-              "names the results folder (no '/', '\\', '.' or '..')"),
+              "names the results folder: 1 to 100 bytes of printable text (no control "
+              "characters), no '/' or '\\', not '.' or '..'"),
         [] {
           SchemaKey key = word("machine", machine_names(), "xy_stage",
                                "a registered machine, or {model: FILE.xml, kinematics: NAME} for "
@@ -161,14 +170,17 @@ std::vector<SchemaSection> make_schema() {
   const auto axis_keys = [](const std::string& scope, bool joint) {
     const std::string v_unit = joint ? "mm/s or deg/s" : "mm/s";
     const std::string a_unit = joint ? "mm/s^2 or deg/s^2" : "mm/s^2";
-    SchemaKey v = number("v_max", v_unit, ValueRange::positive(), kDefaultTcpVMax_mm_s,
-                         "speed limit " + scope);
-    SchemaKey a = number("a_max", a_unit, ValueRange::positive(), kDefaultTcpAMax_mm_s2,
-                         "acceleration limit " + scope);
-    SchemaKey j = number("j_max", "mm/s^3", ValueRange::non_negative(), 0.0,
-                         "jerk limit " + scope +
-                             "; 0: none (lspb_mtt and stop_and_go then plan "
-                             "double-S moves; bezier refuses one)");
+    SchemaKey v =
+        number("v_max", v_unit, ValueRange::closed(ranges::kMinLimit, ranges::kMaxSpeed_mm_s),
+               kDefaultTcpVMax_mm_s, "speed limit " + scope);
+    SchemaKey a = number("a_max", a_unit,
+                         ValueRange::closed(ranges::kMinLimit, ranges::kMaxAcceleration_mm_s2),
+                         kDefaultTcpAMax_mm_s2, "acceleration limit " + scope);
+    SchemaKey j =
+        number("j_max", "mm/s^3", ValueRange::closed(0.0, ranges::kMaxJerk_mm_s3), 0.0,
+               "jerk limit " + scope + ", 0 or at least " + format_number(ranges::kMinLimit) +
+                   "; 0: none (lspb_mtt and stop_and_go then plan "
+                   "double-S moves; bezier refuses one)");
     if (joint) {
       v.default_text = a.default_text = "required";
       v.default_value = a.default_value = std::nullopt;
@@ -202,22 +214,22 @@ std::vector<SchemaSection> make_schema() {
        {word("type", {"aerosol", "extrusion"}, process.type,
              "aerosol: a stream from job start to end, Gaussian footprint, a flap shutter; "
              "extrusion: commanded flow with a first-order lag"),
-        number("flow_mm3_s", "mm^3/s", ValueRange::non_negative(), process.flow_mm3_s,
-               "stream flow; 0: a straight line at 3 mm/s peaks at 2 um (Q = 2 um * 3 mm/s * "
-               "sigma * sqrt(2 pi))",
-               "aerosol"),
-        number("sigma_mm", "mm", ValueRange::positive(), process.sigma_mm,
+        number("flow_mm3_s", "mm^3/s", ValueRange::closed(0.0, 1e6), process.flow_mm3_s,
+               "aerosol: the stream's flow, 0: a straight line at 3 mm/s peaks at 2 um (Q = 2 um "
+               "* 3 mm/s * sigma * sqrt(2 pi)); extrusion: a fixed nominal flow (a constant-rate "
+               "extruder), 0: speed * bead width * layer height"),
+        number("sigma_mm", "mm", ValueRange::closed(0.001, 100.0), process.sigma_mm,
                "standard deviation of the Gaussian footprint", "aerosol"),
-        number("shutter_time_s", "s", ValueRange::positive(), process.shutter_time_s,
+        number("shutter_time_s", "s", ValueRange::closed(0.001, 10.0), process.shutter_time_s,
                "time the flap takes to open or close", "aerosol"),
-        number("line_width_mm", "mm", ValueRange::non_negative(), process.line_width_mm,
+        number("line_width_mm", "mm", ValueRange::closed(0.0, 100.0), process.line_width_mm,
                "the line's width for the target region; 0: 4 sigma (aerosol) or the bead width "
                "(extrusion)"),
-        number("bead_width_mm", "mm", ValueRange::positive(), process.bead_width_mm,
+        number("bead_width_mm", "mm", ValueRange::closed(0.01, 100.0), process.bead_width_mm,
                "bead width; the flow is speed * bead width * layer height", "extrusion"),
-        number("layer_height_mm", "mm", ValueRange::positive(), process.layer_height_mm,
+        number("layer_height_mm", "mm", ValueRange::closed(0.001, 100.0), process.layer_height_mm,
                "bead height", "extrusion"),
-        number("tau_s", "s", ValueRange::positive(), process.tau_s,
+        number("tau_s", "s", positive_up_to(100.0), process.tau_s,
                "time constant of the flow's first-order lag behind its command", "extrusion")}});
 
   // toolpath and its kinds
@@ -225,13 +237,14 @@ std::vector<SchemaSection> make_schema() {
       {"toolpath",
        "the print paths: speed, start and end, and exactly one of segments, polylines, gcode, "
        "random_segments, surface",
-       {number("speed", "mm/s", ValueRange::positive(), 0.0,
+       {number("speed", "mm/s", positive_up_to(ranges::kMaxSpeed_mm_s), 0.0,
                "print speed of every path that gives none"),
-        other("start", "point [x, y] or [x, y, z]", "mm", "[0, 0, 0]",
+        other("start", "point [x, y] or [x, y, z], each in [-1e+06, 1e+06]", "mm", "[0, 0, 0]",
               "where the machine starts, at rest (surface: 20 mm above the part; gcode: the "
               "file's first print point, before offset)"),
-        other("end", "point [x, y] or [x, y, z]", "mm", "start", "where the machine ends, at rest"),
-        other("offset", "point [dx, dy] or [dx, dy, dz]", "mm", "none",
+        other("end", "point [x, y] or [x, y, z], each in [-1e+06, 1e+06]", "mm", "start",
+              "where the machine ends, at rest"),
+        other("offset", "point [dx, dy] or [dx, dy, dz], each in [-1e+06, 1e+06]", "mm", "none",
               "added to every point, start and end (not with surface)"),
         other("segments", "list of [[x, y], [x, y]]", "mm", "-",
               "print segments in this order; segments whose ends touch meet at a joint"),
@@ -250,7 +263,8 @@ std::vector<SchemaSection> make_schema() {
       {"toolpath.polylines[]",
        "one polyline: a bare point list, or a map",
        {other("points", "list of points", "mm", "required", "the polyline's points, >= 2"),
-        number("speed", "mm/s", ValueRange::positive(), 0.0, "this polyline's print speed")}});
+        number("speed", "mm/s", positive_up_to(ranges::kMaxSpeed_mm_s), 0.0,
+               "this polyline's print speed")}});
   schema.back().keys.back().default_text = "toolpath.speed";
   schema.back().keys.back().default_value = std::nullopt;
   {
@@ -272,21 +286,22 @@ std::vector<SchemaSection> make_schema() {
                "feed rates above the machine's limits: clamp slows each move to what every "
                "axis can do along it (as firmware does; metrics.json counts them), error "
                "refuses them"),
-          number("chord_tolerance_mm", "mm", ValueRange{0.0, false, 1.0, true},
+          number("chord_tolerance_mm", "mm", ValueRange::closed(1e-4, 1.0),
                  gcode.chord_tolerance_mm,
                  "arcs (G2/G3) become chords whose sagitta is at most this")}});
   }
   {
-    SchemaKey speed =
-        number("speed", "mm/s", ValueRange::positive(), random.speed_mm_s, "print speed");
+    SchemaKey speed = number("speed", "mm/s", positive_up_to(ranges::kMaxSpeed_mm_s),
+                             random.speed_mm_s, "print speed");
     speed.default_text = "toolpath.speed";
     speed.default_value = std::nullopt;
     schema.push_back(
         {"toolpath.random_segments",
          "n random segments on a bed (Ganganath et al. 2016); its start and end unless given",
          {whole("n", "", 1, 100000, random.count, "number of segments"),
-          other("bed", "[w, h], each > 0", "mm", "required", "the bed's size; segments lie inside"),
-          other("length", "[min, max], each > 0, min <= max", "mm", "required",
+          other("bed", "[w, h], each in (0, 1e+06]", "mm", "required",
+                "the bed's size; segments lie inside"),
+          other("length", "[min, max], each in (0, 1e+06], min <= max", "mm", "required",
                 "segment lengths, uniform in [min, max]"),
           [&] {
             SchemaKey seed = number("seed", "", ValueRange::non_negative(),
@@ -297,8 +312,8 @@ std::vector<SchemaSection> make_schema() {
           speed}});
   }
   {
-    SchemaKey speed =
-        number("speed", "mm/s", ValueRange::positive(), 0.0, "print speed of the hatch");
+    SchemaKey speed = number("speed", "mm/s", positive_up_to(ranges::kMaxSpeed_mm_s), 0.0,
+                             "print speed of the hatch");
     speed.default_text = "toolpath.speed";
     speed.default_value = std::nullopt;
     schema.push_back(
@@ -306,16 +321,16 @@ std::vector<SchemaSection> make_schema() {
          "conformal hatching of a part's top surface (Shembekar et al. 2018, Algorithm 1)",
          {other("file", "text", "", "required", "the part's STL (ASCII or binary)"),
           word("units", {"mm", "inch", "in"}, "mm", "the STL's unit"),
-          other("offset", "point [x, y, z]", "mm", "[0, 0, 0]",
+          other("offset", "point [x, y, z], each in [-1e+06, 1e+06]", "mm", "[0, 0, 0]",
                 "the part's placement in the work frame, after rotation"),
-          other("rotation", "[rx, ry, rz] or one number (about z)", "deg", "[0, 0, 0]",
-                "about fixed x, then y, then z, before the offset"),
+          other("rotation", "[rx, ry, rz] or one number (about z), each in [-360, 360]", "deg",
+                "[0, 0, 0]", "about fixed x, then y, then z, before the offset"),
           number("hatch_mm", "mm", ValueRange::closed(0.01, 100.0), surface.hatch_mm,
                  "line spacing and point spacing of the hatch"),
-          other("angles", "list of numbers", "deg", "[0, 90]",
+          other("angles", "list of numbers, each in [-360, 360]", "deg", "[0, 90]",
                 "hatch angle of layer k: angles[k % n]"),
           whole("layers", "", 1, 1000, surface.layers, "number of layers"),
-          number("layer_height_mm", "mm", ValueRange::positive(), surface.layer_height_mm,
+          number("layer_height_mm", "mm", positive_up_to(100.0), surface.layer_height_mm,
                  "layer spacing along the offset direction"),
           number("alpha", "", ValueRange::closed(0.0, 1.0), surface.alpha,
                  "tool axis: 0 vertical .. 1 the surface normal"),
@@ -341,16 +356,17 @@ std::vector<SchemaSection> make_schema() {
                 "down, bit 2 wrist flipped)"),
           number("roll_step_deg", "deg", ValueRange::closed(1.0, 90.0), arm.roll_step_deg,
                  "the ladder's roll step; divides 360"),
-          number("sample_spacing_mm", "mm", ValueRange::positive(), arm.sample_spacing_mm,
+          number("sample_spacing_mm", "mm", ValueRange::closed(0.1, 1000.0), arm.sample_spacing_mm,
                  "stations along each path (also where the tool turns 5 deg)"),
           number("min_joint_margin_deg", "deg", ValueRange::closed(0.0, 90.0),
                  arm.min_joint_margin_deg, "joints 1-5 at least this far inside their ranges"),
           number("min_wrist_alignment", "", ValueRange{0.0, true, 1.0, false},
                  arm.min_wrist_alignment,
                  "|sin q5| at least this: away from the wrist singularity"),
-          number("min_wrist_offset_mm", "mm", ValueRange::non_negative(), arm.min_wrist_offset_mm,
+          number("min_wrist_offset_mm", "mm", ValueRange::closed(0.0, 1000.0),
+                 arm.min_wrist_offset_mm,
                  "wrist centre at least this far from the joint-1 axis (shoulder singularity)"),
-          number("min_manipulability", "", ValueRange::non_negative(), arm.min_manipulability,
+          number("min_manipulability", "", ValueRange::closed(0.0, 1.0), arm.min_manipulability,
                  "sqrt(det(J J^T)) at least this (linear rows in m)"),
           number(
               "min_clearance_mm", "mm", ValueRange::closed(-100.0, 100.0), arm.min_clearance_mm,
@@ -392,17 +408,32 @@ std::vector<SchemaSection> make_schema() {
   schema.push_back(
       {"sim",
        "simulation and deposition-grid settings",
-       {number("timestep_s", "s", ValueRange{0.0, false, 0.01, true}, sim.timestep_s,
-               "MuJoCo's physics step"),
-        number("control_period_s", "s", ValueRange{0.0, false, 0.01, true}, sim.control_period_s,
+       {number("timestep_s", "s",
+               ValueRange::closed(ranges::kMinTimestep_s, ranges::kMaxTimestep_s), sim.timestep_s,
+               "MuJoCo's physics step; with kp_scale: kp_scale * (timestep_s / 1 ms)^2 <= " +
+                   format_number(ranges::kMaxServoStiffnessPerStep) +
+                   " (the servo loop's stability)"),
+        number("control_period_s", "s",
+               ValueRange::closed(ranges::kMinTimestep_s, ranges::kMaxControlPeriod_s),
+               sim.control_period_s,
                "servo update period, a whole multiple of timestep_s (default: the multiple "
                "nearest 1 ms)"),
-        number("cell_mm", "mm", ValueRange::non_negative(), sim.cell_mm,
-               "deposition grid cell; 0: sigma / 4 (aerosol) or bead width / 8 (extrusion)"),
-        number("kp_scale", "", ValueRange::positive(), sim.kp_scale,
-               "multiplies the model's servo gains"),
-        number("settle_s", "s", ValueRange::non_negative(), sim.settle_s,
-               "extra simulated time after the trajectory ends")}});
+        number("cell_mm", "mm", ValueRange::closed(0.0, 100.0), sim.cell_mm,
+               "deposition grid cell, 0 or between sigma / 64 and sigma of the footprint (sigma: "
+               "process.sigma_mm, or bead width / 4); 0: sigma / 4 (aerosol) or bead width / 8 "
+               "(extrusion)"),
+        number("kp_scale", "", ValueRange::closed(ranges::kMinKpScale, ranges::kMaxKpScale),
+               sim.kp_scale, "multiplies the model's servo gains (see timestep_s)"),
+        number("settle_s", "s", ValueRange::closed(0.0, ranges::kMaxSettle_s), sim.settle_s,
+               "extra simulated time after the trajectory ends"),
+        [&] {
+          SchemaKey key =
+              whole("max_steps", "", 1, ranges::kMaxMaxSteps, static_cast<double>(sim.max_steps),
+                    "the most physics steps a run may take ((plan + settle_s) / "
+                    "timestep_s); a longer job is refused before it starts");
+          key.default_text = "1e+07";
+          return key;
+        }()}});
   {
     SchemaKey render = word("render", {"true", "false"}, outputs.render ? "true" : "false",
                             "write the scene image and the plots");
@@ -417,6 +448,28 @@ std::vector<SchemaSection> make_schema() {
 }
 
 }  // namespace
+
+std::string schema_markdown_table(const SchemaSection& section) {
+  // a cell's text: '|' escaped, names in code spans
+  const auto cell = [](const std::string& text) {
+    std::string out;
+    for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+    return out.empty() ? std::string("-") : out;
+  };
+  const bool typed = std::any_of(section.keys.begin(), section.keys.end(),
+                                 [](const SchemaKey& k) { return !k.applies_to.empty(); });
+  std::string out = typed
+                        ? "| key | applies to | unit | accepted | default | meaning |\n"
+                          "|---|---|---|---|---|---|\n"
+                        : "| key | unit | accepted | default | meaning |\n|---|---|---|---|---|\n";
+  for (const SchemaKey& k : section.keys) {
+    out += "| `" + k.name + "` | ";
+    if (typed) out += (k.applies_to.empty() ? "both" : k.applies_to) + " | ";
+    out += cell(k.unit) + " | " + cell(k.accepted()) + " | " + cell(k.default_text) + " | " +
+           cell(k.meaning) + " |\n";
+  }
+  return out;
+}
 
 const std::vector<SchemaSection>& scenario_schema() {
   static const std::vector<SchemaSection> schema = make_schema();

@@ -58,6 +58,11 @@ struct SchemaSection {
 
 // every section of the scenario file, in the order of SCHEMA.md
 const std::vector<SchemaSection>& scenario_schema();
+
+// A section's table as SCHEMA.md holds it (a Markdown table: key, [applies to,] unit,
+// accepted, default, meaning), so the document's tables are these tables' printout: a test
+// compares them (SchemaDocument.TablesAreTheSchemasOwn).
+std::string schema_markdown_table(const SchemaSection& section);
 // the section at this dotted path; throws std::out_of_range for an unknown one
 const SchemaSection& schema_section(const std::string& path);
 

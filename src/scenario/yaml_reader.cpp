@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/input_ranges.hpp"
 #include "core/number_text.hpp"
 
 namespace depotwin::scenario_detail {
@@ -44,8 +45,13 @@ std::string describe(const YAML::Node& node) {
   if (is_empty(node)) return "nothing";
   if (node.IsSequence()) return "a list";
   if (node.IsMap()) return "a map";
-  if (is_quoted(node)) return "the text \"" + node.Scalar() + "\"";
-  return "'" + node.Scalar() + "'";
+  if (is_quoted(node)) return "the text \"" + printable_text(node.Scalar()) + "\"";
+  return "'" + printable_text(node.Scalar()) + "'";
+}
+
+void ProblemList::note_key_line(const std::string& key, int line) {
+  // list entries (segments, polylines) are many and named by their index: not kept
+  if (key.find('[') == std::string::npos) key_lines_.emplace(key, line);
 }
 
 void ProblemList::add(int line, const std::string& key, const std::string& message) {
@@ -97,13 +103,16 @@ MapView::MapView(const Field& field, const std::vector<std::string>& allowed, Pr
     if (std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
       std::string known;
       for (const std::string& a : allowed) known += (known.empty() ? "" : ", ") + a;
-      problems.add(key_line, entry.key, "unknown key (expected one of: " + known + ")");
+      const std::string shown = printable_text(name);
+      problems.add(key_line, field.key.empty() ? shown : field.key + "." + shown,
+                   "unknown key (expected one of: " + known + ")");
       continue;
     }
     if (find(name)) {
       problems.add(key_line, entry.key, "given twice (keep one)");
       continue;
     }
+    problems.note_key_line(entry.key, key_line);
     entries_.emplace_back(name, std::move(entry));
   }
 }
@@ -127,7 +136,7 @@ std::optional<double> read_number(const Field& field, ProblemList& problems, con
     return std::nullopt;
   }
   if (is_yaml_special_float(text)) {
-    problems.add(field.line, field.key, "must be a finite number, got " + text);
+    problems.add(field.line, field.key, "must be a finite number, got " + printable_text(text));
     return std::nullopt;
   }
   const std::optional<double> value = parse_double(text);
@@ -136,11 +145,17 @@ std::optional<double> read_number(const Field& field, ProblemList& problems, con
     return std::nullopt;
   }
   if (!std::isfinite(*value)) {
-    problems.add(field.line, field.key, "must be a finite number, got " + text);
+    problems.add(field.line, field.key,
+                 "must be a finite number, got " +
+                     // digits beyond the doubles are not echoed (hundreds of them)
+                     (text.find_first_of("0123456789") == std::string::npos
+                          ? printable_text(text)
+                          : std::string(*value < 0 ? "-" : "") + "a number beyond 1.8e+308"));
     return std::nullopt;
   }
   if (!range.contains(*value)) {
-    problems.add(field.line, field.key, "must be " + range.text() + ", got " + text);
+    problems.add(field.line, field.key,
+                 "must be " + range.text() + ", got " + format_number(*value));
     return std::nullopt;
   }
   return value;
@@ -153,7 +168,7 @@ std::optional<long long> read_integer(const Field& field, ProblemList& problems,
   const Range range{static_cast<double>(min_value), true, static_cast<double>(max_value), true};
   if (std::floor(*value) != *value || !range.contains(*value)) {
     problems.add(field.line, field.key,
-                 "must be a whole number " + range.text() + ", got " + field.node.Scalar());
+                 "must be a whole number " + range.text() + ", got " + format_number(*value));
     return std::nullopt;
   }
   return static_cast<long long>(*value);
@@ -166,8 +181,13 @@ std::optional<std::uint64_t> read_seed(const Field& field, ProblemList& problems
   const char* last = text.data() + text.size();
   const auto [end, error] = std::from_chars(text.data(), last, value);
   if (!node.IsScalar() || is_quoted(node) || text.empty() || error != std::errc() || end != last) {
-    problems.add(field.line, field.key,
-                 "expected a whole number >= 0 (a random seed), got " + describe(node));
+    // a number is named by its value (never hundreds of digits), anything else as written
+    const std::optional<double> number =
+        node.IsScalar() && !is_quoted(node) ? parse_double(text) : std::nullopt;
+    const std::string got = !number                  ? describe(node)
+                            : std::isfinite(*number) ? format_number(*number)
+                                                     : "a number beyond 1.8e+308";
+    problems.add(field.line, field.key, "expected a whole number >= 0 (a random seed), got " + got);
     return std::nullopt;
   }
   return value;
@@ -229,8 +249,10 @@ std::optional<Vec3> read_point(const Field& field, ProblemList& problems) {
   }
   Vec3 point = Vec3::Zero();
   bool ok = true;
+  const Range coordinate =
+      Range::closed(-input_ranges::kMaxCoordinate_mm, input_ranges::kMaxCoordinate_mm);
   for (std::size_t i = 0; i < node.size(); ++i) {
-    const std::optional<double> value = read_number(field.item(i), problems);
+    const std::optional<double> value = read_number(field.item(i), problems, coordinate);
     ok = ok && value.has_value();
     if (value) point[static_cast<int>(i)] = *value;
   }

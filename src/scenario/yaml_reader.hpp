@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,12 +35,17 @@ class ProblemList {
 
   const std::string& file() const { return file_; }
   std::size_t size() const { return problems_.size(); }
+  // the line of every map key read outside lists (e.g. "sim.timestep_s"), for checks made
+  // after loading that name a key
+  void note_key_line(const std::string& key, int line);
+  const std::map<std::string, int>& key_lines() const { return key_lines_; }
   bool empty() const { return problems_.empty(); }
   std::vector<Problem>& problems() { return problems_; }
 
  private:
   std::string file_;
   std::vector<Problem> problems_;
+  std::map<std::string, int> key_lines_;
 };
 
 // a value in the document with the dotted key path and line used in messages

@@ -95,25 +95,44 @@ BoundModel bind_model(const std::string& model_path, const Machine& machine,
   bound.model =
       model_text.empty() ? load_model(model_path) : load_model_from_string(model_text, model_path);
   mjModel& m = *bound.model;
+  // every name the machine needs is looked for, and every one missing is reported at once
+  std::vector<Problem> problems;
+  const auto collect = [&](const auto& resolve) {
+    try {
+      resolve();
+    } catch (const InputError& e) {
+      problems.insert(problems.end(), e.problems().begin(), e.problems().end());
+    }
+  };
   // the TCP site and the work frame
-  bound.nozzle_site = require_id(m, mjOBJ_SITE, kNozzleSite, model_path,
-                                 "the TCP: where material meets the substrate");
-  bound.substrate_body =
-      require_id(m, mjOBJ_BODY, kSubstrateBody, model_path, "the work frame the TCP is read in");
+  collect([&] {
+    bound.nozzle_site = require_id(m, mjOBJ_SITE, kNozzleSite, model_path,
+                                   "the TCP: where material meets the substrate");
+  });
+  collect([&] {
+    bound.substrate_body =
+        require_id(m, mjOBJ_BODY, kSubstrateBody, model_path, "the work frame the TCP is read in");
+  });
 
   // one position servo per machine joint, its range covering the machine's travel
   for (const JointLimit& limit : machine.joint_limits()) {
-    Servo servo = resolve_servo(m, limit.name, model_path,
-                                "machine " + machine.name() + " drives a joint of this name");
+    Servo servo;
+    bool resolved = false;
+    collect([&] {
+      servo = resolve_servo(m, limit.name, model_path,
+                            "machine " + machine.name() + " drives a joint of this name");
+      resolved = true;
+    });
+    if (!resolved) continue;
     if (m.jnt_limited[servo.joint]) {
       const double lo = m.jnt_range[2 * servo.joint] / servo.user_to_si;
       const double hi = m.jnt_range[2 * servo.joint + 1] / servo.user_to_si;
       if (lo > limit.min + 1e-9 || hi < limit.max - 1e-9)
-        throw InputError(model_path, 0, "joint " + limit.name,
-                         "range [" + format_number(lo) + ", " + format_number(hi) + "] " +
-                             servo.unit + " is narrower than the machine's travel [" +
-                             format_number(limit.min) + ", " + format_number(limit.max) + "] " +
-                             servo.unit);
+        problems.push_back(Problem{model_path, 0, "joint " + limit.name,
+                                   "range [" + format_number(lo) + ", " + format_number(hi) + "] " +
+                                       servo.unit + " is narrower than the machine's travel [" +
+                                       format_number(limit.min) + ", " + format_number(limit.max) +
+                                       "] " + servo.unit});
     }
     // kp_scale stiffens the servo; kv follows with the square root (same damping ratio)
     mjtNum* gain = m.actuator_gainprm + servo.actuator * mjNGAIN;
@@ -128,7 +147,9 @@ BoundModel bind_model(const std::string& model_path, const Machine& machine,
   }
 
   // the optional shutter blade
-  if (mj_name2id(&m, mjOBJ_JOINT, kShutterJoint) >= 0) bind_shutter(bound, settings);
+  if (mj_name2id(&m, mjOBJ_JOINT, kShutterJoint) >= 0)
+    collect([&] { bind_shutter(bound, settings); });
+  if (!problems.empty()) throw InputError(std::move(problems));
 
   m.opt.timestep = settings.timestep_s;
   bound.control_stride = settings.control_stride();

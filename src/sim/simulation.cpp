@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "core/input_ranges.hpp"
 #include "sim/closures.hpp"
 #include "sim/joint_reference.hpp"
 #include "sim/model_binding.hpp"
@@ -21,8 +22,9 @@ namespace depotwin {
 
 namespace {
 
-constexpr double kMinTimestep_s = 1e-5;
-constexpr double kMaxTimestep_s = 0.01;
+// the bounds the scenario schema also gives (one source: core/input_ranges.hpp)
+constexpr double kMinTimestep_s = input_ranges::kMinTimestep_s;
+constexpr double kMaxTimestep_s = input_ranges::kMaxTimestep_s;
 // contacts followed per step for the contact log (more are counted, not followed as pairs)
 constexpr size_t kMaxLoggedContacts = 256;
 // how often run() looks at the clock for progress reports
@@ -53,10 +55,20 @@ std::string SimSettings::validate() const {
   if (ratio > 1.0 && std::abs(ratio - std::round(ratio)) > 1e-6 * ratio)
     return "control_period_s (" + format_number(control_period_s) +
            " s) must be a whole number of timesteps (" + format_number(timestep_s) + " s)";
-  if (!std::isfinite(kp_scale) || kp_scale <= 0.0)
-    return "kp_scale must be a positive number, got " + format_number(kp_scale);
-  if (!std::isfinite(settle_s) || settle_s < 0.0)
-    return "settle_s must be >= 0, got " + format_number(settle_s);
+  if (!std::isfinite(kp_scale) || kp_scale < input_ranges::kMinKpScale ||
+      kp_scale > input_ranges::kMaxKpScale)
+    return "kp_scale must be between " + format_number(input_ranges::kMinKpScale) + " and " +
+           format_number(input_ranges::kMaxKpScale) + ", got " + format_number(kp_scale);
+  const double stiffness = kp_scale * std::pow(timestep_s / input_ranges::kReferenceTimestep_s, 2);
+  if (stiffness > input_ranges::kMaxServoStiffnessPerStep * (1.0 + 1e-12))
+    return "timestep_s " + format_number(timestep_s) + " s with kp_scale " +
+           format_number(kp_scale) +
+           " makes the servos unstable: kp_scale * (timestep_s / 1 ms)^2 = " +
+           format_number(stiffness) + ", at most " +
+           format_number(input_ranges::kMaxServoStiffnessPerStep);
+  if (!std::isfinite(settle_s) || settle_s < 0.0 || settle_s > input_ranges::kMaxSettle_s)
+    return "settle_s must be between 0 and " + format_number(input_ranges::kMaxSettle_s) +
+           " s, got " + format_number(settle_s);
   if (!std::isfinite(shutter_time_s) || shutter_time_s < 0.0)
     return "shutter_time_s must be >= 0 (0: the model's), got " + format_number(shutter_time_s);
   return "";
@@ -72,6 +84,10 @@ struct Simulation::Impl {
   // the contacting geom pairs of this step and the previous one (reserved: no allocation)
   std::vector<std::pair<int, int>> contact_pairs, previous_contact_pairs;
   int machine_root = -1;  // the body tree that carries the nozzle
+
+  // a MuJoCo warning during a run (the state diverged: NaN or huge values) is reported as
+  // what the user can change: the step, the servo gains, the plan's limits
+  void check_run_warnings(const mjData& d, double t) const;
 
   // a reset state exactly on the first reference, closed chains assembled around it
   void start_on(const JointReferences& refs);
@@ -99,6 +115,22 @@ Simulation::Simulation(const std::string& model_path, const Machine& machine,
   s.previous_contact_pairs.reserve(kMaxLoggedContacts);
   const mjModel& m = *s.bound.model;
   s.machine_root = m.body_rootid[m.site_bodyid[s.bound.nozzle_site]];
+}
+
+std::vector<Problem> check_simulation_model(const std::string& model_path, const Machine& machine,
+                                            const SimSettings& settings,
+                                            const std::string& model_text) {
+  const std::string problem = settings.validate();
+  if (!problem.empty()) return {Problem{"", 0, "sim", problem}};
+  try {
+    bind_model(model_path, machine, settings, model_text);
+  } catch (const InputError& e) {
+    return e.problems();
+  } catch (const InternalError& e) {
+    // a warning while computing the model's reference pose: the model, not the program
+    return {Problem{model_path, 0, "model", e.what()}};
+  }
+  return {};
 }
 
 Simulation::~Simulation() = default;
@@ -141,6 +173,20 @@ const mjModel& SimulationAccess::model(const Simulation& simulation) {
 }
 const mjData& SimulationAccess::data(const Simulation& simulation) {
   return *simulation.impl_->bound.data;
+}
+
+void Simulation::Impl::check_run_warnings(const mjData& d, double t) const {
+  try {
+    check_warnings(d, "in the simulation", t);
+  } catch (const InternalError& e) {
+    const SimSettings& settings = bound.settings;
+    throw InputError(
+        "sim", std::string(e.what()) + ". The servos could not follow the plan at sim.timestep_s " +
+                   format_number(settings.timestep_s) + " s with sim.kp_scale " +
+                   format_number(settings.kp_scale) +
+                   ": lower sim.timestep_s, bring sim.kp_scale towards 1, or lower the limits "
+                   "(v_max, a_max) so the plan asks less of the machine");
+  }
 }
 
 void Simulation::Impl::start_on(const JointReferences& refs) {
@@ -288,11 +334,19 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
   mjData* d = s.bound.data.get();
   if (trajectory.pieces().empty()) throw InputError("trajectory", "the trajectory is empty");
 
-  // the plan as joint references, checked whole before anything is simulated
+  // the plan as joint references, checked whole before anything is simulated; the step count
+  // is bounded before it becomes an integer (pipeline/job_check.hpp refuses a job of more
+  // than sim.max_steps long before this)
   const double dt = m->opt.timestep;
-  const long steps = std::max(
-      1L, static_cast<long>(
-              std::ceil((trajectory.duration_s() + s.bound.settings.settle_s) / dt - 1e-9)));
+  const double steps_needed =
+      std::ceil((trajectory.duration_s() + s.bound.settings.settle_s) / dt - 1e-9);
+  if (!(steps_needed <= input_ranges::kMaxMaxSteps))
+    throw InputError("sim.max_steps",
+                     "the run would take " + format_number(steps_needed) + " physics steps (" +
+                         format_number(trajectory.duration_s()) + " s of motion + " +
+                         format_number(s.bound.settings.settle_s) + " s settling at " +
+                         format_number(dt) + " s), more than any run may");
+  const long steps = std::max(1L, static_cast<long>(steps_needed));
   const long stride = s.bound.control_stride;
   const int joint_count = static_cast<int>(s.bound.joints.size());
   RecordedRun run = allocate_record(s.bound, steps);
@@ -346,7 +400,7 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
       run.joint_acceleration[k * joint_count + j] = d->qacc[servo.dof_adr] / servo.user_to_si;
       run.actuator_force[k * joint_count + j] = d->actuator_force[servo.actuator];
     }
-    check_warnings(*d, "in the simulation", t);
+    s.check_run_warnings(*d, t);
 
     if (progress && k % kProgressCheckSteps == 0) {
       const Clock::time_point now = Clock::now();

@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/recorded_run.hpp"
 #include "core/trajectory.hpp"
 #include "core/types.hpp"
@@ -64,6 +65,14 @@ struct JointReference {
   const double* velocity = nullptr;
   const double* acceleration = nullptr;
 };
+
+// What Simulation's constructor would refuse, found without simulating: the settings checked,
+// the model loaded and compiled by MuJoCo, and every name the machine needs resolved (all of
+// them, not the first missing). The problems name the model file and the element; none when
+// the model binds.
+std::vector<Problem> check_simulation_model(const std::string& model_path, const Machine& machine,
+                                            const SimSettings& settings = {},
+                                            const std::string& model_text = {});
 
 class Simulation {
  public:

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "pipeline/job_check.hpp"
 #include "pipeline/run.hpp"
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
@@ -100,7 +101,9 @@ TaskRecord run_task(const Sweep& sweep, const SweepTask& task, const std::string
                        "the task's scenario lists " + std::to_string(scenario.planners.size()) +
                            " planners; a task runs one");
     const PlannerSpec& planner = scenario.planners.front();
-    const PreparedJob job = prepare_job(scenario);
+    // the one validator's second stage, as `run` makes it: the plan's steps and memory
+    // against sim.max_steps and the default --max-memory before anything is simulated
+    const PreparedJob job = prepare_checked_job(scenario, {planner}, JobBudget{}, true, true);
     RunSettings settings;
     settings.render = false;
     settings.progress = false;

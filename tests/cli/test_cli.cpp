@@ -432,8 +432,11 @@ TEST(Cli, ArmPointOutOfReachIsNamed) {
   const Result r = depotwin("validate " + path);
   EXPECT_EQ(r.status, 2) << r.output;
   const std::string where = path + ":7: toolpath.surface: ";
-  // the job's start above the part, and the points of the hatch by layer, line and point
-  EXPECT_NE(r.output.find(where + "the start (600.000, 0.000, "), std::string::npos) << r.output;
+  // the job's start above the part (its default: at the surface's line, under its own key),
+  // and the points of the hatch by layer, line and point
+  EXPECT_NE(r.output.find(path + ":7: toolpath.start: the start (600.000, 0.000, "),
+            std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find(where + "layer 0, line 0, point 0 (568.000, -6.000, "), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find(where + "layer 0, line 1, point 16 (632.000, -2.000, "),

@@ -88,8 +88,8 @@ TEST(Describe, JsonDefaultsAreTheStructs) {
   EXPECT_EQ(named(keys, "bead_width_mm").at("default_value").get<double>(), defaults.bead_width_mm);
   EXPECT_EQ(named(keys, "tau_s").at("default_value").get<double>(), defaults.tau_s);
   EXPECT_EQ(named(keys, "sigma_mm").at("unit"), "mm");
-  EXPECT_EQ(named(keys, "sigma_mm").at("min").get<double>(), 0.0);
-  EXPECT_FALSE(named(keys, "sigma_mm").at("min_inclusive").get<bool>());
+  EXPECT_EQ(named(keys, "sigma_mm").at("min").get<double>(), 0.001);
+  EXPECT_TRUE(named(keys, "sigma_mm").at("min_inclusive").get<bool>());
   EXPECT_EQ(named(keys, "tau_s").at("applies_to"), "extrusion");
   const json sim = describe_json("sim").at("sections").at(0).at("keys");
   EXPECT_EQ(named(sim, "kp_scale").at("default_value").get<double>(), SimSpec{}.kp_scale);

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "pipeline/compare.hpp"
+#include "pipeline/job_check.hpp"
 #include "pipeline/run.hpp"
 #include "pipeline_test_util.hpp"
 #include "plots/png_check.hpp"
@@ -223,18 +224,59 @@ TEST(XyPipeline, JerkLimitLengthensThePlanAndLowersTheAccelerationOvershoot) {
 namespace depotwin {
 namespace {
 
-// an absurd jerk limit makes a job of days: refused before anything is sampled
-TEST(XyPipeline, AJobBeyondFourHoursIsRefused) {
+// an absurd jerk limit (set in code: a file may not go below 1e-6) makes a plan of a day:
+// refused before anything is sampled or simulated, at the key that drives it, naming the
+// limit the user can raise
+TEST(XyPipeline, AJobBeyondMaxStepsIsRefusedBeforeItIsSampled) {
   Scenario fig7 = load_scenario(testing_support::scenario_path("thompson_fig7.yaml"));
-  for (AxisLimits& axis : fig7.limits.axes) axis.j_max_mm_s3 = 1e-9;
-  const PreparedJob job = prepare_job(fig7);
+  for (AxisLimits& axis : fig7.limits.axes) axis.j_max_mm_s3 = 1e-12;
   try {
-    plan_job(job, PlannerSpec{"lspb_mtt", {}, 0});
+    prepare_checked_job(fig7, {PlannerSpec{"lspb_mtt", {}, 0}}, JobBudget{}, true, false);
     FAIL() << "expected an InputError";
   } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("beyond the 4 h a job may last"), std::string::npos)
+    ASSERT_FALSE(error.problems().empty());
+    const Problem& steps = error.problems().front();
+    EXPECT_EQ(steps.key, "limits.j_max") << error.what();
+    EXPECT_EQ(steps.line, 14) << error.what();  // fig7's `limits:` (j_max is not in the file)
+    EXPECT_NE(steps.message.find("run lspb_mtt would take"), std::string::npos) << error.what();
+    EXPECT_NE(steps.message.find("more than sim.max_steps = 1e+07"), std::string::npos)
         << error.what();
   }
+}
+
+// extrusion at a fixed nominal flow (process.flow_mm3_s: a constant-rate extruder), on two
+// paths printed at 2 and 4 mm/s: the nozzle emits Q for as long as the flow is commanded on
+// (the lag delays it, the ooze after the last stop is put down where the nozzle stops), so
+// the material is Q times the print time whatever the speed, where the speed-scaled flow
+// would give bead width x layer height x the length; and the slower path's bead is twice as
+// thick
+TEST(XyPipeline, ExtrusionAtAFixedFlowEmitsFlowTimesPrintTime) {
+  const std::string dir = fresh_directory("fixed_flow");
+  const PreparedJob job = prepare_job(load_scenario(write_text(dir, "flow.yaml", R"(name: fixed_flow
+machine: xy_stage
+limits: {v_max: 10, a_max: 100}
+process: {type: extrusion, flow_mm3_s: 0.5, bead_width_mm: 0.4, layer_height_mm: 0.2, tau_s: 0.01}
+toolpath:
+  start: [-2, 0]
+  end: [22, 12]
+  polylines:
+    - {points: [[0, 0], [20, 0]], speed: 2}
+    - {points: [[0, 10], [20, 10]], speed: 4}
+planners: [stop_and_go]
+)")));
+  const SimulatedRun run = simulate_job(job, planner("stop_and_go"), quiet());
+  const MetricsReport& r = run.report;
+  const double flow_mm3_s = 0.5;
+  const double print_s = run.plan.trajectory.depositing_time_s();
+  const MaterialStats& m = *r.material;
+  // a step (1 ms) of flow either way
+  EXPECT_NEAR(m.emitted, flow_mm3_s * print_s, 2 * 0.001 * flow_mm3_s);
+  EXPECT_GT(std::abs(m.emitted - 0.4 * 0.2 * 40.0), 0.1 * m.emitted);
+  // a steady bead's thickness goes as Q / v: the 2 mm/s line twice the 4 mm/s one
+  const ThicknessField& field = run.deposit->field();
+  for (double x : {6.0, 10.0, 14.0})
+    EXPECT_NEAR(field.thickness_mm_at(x, 0.0) / field.thickness_mm_at(x, 10.0), 2.0, 0.05)
+        << "x " << x;
 }
 
 }  // namespace

@@ -70,7 +70,7 @@ limits: {v_max: -4, a_max: 30}
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(problems.size(), 1u) << dump(problems);
-  expect_problem(problems, scenario_path(), "limits.v_max", 1, "must be > 0, got -4");
+  expect_problem(problems, scenario_path(), "limits.v_max", 1, "must be in [1e-06, 1e+06], got -4");
 }
 
 TEST_F(ScenarioErrors, ZeroLimit) {
@@ -81,7 +81,7 @@ limits:
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(problems.size(), 1u) << dump(problems);
-  expect_problem(problems, scenario_path(), "limits.a_max", 3, "must be > 0, got 0");
+  expect_problem(problems, scenario_path(), "limits.a_max", 3, "must be in [1e-06, 1e+09], got 0");
 }
 
 TEST_F(ScenarioErrors, NanAndInfiniteLimits) {
@@ -393,9 +393,10 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 sim: {timestep_s: 0.02, cell_mm: -1, kp_scale: 0, settle_s: 0}
 )");
   ASSERT_EQ(problems.size(), 3u) << dump(problems);
-  expect_problem(problems, scenario_path(), "sim.timestep_s", 2, "must be in (0, 0.01], got 0.02");
-  expect_problem(problems, scenario_path(), "sim.cell_mm", 2, "must be >= 0, got -1");
-  expect_problem(problems, scenario_path(), "sim.kp_scale", 2, "must be > 0, got 0");
+  expect_problem(problems, scenario_path(), "sim.timestep_s", 2,
+                 "must be in [1e-05, 0.01], got 0.02");
+  expect_problem(problems, scenario_path(), "sim.cell_mm", 2, "must be in [0, 100], got -1");
+  expect_problem(problems, scenario_path(), "sim.kp_scale", 2, "must be in [0.1, 10], got 0");
 }
 
 TEST_F(ScenarioErrors, ProcessKeyOfTheOtherType) {
@@ -407,9 +408,78 @@ process:
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
   ASSERT_EQ(problems.size(), 2u) << dump(problems);
-  expect_problem(problems, scenario_path(), "process.sigma_mm", 3, "must be > 0, got 0");
+  expect_problem(problems, scenario_path(), "process.sigma_mm", 3,
+                 "must be in [0.001, 100], got 0");
   expect_problem(problems, scenario_path(), "process.tau_s", 4,
                  "applies to extrusion, not to process type aerosol");
+}
+
+// the cell of the deposition grid against the footprint it samples, and the servo loop's
+// stability against the step: cross-checks between sections, at the key given
+TEST_F(ScenarioErrors, SimAgainstProcessAndTheServoLoop) {
+  const auto problems = problems_of(R"(
+process: {type: aerosol, sigma_mm: 0.2}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+sim:
+  cell_mm: 0.001
+  timestep_s: 0.01
+)");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  // sigma / 64 = 0.003125 mm
+  expect_problem(problems, scenario_path(), "sim.cell_mm", 4,
+                 "between sigma / 64 = 0.003125 and sigma = 0.2 mm");
+  // kp_scale 1 at 10 ms: 1 * (10 ms / 1 ms)^2 = 100 > 25
+  expect_problem(problems, scenario_path(), "sim.timestep_s", 5, "(timestep_s / 1 ms)^2 = 100");
+}
+
+// a path given twice is refused at the second, naming the first (either way round)
+TEST_F(ScenarioErrors, RepeatedPathsNameTheFirst) {
+  const auto problems = problems_of(R"(
+toolpath:
+  speed: 3
+  segments:
+    - [[0, 0], [1, 0]]
+    - [[2, 0], [3, 0]]
+    - [[1, 0], [0, 0]]
+  )");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.segments[2]", 6,
+                 "repeats toolpath.segments[0] (the same points, reversed)");
+  const auto polylines = problems_of(R"(
+toolpath:
+  speed: 3
+  polylines:
+    - [[0, 0], [1, 0], [1, 1]]
+    - [[0, 0], [1, 0], [1, 2]]
+    - [[0, 0], [1, 0], [1, 1]]
+)");
+  ASSERT_EQ(polylines.size(), 1u) << dump(polylines);
+  expect_problem(polylines, scenario_path(), "toolpath.polylines[2]", 6,
+                 "repeats toolpath.polylines[0] (the same points)");
+}
+
+// a name (and a label) names a folder: printable, at most 100 bytes, refused otherwise
+TEST_F(ScenarioErrors, HostileNamesAreRefused) {
+  const auto problems = problems_of(
+      "name: \"a\\nb\\tc\\a\"\n"
+      "toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\n"
+      "planners: [{name: lspb_mtt, label: \"x\\e[31m\"}]\n");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  expect_problem(problems, scenario_path(), "name", 1, "'a\\x0Ab\\x09c\\x07' holds a control");
+  expect_problem(problems, scenario_path(), "planners[0].label", 3, "'x\\x1B[31m' holds a control");
+  const auto long_name = problems_of("name: " + std::string(101, 'n') +
+                                     "\ntoolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\n");
+  ASSERT_EQ(long_name.size(), 1u) << dump(long_name);
+  expect_problem(long_name, scenario_path(), "name", 1, "is 101 bytes long");
+}
+
+// process.flow_mm3_s on extrusion: a fixed nominal flow (a constant-rate extruder)
+TEST_F(ScenarioErrors, ExtrusionTakesAFixedFlow) {
+  const auto problems = problems_of(R"(
+process: {type: extrusion, flow_mm3_s: 0.5}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  EXPECT_TRUE(problems.empty()) << dump(problems);
 }
 
 TEST_F(ScenarioErrors, UnknownProcessType) {
@@ -616,7 +686,7 @@ planners: [lspb_mtt, teleport]
   } catch (const InputError& e) {
     const std::vector<Problem>& problems = e.problems();
     ASSERT_EQ(problems.size(), 3u) << dump(problems);
-    EXPECT_EQ(problems[0].str(), path + ":2: limits.v_max: must be > 0, got 0");
+    EXPECT_EQ(problems[0].str(), path + ":2: limits.v_max: must be in [1e-06, 1e+06], got 0");
     EXPECT_EQ(problems[1].key, "toolpath.segments[0]");
     EXPECT_EQ(problems[1].line, 6);
     EXPECT_EQ(problems[2].key, "planners[1]");

@@ -133,7 +133,7 @@ toolpath:
   expect_problem(problems, scenario_path(), "toolpath.gcode.feed", 7,
                  "unknown value 'slow' (expected clamp | error)");
   expect_problem(problems, scenario_path(), "toolpath.gcode.chord_tolerance_mm", 8,
-                 "must be in (0, 1], got 0");
+                 "must be in [0.0001, 1], got 0");
 }
 
 // a G3 quarter circle of radius 10 becomes chords within the tolerance, on the circle

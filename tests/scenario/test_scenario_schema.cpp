@@ -218,5 +218,37 @@ TEST(SchemaDocument, NamesEveryParameterAndPointsToDescribe) {
   EXPECT_NE(text.find("interior angle"), std::string::npos);
 }
 
+// SCHEMA.md's tables are the schema's own (schema_markdown_table): every section's table sits
+// between `<!-- schema: PATH -->` and `<!-- end schema -->`, character for character, so every
+// range, default and unit in them is the one the loader enforces
+TEST(SchemaDocument, TablesAreTheSchemasOwn) {
+  const std::string text = schema_md();
+  ASSERT_FALSE(text.empty());
+  for (const SchemaSection& section : scenario_schema()) {
+    const std::string begin =
+        "<!-- schema: " + (section.path.empty() ? "top" : section.path) + " -->\n";
+    const std::string expected = schema_markdown_table(section);
+    const std::size_t at = text.find(begin);
+    EXPECT_NE(at, std::string::npos)
+        << "SCHEMA.md has no table for '" << section.path << "'; add:\n"
+        << begin << expected << "<!-- end schema -->";
+    if (at == std::string::npos) continue;
+    const std::size_t from = at + begin.size();
+    const std::size_t to = text.find("<!-- end schema -->", from);
+    ASSERT_NE(to, std::string::npos) << section.path;
+    // a table inside a list item is indented: compared without the indent
+    std::string table;
+    std::istringstream lines(text.substr(from, to - from));
+    for (std::string line; std::getline(lines, line);) {
+      line.erase(0, line.find_first_not_of(' '));
+      if (!line.empty()) table += line + "\n";
+    }
+    EXPECT_EQ(table, expected) << "SCHEMA.md's table for '" << section.path
+                               << "' differs from the schema; replace it "
+                               << "with:\n"
+                               << begin << expected << "<!-- end schema -->";
+  }
+}
+
 }  // namespace
 }  // namespace depotwin

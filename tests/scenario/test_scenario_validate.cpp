@@ -26,7 +26,7 @@ toolpath:
   const std::string file = scenario_path();
   ASSERT_EQ(problems.size(), 3u) << dump(problems);
   expect_problem(problems, file, "limits.a_max", 1, "expected a number");
-  expect_problem(problems, file, "process.sigma_mm", 2, "must be > 0");
+  expect_problem(problems, file, "process.sigma_mm", 2, "must be in [0.001, 100], got -1");
   expect_problem(problems, file, "toolpath.segments[0]", 6,
                  "print speed 5 mm/s needs 5 mm/s on x, above limits v_max 4");
 }
@@ -42,7 +42,7 @@ toolpath:
     - [[0, 5], [0, 15]]
 )");
   ASSERT_EQ(problems.size(), 2u) << dump(problems);
-  expect_problem(problems, scenario_path(), "limits.x.v_max", 1, "must be > 0");
+  expect_problem(problems, scenario_path(), "limits.x.v_max", 1, "must be in [1e-06, 1e+06]");
   expect_problem(problems, scenario_path(), "toolpath.segments[1]", 6,
                  "print speed 5 mm/s needs 5 mm/s on y, above limits v_max 4");
 }
@@ -107,7 +107,7 @@ toolpath:
   const std::string file = scenario_path();
   ASSERT_EQ(problems.size(), 3u) << dump(problems);
   expect_problem(problems, file, "limits.joint", 2, "a carriage j_max is not supported");
-  expect_problem(problems, file, "sim.kp_scale", 3, "must be > 0");
+  expect_problem(problems, file, "sim.kp_scale", 3, "must be in [0.1, 10], got 0");
   expect_problem(problems, file, "toolpath.polylines[0]", 7,
                  "point 1 (500, 0, 0) mm is not reachable by linear_delta");
   EXPECT_LT(problems[0].line, problems[1].line);

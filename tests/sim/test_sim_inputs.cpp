@@ -168,7 +168,9 @@ TEST(SimInputs, TrajectoryOutsideTheTravelNamesTimeAndJoint) {
   EXPECT_THROW(simulation.run(Trajectory()), InputError);
 }
 
-TEST(SimInputs, DivergenceEndsAsInternalError) {
+// a divergence is the user's to fix (their model, the step, the gains, the plan): an InputError
+// on `sim` naming what to change, with MuJoCo's own warning
+TEST(SimInputs, DivergenceIsReportedAsWhatTheUserCanChange) {
   // absurd unlimited servo gains at a 1 ms step: explicit integration blows up
   const std::string path =
       write_model("unstable", small_xy_model("",
@@ -179,11 +181,14 @@ TEST(SimInputs, DivergenceEndsAsInternalError) {
   Simulation simulation(path, *machine);
   try {
     simulation.run(short_print());
-    FAIL() << "no InternalError";
-  } catch (const InternalError& error) {
-    EXPECT_NE(std::string(error.what()).find("MuJoCo warning in the simulation at t ="),
-              std::string::npos)
-        << error.what();
+    FAIL() << "no InputError";
+  } catch (const InputError& error) {
+    ASSERT_EQ(error.problems().size(), 1u);
+    const Problem& problem = error.problems().front();
+    EXPECT_EQ(problem.key, "sim");
+    for (const char* words :
+         {"MuJoCo warning in the simulation at t =", "lower sim.timestep_s", "sim.kp_scale 1"})
+      EXPECT_NE(problem.message.find(words), std::string::npos) << problem.message;
   }
 }
 

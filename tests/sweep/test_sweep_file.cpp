@@ -230,7 +230,7 @@ TEST(ScenarioOverrides, ProblemsOfAnOverrideAreAtItsLineOthersAtTheScenarios) {
       "override toolpath.speed as a whole",
       "sweep.yaml:4: limits.a_maxx: unknown key (expected one of: v_max, a_max, j_max, x, y, z, "
       "joint)",
-      "sweep.yaml:5: limits.v_max: must be > 0, got -1",
+      "sweep.yaml:5: limits.v_max: must be in [1e-06, 1e+06], got -1",
       "sweep.yaml:8: process.sigma_mm: expected a number, got a list",
   };
   EXPECT_EQ(problems, expected);
@@ -297,7 +297,7 @@ grid:
                              "and a task runs one: sweep planner: in grid: (or choose one "
                              "under set:) (every task)");
   EXPECT_EQ(problems[1], file +
-                             ":4: limits.a_max: must be > 0, got -1 (2 tasks: 1, 3; task 1: "
+                             ":4: limits.a_max: must be in [1e-06, 1e+09], got -1 (2 tasks: 1, 3; task 1: "
                              "toolpath.speed=2, limits.a_max=-1)");
   EXPECT_EQ(problems[2].substr(0, problems[2].rfind(" (2 tasks")),
             scenario_path("thompson_fig7.yaml") +

@@ -398,8 +398,12 @@ void assign_node_speeds(PathGeometry& g, double period_s) {
   if (g.lead) {
     PathLine& lead_in = g.lines.front();
     const double v = g.nodes[1].speed_mm_s;
-    const int steps =
-        std::max(1, static_cast<int>(std::ceil(v / (lead_in.accel_mm_s2 * period_s) - 1e-9)));
+    const double ramp_steps = std::ceil(v / (lead_in.accel_mm_s2 * period_s) - 1e-9);
+    if (!(ramp_steps <= 1e9))
+      throw InputError("limits.a_max",
+                       "bezier: the lead-in ramp takes more than 1e9 samples of its period; "
+                       "raise a_max or the period_s");
+    const int steps = std::max(1, static_cast<int>(ramp_steps));
     GridProfile ramp;
     ramp.v_start_mm_s = 0.0;
     ramp.phases[0] = {steps, v / (steps * period_s)};

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <vector>
 
+#include "core/error.hpp"
+#include "core/number_text.hpp"
+
 namespace depotwin {
 
 int GridProfile::total_steps() const {
@@ -53,9 +56,17 @@ double GridProfile::distance_after(int steps, double period_s) const {
 
 namespace {
 
-// sample periods needed to change speed by dv at acceleration a (exact multiples stay exact)
+// sample periods needed to change speed by dv at acceleration a (exact multiples stay exact);
+// a count beyond an int (a tiny a_max or period) is refused before it is converted
 int steps_for(double dv, double a, double period_s) {
-  return static_cast<int>(std::ceil(std::abs(dv) / (a * period_s) - 1e-9));
+  const double steps = std::ceil(std::abs(dv) / (a * period_s) - 1e-9);
+  if (!(steps <= 1e9))
+    throw InputError("limits.a_max",
+                     "bezier: changing speed by " + message_number(std::abs(dv)) + " mm/s at " +
+                         message_number(a) +
+                         " mm/s^2 takes more than 1e9 samples of its period; raise a_max or the "
+                         "period_s");
+  return static_cast<int>(steps);
 }
 
 double phase_accel(double dv, int steps, double period_s) {

@@ -8,6 +8,8 @@
 
 #include "planners/ordering/exact.hpp"
 #include "planners/ordering/lower_bound.hpp"
+#include "planners/ordering/sequencer.hpp"
+#include "planners/ordering/transition_cost.hpp"
 
 namespace depotwin {
 namespace {
@@ -76,6 +78,33 @@ TEST(LowerBound, StartFarFromTheBedStillExact) {
   toolpath.start_mm = Vec3(-400, 900, 0);
   const TransitionCost cost(toolpath, kPaperLimits, CostModel::machine);
   EXPECT_NEAR(matching_lower_bound(cost), dense_matching_bound(cost), 1e-6 * 41);
+}
+
+}  // namespace
+}  // namespace depotwin
+
+namespace depotwin {
+namespace {
+
+// the sequencer computes the bound only when asked and only up to lower_bound_max_paths
+// paths (SequencerOptions): the same bound as matching_lower_bound below it, NaN above
+TEST(LowerBound, SequencerComputesItOnlyUpToTheMaximumPaths) {
+  const Toolpath toolpath = testing::paper_instance(12, 5);
+  const TcpLimits limits(kPaperLimits);
+  const OrderSpec nearest{"nearest_neighbor", "", "machine", 1};
+  SequencerOptions options;
+  options.lower_bound_max_paths = 12;
+  const OrderResult bounded = sequence(toolpath, limits, nearest, options);
+  const TransitionCost cost(toolpath, limits, CostModel::machine);
+  EXPECT_EQ(bounded.lower_bound_s, matching_lower_bound(cost));
+  EXPECT_LE(bounded.lower_bound_s, bounded.cost_s);
+  options.lower_bound_max_paths = 11;
+  EXPECT_TRUE(std::isnan(sequence(toolpath, limits, nearest, options).lower_bound_s));
+  options.lower_bound_max_paths = 12;
+  options.lower_bound = false;
+  EXPECT_TRUE(std::isnan(sequence(toolpath, limits, nearest, options).lower_bound_s));
+  // the default
+  EXPECT_EQ(SequencerOptions{}.lower_bound_max_paths, 5000);
 }
 
 }  // namespace

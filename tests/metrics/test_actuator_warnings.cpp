@@ -1,0 +1,45 @@
+// A simulated joint beyond its limits is said in metrics.json's warnings, one line per joint
+// and quantity, in the report's units; a peak at its limit is not beyond it.
+#include <gtest/gtest.h>
+
+#include "metrics/metrics_report.hpp"
+#include "metrics/run_report.hpp"
+
+namespace depotwin {
+namespace {
+
+// two joints: a slide (mm) and a hinge (deg), each with speed, acceleration and force limits
+ActuatorStats two_joints() {
+  ActuatorStats stats;
+  stats.joint_names = {"y", "j5"};
+  stats.revolute = {false, true};
+  stats.limit_vel = {200.0, 320.0};
+  stats.limit_acc = {2000.0, 1280.0};
+  stats.limit_force = {50.0, 0.0};  // the hinge has no force limit
+  stats.peak_vel = {150.0, 320.0};  // the hinge exactly at its limit
+  stats.peak_acc = {1000.0, 1000.0};
+  stats.peak_force = {10.0, 1e6};
+  return stats;
+}
+
+TEST(ActuatorWarnings, NoneWithinTheLimits) {
+  EXPECT_TRUE(actuator_limit_warnings(two_joints()).empty());
+}
+
+TEST(ActuatorWarnings, OneLinePerQuantityBeyondItsLimit) {
+  ActuatorStats stats = two_joints();
+  stats.peak_vel[0] = 733.0;    // the kp_scale 1e300 run: 733 mm/s against 200
+  stats.peak_acc[1] = 14400.0;  // shembekar_beam's lspb_mtt wrist: 14 400 deg/s^2 vs 1 280
+  stats.peak_force[0] = 50.5;
+  const std::vector<std::string> warnings = actuator_limit_warnings(stats);
+  ASSERT_EQ(warnings.size(), 3u);
+  EXPECT_EQ(warnings[0], "joint y: peak speed 733 mm/s above its limit 200 mm/s in the simulation");
+  EXPECT_EQ(warnings[1],
+            "joint y: peak actuator force 50.5 N above its limit 50 N in the simulation");
+  EXPECT_EQ(warnings[2],
+            "joint j5: peak acceleration 1.44e+04 deg/s^2 above its limit 1280 deg/s^2 in the "
+            "simulation");
+}
+
+}  // namespace
+}  // namespace depotwin
