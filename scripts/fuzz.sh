@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Bounded fuzz runs: builds the libFuzzer targets of tests/fuzz/ with clang, ASan and UBSan into
+# build-fuzz/, then runs each from its committed corpus for a while. A crash, a sanitizer
+# report, an exception other than InputError, a hang (one input over 25 s), an allocation over
+# 1 GB or 2.5 GB in all fails the run; the input is kept in build-fuzz/artifacts/<target>/.
+#   scripts/fuzz.sh [TARGET...]        scenario gcode stl move (default: all four)
+#   DEPOTWIN_FUZZ_SECONDS=60           how long each target runs (the CI's setting)
+#   DEPOTWIN_FUZZ_RUNS=N               run N inputs per target instead (a long run: 10000000)
+#   DEPOTWIN_FUZZ_BUILD_DIR=DIR        where to build (default build-fuzz/)
+# New inputs that reach new code stay in build-fuzz/corpus/<target>/ (not committed); the
+# committed corpus is tests/fuzz/corpus/<target>/: small seeds, and a regression input for every
+# crash found and fixed.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$root/scripts/setup.sh"
+build_dir="${DEPOTWIN_FUZZ_BUILD_DIR:-$root/build-fuzz}"
+jobs="${DEPOTWIN_JOBS:-$(nproc)}"
+seconds="${DEPOTWIN_FUZZ_SECONDS:-60}"
+runs="${DEPOTWIN_FUZZ_RUNS:-}"
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then targets=(scenario gcode stl move); fi
+for target in "${targets[@]}"; do
+  if [ ! -d "$root/tests/fuzz/corpus/$target" ]; then
+    echo "fuzz: unknown target '$target' (expected scenario, gcode, stl or move)" >&2
+    exit 2
+  fi
+done
+source "$root/tests/sanitizers/options.sh"
+
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+echo "fuzz: configuring $build_dir (clang, libFuzzer, ASan + UBSan)"
+cmake -S "$root" -B "$build_dir" -DCMAKE_CXX_COMPILER=clang++ -DDEPOTWIN_FUZZ=ON \
+  -DDEPOTWIN_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" "${launcher[@]}" >/dev/null
+echo "fuzz: building ${targets[*]/#/fuzz_}"
+cmake --build "$build_dir" -j "$jobs" --target "${targets[@]/#/fuzz_}"
+
+# temporary files (fuzz_scenario's directory) under the build, removed afterwards
+export TMPDIR="$build_dir/tmp"
+mkdir -p "$TMPDIR"
+trap 'rm -rf "$TMPDIR"' EXIT
+failed=()
+for target in "${targets[@]}"; do
+  corpus="$build_dir/corpus/$target"
+  artifacts="$build_dir/artifacts/$target"
+  mkdir -p "$corpus" "$artifacts"
+  for seed in "$root/tests/fuzz/corpus/$target"/*; do
+    [ -e "$corpus/$(basename "$seed")" ] || cp "$seed" "$corpus"/
+  done
+  limit=(-max_total_time="$seconds")
+  what="$seconds s"
+  if [ -n "$runs" ]; then
+    limit=(-runs="$runs")
+    what="$runs runs"
+  fi
+  echo "fuzz: $target for $what (corpus $corpus)"
+  log="$build_dir/fuzz-$target.log"
+  if "$build_dir/tests/fuzz/fuzz_$target" "${limit[@]}" -timeout=25 -rss_limit_mb=2560 \
+    -malloc_limit_mb=1024 -dict="$root/tests/fuzz/$target.dict" -print_final_stats=1 \
+    -artifact_prefix="$artifacts/" "$corpus" >"$log" 2>&1; then
+    # libFuzzer's final stats: executions, rate, peak memory
+    grep -E "^stat::(number_of_executed_units|average_exec_per_sec|peak_rss_mb)" "$log" |
+      sed "s/^/fuzz: $target: /"
+  else
+    tail -n 60 "$log"
+    echo "fuzz: $target FAILED: input kept in $artifacts/ (log: $log). Once fixed, commit it" \
+      "as tests/fuzz/corpus/$target/regression-<what>."
+    failed+=("$target")
+  fi
+done
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "fuzz: failed: ${failed[*]}"
+  exit 1
+fi
+echo "fuzz: ${targets[*]}: no crash"
