@@ -20,6 +20,7 @@ packages=(
   ffmpeg                                 # run.mp4 (render/video: raw frames piped to its H.264 encoder)
   libglfw3-dev                           # the `view` window (viewer/)
   xvfb xauth                             # the viewer's screenshot test runs under xvfb-run
+  clang libclang-rt-14-dev               # sanitizer build and libFuzzer targets (scripts/sanitize.sh, fuzz.sh)
 )
 
 missing=()
