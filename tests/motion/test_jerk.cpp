@@ -125,6 +125,18 @@ TEST(Jerk, RestToRestReachingNeither) {
   expect_valid(p, b, p.duration_s(), kV, kA, kJ);
 }
 
+TEST(Jerk, AMoveOfARoundingErrorTakesItsOwnTime) {
+  // 1e-10 mm is within the feasibility tolerance of standing still, yet no move of zero
+  // duration makes it: T = (32 d / j)^(1/3), alone and synchronised (zero once, an internal
+  // error)
+  const AxisBoundary b{0, 1e-10, 0, 0};
+  const double expected_s = std::cbrt(32 * 1e-10 / kJ);
+  EXPECT_NEAR(jerk_min_time_move(b, kV, kA, kJ).duration_s(), expected_s, 1e-9 * expected_s);
+  const SynchronizedMove move = synchronized_move({AxisMove{b, kV, kA, kJ}});
+  EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
+  expect_valid(move.axes[0], b, expected_s, kV, kA, kJ);
+}
+
 TEST(Jerk, ReversalInPlace) {
   // +3 -> -3 mm/s with d = 0: one S-curve, tau(6) = 6 / a + a / j, and it moves (3 - 3) / 2 tau = 0
   const AxisBoundary b{0, 0, 3, -3};

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "motion/mtt.hpp"
+#include "motion/sync.hpp"
 
 namespace depotwin {
 namespace {
@@ -29,6 +30,19 @@ TEST(Mtt, RestToRestTriangle) {
   const AxisProfile p = min_time_move(b, kV, kA);
   EXPECT_NEAR(p.duration_s(), 2 * std::sqrt(0.3 / kA), 1e-12);
   expect_meets(p, b, kV, kA);
+}
+
+TEST(Mtt, AMoveOfARoundingErrorTakesItsOwnTime) {
+  // 1e-10 mm is within the feasibility tolerance of standing still, yet no move of zero
+  // duration makes it: T = 2 sqrt(d / a), alone and synchronised (zero once, an internal error)
+  const AxisBoundary b{0, 1e-10, 0, 0};
+  const double expected_s = 2 * std::sqrt(1e-10 / kA);
+  EXPECT_NEAR(min_time_move(b, kV, kA).duration_s(), expected_s, 1e-9 * expected_s);
+  const SynchronizedMove move = synchronized_move({AxisMove{b, kV, kA}});
+  EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
+  expect_meets(move.axes[0], b, kV, kA);
+  // a null move still takes no time
+  EXPECT_EQ(synchronized_move({AxisMove{AxisBoundary{2, 2, 0, 0}, kV, kA}}).duration_s, 0.0);
 }
 
 TEST(Mtt, RestToRestTrapezoid) {
