@@ -27,6 +27,12 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
 
 namespace {
 
+// the ranges the move is computed in: beyond them its times and displacements (ratios such as
+// v_max / a_max and a_max / j_max) leave what doubles hold with the precision the profile needs
+constexpr double kMaxPosition = 1e9;  // |q0|, |q1|
+constexpr double kMinLimit = 1e-6;    // v_max, a_max and a non-zero j_max
+constexpr double kMaxLimit = 1e9;
+
 // "1 value", "3 values"
 std::string count_text(size_t count) {
   return std::to_string(count) + (count == 1 ? " value" : " values");
@@ -92,14 +98,27 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
     m.v_max = value_for_axis(request.v_max, i);
     m.a_max = value_for_axis(request.a_max, i);
     const std::string axis = " of axis " + std::to_string(i);
+    const std::string limit_range = " (at least 1e-6, at most 1e9)";
+    for (const auto& [name, position] : {std::pair{"--q0", m.boundary.q0}, {"--q1", m.boundary.q1}})
+      if (std::abs(position) > kMaxPosition)
+        problems.push_back({"", 0, name, "must be at most 1e9 in magnitude" + axis});
     if (!(m.v_max > 0.0)) problems.push_back({"", 0, "--vmax", "must be > 0" + axis});
     if (!(m.a_max > 0.0)) problems.push_back({"", 0, "--amax", "must be > 0" + axis});
+    if (m.v_max > 0.0 && (m.v_max < kMinLimit || m.v_max > kMaxLimit))
+      problems.push_back({"", 0, "--vmax", "out of range" + axis + limit_range});
+    if (m.a_max > 0.0 && (m.a_max < kMinLimit || m.a_max > kMaxLimit))
+      problems.push_back({"", 0, "--amax", "out of range" + axis + limit_range});
     if (m.v_max > 0.0 && std::abs(m.boundary.v0) > m.v_max)
       problems.push_back({"", 0, "--v0", "|v0| exceeds v_max" + axis});
     if (m.v_max > 0.0 && std::abs(m.boundary.v1) > m.v_max)
       problems.push_back({"", 0, "--v1", "|v1| exceeds v_max" + axis});
-    if (!request.j_max.empty() && !(value_for_axis(request.j_max, i) >= 0.0))
-      problems.push_back({"", 0, "--jmax", "must be >= 0 (0: no jerk limit)" + axis});
+    if (!request.j_max.empty()) {
+      const double j_max = value_for_axis(request.j_max, i);
+      if (!(j_max >= 0.0))
+        problems.push_back({"", 0, "--jmax", "must be >= 0 (0: no jerk limit)" + axis});
+      else if (j_max > 0.0 && (j_max < kMinLimit || j_max > kMaxLimit))
+        problems.push_back({"", 0, "--jmax", "out of range" + axis + limit_range + ", or 0"});
+    }
   }
   if (!problems.empty()) throw InputError(problems);
   // the jerk limits (0: none); "j_max" is reported once any axis has one
