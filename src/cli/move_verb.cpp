@@ -17,7 +17,8 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
   while (std::getline(stream, item, ',')) {
     char* end = nullptr;
     const double value = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(value))
+    // the whole item (an embedded NUL byte would end strtod's text early)
+    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(value))
       throw InputError(option, "'" + item + "' is not a finite number (expected e.g. 0,5.5)");
     values.push_back(value);
   }
