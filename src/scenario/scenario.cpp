@@ -232,9 +232,9 @@ bool Loader::read_document(YAML::Node& root) {
     return false;
   }
   // exactly one YAML document
-  std::vector<YAML::Node> documents;
+  YamlDocuments documents;
   try {
-    documents = YAML::LoadAll(text.str());
+    documents = load_documents(text.str());
   } catch (const YAML::ParserException& e) {
     problems_.add(e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
     return false;
@@ -242,16 +242,16 @@ bool Loader::read_document(YAML::Node& root) {
     problems_.add(0, "", std::string("malformed YAML: ") + e.what());
     return false;
   }
-  if (documents.empty() || documents.front().IsNull()) {
+  if (documents.count == 0 || documents.first.IsNull()) {
     problems_.add(1, "", "the file holds no settings: expected a map with at least `toolpath:`");
     return false;
   }
-  if (documents.size() > 1) {
-    problems_.add(line_of(documents[1]), "",
+  if (documents.count > 1) {
+    problems_.add(documents.second_line, "",
                   "more than one YAML document (---): a scenario file holds one");
     return false;
   }
-  root = documents.front();
+  root = documents.first;
   return true;
 }
 
