@@ -55,8 +55,13 @@ void check_scenario(const depotwin::Scenario& scenario) {
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
-  // a private directory with the fixtures beside the scenario file
-  std::string pattern = (fs::temp_directory_path() / "depotwin-fuzz-scenario-XXXXXX").string();
+  // a private directory with the fixtures beside the scenario file, in memory when /dev/shm is
+  // there (rewriting a file on ext4 flushes it to disk: most of the time per input)
+  std::error_code error;
+  const fs::path base = fs::is_directory("/dev/shm", error) && ::access("/dev/shm", W_OK) == 0
+                            ? fs::path("/dev/shm")
+                            : fs::temp_directory_path();
+  std::string pattern = (base / "depotwin-fuzz-scenario-XXXXXX").string();
   if (::mkdtemp(pattern.data()) == nullptr) {
     std::perror("fuzz_scenario: mkdtemp");
     std::abort();
@@ -71,7 +76,9 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const fs::path file = work_dir / "scenario.yaml";
   {
-    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    std::error_code error;
+    fs::remove(file, error);  // a new file rather than a truncated one (no flush on ext4)
+    std::ofstream out(file, std::ios::binary);
     out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
     require(static_cast<bool>(out), "the input written to scenario.yaml");
   }
