@@ -65,7 +65,7 @@ for target in "${targets[@]}"; do
   leaks=(-detect_leaks=1)
   if [ "$target" = stl ]; then leaks=(-detect_leaks=0); fi
   echo "fuzz: $target for $what (corpus $corpus)"
-  log="$build_dir/fuzz-$target.log"
+  log="$build_dir/fuzz-$target${runs:+-$runs-runs}.log"
   if "$build_dir/tests/fuzz/fuzz_$target" "${limit[@]}" "${leaks[@]}" -timeout=25 -rss_limit_mb=2560 \
     -malloc_limit_mb=1024 -dict="$root/tests/fuzz/$target.dict" -print_final_stats=1 \
     -artifact_prefix="$artifacts/" "$corpus" >"$log" 2>&1; then
