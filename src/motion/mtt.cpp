@@ -125,7 +125,9 @@ FeasibleDurations feasible_durations(const AxisBoundary& b, double v_max, double
   for (const auto& interval : feasible) {
     const bool possible =
         interval.first > 0.0 ? reachable(b, interval.first, v_max, a_max) : null_move(b);
-    if (interval.second - interval.first > 1e-12 || possible) out.intervals.push_back(interval);
+    // (a sliver a rounding error of T wide is no interval: one ulp of 1e5 s is 1.5e-11 s)
+    const double sliver_s = 1e-12 * (1.0 + interval.first);
+    if (interval.second - interval.first > sliver_s || possible) out.intervals.push_back(interval);
   }
   if (out.intervals.empty() || std::isfinite(out.intervals.back().second))
     throw InternalError("move: no feasible duration found (bug)");

@@ -137,6 +137,21 @@ TEST(Jerk, AMoveOfARoundingErrorTakesItsOwnTime) {
   expect_valid(move.axes[0], b, expected_s, kV, kA, kJ);
 }
 
+TEST(Jerk, ALongMoveHasNoFeasibleSliverOfOneRoundingError) {
+  // Mtt.ALongMoveHasNoFeasibleSliverOfOneRoundingError with a jerk limit: the move must still
+  // pass the ramp to rest (at least 77777 s plus the jerk ramps) and come back, exactly
+  const AxisBoundary b{0, 0, 77777, 1e-9};
+  const double v_max = 7777710, a_max = 1, j_max = 100;
+  const SynchronizedMove move = synchronized_move({AxisMove{b, v_max, a_max, j_max}});
+  EXPECT_GT(move.duration_s, 77777 + a_max / j_max);
+  EXPECT_NEAR(move.duration_s, jerk_min_time_move(b, v_max, a_max, j_max).duration_s(),
+              1e-9 * move.duration_s);
+  // at the end, within 1e-12 of the 3e9 mm excursion and of v0 (doubles hold 16 digits)
+  const double excursion_mm = b.v0 * b.v0 / (2 * a_max);
+  EXPECT_NEAR(move.axes[0].q_end(), b.q1, 1e-12 * excursion_mm);
+  EXPECT_NEAR(move.axes[0].v_end(), b.v1, 1e-12 * b.v0);
+}
+
 TEST(Jerk, ReversalInPlace) {
   // +3 -> -3 mm/s with d = 0: one S-curve, tau(6) = 6 / a + a / j, and it moves (3 - 3) / 2 tau = 0
   const AxisBoundary b{0, 0, 3, -3};
