@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Bounded fuzz runs: builds the libFuzzer targets of tests/fuzz/ with clang, ASan and UBSan into
 # build-fuzz/, then runs each from its committed corpus for a while. A crash, a sanitizer
-# report, an exception other than InputError, a hang (one input over 25 s), an allocation over
+# report, an exception other than InputError, a hang (one input over 60 s), an allocation over
 # 1 GB or 2.5 GB in all fails the run; the input is kept in build-fuzz/artifacts/<target>/.
 #   scripts/fuzz.sh [TARGET...]        scenario gcode stl move (default: all four)
 #   DEPOTWIN_FUZZ_SECONDS=60           how long each target runs (the CI's setting)
@@ -66,7 +66,7 @@ for target in "${targets[@]}"; do
   if [ "$target" = stl ]; then leaks=(-detect_leaks=0); fi
   echo "fuzz: $target for $what (corpus $corpus)"
   log="$build_dir/fuzz-$target${runs:+-$runs-runs}.log"
-  if "$build_dir/tests/fuzz/fuzz_$target" "${limit[@]}" "${leaks[@]}" -timeout=25 -rss_limit_mb=2560 \
+  if "$build_dir/tests/fuzz/fuzz_$target" "${limit[@]}" "${leaks[@]}" -timeout=60 -rss_limit_mb=2560 \
     -malloc_limit_mb=1024 -dict="$root/tests/fuzz/$target.dict" -print_final_stats=1 \
     -artifact_prefix="$artifacts/" "$corpus" >"$log" 2>&1; then
     # libFuzzer's final stats: executions, rate, peak memory
