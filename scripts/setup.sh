@@ -23,6 +23,7 @@ packages=(
   libsqlite3-dev                         # sweep results (results.sqlite)
   parallel                               # sweeps through GNU parallel (sweep --emit parallel)
   slurmctld slurmd slurm-client munge    # sweeps on Slurm arrays; scripts/slurm-local.sh
+  clang libclang-rt-14-dev               # sanitizer build and libFuzzer targets (scripts/sanitize.sh, fuzz.sh)
 )
 
 missing=()

@@ -15,7 +15,8 @@ struct MoveRequest {
 };
 
 // Throws InputError naming the options and their counts for mismatched lists, and the
-// option for bad limits or boundary velocities.
+// option for bad limits or boundary velocities: |q0|, |q1| at most 1e9; v_max, a_max and a
+// non-zero j_max within [1e-6, 1e9]; |v0|, |v1| at most v_max.
 nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request);
 
 // "1,2.5,-3" -> {1, 2.5, -3}; InputError naming `option` for anything that is not a number

@@ -141,6 +141,13 @@ AxisProblem checked_problem(const AxisBoundary& b, double v_max, double a_max, d
   return AxisProblem{b.v0, b.v1, std::max({v_max, std::abs(b.v0), std::abs(b.v1)}), a_max, j_max};
 }
 
+// no motion to make: what a zero duration can do (a zero-length feasible interval at T = 0
+// stays only for such a move, the one jerk_fixed_time_move accepts at T = 0; a move a rounding
+// error long gets its own tiny duration instead)
+bool null_move(const AxisBoundary& b) {
+  return std::abs(b.q1 - b.q0) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12;
+}
+
 double tolerance(const AxisBoundary& b, double T, const AxisProblem& pr) {
   return 1e-9 * (1.0 + std::abs(b.q1 - b.q0) + pr.v_max * T);
 }
@@ -233,8 +240,10 @@ FeasibleDurations jerk_feasible_durations(const AxisBoundary& b, double v_max, d
   // a single point survives only where the move really is possible (e.g. T = 0 for a null move)
   FeasibleDurations out;
   for (const auto& interval : feasible) {
-    if (interval.second - interval.first > 1e-12 || reachable(b, interval.first, pr))
-      out.intervals.push_back(interval);
+    const bool possible = interval.first > 0.0 ? reachable(b, interval.first, pr) : null_move(b);
+    // (a sliver a rounding error of T wide is no interval: one ulp of 1e5 s is 1.5e-11 s)
+    const double sliver_s = 1e-12 * (1.0 + interval.first);
+    if (interval.second - interval.first > sliver_s || possible) out.intervals.push_back(interval);
   }
   if (out.intervals.empty() || std::isfinite(out.intervals.back().second))
     throw InternalError("jerk-limited move: no feasible duration found (bug)");
@@ -246,7 +255,7 @@ AxisProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, doubl
   const AxisProblem pr = checked_problem(b, v_max, a_max, j_max);
   const double T = duration_s, d = b.q1 - b.q0;
   if (T <= 0.0) {
-    if (std::abs(d) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12) return AxisProfile(b.q0, b.v0);
+    if (null_move(b)) return AxisProfile(b.q0, b.v0);
     throw InternalError("jerk-limited move: zero duration for a non-null move");
   }
   if (!reachable(b, T, pr))

@@ -66,6 +66,13 @@ bool reachable(const AxisBoundary& b, double T, double V, double A) {
   return d_min <= d + scale && d <= d_max + scale;
 }
 
+// no motion to make: what a zero duration can do (a zero-length feasible interval at T = 0
+// stays only for such a move, the one fixed_time_move accepts at T = 0; a move a rounding error
+// long gets its own tiny duration instead)
+bool null_move(const AxisBoundary& b) {
+  return std::abs(b.q1 - b.q0) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12;
+}
+
 void check_inputs(const AxisBoundary& b, double v_max, double a_max) {
   if (!(v_max > 0.0) || !(a_max > 0.0) || !std::isfinite(v_max) || !std::isfinite(a_max))
     throw InternalError("move: v_max and a_max must be positive and finite");
@@ -116,8 +123,11 @@ FeasibleDurations feasible_durations(const AxisBoundary& b, double v_max, double
   // a single point survives only where the move really is possible (e.g. T = 0 for a null move)
   FeasibleDurations out;
   for (const auto& interval : feasible) {
-    if (interval.second - interval.first > 1e-12 || reachable(b, interval.first, v_max, a_max))
-      out.intervals.push_back(interval);
+    const bool possible =
+        interval.first > 0.0 ? reachable(b, interval.first, v_max, a_max) : null_move(b);
+    // (a sliver a rounding error of T wide is no interval: one ulp of 1e5 s is 1.5e-11 s)
+    const double sliver_s = 1e-12 * (1.0 + interval.first);
+    if (interval.second - interval.first > sliver_s || possible) out.intervals.push_back(interval);
   }
   if (out.intervals.empty() || std::isfinite(out.intervals.back().second))
     throw InternalError("move: no feasible duration found (bug)");
@@ -145,8 +155,7 @@ LspbSolution snap_to_bang_bang(LspbSolution s, const AxisBoundary& b, double v_m
 AxisProfile fixed_time_move(const AxisBoundary& b, double duration_s, double v_max, double a_max) {
   check_inputs(b, v_max, a_max);
   if (duration_s <= 0.0) {
-    if (std::abs(b.q1 - b.q0) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12)
-      return AxisProfile(b.q0, b.v0);
+    if (null_move(b)) return AxisProfile(b.q0, b.v0);
     throw InternalError("move: zero duration for a non-null move");
   }
   // the paper's six LSPB candidates, eqs. (11)-(18)

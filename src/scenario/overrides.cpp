@@ -12,10 +12,11 @@ namespace depotwin {
 namespace scenario_detail {
 
 std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemList& problems) {
-  // exactly one YAML document
-  std::vector<YAML::Node> documents;
+  // exactly one YAML document (load_documents: not YAML::LoadAll, which never returns on some
+  // malformed text)
+  YamlDocuments documents;
   try {
-    documents = YAML::LoadAll(text);
+    documents = load_documents(text);
   } catch (const YAML::ParserException& e) {
     problems.add(e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
     return std::nullopt;
@@ -23,16 +24,16 @@ std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemLi
     problems.add(0, "", std::string("malformed YAML: ") + e.what());
     return std::nullopt;
   }
-  if (documents.empty() || documents.front().IsNull()) {
+  if (documents.count == 0 || documents.first.IsNull()) {
     problems.add(1, "", "the file holds no settings: expected a map with at least `toolpath:`");
     return std::nullopt;
   }
-  if (documents.size() > 1) {
-    problems.add(line_of(documents[1]), "",
+  if (documents.count > 1) {
+    problems.add(documents.second_line, "",
                  "more than one YAML document (---): a scenario file holds one");
     return std::nullopt;
   }
-  return documents.front();
+  return documents.first;
 }
 
 std::optional<std::vector<KeyStep>> parse_override_key(const std::string& key, std::string& why) {

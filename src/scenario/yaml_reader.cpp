@@ -1,5 +1,7 @@
 #include "scenario/yaml_reader.hpp"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -33,7 +35,52 @@ bool is_yaml_special_float(const std::string& text) {
   return lower == ".nan" || lower == ".inf" || lower == "+.inf" || lower == "-.inf";
 }
 
+// counts documents as the parser reads them and keeps where the second one's content begins
+class DocumentCounter : public YAML::EventHandler {
+ public:
+  int count = 0;
+  int second_line = 0;
+
+  void OnDocumentStart(const YAML::Mark&) override { ++count; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { node_at(mark); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { node_at(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    node_at(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    node_at(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    node_at(mark);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void node_at(const YAML::Mark& mark) {
+    if (count == 2 && second_line == 0) second_line = mark.is_null() ? 0 : mark.line + 1;
+  }
+};
+
 }  // namespace
+
+YamlDocuments load_documents(const std::string& text) {
+  // count the documents, stopping at the second (LoadAll's loop is what may not end)
+  std::istringstream stream(text);
+  YAML::Parser parser(stream);
+  DocumentCounter counter;
+  while (counter.count < 2 && parser.HandleNextDocument(counter)) {
+  }
+  YamlDocuments documents;
+  documents.count = counter.count;
+  documents.second_line = counter.second_line;
+  if (documents.count > 0) documents.first = YAML::Load(text);
+  return documents;
+}
 
 int line_of(const YAML::Node& node) {
   if (!node.IsDefined()) return 0;

@@ -21,6 +21,17 @@ namespace depotwin::scenario_detail {
 // 1-based line of a node, 0 when yaml-cpp has no mark for it
 int line_of(const YAML::Node& node);
 
+// The first document of a YAML text, how many there are (0, 1, or 2 for "more than one") and
+// the 1-based line where the second one's content begins. Instead of YAML::LoadAll, which in
+// yaml-cpp 0.7 never returns on some malformed text ("," or ",-/": it keeps adding null
+// documents, jbeder/yaml-cpp#1040). Throws what yaml-cpp throws for malformed YAML.
+struct YamlDocuments {
+  YAML::Node first;
+  int count = 0;
+  int second_line = 0;
+};
+YamlDocuments load_documents(const std::string& text);
+
 // what a node holds, for messages: "a map", "a list", "nothing", "the text 'abc'"
 std::string describe(const YAML::Node& node);
 

@@ -132,8 +132,13 @@ Toolpath make_random_segments(const RandomSegmentsSpec& spec) {
   std::mt19937_64 rng(spec.seed);
   SegmentGrid grid(spec.bed_x_mm, spec.bed_y_mm, spec.length_max_mm);
   // a generous budget: at the paper's densest case (N = 100 on 100 x 100 mm) a 40 mm
-  // segment is accepted about once in a few hundred tries
+  // segment is accepted about once in a few hundred tries (2 000 to 4 000 for the instance,
+  // 31 a segment for 10^5 segments at that density). A bed filled to its last segments would
+  // take each of them up to the first budget and the instance minutes (2 000 segments on
+  // 90 x 90 mm: a minute, then an error), so the tries are bounded in all too
   constexpr long kAttemptsPerSegment = 1000000;
+  const long attempts_budget = kAttemptsPerSegment + 100L * spec.count;
+  long attempts_in_all = 0;
 
   Toolpath toolpath;
   toolpath.paths.reserve(spec.count);
@@ -142,7 +147,9 @@ Toolpath make_random_segments(const RandomSegmentsSpec& spec) {
     // so rejections do not bias the lengths towards short segments (unless asked to)
     double length_mm = uniform(rng, spec.length_min_mm, spec.length_max_mm);
     bool placed = false;
-    for (long attempt = 0; attempt < kAttemptsPerSegment && !placed; ++attempt) {
+    long attempt = 0;
+    for (; attempt < kAttemptsPerSegment && attempts_in_all < attempts_budget && !placed;
+         ++attempt, ++attempts_in_all) {
       Segment2 s;
       if (spec.redraw_length_on_reject) {
         // start point, direction and length uniform; redrawn together when rejected
@@ -175,8 +182,8 @@ Toolpath make_random_segments(const RandomSegmentsSpec& spec) {
       throw InputError("toolpath.random_segments",
                        "could not place segment " + std::to_string(i + 1) + " of " +
                            std::to_string(spec.count) + " without crossing the others after " +
-                           std::to_string(kAttemptsPerSegment) +
-                           " tries: use a larger bed, fewer or shorter segments");
+                           std::to_string(attempt) + " tries (" + std::to_string(attempts_in_all) +
+                           " for all): use a larger bed, fewer or shorter segments");
   }
   // start and end of the job, uniform on the bed
   toolpath.start_mm = Vec3(uniform(rng, 0.0, spec.bed_x_mm), uniform(rng, 0.0, spec.bed_y_mm), 0.0);

@@ -88,7 +88,13 @@ std::string format_count(std::size_t n) {
 TriangleMesh read_stl(const std::string& path, double mm_per_unit, const std::string& key) {
   if (!std::isfinite(mm_per_unit) || mm_per_unit <= 0.0)
     throw InputError(path, 0, key, "the unit scale (mm per unit) must be positive and finite");
-  const std::string bytes = read_bytes(path, key);
+  return read_stl_bytes(read_bytes(path, key), path, mm_per_unit, key);
+}
+
+TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& path, double mm_per_unit,
+                            const std::string& key) {
+  if (!std::isfinite(mm_per_unit) || mm_per_unit <= 0.0)
+    throw InputError(path, 0, key, "the unit scale (mm per unit) must be positive and finite");
   if (bytes.empty()) throw InputError(path, 0, key, "the STL file is empty");
 
   // binary by its size, whatever the header says

@@ -23,6 +23,9 @@ namespace depotwin {
 // non-positive or non-finite mm_per_unit.
 TriangleMesh read_stl(const std::string& path, double mm_per_unit,
                       const std::string& key = "toolpath.surface.file");
+// The same for a file's bytes already in memory; `label` names the file in messages.
+TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& label, double mm_per_unit,
+                            const std::string& key = "toolpath.surface.file");
 
 // The bytes of a binary STL of the mesh (little-endian floats, facet normals by the right-hand
 // rule, attribute 0): deterministic, for files committed with scenarios. The header is cut or

@@ -125,6 +125,33 @@ TEST(Jerk, RestToRestReachingNeither) {
   expect_valid(p, b, p.duration_s(), kV, kA, kJ);
 }
 
+TEST(Jerk, AMoveOfARoundingErrorTakesItsOwnTime) {
+  // 1e-10 mm is within the feasibility tolerance of standing still, yet no move of zero
+  // duration makes it: T = (32 d / j)^(1/3), alone and synchronised (zero once, an internal
+  // error)
+  const AxisBoundary b{0, 1e-10, 0, 0};
+  const double expected_s = std::cbrt(32 * 1e-10 / kJ);
+  EXPECT_NEAR(jerk_min_time_move(b, kV, kA, kJ).duration_s(), expected_s, 1e-9 * expected_s);
+  const SynchronizedMove move = synchronized_move({AxisMove{b, kV, kA, kJ}});
+  EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
+  expect_valid(move.axes[0], b, expected_s, kV, kA, kJ);
+}
+
+TEST(Jerk, ALongMoveHasNoFeasibleSliverOfOneRoundingError) {
+  // Mtt.ALongMoveHasNoFeasibleSliverOfOneRoundingError with a jerk limit: the move must still
+  // pass the ramp to rest (at least 77777 s plus the jerk ramps) and come back, exactly
+  const AxisBoundary b{0, 0, 77777, 1e-9};
+  const double v_max = 7777710, a_max = 1, j_max = 100;
+  const SynchronizedMove move = synchronized_move({AxisMove{b, v_max, a_max, j_max}});
+  EXPECT_GT(move.duration_s, 77777 + a_max / j_max);
+  EXPECT_NEAR(move.duration_s, jerk_min_time_move(b, v_max, a_max, j_max).duration_s(),
+              1e-9 * move.duration_s);
+  // at the end, within 1e-12 of the 3e9 mm excursion and of v0 (doubles hold 16 digits)
+  const double excursion_mm = b.v0 * b.v0 / (2 * a_max);
+  EXPECT_NEAR(move.axes[0].q_end(), b.q1, 1e-12 * excursion_mm);
+  EXPECT_NEAR(move.axes[0].v_end(), b.v1, 1e-12 * b.v0);
+}
+
 TEST(Jerk, ReversalInPlace) {
   // +3 -> -3 mm/s with d = 0: one S-curve, tau(6) = 6 / a + a / j, and it moves (3 - 3) / 2 tau = 0
   const AxisBoundary b{0, 0, 3, -3};

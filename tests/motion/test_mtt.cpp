@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "motion/mtt.hpp"
+#include "motion/sync.hpp"
 
 namespace depotwin {
 namespace {
@@ -29,6 +30,33 @@ TEST(Mtt, RestToRestTriangle) {
   const AxisProfile p = min_time_move(b, kV, kA);
   EXPECT_NEAR(p.duration_s(), 2 * std::sqrt(0.3 / kA), 1e-12);
   expect_meets(p, b, kV, kA);
+}
+
+TEST(Mtt, AMoveOfARoundingErrorTakesItsOwnTime) {
+  // 1e-10 mm is within the feasibility tolerance of standing still, yet no move of zero
+  // duration makes it: T = 2 sqrt(d / a), alone and synchronised (zero once, an internal error)
+  const AxisBoundary b{0, 1e-10, 0, 0};
+  const double expected_s = 2 * std::sqrt(1e-10 / kA);
+  EXPECT_NEAR(min_time_move(b, kV, kA).duration_s(), expected_s, 1e-9 * expected_s);
+  const SynchronizedMove move = synchronized_move({AxisMove{b, kV, kA}});
+  EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
+  expect_meets(move.axes[0], b, kV, kA);
+  // a null move still takes no time
+  EXPECT_EQ(synchronized_move({AxisMove{AxisBoundary{2, 2, 0, 0}, kV, kA}}).duration_s, 0.0);
+}
+
+TEST(Mtt, ALongMoveHasNoFeasibleSliverOfOneRoundingError) {
+  // from 77777 mm/s at a_max 1 mm/s^2 back to where it started (at rest): past the ramp to
+  // rest (77777 s, where it is 3e9 mm away) and back, v_p = -sqrt((v0^2 + v1^2) / 2),
+  // T = (v0 + v1 - 2 v_p) / a. The blocked durations began one rounding error (1.5e-11 s)
+  // after the ramp, and that sliver was taken for a feasible duration (an internal error
+  // then): found by fuzz_move
+  const AxisBoundary b{0, 0, 77777, 1e-9};
+  const double v_max = 7777710, a_max = 1;
+  const double expected_s = b.v0 + b.v1 + 2 * std::sqrt((b.v0 * b.v0 + b.v1 * b.v1) / 2);
+  EXPECT_NEAR(min_time_move(b, v_max, a_max).duration_s(), expected_s, 1e-9 * expected_s);
+  const SynchronizedMove move = synchronized_move({AxisMove{b, v_max, a_max}});
+  EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
 }
 
 TEST(Mtt, RestToRestTrapezoid) {

@@ -651,6 +651,16 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
   expect_problem(problems, scenario_path(), "name", 1, "cannot name a results folder");
 }
 
+TEST_F(ScenarioErrors, TextYamlCppLoopsOnIsAFileWithoutSettings) {
+  // yaml-cpp 0.7's LoadAll never returned on these (null documents without end, memory
+  // growing): found by fuzz_scenario
+  for (const char* text : {",", ",-/"}) {
+    const auto problems = problems_of(text);
+    ASSERT_EQ(problems.size(), 1u) << text << "\n" << dump(problems);
+    EXPECT_EQ(problems[0].line, 1) << problems[0].str();
+  }
+}
+
 TEST_F(ScenarioErrors, EmptyFileAndSeveralDocuments) {
   const auto empty = problems_of("# only a comment\n");
   ASSERT_EQ(empty.size(), 1u) << dump(empty);

@@ -126,5 +126,23 @@ TEST(RandomInstances, ImpossibleSpecsAreInputErrors) {
   EXPECT_THROW(make_random_segments(spec), InputError);
 }
 
+TEST(RandomInstances, ABedTooFullIsRefusedWithinTheBudgetOfTriesInAll) {
+  // 2 000 segments of 10-40 mm cannot all lie on 90 x 90 mm without crossing: the last ones
+  // took up to 10^6 tries each (a minute, found by fuzz_scenario); the whole instance now gets
+  // 10^6 + 100 n tries, and the message counts them
+  RandomSegmentsSpec spec;
+  spec.count = 2000;
+  spec.bed_x_mm = spec.bed_y_mm = 90.0;
+  spec.seed = 7;
+  try {
+    make_random_segments(spec);
+    FAIL() << "2000 segments were placed on 90 x 90 mm";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 1u);
+    EXPECT_NE(e.problems()[0].message.find("(1200000 for all)"), std::string::npos)
+        << e.problems()[0].message;
+  }
+}
+
 }  // namespace
 }  // namespace depotwin

@@ -1,0 +1,79 @@
+// Fuzz target: the G-code importer (toolpath/gcode.hpp) on arbitrary text, as a scenario's
+// `gcode:` file goes through it: parse, import under every print rule, chord the arcs. Bad
+// input must be an InputError; whatever is imported must be finite, with positive speeds.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "core/error.hpp"
+#include "fuzz/fuzz_check.hpp"
+#include "toolpath/gcode.hpp"
+
+namespace {
+
+using depotwin::fuzz::is_finite;
+using depotwin::fuzz::require;
+
+void check_import(const depotwin::GcodeImport& imported) {
+  require(imported.rule != depotwin::PrintRule::automatic, "the rule applied is never auto");
+  require(imported.point_lines.size() == imported.toolpath.paths.size(), "one line list a path");
+  for (std::size_t i = 0; i < imported.toolpath.paths.size(); ++i) {
+    const depotwin::PrintPath& path = imported.toolpath.paths[i];
+    require(path.points.size() >= 2, "a print path has two points at least");
+    require(imported.point_lines[i].size() == path.points.size(), "a line per point");
+    require(path.arcs.empty() || path.arcs.size() + 1 == path.points.size(), "an arc per edge");
+    require(is_finite(path.speed_mm_s) && path.speed_mm_s > 0.0, "a finite positive speed");
+    for (const depotwin::Vec3& point : path.points) require(point.allFinite(), "finite points");
+    for (const depotwin::EdgeArc& arc : path.arcs)
+      require(arc.center_mm.allFinite() && is_finite(arc.sweep_rad), "finite arcs");
+    require(is_finite(path.length_mm()), "a finite length");
+    // arcs become chords as the scenario loader makes them (0.01 mm, its default)
+    const depotwin::PrintPath chorded = path.chorded(0.01);
+    require(chorded.points.size() >= path.points.size(), "chording adds points");
+    for (const depotwin::Vec3& point : chorded.points) require(point.allFinite(), "finite chords");
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  depotwin::GcodeOptions options;
+  depotwin::GcodeProgram program;
+  try {
+    program = depotwin::parse_gcode_program(text, "fuzz.gcode", options);
+  } catch (const depotwin::InputError&) {
+    return 0;  // rejected with a message: expected
+  }
+  require(
+      program.n_lines >= 0 && is_finite(program.dwell_s) && is_finite(program.extrusion_e_total),
+      "finite program totals");
+  for (const depotwin::GcodeMove& move : program.moves)
+    require(move.from_mm.allFinite() && move.to_mm.allFinite() && is_finite(move.length_mm) &&
+                move.length_mm > 0.0 && is_finite(move.e_delta),
+            "finite moves");
+  // every rule, every layer; then the last layer alone, with a default speed (as a scenario's
+  // toolpath.speed gives)
+  for (const depotwin::PrintRule rule : {depotwin::PrintRule::automatic, depotwin::PrintRule::e,
+                                         depotwin::PrintRule::shutter, depotwin::PrintRule::feed}) {
+    options.rule = rule;
+    for (const double default_speed_mm_s : {0.0, 10.0}) {
+      options.default_speed_mm_s = default_speed_mm_s;
+      options.first_layer = 0;
+      options.last_layer = -1;
+      try {
+        check_import(depotwin::import_gcode_program(program, options));
+        const std::size_t layers =
+            depotwin::print_layer_levels(program,
+                                         depotwin::resolve_print_rule(program, rule, nullptr))
+                .size();
+        if (layers < 2) continue;
+        options.first_layer = options.last_layer = static_cast<int>(layers) - 1;
+        check_import(depotwin::import_gcode_program(program, options));
+      } catch (const depotwin::InputError&) {
+        // e.g. a print move before any feed rate: expected
+      }
+    }
+  }
+  return 0;
+}
