@@ -28,25 +28,25 @@ const std::vector<PlannerInfo>& planner_registry() {
        "Thompson & Yoon 2014: LSPB on print segments, minimum-time transitions",
        {},
        [](const PlannerSpec&) { return std::make_unique<LspbMttPlanner>(); },
-       true},
+       /*honours_jerk_limit=*/true},
       {"stop_and_go",
        "naive baseline: rest-to-rest trapezoid per print segment, material on throughout",
        {},
        [](const PlannerSpec&) { return std::make_unique<StopAndGoPlanner>(); },
-       true},
+       /*honours_jerk_limit=*/true},
       {"bezier", "Giberti et al. 2017: lines with Bezier corner blends at constant speed",
        bezier_parameters(), [](const PlannerSpec& spec) { return make_bezier_planner(spec); },
-       false, /*consumes_arcs=*/true},
+       /*honours_jerk_limit=*/true, /*consumes_arcs=*/true},
       {"conformal",
        "Shembekar et al. 2018: conformal paths flown by with zone blends, time-optimal under TCP "
        "and joint limits (TOPP-RA), speed and flow control",
        conformal_parameters(), [](const PlannerSpec& spec) { return make_conformal_planner(spec); },
-       false},
+       /*honours_jerk_limit=*/true},
       {"firmware",
        "the printer's own firmware as baseline: Marlin (junction deviation) or Klipper "
        "(square-corner velocity) trapezoidal look-ahead, material on while printing",
        firmware_parameters(), [](const PlannerSpec& spec) { return make_firmware_planner(spec); },
-       false},
+       /*honours_jerk_limit=*/true},
   };
   return registry;
 }
