@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -134,6 +135,21 @@ void stretch_limits(Stretch& st, const std::vector<PointTerms>& terms, const Pat
   st.jerk = jerk;
   st.v_cap = v_cap;
 }
+
+// a stretch's double-S with what it was planned from, and the grid point where it rises
+// highest above the ceiling (0: nowhere)
+struct PlannedStretch {
+  Stretch stretch;
+  double v_begin = 0.0, v_end = 0.0;
+  size_t worst = 0;
+  PlannedStretch() = default;
+  PlannedStretch(const Stretch& st, double v0, double v1) : stretch(st), v_begin(v0), v_end(v1) {}
+  bool same_as(const PlannedStretch& other) const {
+    return v_begin == other.v_begin && v_end == other.v_end &&
+           stretch.accel == other.stretch.accel && stretch.jerk == other.stretch.jerk &&
+           stretch.v_cap == other.stretch.v_cap;
+  }
+};
 
 double ramp_room(double va, double vb, double accel, double jerk) {
   if (va == vb) return 0.0;
@@ -270,8 +286,11 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
 
     // critical points, stretches and their double-S moves; a stretch whose S-curve rises above
     // the ceiling gets a critical point where it does most, and all are planned again
+    // (a stretch planned in an earlier insertion round with the same ends, speeds and limits
+    // is taken from `planned` as it was: most stay as they were when a few points are added)
     std::vector<size_t> critical = ceiling_minima(x_lim);
     std::vector<Stretch> stretches;
+    std::map<std::pair<size_t, size_t>, PlannedStretch> planned;
     for (size_t insertion = 0;; ++insertion) {
       stretches.assign(critical.size() - 1, Stretch{});
       for (size_t m = 0; m + 1 < critical.size(); ++m) {
@@ -289,6 +308,13 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
         Stretch& st = stretches[m];
         const double s0 = grid.points[st.first].s_mm;
         const double length = grid.points[st.last].s_mm - s0;
+        const PlannedStretch key{st, v[m], v[m + 1]};
+        auto found = planned.find({st.first, st.last});
+        if (found != planned.end() && found->second.same_as(key)) {
+          st.law = found->second.stretch.law;
+          if (found->second.worst > 0) added.push_back(found->second.worst);
+          continue;
+        }
         st.law = jerk_min_time_move(AxisBoundary{0.0, length, v[m], v[m + 1]},
                                     std::max({st.v_cap, v[m], v[m + 1]}), st.accel, st.jerk);
         size_t worst = 0;
@@ -302,6 +328,9 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
           }
         }
         if (worst > 0) added.push_back(worst);
+        PlannedStretch& entry = planned[{st.first, st.last}];
+        entry = PlannedStretch{st, v[m], v[m + 1]};
+        entry.worst = worst;
       }
       if (added.empty()) break;
       if (insertion > n)
