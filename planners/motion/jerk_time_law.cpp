@@ -188,6 +188,51 @@ void settle_speeds(std::vector<double>& v, const std::vector<Stretch>& stretches
   throw InternalError(grid.name + ": jerk-limited critical speeds did not settle");
 }
 
+// the S-curve from speed va to vb (zero acceleration at both ends) appended to law, as
+// motion/jerk.cpp builds it: triangular acceleration below the knee a^2 / j, else trapezoidal
+void append_ramp(AxisProfile& law, double va, double vb, double accel, double jerk) {
+  const double dv = std::abs(vb - va), sign = vb >= va ? 1.0 : -1.0;
+  if (dv == 0.0) return;
+  if (dv <= accel * accel / jerk) {
+    const double t_ramp = std::sqrt(dv / jerk);
+    law.append_jerk(t_ramp, sign * jerk);
+    law.append_jerk(t_ramp, -sign * jerk);
+  } else {
+    const double t_ramp = accel / jerk;
+    law.append_jerk(t_ramp, sign * jerk);
+    law.append_jerk(dv / accel - t_ramp, 0.0);
+    law.append_jerk(t_ramp, -sign * jerk);
+  }
+}
+
+// The time-optimal double-S over length L from v0 to v1 (both >= 0, L holding their S-curve:
+// settle_speeds) with speeds up to v_cap: S-curve up to the highest peak whose two S-curves
+// fit in L, cruise there for the rest (Biagiotti & Melchiorri sec. 3.4; motion/jerk.hpp's
+// jerk_min_time_move for this forward case, without its general feasible-duration search).
+AxisProfile forward_double_s(double L, double v0, double v1, double v_cap, double accel,
+                             double jerk) {
+  const auto rooms = [&](double peak) {
+    return ramp_room(v0, peak, accel, jerk) + ramp_room(peak, v1, accel, jerk);
+  };
+  double lo = std::max(v0, v1), hi = std::max(lo, v_cap);
+  if (rooms(hi) <= L) {
+    lo = hi;
+  } else {
+    for (int i = 0; i < 200; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      if (mid <= lo || mid >= hi) break;
+      (rooms(mid) <= L ? lo : hi) = mid;
+    }
+  }
+  const double peak = lo;
+  AxisProfile law(0.0, v0);
+  append_ramp(law, v0, peak, accel, jerk);
+  const double cruise_s = peak > 0.0 ? (L - rooms(peak)) / peak : 0.0;
+  if (cruise_s > 1e-13 * (1.0 + law.duration_s())) law.append_jerk(cruise_s, 0.0);
+  append_ramp(law, peak, v1, accel, jerk);
+  return law;
+}
+
 // the path speed where a law reaches distance q (q within it: its speed is never negative)
 double speed_at_distance(const AxisProfile& law, double q) {
   double lo = 0.0, hi = law.duration_s();
@@ -315,8 +360,7 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
           if (found->second.worst > 0) added.push_back(found->second.worst);
           continue;
         }
-        st.law = jerk_min_time_move(AxisBoundary{0.0, length, v[m], v[m + 1]},
-                                    std::max({st.v_cap, v[m], v[m + 1]}), st.accel, st.jerk);
+        st.law = forward_double_s(length, v[m], v[m + 1], st.v_cap, st.accel, st.jerk);
         size_t worst = 0;
         double worst_ratio = 1.0 + 1e-9;
         for (size_t i = st.first + 1; i < st.last; ++i) {
