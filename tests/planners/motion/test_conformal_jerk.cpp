@@ -86,5 +86,75 @@ TEST(ConformalJerk, RandomToolpathsStayWithinTheJerkLimit) {
               worst);
 }
 
+// A path whose tool axis turns over a fillet, planned through a joint map with a slow tilt
+// joint (the tool axis' angle from +z in the xz-plane, as an arm's wrist): under a TCP j_max
+// the joint still binds (the TOPP-RA ceiling carries its limits), the TCP's finite-difference
+// jerk stays within j_max + 1 %, and the tilt joint within its speed and acceleration by
+// differences of the 1 ms samples (0.5 %, as without j_max in test_conformal.cpp).
+TEST(ConformalJerk, JointLimitedFilletStaysWithinTcpJerkAndJointLimits) {
+  constexpr double kTiltVmax = 1.0, kTiltAmax = 50.0;  // rad/s, rad/s^2
+  auto map = std::make_shared<JointMap>();
+  map->limits = {JointLimit{"x", -1e3, 1e3, 1e4, 1e6, 0}, JointLimit{"y", -1e3, 1e3, 1e4, 1e6, 0},
+                 JointLimit{"z", -1e3, 1e3, 1e4, 1e6, 0},
+                 JointLimit{"tilt", -kPi, kPi, kTiltVmax, kTiltAmax, 0}};
+  map->solve = [](const std::vector<Pose>& poses, std::vector<JointVector>& joints, std::string*) {
+    joints.resize(poses.size());
+    for (size_t i = 0; i < poses.size(); ++i)
+      joints[i] = {poses[i].position_mm.x(), poses[i].position_mm.y(), poses[i].position_mm.z(),
+                   std::atan2(poses[i].tool_axis.x(), poses[i].tool_axis.z())};
+    return true;
+  };
+  const MachineLimits tcp = MachineLimits::uniform(1000.0, 5000.0, 100000.0);
+  const TcpLimits limits(
+      tcp, [tcp](const Vec3&, const Vec3&) { return tcp; }, map);
+  // floor, a 2 mm fillet turning 45 deg in 3 edges, a 45 deg slope; normals the surface's
+  PrintPath path;
+  path.speed_mm_s = 20.0;
+  for (int i = 0; i <= 20; ++i) {
+    path.points.emplace_back(0.5 * i, 0.0, 0.0);
+    path.normals.push_back(Vec3::UnitZ());
+  }
+  const Vec3 centre(10.0, 0.0, 2.0);
+  for (int i = 1; i <= 3; ++i) {
+    const double theta = -kPi / 2 + (kPi / 4) * i / 3;
+    path.points.push_back(centre + 2.0 * Vec3(std::cos(theta), 0.0, std::sin(theta)));
+    path.normals.push_back((centre - path.points.back()).normalized());
+  }
+  const Vec3 up = Vec3(1, 0, 1).normalized(), start = path.points.back();
+  for (int i = 1; i <= 20; ++i) {
+    path.points.push_back(start + 0.5 * i * up);
+    path.normals.push_back(Vec3(-1, 0, 1).normalized());
+  }
+  const Toolpath toolpath = one_path(path);
+  const Trajectory plan = planner_with(ConformalControl::none).plan(toolpath, limits);
+  testing_support::expect_contract(plan, toolpath, tcp);
+  testing_support::expect_finite_difference_limits(plan, tcp, 0.01);
+  double velocity = 0.0, acceleration = 0.0, slowest_mm_s = path.speed_mm_s;
+  for (const TrajectoryPiece& piece : plan.pieces()) {
+    const SampledMotion& motion = std::get<SampledMotion>(piece.motion);
+    std::vector<double> q;
+    for (const Vec3& axis : motion.tool_axis) q.push_back(std::atan2(axis.x(), axis.z()));
+    const double h = motion.period_s;
+    for (size_t k = 0; k + 1 < q.size(); ++k)
+      velocity = std::max(velocity, std::abs(q[k + 1] - q[k]) / h / kTiltVmax);
+    for (size_t k = 1; k + 1 < q.size(); ++k)
+      acceleration =
+          std::max(acceleration, std::abs(q[k + 1] - 2 * q[k] + q[k - 1]) / (h * h) / kTiltAmax);
+    // the print speed on the fillet (x in 10.5 .. 11): the tilt joint slows it below 20 mm/s
+    if (piece.depositing)
+      for (size_t k = 0; k < motion.position_mm.size(); ++k)
+        if (motion.position_mm[k].x() > 10.5 && motion.position_mm[k].x() < 11.0)
+          slowest_mm_s = std::min(slowest_mm_s, motion.velocity_mm_s[k].norm());
+  }
+  EXPECT_LE(velocity, 1.005);
+  EXPECT_LE(acceleration, 1.005);
+  EXPECT_GT(velocity, 0.9);  // the joint binds
+  EXPECT_LT(slowest_mm_s, 0.5 * path.speed_mm_s);
+  std::printf(
+      "conformal on the fillet under j_max: tilt peak speed %.4f, acceleration %.4f of "
+      "its limits; TCP jerk %.4f of j_max\n",
+      velocity, acceleration, testing_support::finite_difference_peaks(plan, tcp).max_jerk_ratio());
+}
+
 }  // namespace
 }  // namespace depotwin
