@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/number_text.hpp"
+#include "planners/motion/jerk_time_law.hpp"
 #include "planners/motion/path_parametrization.hpp"
 
 namespace depotwin {
@@ -38,14 +39,37 @@ constexpr size_t kMaxDetailedWarnings = 20;
 // point) to corner + delta d_out, by arc length. |B'(u)| = 2 delta sqrt(2 (1 - c)) sqrt(w^2 + k^2)
 // with c = d_in . d_out, w = u - 1/2, k^2 = (1 + c) / (4 (1 - c)): the arc length is closed
 // form (asinh), inverted by safeguarded Newton.
+//
+// Under a jerk limit (curvature_continuous) the blend is the quartic with control points
+// corner - delta d_in, corner - delta/2 d_in, corner, corner + delta/2 d_out, corner + delta
+// d_out (bezier_curve.hpp's degree-4 blend with weight 1): the same ends and tangents, zero
+// curvature at both ends, so the curvature, and with it the acceleration at any speed, is
+// continuous along the path. It passes the corner at (3 delta / 8) sin(theta / 2), within the
+// quadratic's bound. Its arc length is integrated (Gauss-Legendre on 64 panels) and inverted
+// by the same Newton iteration.
 class Blend {
  public:
-  Blend(const Vec3& corner, const Vec3& d_in, const Vec3& d_out, double delta)
+  Blend(const Vec3& corner, const Vec3& d_in, const Vec3& d_out, double delta,
+        bool curvature_continuous = false)
       : corner_(corner), e0_(delta * d_in), e1_(delta * d_out), delta_(delta) {
     start_ = corner - e0_;
     end_ = corner + e1_;
     const double c = std::clamp(d_in.dot(d_out), -1.0, 1.0);
     straight_ = 1.0 - c < 1e-10;
+    quartic_ = curvature_continuous && !straight_;
+    if (quartic_) {
+      // the quartic's first and second derivative control points (forward differences)
+      const Vec3 q[5] = {start_, corner - 0.5 * e0_, corner, corner + 0.5 * e1_, end_};
+      for (int i = 0; i < 4; ++i) first_[i] = 4.0 * (q[i + 1] - q[i]);
+      for (int i = 0; i < 3; ++i) second_[i] = 3.0 * (first_[i + 1] - first_[i]);
+      for (int i = 0; i < 5; ++i) points_[i] = q[i];
+      panel_length_[0] = 0.0;
+      for (int p = 0; p < kPanels; ++p)
+        panel_length_[p + 1] =
+            panel_length_[p] + gauss_length(double(p) / kPanels, double(p + 1) / kPanels);
+      length_ = panel_length_[kPanels];
+      return;
+    }
     if (!straight_) {
       scale_ = 2.0 * delta * std::sqrt(2.0 * (1.0 - c));
       k2_ = (1.0 + c) / (4.0 * (1.0 - c));
@@ -78,27 +102,54 @@ class Blend {
   }
 
   Vec3 point(double u) const {
+    if (quartic_) return bernstein(points_, 4, u);
     return (1 - u) * (1 - u) * start_ + 2 * u * (1 - u) * corner_ + u * u * end_;
   }
 
   // position and arc-length derivatives at parameter u
   void at(double u, Vec3& p, Vec3& d1, Vec3& d2) const {
     p = point(u);
-    const Vec3 du = 2.0 * ((1 - u) * e0_ + u * e1_);
-    const Vec3 duu = 2.0 * (e1_ - e0_);
+    const Vec3 du = quartic_ ? bernstein(first_, 3, u) : Vec3(2.0 * ((1 - u) * e0_ + u * e1_));
+    const Vec3 duu = quartic_ ? bernstein(second_, 2, u) : Vec3(2.0 * (e1_ - e0_));
     const double speed_u = du.norm();
     d1 = du / speed_u;
     d2 = (duu - duu.dot(d1) * d1) / (speed_u * speed_u);
   }
 
  private:
+  static constexpr int kPanels = 64;
+
+  // sum of control points c_0..c_m times the Bernstein polynomials of degree m at u
+  static Vec3 bernstein(const Vec3* c, int m, double u) {
+    Vec3 b[5];
+    for (int i = 0; i <= m; ++i) b[i] = c[i];
+    for (int level = 1; level <= m; ++level)
+      for (int i = 0; i <= m - level; ++i) b[i] = (1.0 - u) * b[i] + u * b[i + 1];
+    return b[0];
+  }
+  // the quartic's arc length over [u0, u1] (4-point Gauss-Legendre)
+  double gauss_length(double u0, double u1) const {
+    static constexpr double kNode[2] = {0.3399810435848563, 0.8611363115940526};
+    static constexpr double kWeight[2] = {0.6521451548625461, 0.3478548451374538};
+    const double mid = 0.5 * (u0 + u1), half = 0.5 * (u1 - u0);
+    double length = 0.0;
+    for (int k = 0; k < 2; ++k)
+      for (const double sign : {-1.0, 1.0})
+        length += kWeight[k] * half * speed(mid + sign * half * kNode[k]);
+    return length;
+  }
   double g(double w) const { return w * std::sqrt(w * w + k2_) + k2_ * std::asinh(w / k_); }
   double arc(double u) const {
     if (straight_) return 2.0 * delta_ * u;
+    if (quartic_) {
+      const int panel = std::clamp(static_cast<int>(u * kPanels), 0, kPanels - 1);
+      return panel_length_[panel] + gauss_length(double(panel) / kPanels, u);
+    }
     return 0.5 * scale_ * (g(u - 0.5) - g0_);
   }
   double speed(double u) const {
     if (straight_) return 2.0 * delta_;
+    if (quartic_) return bernstein(first_, 3, u).norm();
     const double w = u - 0.5;
     return scale_ * std::sqrt(w * w + k2_);
   }
@@ -106,6 +157,9 @@ class Blend {
   Vec3 corner_, e0_, e1_, start_, end_;
   double delta_ = 0.0, scale_ = 0.0, k2_ = 0.0, k_ = 0.0, g0_ = 0.0, length_ = 0.0;
   bool straight_ = false;
+  bool quartic_ = false;
+  Vec3 points_[5], first_[4], second_[3];
+  double panel_length_[kPanels + 1] = {};
 };
 
 // The orientation over a blend: a spherical quadratic Bezier of the axis (de Casteljau with
@@ -150,7 +204,7 @@ struct Polyline {
   std::vector<double> delta;  // per point; 0 at both ends
 };
 
-std::vector<Piece> fly_by_pieces(const Polyline& polyline) {
+std::vector<Piece> fly_by_pieces(const Polyline& polyline, bool curvature_continuous = false) {
   std::vector<Piece> pieces;
   const size_t n = polyline.points.size();
   // a line left between two blends is either none (they touch) or at least kMinLineMm: a
@@ -190,7 +244,7 @@ std::vector<Piece> fly_by_pieces(const Polyline& polyline) {
       const double next_length = (p2 - p1).norm();
       Piece blend;
       blend.is_blend = true;
-      blend.blend = Blend(p1, dir, (p2 - p1) / next_length, d1);
+      blend.blend = Blend(p1, dir, (p2 - p1) / next_length, d1, curvature_continuous);
       blend.length = blend.blend.length();
       blend.orientation_blend = {
           slerp_orientation(line.orientations[e], line.orientations[e + 1], 1.0 - d1 / length),
@@ -394,7 +448,8 @@ struct PathGeometry {
   double max_deviation_mm = 0.0;    // of the blended path from the polyline's points
 };
 
-PathGeometry print_geometry(const PrintPath& path, const ConformalSettings& settings) {
+PathGeometry print_geometry(const PrintPath& path, const ConformalSettings& settings,
+                            bool curvature_continuous = false) {
   PathGeometry out;
   Polyline& line = out.polyline;
   const size_t n = path.points.size();
@@ -426,8 +481,9 @@ PathGeometry print_geometry(const PrintPath& path, const ConformalSettings& sett
       continue;
     }
     line.delta[i] = delta;
-    // the blend passes P_i at its apex, (delta / 2) sin(turn / 2) away, or nearer
-    const Blend blend(path.points[i], d_in, d_out, delta);
+    // the blend passes P_i at its apex, (delta / 2) sin(turn / 2) away, or nearer (the quartic
+    // at 3/8 of it)
+    const Blend blend(path.points[i], d_in, d_out, delta, curvature_continuous);
     double nearest = (blend.point(0.5) - path.points[i]).norm();
     for (int k = 0; k <= 64; ++k)
       nearest = std::min(nearest, (blend.point(k / 64.0) - path.points[i]).norm());
@@ -505,7 +561,8 @@ constexpr double kTravelCorridor_mm = 2.0;
 // Empty when there is nothing to do.
 PathGrid transition_grid(const Vec3& p0, const ToolOrientation& o0, const Vec3& p1,
                          const ToolOrientation& o1, double lift_mm, double ds,
-                         const std::string& name, const PathHeights* heights = nullptr) {
+                         const std::string& name, const PathHeights* heights = nullptr,
+                         bool curvature_continuous = false) {
   const bool same_orientation = o0.axis == o1.axis && o0.roll_rad == o1.roll_rad;
   if ((p1 - p0).norm() <= kSamePoint && same_orientation) return {};
   if ((p1 - p0).norm() <= kSamePoint && lift_mm <= 0.0) lift_mm = kTurnInPlaceLiftMm;
@@ -543,7 +600,7 @@ PathGrid transition_grid(const Vec3& p0, const ToolOrientation& o0, const Vec3& 
     if (axis_angle_rad(in, out) > kMaxBlendTurnRad) continue;  // reverse: stop there
     line.delta[i] = 0.5 * std::min(in.norm(), out.norm());
   }
-  PathGrid grid = polyline_grid(fly_by_pieces(line), ds, kInf, name);
+  PathGrid grid = polyline_grid(fly_by_pieces(line, curvature_continuous), ds, kInf, name);
   // the turn: from where the lift leg's straight part ends to where the lowering's begins
   const double total = grid.length_mm();
   double s1 = 0.0, s2 = total;
@@ -648,6 +705,28 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
       settings.control == ConformalControl::speed || settings.control == ConformalControl::both;
   const bool flow_follows =
       settings.control == ConformalControl::flow || settings.control == ConformalControl::both;
+  // a jerk limit in force anywhere on the job: curvature-continuous blends and the
+  // jerk-limited law over the TOPP-RA profile (jerk_time_law.hpp)
+  Vec3 job_lo = toolpath.start_mm.cwiseMin(toolpath.end_mm);
+  Vec3 job_hi = toolpath.start_mm.cwiseMax(toolpath.end_mm);
+  for (const PrintPath& path : toolpath.paths)
+    for (const Vec3& p : path.points) {
+      job_lo = job_lo.cwiseMin(p);
+      job_hi = job_hi.cwiseMax(p);
+    }
+  const bool jerk_limited =
+      limits.requested().jerk_limited() || limits.over(job_lo, job_hi).jerk_limited();
+  const auto time_law = [&](const PathGrid& grid, const std::vector<MachineLimits>& interval_limits,
+                            const TimeLawOptions& options) {
+    return jerk_limited ? jerk_limited_time_path(grid, interval_limits, settings.period_s, options)
+                        : time_path(grid, interval_limits, settings.period_s, options);
+  };
+  const auto speed_bound = [&](const PathGrid& grid,
+                               const std::vector<MachineLimits>& interval_limits,
+                               const TimeLawOptions& options) {
+    return jerk_limited ? jerk_constant_speed_bound(grid, interval_limits, options)
+                        : constant_speed_bound(grid, interval_limits, options);
+  };
   if (report) {
     *report = ConformalPlanReport{};
     report->gaps = conformal_report(toolpath, settings.gap_offset_mm);
@@ -673,22 +752,22 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
   std::string unlifted_first;
   const auto add_transition = [&](const Vec3& p0, const ToolOrientation& o0, const Vec3& p1,
                                   const ToolOrientation& o1, const std::string& name) {
-    PathGrid grid =
-        transition_grid(p0, o0, p1, o1, settings.lift_mm, settings.ds_mm, name, &heights);
+    PathGrid grid = transition_grid(p0, o0, p1, o1, settings.lift_mm, settings.ds_mm, name,
+                                    &heights, jerk_limited);
     if (grid.points.empty()) return;
     if (joints) {
       try {
         attach_joints_with_headroom(grid, *joints);
       } catch (const InputError& error) {
         if (settings.lift_mm <= 0.0) throw;
-        PathGrid straight = transition_grid(p0, o0, p1, o1, 0.0, settings.ds_mm, name);
+        PathGrid straight =
+            transition_grid(p0, o0, p1, o1, 0.0, settings.ds_mm, name, nullptr, jerk_limited);
         attach_joints_with_headroom(straight, *joints);
         grid = std::move(straight);
         if (unlifted++ == 0) unlifted_first = error.what();
       }
     }
-    const TimedPath timed =
-        time_path(grid, interval_tcp_limits(grid, limits, kChunkMm), settings.period_s);
+    const TimedPath timed = time_law(grid, interval_tcp_limits(grid, limits, kChunkMm), {});
     TrajectoryPiece piece = sampled_piece(timed.samples, t);
     piece.path_index = -1;
     piece.depositing = false;
@@ -707,7 +786,7 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
                    "transition to " + name);
 
     // the flown-by path on its grid, with the joints along it
-    const PathGeometry geometry = print_geometry(path, settings);
+    const PathGeometry geometry = print_geometry(path, settings, jerk_limited);
     for (const size_t i : geometry.sharp_stops) {
       std::ostringstream msg;
       msg << name << ": stops at point " << i << ": the path turns by more than 170 deg";
@@ -725,8 +804,8 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
           << " mm from a point, beyond zone_mm / 2 = " << 0.5 * settings.zone_mm << " mm";
       warn(msg.str());
     }
-    PathGrid grid =
-        polyline_grid(fly_by_pieces(geometry.polyline), settings.ds_mm, path.speed_mm_s, name);
+    PathGrid grid = polyline_grid(fly_by_pieces(geometry.polyline, jerk_limited), settings.ds_mm,
+                                  path.speed_mm_s, name);
     grid.points.front().tool_axis = path.tool_axis(0);
     grid.points.back().tool_axis = path.tool_axis(path.points.size() - 1);
     if (joints) attach_joints_with_headroom(grid, *joints);
@@ -734,9 +813,8 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
 
     // the time law; `speed` and `both` cruise at the largest constant speed no limit slows
     TimeLawOptions options;
-    const double bound = constant_speed || report
-                             ? constant_speed_bound(grid, interval_limits, options)
-                             : std::numeric_limits<double>::quiet_NaN();
+    const double bound = constant_speed || report ? speed_bound(grid, interval_limits, options)
+                                                  : std::numeric_limits<double>::quiet_NaN();
     double line_speed = path.speed_mm_s;
     if (constant_speed) {
       line_speed = std::min(path.speed_mm_s, bound);
@@ -746,13 +824,13 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     TimedPath timed;
     for (int round = 0; round < 8; ++round) {
       set_cruise_speed(grid, line_speed);
-      timed = time_path(grid, interval_limits, settings.period_s, options);
+      timed = time_law(grid, interval_limits, options);
       if (!constant_speed) break;
       // the accelerations the law was planned with (the sampling margin, repairs) can lower
       // the constant speed: plan again at the speed they allow
       TimeLawOptions planned;
       planned.tcp_accel_scale = timed.tcp_accel_scale;
-      const double lowered = constant_speed_bound(grid, interval_limits, planned);
+      const double lowered = speed_bound(grid, interval_limits, planned);
       if (lowered >= line_speed * (1 - 1e-12)) break;
       line_speed = lowered;
       options.tcp_accel_scale = timed.repair_scale;  // time_path adds its margins again

@@ -53,6 +53,13 @@
 // tool in place (lift_mm = 0) lifts by 1 mm to do so. Where the machine's joint map cannot
 // reach the lifted poses (a machine without a z axis) the transition goes straight, and one
 // warning says how many did.
+//
+// Under a jerk limit (a j_max in force anywhere on the job) every blend, of print paths and of
+// transitions, is the quartic with zero curvature at both ends (continuous curvature, so the
+// acceleration has no step at any speed), and the time law is jerk_time_law.hpp's: double-S
+// moves in arc length under the TOPP-RA profile, each TCP axis' jerk within its j_max on the
+// samples by finite differences. `speed` and `both` cruise at jerk_constant_speed_bound.
+// Joint jerk is not planned (arm6 refuses a joint j_max).
 #pragma once
 
 #include <memory>

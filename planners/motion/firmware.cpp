@@ -30,6 +30,10 @@ void move_caps(const Vec3& u, const MachineLimits& limits, double max_velocity, 
   }
 }
 
+// S-curve mode: the axes' speed caps keep this share (the cubic interpolation between samples
+// rounds a ramp's approach to its cruise by about 1e-6 of the speed)
+constexpr double kSCurveSpeedShare = 1.0 - 1e-5;
+
 // sin and cos of half of Marlin's junction angle theta, cos(theta) = -u_prev . u_next
 void half_angle(const Vec3& u_prev, const Vec3& u_next, double& sin_half, double& cos_half) {
   const double cos_theta = std::clamp(-u_prev.dot(u_next), -1.0, 1.0);
@@ -72,26 +76,229 @@ AxisProfile rest_to_rest(double length, double v, double a) {
   return s;
 }
 
+// ---------------------------------------------------------------------------------------
+// S_CURVE_ACCELERATION (jerk-limited mode): quintic Bezier ramps and junction blends
+
+// a Bezier ramp between speeds va and vb fits in `length` (its distance is (va + vb) / 2 T)
+bool s_curve_fits(double va, double vb, double length, double accel, double jerk) {
+  return 0.5 * (va + vb) * s_curve_ramp_time(vb - va, accel, jerk) <= length * (1 + 1e-12) + 1e-12;
+}
+
+// the highest speed in [low, high] whose ramp to or from `low` fits in `length`
+double s_curve_reach(double low, double high, double length, double accel, double jerk) {
+  if (s_curve_fits(low, high, length, accel, jerk)) return high;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (low + high);
+    if (mid <= low || mid >= high) break;
+    (s_curve_fits(low, mid, length, accel, jerk) ? low : high) = mid;
+  }
+  return low;
+}
+
+// The passes with Bezier ramps: every junction speed within its cap (rest at both ends) and
+// every move able to ramp between its end speeds. The distance a ramp needs is not monotone in
+// its lower speed (a faster start can need more room: (va + vb) / 2 grows faster than T
+// shrinks), so the passes repeat until nothing changes; each change lowers the higher speed of
+// a move that cannot hold its ramp, which only shortens that ramp.
+std::vector<double> s_curve_reachable_speeds(const std::vector<double>& caps,
+                                             const std::vector<double>& accel,
+                                             const std::vector<double>& jerk,
+                                             const std::vector<double>& length) {
+  const size_t n = length.size();
+  std::vector<double> v = caps;
+  v.front() = 0.0;
+  v.back() = 0.0;
+  const auto settle = [&](size_t k) {
+    if (s_curve_fits(v[k], v[k + 1], length[k], accel[k], jerk[k])) return false;
+    const bool first_higher = v[k] > v[k + 1];
+    const double low = first_higher ? v[k + 1] : v[k], high = first_higher ? v[k] : v[k + 1];
+    (first_higher ? v[k] : v[k + 1]) = s_curve_reach(low, high, length[k], accel[k], jerk[k]);
+    return true;
+  };
+  for (int sweep = 0; sweep < 10000; ++sweep) {
+    bool changed = false;
+    for (size_t k = 0; k < n; ++k) changed = settle(k) || changed;
+    for (size_t k = n; k-- > 0;) changed = settle(k) || changed;
+    if (!changed) return v;
+  }
+  throw InternalError("firmware: S-curve look-ahead passes did not settle");
+}
+
+// The time over which junction blends turn the velocity (S-curve mode): per unit of junction
+// speed, the acceleration part 15/8 max_i |du_i| / a_i and the jerk part 10/sqrt(3) max_i
+// |du_i| / j_i; tau(v) = max(v g_a, sqrt(v g_j), kSCurveMinTime_s), 0 for collinear moves.
+struct SCurveBlend {
+  double per_speed = 0.0;       // g_a, s per mm/s
+  double per_speed_jerk = 0.0;  // g_j, s^2 per mm/s
+  double time(double v) const {
+    if (!(v > 0.0) || (per_speed <= 0.0 && per_speed_jerk <= 0.0)) return 0.0;
+    return std::max({v * per_speed, std::sqrt(v * per_speed_jerk), kSCurveMinTime_s});
+  }
+  // the largest junction speed whose blend holds it for at most `room` on each side:
+  // v tau(v) / 2 <= room
+  double speed_cap(double room) const {
+    if (per_speed <= 0.0 && per_speed_jerk <= 0.0) return kInfinity;
+    double cap = 2.0 * room / kSCurveMinTime_s;
+    if (per_speed > 0.0) cap = std::min(cap, std::sqrt(2.0 * room / per_speed));
+    if (per_speed_jerk > 0.0) cap = std::min(cap, std::cbrt(4.0 * room * room / per_speed_jerk));
+    return cap;
+  }
+};
+
+SCurveBlend s_curve_blend(const Vec3& u_prev, const Vec3& u_next, const Vec3& axis_accel,
+                          const Vec3& axis_jerk) {
+  SCurveBlend blend;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double du = std::abs(u_next[axis] - u_prev[axis]);
+    blend.per_speed =
+        std::max(blend.per_speed, kSCurvePeakAccel * du / (kSCurveLimitShare * axis_accel[axis]));
+    if (axis_jerk[axis] > 0.0)
+      blend.per_speed_jerk = std::max(blend.per_speed_jerk,
+                                      kSCurvePeakJerk * du / (kSCurveLimitShare * axis_jerk[axis]));
+  }
+  return blend;
+}
+
+// One stretch of a sampled S-curve move: the velocity is v_base + dv B((offset + t) / shape)
+// for t in [0, duration] (dv = 0: constant velocity), starting at p0.
+struct SCurveStretch {
+  double duration_s = 0.0;
+  Vec3 p0 = Vec3::Zero();
+  Vec3 v_base = Vec3::Zero();
+  Vec3 dv = Vec3::Zero();
+  double shape_s = 0.0;
+  double offset_s = 0.0;
+
+  void at(double t, Vec3& position, Vec3& velocity) const {
+    if (shape_s <= 0.0 || dv == Vec3::Zero()) {
+      position = p0 + v_base * t;
+      velocity = v_base;
+      return;
+    }
+    const double x0 = offset_s / shape_s, x = (offset_s + t) / shape_s;
+    position =
+        p0 + v_base * t + dv * (shape_s * (s_curve_shape_integral(x) - s_curve_shape_integral(x0)));
+    velocity = v_base + dv * s_curve_shape(x);
+  }
+};
+
+// A move's stretches, chained from p0: each starts where the previous one ends.
+class SCurveMotion {
+ public:
+  explicit SCurveMotion(const Vec3& p0) : end_(p0) {}
+  void add(double duration_s, const Vec3& v_base, const Vec3& dv, double shape_s,
+           double offset_s = 0.0) {
+    if (!(duration_s > 0.0)) return;
+    SCurveStretch stretch{duration_s, end_, v_base, dv, shape_s, offset_s};
+    Vec3 velocity;
+    stretch.at(duration_s, end_, velocity);
+    stretches_.push_back(stretch);
+  }
+  // the ramp from speed v0 to v1 along u
+  void ramp(const Vec3& u, double v0, double v1, double time_s) {
+    add(time_s, v0 * u, (v1 - v0) * u, time_s);
+  }
+  double duration_s() const {
+    double total = 0.0;
+    for (const SCurveStretch& s : stretches_) total += s.duration_s;
+    return total;
+  }
+  // samples at most 1 ms apart, a whole number of them over the duration; the last one is put
+  // exactly on `end_mm`, where the next piece starts
+  SampledMotion sampled(const Vec3& end_mm) const {
+    const double duration = duration_s();
+    const int periods =
+        std::max(1, static_cast<int>(std::ceil(duration / kSCurveSamplePeriod_s - 1e-9)));
+    SampledMotion motion;
+    motion.period_s = duration / periods;
+    motion.position_mm.resize(periods + 1);
+    motion.velocity_mm_s.resize(periods + 1);
+    size_t index = 0;
+    double stretch_begin = 0.0;
+    for (int k = 0; k <= periods; ++k) {
+      const double t = k == periods ? duration : k * motion.period_s;
+      while (index + 1 < stretches_.size() && t > stretch_begin + stretches_[index].duration_s) {
+        stretch_begin += stretches_[index].duration_s;
+        ++index;
+      }
+      const SCurveStretch& s = stretches_[index];
+      s.at(std::min(t - stretch_begin, s.duration_s), motion.position_mm[k],
+           motion.velocity_mm_s[k]);
+    }
+    motion.position_mm.back() = end_mm;
+    return motion;
+  }
+
+  static constexpr double kSCurveSamplePeriod_s = 0.001;
+
+ private:
+  Vec3 end_;
+  std::vector<SCurveStretch> stretches_;
+};
+
+// the fastest peak <= cap of a move from v0 to v1 whose two ramps fit in `length`
+double s_curve_peak(double v0, double v1, double cap, double length, double accel, double jerk) {
+  const auto fits = [&](double peak) {
+    return 0.5 * (v0 + peak) * s_curve_ramp_time(peak - v0, accel, jerk) +
+               0.5 * (peak + v1) * s_curve_ramp_time(peak - v1, accel, jerk) <=
+           length * (1 + 1e-12) + 1e-12;
+  };
+  double low = std::max(v0, v1), high = std::max(low, cap);
+  if (fits(high)) return high;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (low + high);
+    if (mid <= low || mid >= high) break;
+    (fits(mid) ? low : high) = mid;
+  }
+  return low;
+}
+
+// the move's jerk along unit direction u under per-axis limits (0 on an axis: none there)
+double move_jerk(const Vec3& u, const MachineLimits& limits) {
+  double jerk = kInfinity;
+  for (int axis = 0; axis < 3; ++axis)
+    if (std::abs(u[axis]) >= 1e-15 && limits.axes[axis].j_max_mm_s3 > 0.0)
+      jerk = std::min(jerk, limits.axes[axis].j_max_mm_s3 / std::abs(u[axis]));
+  return jerk;
+}
+
 // A travel (material off): rest to rest along the line at the machine's speed, the tool
 // turning in time (smoothstep) as in transition_piece.
 TrajectoryPiece travel_piece(double t_begin_s, const Vec3& from, const Vec3& to,
                              const TcpLimits& limits, const FirmwareSettings& settings,
-                             const ToolOrientation& tool0, const ToolOrientation& tool1) {
+                             const ToolOrientation& tool0, const ToolOrientation& tool1,
+                             bool s_curve) {
   const double length = (to - from).norm();
   const Vec3 u = (to - from) / length;
   double v = 0.0, a = 0.0;
-  move_caps(u, limits.along(from, to), settings.max_velocity, settings.max_accel, v, a);
-  const AxisProfile along = rest_to_rest(length, v, a);
-  PhaseMotion motion;
-  for (int axis = 0; axis < 3; ++axis) {
-    AxisProfile profile(from[axis], 0.0);
-    for (const Phase& phase : along.phases()) profile.append(phase.duration_s, u[axis] * phase.a0);
-    motion.axes[axis] = std::move(profile);
-  }
+  const MachineLimits along_limits = limits.along(from, to);
+  move_caps(u, along_limits, settings.max_velocity, settings.max_accel, v, a);
+  if (s_curve) v *= kSCurveSpeedShare;
   TrajectoryPiece piece;
   piece.t_begin_s = t_begin_s;
-  piece.t_end_s = t_begin_s + along.duration_s();
-  piece.motion = std::move(motion);
+  if (s_curve) {
+    // Bezier ramps up to the highest peak both ramps leave room for, cruise, ramp down
+    const double jerk = move_jerk(u, along_limits);
+    const double peak = s_curve_peak(0.0, 0.0, v, length, a, jerk);
+    const double ramp_s = s_curve_ramp_time(peak, a, jerk);
+    SCurveMotion motion(from);
+    motion.ramp(u, 0.0, peak, ramp_s);
+    motion.add((length - peak * ramp_s) / peak, peak * u, Vec3::Zero(), 0.0);
+    motion.ramp(u, peak, 0.0, ramp_s);
+    piece.t_end_s = t_begin_s + motion.duration_s();
+    piece.motion = motion.sampled(to);
+  } else {
+    const AxisProfile along = rest_to_rest(length, v, a);
+    PhaseMotion motion;
+    for (int axis = 0; axis < 3; ++axis) {
+      AxisProfile profile(from[axis], 0.0);
+      for (const Phase& phase : along.phases())
+        profile.append(phase.duration_s, u[axis] * phase.a0);
+      motion.axes[axis] = std::move(profile);
+    }
+    piece.t_end_s = t_begin_s + along.duration_s();
+    piece.motion = std::move(motion);
+  }
   piece.tool_axis.begin = tool0.axis;
   piece.tool_axis.end = tool1.axis;
   piece.tool_axis.roll_begin = tool0.roll_rad;
@@ -114,17 +321,38 @@ double klipper_junction_deviation(double square_corner_velocity, double max_acce
   return square_corner_velocity * square_corner_velocity * (std::sqrt(2.0) - 1.0) / max_accel_mm_s2;
 }
 
+double s_curve_shape(double x) {
+  return x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
+}
+
+double s_curve_shape_integral(double x) {
+  const double x2 = x * x;
+  return x2 * x2 * (2.5 + x * (-3.0 + x));
+}
+
+double s_curve_ramp_time(double dv, double accel_mm_s2, double jerk_mm_s3) {
+  dv = std::abs(dv);
+  if (dv == 0.0) return 0.0;
+  double time = kSCurvePeakAccel * dv / (kSCurveLimitShare * accel_mm_s2);
+  if (jerk_mm_s3 > 0.0 && std::isfinite(jerk_mm_s3))
+    time = std::max(time, std::sqrt(kSCurvePeakJerk * dv / (kSCurveLimitShare * jerk_mm_s3)));
+  return std::max(time, kSCurveMinTime_s);
+}
+
 FirmwareProfile firmware_lookahead(const std::vector<FirmwareMove>& moves,
-                                   const FirmwareSettings& settings, double junction_deviation_mm) {
+                                   const FirmwareSettings& settings, double junction_deviation_mm,
+                                   bool s_curve) {
   const size_t n = moves.size();
-  std::vector<double> length(n), accel(n), cruise2(n);
+  std::vector<double> length(n), accel(n), cruise2(n), jerk(n);
   for (size_t k = 0; k < n; ++k) {
     length[k] = moves[k].length_mm;
     accel[k] = moves[k].accel_mm_s2;
     cruise2[k] = moves[k].cruise_speed_mm_s * moves[k].cruise_speed_mm_s;
+    jerk[k] = moves[k].jerk_mm_s3;
   }
   // each junction's cap: both moves' top speeds, the junction deviation, and room for the blend
   std::vector<double> cap2(n + 1, 0.0), blend_per_speed(n + 1, 0.0);
+  std::vector<SCurveBlend> s_curve_blends(n + 1);
   for (size_t j = 1; j < n; ++j) {
     const FirmwareMove& prev = moves[j - 1];
     const FirmwareMove& next = moves[j];
@@ -144,6 +372,15 @@ FirmwareProfile firmware_lookahead(const std::vector<FirmwareMove>& moves,
       }
     }
     // the blend holds the junction speed for tau / 2 on each side: h = v^2 g / 2 <= share * d
+    if (s_curve) {
+      s_curve_blends[j] = s_curve_blend(prev.direction, next.direction, next.blend_accel_mm_s2,
+                                        next.blend_jerk_mm_s3);
+      const double room = kBlendShare * std::min(prev.length_mm, next.length_mm);
+      const double blend_cap = s_curve_blends[j].speed_cap(room);
+      c2 = std::min(c2, blend_cap * blend_cap);
+      cap2[j] = c2;
+      continue;
+    }
     blend_per_speed[j] =
         blend_time_per_speed(prev.direction, next.direction, next.blend_accel_mm_s2);
     if (blend_per_speed[j] > 0.0)
@@ -179,6 +416,25 @@ FirmwareProfile firmware_lookahead(const std::vector<FirmwareMove>& moves,
     for (size_t j = 1; j < n; ++j) cap2[j] = std::min({cap2[j], cruise2[j - 1], cruise2[j]});
   }
 
+  // S-curve mode: the same two rounds with the Bezier ramps' passes
+  if (s_curve) {
+    std::vector<double> caps(n + 1);
+    for (size_t j = 0; j <= n; ++j) caps[j] = std::sqrt(cap2[j]);
+    std::vector<double> v = s_curve_reachable_speeds(caps, accel, jerk, length);
+    std::vector<double> free_length(length);
+    for (size_t k = 0; k < n; ++k)
+      free_length[k] = length[k] - 0.5 * v[k] * s_curve_blends[k].time(v[k]) -
+                       0.5 * v[k + 1] * s_curve_blends[k + 1].time(v[k + 1]);
+    v = s_curve_reachable_speeds(caps, accel, jerk, free_length);
+    FirmwareProfile profile;
+    profile.junction_speed_mm_s = v;
+    profile.blend_time_s.resize(n + 1);
+    for (size_t j = 0; j <= n; ++j) profile.blend_time_s[j] = s_curve_blends[j].time(v[j]);
+    profile.cruise_speed_mm_s.resize(n);
+    for (size_t k = 0; k < n; ++k) profile.cruise_speed_mm_s[k] = std::sqrt(cruise2[k]);
+    return profile;
+  }
+
   // the passes over the whole moves, then again over what the blends leave of each move (the
   // blends shrink with the speeds, so the second answer's blends fit where the first's did)
   std::vector<double> v2 = reachable_speeds_squared(cap2, accel, length);
@@ -202,6 +458,65 @@ FirmwareProfile firmware_lookahead(const std::vector<FirmwareMove>& moves,
   return profile;
 }
 
+namespace {
+
+// The print moves of one chain in S-curve mode (see the header): per move, the second half of
+// its start junction's blend, the Bezier ramp to its peak, the cruise, the ramp to its end
+// speed and the first half of its end junction's blend; a piece runs from the middle of one
+// blend to the middle of the next (off the corner by 5 |dv| tau / 64), sampled.
+void append_s_curve_chain(const std::vector<PrintSegment>& segments, size_t first,
+                          const std::vector<FirmwareMove>& moves, const FirmwareProfile& profile,
+                          double& t, std::vector<TrajectoryPiece>& pieces) {
+  const auto& speed = profile.junction_speed_mm_s;
+  const auto& tau = profile.blend_time_s;
+  // the middle of junction j's blend (j between moves j - 1 and j), or the move's end point
+  const auto blend_middle = [&](size_t j, const Vec3& corner) -> Vec3 {
+    if (!(tau[j] > 0.0)) return corner;
+    const Vec3 dv = speed[j] * (moves[j].direction - moves[j - 1].direction);
+    return corner + dv * (tau[j] * s_curve_shape_integral(0.5));
+  };
+  for (size_t k = 0; k < moves.size(); ++k) {
+    const PrintSegment& s = segments[first + k];
+    const FirmwareMove& move = moves[k];
+    const Vec3& u = move.direction;
+    const double v0 = speed[k], v1 = speed[k + 1];
+    const double hold0 = tau[k] > 0.0 ? 0.5 * v0 * tau[k] : 0.0;
+    const double hold1 = tau[k + 1] > 0.0 ? 0.5 * v1 * tau[k + 1] : 0.0;
+    const double free_length = move.length_mm - hold0 - hold1;
+    const double peak = s_curve_peak(v0, v1, profile.cruise_speed_mm_s[k], free_length,
+                                     move.accel_mm_s2, move.jerk_mm_s3);
+    const double t_up = s_curve_ramp_time(peak - v0, move.accel_mm_s2, move.jerk_mm_s3);
+    const double t_down = s_curve_ramp_time(peak - v1, move.accel_mm_s2, move.jerk_mm_s3);
+    const double ramps_mm = 0.5 * (v0 + peak) * t_up + 0.5 * (peak + v1) * t_down;
+    const double t_cruise = peak > 0.0 ? std::max(0.0, free_length - ramps_mm) / peak : 0.0;
+
+    SCurveMotion motion(blend_middle(k, s.p0));
+    if (tau[k] > 0.0) {
+      // the second half of the start junction's blend: from the middle of its turn
+      const Vec3& u_prev = moves[k - 1].direction;
+      motion.add(0.5 * tau[k], v0 * u_prev, v0 * (u - u_prev), tau[k], 0.5 * tau[k]);
+    }
+    motion.ramp(u, v0, peak, t_up);
+    motion.add(t_cruise, peak * u, Vec3::Zero(), 0.0);
+    motion.ramp(u, peak, v1, t_down);
+    if (tau[k + 1] > 0.0)
+      motion.add(0.5 * tau[k + 1], v1 * u, v1 * (moves[k + 1].direction - u), tau[k + 1]);
+    TrajectoryPiece piece;
+    piece.t_begin_s = t;
+    piece.t_end_s = t + motion.duration_s();
+    piece.path_index = s.path_index;
+    piece.depositing = true;
+    piece.flow_lead_s = 0.0;  // the E axis tied to the motion, as in the look-ahead mode
+    piece.desired_speed_mm_s = s.speed_mm_s;
+    piece.motion = motion.sampled(blend_middle(k + 1, s.p1));
+    piece.tool_axis = segment_tool_axis(s.p0, s.tool0, s.p1, s.tool1);
+    pieces.push_back(std::move(piece));
+    t = pieces.back().t_end_s;
+  }
+}
+
+}  // namespace
+
 Trajectory FirmwarePlanner::plan(const Toolpath& toolpath, const TcpLimits& limits) const {
   const std::vector<PrintSegment> segments = split_into_segments(toolpath, limits);
   const MachineLimits& requested = limits.requested();
@@ -218,13 +533,23 @@ Trajectory FirmwarePlanner::plan(const Toolpath& toolpath, const TcpLimits& limi
           ? klipper_junction_deviation(settings.square_corner_velocity, config_accel)
           : settings.junction_deviation_mm;
 
+  // a jerk limit in force anywhere on the job: Marlin's S_CURVE_ACCELERATION (see the header)
+  Vec3 job_lo = toolpath.start_mm.cwiseMin(toolpath.end_mm);
+  Vec3 job_hi = toolpath.start_mm.cwiseMax(toolpath.end_mm);
+  for (const PrintSegment& s : segments) {
+    job_lo = job_lo.cwiseMin(s.p0).cwiseMin(s.p1);
+    job_hi = job_hi.cwiseMax(s.p0).cwiseMax(s.p1);
+  }
+  const bool s_curve = requested.jerk_limited() || limits.over(job_lo, job_hi).jerk_limited();
+
   std::vector<TrajectoryPiece> pieces;
   double t = 0.0;
   Vec3 position = toolpath.start_mm;
   ToolOrientation tool = toolpath.start_orientation();
   const auto travel_to = [&](const Vec3& target, const ToolOrientation& target_tool) {
     if ((target - position).norm() > 1e-12) {
-      pieces.push_back(travel_piece(t, position, target, limits, settings, tool, target_tool));
+      pieces.push_back(
+          travel_piece(t, position, target, limits, settings, tool, target_tool, s_curve));
       t = pieces.back().t_end_s;
     }
     position = target;
@@ -247,6 +572,10 @@ Trajectory FirmwarePlanner::plan(const Toolpath& toolpath, const TcpLimits& limi
       double speed_cap = 0.0;
       move_caps(move.direction, s.limits, settings.max_velocity, settings.max_accel, speed_cap,
                 move.accel_mm_s2);
+      if (s_curve) {
+        speed_cap *= kSCurveSpeedShare;
+        move.jerk_mm_s3 = move_jerk(move.direction, s.limits);
+      }
       move.cruise_speed_mm_s = std::min(s.speed_mm_s, speed_cap);
       // the blend at the move's start stays in the box of both moves: every axis within the
       // limits there (and within max_accel when given)
@@ -256,16 +585,26 @@ Trajectory FirmwarePlanner::plan(const Toolpath& toolpath, const TcpLimits& limi
             limits.uniform() ? requested
                              : limits.over(prev.p0.cwiseMin(prev.p1).cwiseMin(s.p0).cwiseMin(s.p1),
                                            prev.p0.cwiseMax(prev.p1).cwiseMax(s.p0).cwiseMax(s.p1));
-        for (int axis = 0; axis < 3; ++axis)
+        for (int axis = 0; axis < 3; ++axis) {
           move.blend_accel_mm_s2[axis] =
               settings.max_accel > 0.0 ? std::min(settings.max_accel, around.axes[axis].a_max_mm_s2)
                                        : around.axes[axis].a_max_mm_s2;
+          move.blend_jerk_mm_s3[axis] = around.axes[axis].j_max_mm_s3;
+        }
       }
       moves.push_back(move);
     }
-    const FirmwareProfile profile = firmware_lookahead(moves, settings, junction_deviation);
+    const FirmwareProfile profile =
+        firmware_lookahead(moves, settings, junction_deviation, s_curve);
     const auto& speed = profile.junction_speed_mm_s;
     const auto& tau = profile.blend_time_s;
+    if (s_curve) {
+      append_s_curve_chain(segments, first, moves, profile, t, pieces);
+      position = segments[end - 1].p1;
+      tool = segments[end - 1].tool1;
+      first = end;
+      continue;
+    }
     // the velocity change of junction j (between moves j-1 and j), spread over tau_j
     const auto blend_accel = [&](size_t j) -> Vec3 {
       return speed[j] * (moves[j].direction - moves[j - 1].direction) / tau[j];

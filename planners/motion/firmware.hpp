@@ -12,8 +12,28 @@
 // cannot, so each junction's velocity change is spread over tau = max_i |dv_i| / a_i (every
 // axis within its a_max), centred on the junction at the junction speed: the corner is cut by
 // |dv| tau / 8, less than the junction deviation itself.
+//
+// Under a jerk limit (the limits carry a j_max) the planner is Marlin with S_CURVE_ACCELERATION
+// (Marlin planner.cpp / stepper.cpp, `_calc_bezier_curve_coeffs`; the same polynomial as the
+// Klipper S-curve branch's `acceleration_order: 6`, dmbutyugin/klipper scurve): every speed
+// change follows the quintic Bezier in time whose control points are v0, v0, v0, v1, v1, v1,
+//   v(t) = v0 + (v1 - v0) B(t / T),   B(x) = 10 x^3 - 15 x^4 + 6 x^5,
+// so the acceleration (peak 15/8 (v1 - v0) / T) and the jerk (peak 10/sqrt(3) (v1 - v0) / T^2)
+// start and end at 0. Marlin keeps the trapezoid's ramp time T = dv / a (its peak acceleration
+// is then 1.875 a) and has no jerk limit; here T is stretched until both peaks are within the
+// move's a_max and j_max (s_curve_ramp_time), and the look-ahead's passes use these ramps
+// (a move can join its end speeds when (v0 + v1) / 2 T(|v1 - v0|) fits in it). Junction speeds
+// stay Marlin's (or Klipper's) junction deviation. The junction's instantaneous direction change
+// gets the same shape: the velocity turns from v u_prev to v u_next as v u_prev + v (u_next -
+// u_prev) B(t / tau), centred on the junction, tau the least time in which every axis keeps
+// 15/8 |dv_i| / tau <= a_i and 10/sqrt(3) |dv_i| / tau^2 <= j_i; the corner is cut by
+// 5 |dv| tau / 64. Travels ramp the same way. Ramps and blends last at least kSCurveMinTime_s.
+// The motion is then written as samples (at most 1 ms apart, a whole number per piece, so no
+// piece changes its duration); every ramp keeps kSCurveLimitShare of a_max and j_max for the
+// cubic interpolation between samples.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -41,6 +61,10 @@ struct FirmwareMove {
   double accel_mm_s2 = 0.0;               // the move's acceleration (no axis beyond its own)
   double cruise_speed_mm_s = 0.0;         // the move's top speed (feed, max_velocity, axes)
   Vec3 blend_accel_mm_s2 = Vec3::Zero();  // per-axis a_max around its start junction
+  // S-curve mode only: the move's jerk limit along it (infinity: none) and the per-axis j_max
+  // around its start junction (0: none)
+  double jerk_mm_s3 = std::numeric_limits<double>::infinity();
+  Vec3 blend_jerk_mm_s3 = Vec3::Zero();
 };
 
 // The look-ahead's answer for one chain of n moves (rest at both ends).
@@ -64,9 +88,28 @@ double junction_speed_squared(const Vec3& u_prev, const Vec3& u_next, double acc
 double klipper_junction_deviation(double square_corner_velocity, double max_accel_mm_s2);
 
 // The look-ahead over one chain of connected moves: junction caps, the smoothed pass of
-// minimum_cruise_ratio (klipper), backward and forward passes, and the junction blends.
+// minimum_cruise_ratio (klipper), backward and forward passes, and the junction blends. With
+// s_curve, the passes and blends are those of the quintic Bezier ramps (see the top).
 FirmwareProfile firmware_lookahead(const std::vector<FirmwareMove>& moves,
-                                   const FirmwareSettings& settings, double junction_deviation_mm);
+                                   const FirmwareSettings& settings, double junction_deviation_mm,
+                                   bool s_curve = false);
+
+// S_CURVE_ACCELERATION's speed shape B(x) = 10 x^3 - 15 x^4 + 6 x^5 on [0, 1], and its
+// integral from 0 to x, 5/2 x^4 - 3 x^5 + x^6
+double s_curve_shape(double x);
+double s_curve_shape_integral(double x);
+// max B' and max |B''|: the ramp's peak acceleration and jerk per dv / T and dv / T^2
+constexpr double kSCurvePeakAccel = 1.875;
+constexpr double kSCurvePeakJerk = 5.773502691896258;  // 10 / sqrt(3)
+// the shortest ramp or junction blend (s), so that 1 ms samples follow its jerk closely
+constexpr double kSCurveMinTime_s = 0.008;
+// the share of a_max and j_max the ramps plan with (the rest: the cubic interpolation of the
+// samples)
+constexpr double kSCurveLimitShare = 0.97;
+// the time of a Bezier ramp changing the speed by dv: the least with peak acceleration and jerk
+// within kSCurveLimitShare of accel and jerk (jerk infinity: none), and at least
+// kSCurveMinTime_s; 0 for dv = 0
+double s_curve_ramp_time(double dv, double accel_mm_s2, double jerk_mm_s3);
 
 class FirmwarePlanner : public Planner {
  public:

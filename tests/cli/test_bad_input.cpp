@@ -325,11 +325,6 @@ std::vector<Row> rows() {
   r.push_back(scenario("SpeedAboveTheLimits", probe_with("  speed:", "  speed: 5"),
                        "{s}:9: toolpath\\.segments\\[0\\]: print speed 5 mm/s needs 5 mm/s on "
                        "x, above limits v_max 4"));
-  r.push_back(
-      scenario("JerkLimitIgnoredByBezier",
-               replace_line(probe_with("limits:", "limits: {v_max: 4, a_max: 30, j_max: 300}"),
-                            "planners:", "planners: [bezier]"),
-               "{s}:11: planners\\[0\\]: .*j_max"));
   // ---- hostile names ----
   r.push_back(scenario("NameOf300Characters", probe("", std::string(300, 'n')),
                        "{s}:1: name: 'n{40}\\.\\.\\.' is 300 bytes long"));

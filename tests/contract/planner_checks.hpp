@@ -171,6 +171,78 @@ inline void expect_jerk_limited(const Trajectory& trajectory, const MachineLimit
   for (int axis = 0; axis < 3; ++axis) EXPECT_NEAR(previous_end[axis], 0.0, 1e-6);
 }
 
+// The largest per-axis speed, acceleration and jerk of a plan against its limits, by finite
+// differences of the plan sampled every `period_s` from t = 0 (the grid the simulation's
+// controller reads it on): v = dp / h, a = d2p / h^2, j = d3p / h^3 of the positions, and
+// a = dv / h, j = d2v / h^2 of the velocities. Each is an average of the true derivative over
+// its stencil, so a plan within its limits stays within them here; a step of the acceleration
+// shows as a jerk of about step / h. Ratios to the limit (jerk: 0 where an axis has no j_max).
+struct FiniteDifferencePeaks {
+  std::array<double, 3> speed_ratio{}, accel_ratio{}, jerk_ratio{};
+  std::array<double, 3> jerk_at_s{};  // where each axis' jerk ratio peaks
+  double max_speed_ratio() const {
+    return *std::max_element(speed_ratio.begin(), speed_ratio.end());
+  }
+  double max_accel_ratio() const {
+    return *std::max_element(accel_ratio.begin(), accel_ratio.end());
+  }
+  double max_jerk_ratio() const { return *std::max_element(jerk_ratio.begin(), jerk_ratio.end()); }
+};
+
+inline FiniteDifferencePeaks finite_difference_peaks(const Trajectory& trajectory,
+                                                     const MachineLimits& limits,
+                                                     double period_s = 0.001) {
+  FiniteDifferencePeaks peaks;
+  const double h = period_s;
+  // three periods of rest beyond the end (Trajectory::at clamps): the stencils reach it
+  const long count = static_cast<long>(std::ceil(trajectory.duration_s() / h)) + 4;
+  std::vector<Vec3> p(count), v(count);
+  for (long k = 0; k < count; ++k) {
+    const TrajectorySample s = trajectory.at(k * h);
+    p[k] = s.position_mm;
+    v[k] = s.velocity_mm_s;
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    const AxisLimits& limit = limits.axes[axis];
+    double& speed = peaks.speed_ratio[axis];
+    double& accel = peaks.accel_ratio[axis];
+    double& jerk = peaks.jerk_ratio[axis];
+    for (long k = 0; k + 1 < count; ++k) {
+      speed = std::max(speed, std::abs(p[k + 1][axis] - p[k][axis]) / h / limit.v_max_mm_s);
+      accel = std::max(accel, std::abs(v[k + 1][axis] - v[k][axis]) / h / limit.a_max_mm_s2);
+      if (k + 2 < count) {
+        const double a = (p[k + 2][axis] - 2 * p[k + 1][axis] + p[k][axis]) / (h * h);
+        accel = std::max(accel, std::abs(a) / limit.a_max_mm_s2);
+      }
+      if (!(limit.j_max_mm_s3 > 0.0) || k + 2 >= count) continue;
+      double j = std::abs(v[k + 2][axis] - 2 * v[k + 1][axis] + v[k][axis]) / (h * h);
+      if (k + 3 < count)
+        j = std::max(
+            j, std::abs(p[k + 3][axis] - 3 * p[k + 2][axis] + 3 * p[k + 1][axis] - p[k][axis]) /
+                   (h * h * h));
+      if (j / limit.j_max_mm_s3 > jerk) {
+        jerk = j / limit.j_max_mm_s3;
+        peaks.jerk_at_s[axis] = (k + 1) * h;
+      }
+    }
+  }
+  return peaks;
+}
+
+// A plan within its limits by finite differences (finite_difference_peaks): speed and
+// acceleration within rounding, jerk within 1 + jerk_tolerance.
+inline void expect_finite_difference_limits(const Trajectory& trajectory,
+                                            const MachineLimits& limits,
+                                            double jerk_tolerance = 0.01) {
+  const FiniteDifferencePeaks peaks = finite_difference_peaks(trajectory, limits);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_LE(peaks.speed_ratio[axis], 1 + 1e-6) << "axis " << axis;
+    EXPECT_LE(peaks.accel_ratio[axis], 1 + 1e-6) << "axis " << axis;
+    EXPECT_LE(peaks.jerk_ratio[axis], 1 + jerk_tolerance)
+        << "axis " << axis << " jerk peaks at t " << peaks.jerk_at_s[axis];
+  }
+}
+
 // The planner contract: starts and ends at rest at the start and end points, continuous
 // position, per-axis limits held, every print path covered with material on, nothing
 // deposited in transitions.

@@ -1,7 +1,11 @@
 // One contract test over every registered planner (OMPL's PlannerTest, toppra's typed
 // suites): planar paths and 3-D paths whose tool axes vary; with a jerk limit, every planner
-// that honours it stays jerk-limited and the others refuse it.
+// honours it (finite-difference jerk on its 1 ms samples).
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <variant>
 
 #include "contract/planner_checks.hpp"
 #include "core/error.hpp"
@@ -114,27 +118,40 @@ TEST_P(PlannerContract, ArmPathsWithRolls) {
   }
 }
 
-TEST_P(PlannerContract, JerkLimitIsHonouredOrRefused) {
+// Every planner honours j_max (the registry says so, and a j_max in force is no error): on
+// random planar toolpaths its plan keeps the contract, and sampled every 1 ms its per-axis
+// jerk by finite differences (finite_difference_peaks) stays within j_max + 1 %: the stencils
+// average the true jerk, so the 1 % covers only the sampled plans' cubic interpolation between
+// their 1 ms samples. A plan of constant-jerk phases is also checked exactly, phase by phase.
+TEST_P(PlannerContract, JerkLimitIsHonoured) {
   const PlannerSpec spec{GetParam(), {}, 0};
   const MachineLimits limits = MachineLimits::uniform(4.0, 30.0, 200.0);
-  if (!find_planner(spec.name)->honours_jerk_limit) {
-    EXPECT_NE(check_planner_limits(spec, limits).find("does not honour j_max"), std::string::npos);
-    EXPECT_EQ(check_planner_limits(spec, MachineLimits::uniform(4.0, 30.0)), "");
-    return;
-  }
+  ASSERT_TRUE(find_planner(spec.name)->honours_jerk_limit);
   EXPECT_EQ(check_planner_limits(spec, limits), "");
   const auto planner = make_planner(spec);
-  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+  double worst = 0.0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     SCOPED_TRACE(testing::Message() << "seed " << seed);
     const Toolpath toolpath = testing_support::random_toolpath(seed, 3.0);
     const Trajectory jerk_limited = planner->plan(toolpath, limits);
     testing_support::expect_contract(jerk_limited, toolpath, limits);
-    testing_support::expect_jerk_limited(jerk_limited, limits);
+    testing_support::expect_finite_difference_limits(jerk_limited, limits, 0.01);
+    worst = std::max(
+        worst, testing_support::finite_difference_peaks(jerk_limited, limits).max_jerk_ratio());
+    const bool phases = std::all_of(jerk_limited.pieces().begin(), jerk_limited.pieces().end(),
+                                    [](const TrajectoryPiece& piece) {
+                                      return std::holds_alternative<PhaseMotion>(piece.motion);
+                                    });
+    if (phases) testing_support::expect_jerk_limited(jerk_limited, limits);
     // the jerk limit costs time: never faster than without it
     const Trajectory free = planner->plan(toolpath, MachineLimits::uniform(4.0, 30.0));
     EXPECT_GE(jerk_limited.duration_s(), free.duration_s() - 1e-9);
     if (HasFatalFailure()) return;
   }
+  // a limit that binds: the largest jerk reaches at least half of j_max somewhere
+  EXPECT_GT(worst, 0.5);
+  std::printf("%s: largest finite-difference jerk / j_max on random toolpaths: %.4f\n",
+              spec.name.c_str(), worst);
 }
 
 TEST_P(PlannerContract, DeterministicPlans) {

@@ -538,18 +538,22 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
   expect_problem(missing_family, scenario_path(), "machine", 1, "missing kinematics");
 }
 
-// a j_max the planner would ignore is an error at the planner's line
-TEST_F(ScenarioErrors, JerkLimitRefusedByPlannerThatIgnoresIt) {
-  const auto problems = problems_of(R"(
+// a j_max is honoured by every planner (each has a jerk-limited mode): no planner line is an
+// error, while a j_max that is not a number still is
+TEST_F(ScenarioErrors, JerkLimitIsAcceptedByEveryPlanner) {
+  const auto accepted = problems_of(R"(
 limits: {v_max: 4, a_max: 30, j_max: 500}
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
-planners:
-  - lspb_mtt
-  - bezier
+planners: [lspb_mtt, stop_and_go, bezier, conformal, firmware]
 )");
-  ASSERT_EQ(problems.size(), 1u) << dump(problems);
-  expect_problem(problems, scenario_path(), "planners[1]", 5,
-                 "planner 'bezier' does not honour j_max");
+  EXPECT_TRUE(accepted.empty()) << dump(accepted);
+  const auto refused = problems_of(R"(
+limits: {v_max: 4, a_max: 30, j_max: -5}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+planners: [bezier]
+)");
+  ASSERT_EQ(refused.size(), 1u) << dump(refused);
+  expect_problem(refused, scenario_path(), "limits.j_max", 1, "must be in [0, 1e+12], got -5");
 }
 
 TEST_F(ScenarioErrors, DuplicateKey) {

@@ -9,9 +9,11 @@
 #include <Eigen/Geometry>  // cross products of arcs
 
 #include "core/error.hpp"
+#include "motion/jerk.hpp"
 #include "planners/motion/bezier/bezier_curve.hpp"
 #include "planners/motion/bezier/bezier_profile.hpp"
 #include "planners/motion/print_segments.hpp"
+#include "planners/motion/sampled_jerk.hpp"
 #include "planners/motion/transition.hpp"
 
 namespace depotwin {
@@ -35,6 +37,10 @@ struct PathLine {
   double accel_mm_s2 = 0.0;             // along-line acceleration every axis allows
   double cap_mm_s = 0.0;                // print speed
   std::optional<GridProfile> prebuilt;  // the lead-in ramp, built to end exactly at P_0
+  // under a jerk limit: the along-line jerk every axis allows (infinity where no axis has a
+  // j_max; 0: the path is not jerk-limited) and the lead-in's S-curve
+  double jerk_mm_s3 = 0.0;
+  std::optional<JerkGridProfile> prebuilt_jerk;
 };
 
 struct PathNode {
@@ -63,18 +69,48 @@ double line_accel(const Vec3& dir, const MachineLimits& limits) {
   return a;
 }
 
+// under a jerk limit, the share of j_max a blend's constant-speed crossing plans with (the
+// Taylor update, the joint corrections and the cubic interpolation of the samples take a
+// little; what they take is checked after sampling and the blend slowed if needed)
+constexpr double kBlendJerkShare = 0.9;
+
+// along-line jerk every axis allows (infinity where no axis has a j_max)
+double line_jerk(const Vec3& dir, const MachineLimits& limits) {
+  double j = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis)
+    if (std::abs(dir[axis]) > 1e-12 && limits.axes[axis].j_max_mm_s3 > 0.0)
+      j = std::min(j, limits.axes[axis].j_max_mm_s3 / std::abs(dir[axis]));
+  return j;
+}
+
 // The highest constant speed through a blend that keeps every axis within its limits:
 // |v T_axis| <= v_max and |v^2 kappa N_axis| <= a_max along the curve; at u = 0 and 1
 // the acceleration jumps between two samples, where cubic Hermite interpolation of the
 // samples overshoots a step by up to 4/3, so the ends count 4/3.
+//
+// Under a jerk limit (the curvature-continuous blend: no jump at its ends) also
+// |v^3 d3p/ds3| <= kBlendJerkShare j_max per axis, the jerk of a constant-speed crossing.
 double blend_speed_cap(const BezierBlend& blend, const MachineLimits& limits, std::string& reason,
                        bool jump_at_start = true, bool jump_at_end = true) {
   constexpr int kIntervals = 256;
   double cap = std::numeric_limits<double>::infinity();
   Vec3 p, d1, d2;
+  if (blend.degree == 4) jump_at_start = jump_at_end = false;
   for (int i = 0; i <= kIntervals; ++i) {
     const double u = double(i) / kIntervals;
     blend.derivatives(u, p, d1, d2);
+    if (blend.degree == 4) {
+      const Vec3 third = blend.third_arc_derivative(u);
+      for (int axis = 0; axis < 3; ++axis) {
+        const double j_max = limits.axes[axis].j_max_mm_s3;
+        if (!(j_max > 0.0) || std::abs(third[axis]) < 1e-12) continue;
+        const double v = std::cbrt(kBlendJerkShare * j_max / std::abs(third[axis]));
+        if (v < cap) {
+          cap = v;
+          reason = std::string("j_max of axis ") + kAxisName[axis];
+        }
+      }
+    }
     const double speed_u = d1.norm();
     const Vec3 tangent = d1 / speed_u;
     // curvature vector: the normal part of d2p/du2 over |dp/du|^2
@@ -166,11 +202,15 @@ std::vector<BezierBlend> arc_pieces(const PrintPath& path, size_t edge) {
 // neighbours tangentially; every other arc becomes chords within `tolerance_mm`, as for the
 // planners that need polylines. `original_vertex` gets each vertex's index in `path`, -1 for
 // a vertex between chords.
+//
+// Under a jerk limit every arc becomes chords (keep_arcs false): a circle entered from its
+// tangent line steps the curvature from 0 to 1 / R, which no finite jerk crosses at speed; the
+// chords' corners get curvature-continuous blends like every other corner.
 PrintPath with_traversable_arcs(const PrintPath& path, double tolerance_mm,
-                                std::vector<int>& original_vertex) {
+                                std::vector<int>& original_vertex, bool keep_arcs = true) {
   const size_t edges = path.points.size() - 1;
   std::vector<bool> exact(edges, false);
-  if (path.has_arcs() && path.normals.empty() && path.rolls.empty())
+  if (keep_arcs && path.has_arcs() && path.normals.empty() && path.rolls.empty())
     for (size_t e = 1; e + 1 < edges; ++e)
       exact[e] = is_arc_edge(path, e) &&
                  std::abs((path.points[e + 1] - path.points[e]).dot(path.arcs[e].axis)) <= 1e-9;
@@ -228,7 +268,8 @@ PrintPath with_traversable_arcs(const PrintPath& path, double tolerance_mm,
 
 PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& original_vertex,
                             const BezierSettings& settings, const MachineLimits& limits,
-                            size_t first_weight, std::vector<std::string>& warnings) {
+                            size_t first_weight, std::vector<std::string>& warnings,
+                            bool jerk_limited) {
   const std::vector<Vec3>& points = path.points;
   const size_t edges = points.size() - 1;
   const double print_speed = path.speed_mm_s;
@@ -247,6 +288,7 @@ PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& origi
     line.dir = dir;
     line.accel_mm_s2 = line_accel(dir, limits);
     line.cap_mm_s = print_speed;
+    if (jerk_limited) line.jerk_mm_s3 = line_jerk(dir, limits);
     return line;
   };
 
@@ -277,7 +319,11 @@ PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& origi
           << settings.delta_mm << " to " << delta << " mm (half the shorter adjacent line)";
       warnings.push_back(msg.str());
     }
-    BezierBlend blend = BezierBlend::at_corner(points[j], in_dir, out_dir, delta, weight);
+    // under a jerk limit the curvature-continuous quartic (see bezier_curve.hpp)
+    BezierBlend blend =
+        jerk_limited
+            ? BezierBlend::curvature_continuous_at_corner(points[j], in_dir, out_dir, delta, weight)
+            : BezierBlend::at_corner(points[j], in_dir, out_dir, delta, weight);
     const double blend_length = blend.arc_length_mm();
     std::string reason;
     const double cap = std::min(print_speed, blend_speed_cap(blend, limits, reason));
@@ -285,9 +331,19 @@ PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& origi
     // extra time over cruising at print speed: blend = the slow blend plus the ramps down
     // to its speed and back, stop = the legs of 2 delta plus ramping to rest and back.
     const double a = std::min(line_accel(in_dir, limits), line_accel(out_dir, limits));
-    const double blend_extra = blend_length / cap - blend_length / print_speed +
-                               (print_speed - cap) * (print_speed - cap) / (a * print_speed);
-    const double stop_extra = (2.0 * delta - blend_length) / print_speed + print_speed / a;
+    double blend_extra = blend_length / cap - blend_length / print_speed +
+                         (print_speed - cap) * (print_speed - cap) / (a * print_speed);
+    double stop_extra = (2.0 * delta - blend_length) / print_speed + print_speed / a;
+    if (jerk_limited) {
+      // the same with S-curves: a ramp by dv takes tau(dv) and loses tau (dv / 2) / v_print
+      const double j = std::min(line_jerk(in_dir, limits), line_jerk(out_dir, limits));
+      const auto ramp_s = [&](double dv) {
+        return std::isfinite(j) ? s_curve_duration(dv, a, j) : dv / a;
+      };
+      blend_extra = blend_length / cap - blend_length / print_speed +
+                    ramp_s(print_speed - cap) * (print_speed - cap) / print_speed;
+      stop_extra = (2.0 * delta - blend_length) / print_speed + ramp_s(print_speed);
+    }
     if (blend_extra > stop_extra) {
       node.exact = true;
       std::ostringstream msg;
@@ -360,6 +416,10 @@ PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& origi
     const double a_out = lead_out_line.accel_mm_s2, period = settings.period_s;
     lead_out_line.length_mm =
         print_speed * print_speed / (2.0 * a_out) + 5.0 * print_speed * period;
+    if (jerk_limited && std::isfinite(lead_out_line.jerk_mm_s3))
+      lead_out_line.length_mm =
+          jerk_grid_room(print_speed, 0.0, a_out, lead_out_line.jerk_mm_s3, period) +
+          2.0 * print_speed * period;
     lead_out_line.to_mm = lead_out_line.from_mm + lead_out_line.length_mm * lead_out_line.dir;
     // the lead-in's length is set once its end speed is known (after the passes)
     lead_in_line.to_mm = points.front();
@@ -377,11 +437,63 @@ PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& origi
 
 // forward/backward passes: node speeds as high as their caps allow while every line
 // can hold the ramps between its end speeds on the sample grid
+//
+// Under a jerk limit a line holds its S-curve when jerk_grid_room fits in it. That room is not
+// monotone in the lower end speed (a faster start can need more room), so instead of one
+// forward and one backward pass the sweeps repeat until nothing changes; each change lowers the
+// higher end speed of a line that cannot hold its S-curve, which only shortens that S-curve.
+void assign_jerk_node_speeds(PathGeometry& g, double period_s, size_t first) {
+  const auto fits = [&](size_t k, double v_a, double v_b) {
+    const PathLine& line = g.lines[k];
+    return jerk_grid_room(v_a, v_b, line.accel_mm_s2, line.jerk_mm_s3, period_s) <=
+           line.length_mm * (1 + 1e-12);
+  };
+  const auto settle = [&](size_t k) {
+    double& v_a = g.nodes[k].speed_mm_s;
+    double& v_b = g.nodes[k + 1].speed_mm_s;
+    if (fits(k, v_a, v_b)) return false;
+    double& high = v_a > v_b ? v_a : v_b;
+    const double low = std::min(v_a, v_b);
+    double lo = low, hi = high;
+    for (int i = 0; i < 100; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      if (mid <= lo || mid >= hi) break;
+      (fits(k, low, mid) ? lo : hi) = mid;
+    }
+    high = lo;
+    return true;
+  };
+  for (int sweep = 0; sweep < 10000; ++sweep) {
+    bool changed = false;
+    for (size_t k = first; k < g.lines.size(); ++k) changed = settle(k) || changed;
+    for (size_t k = g.lines.size(); k-- > first;) changed = settle(k) || changed;
+    if (!changed) return;
+  }
+  throw InternalError("bezier: jerk-limited node speeds did not settle");
+}
+
 void assign_node_speeds(PathGeometry& g, double period_s) {
   const size_t first = g.lead ? 1 : 0;  // the lead-in line is built to fit afterwards
   for (PathNode& node : g.nodes)
     node.speed_mm_s = node.blend || (!node.exact && node.cap_mm_s > 0.0) ? node.cap_mm_s : 0.0;
   if (g.lead) g.nodes[1].speed_mm_s = g.nodes[1].cap_mm_s;
+  const bool jerk_limited = !g.lines.empty() && g.lines.front().jerk_mm_s3 > 0.0;
+  if (jerk_limited) {
+    assign_jerk_node_speeds(g, period_s, first);
+    // the lead-in: one grid S-curve from rest to the speed at P_0, its length made to fit
+    if (g.lead) {
+      PathLine& lead_in = g.lines.front();
+      const double v = g.nodes[1].speed_mm_s;
+      JerkGridProfile ramp;
+      ramp.append_s_curve(grid_s_curve(v, lead_in.accel_mm_s2, lead_in.jerk_mm_s3, period_s), v,
+                          period_s);
+      ramp.v_after_mm_s = v;
+      lead_in.length_mm = ramp.distance_mm(period_s);
+      lead_in.from_mm = lead_in.to_mm - lead_in.length_mm * lead_in.dir;
+      lead_in.prebuilt_jerk = ramp;
+    }
+    return;
+  }
   for (size_t k = first; k < g.lines.size(); ++k) {
     const PathLine& line = g.lines[k];
     g.nodes[k + 1].speed_mm_s = std::min(
@@ -463,6 +575,25 @@ class PathSampler {
     step_ = 0;
     line_u_ = line.length_mm > 0.0 ? s0_mm / line.length_mm : 0.0;  // eq. (13)
     entry_mm_ = s0_mm;
+    jerk_ = line.jerk_mm_s3 > 0.0;
+    if (jerk_) {
+      // under a jerk limit: S-curves on the grid (bezier_profile.hpp)
+      std::optional<JerkGridProfile> profile =
+          line.prebuilt_jerk
+              ? line.prebuilt_jerk
+              : plan_jerk_grid_profile(line.length_mm - s0_mm, v_in, end.speed_mm_s, line.cap_mm_s,
+                                       line.accel_mm_s2, line.jerk_mm_s3, period_, end.exact);
+      if (!profile) {
+        std::ostringstream msg;
+        msg << "bezier: no jerk-limited grid profile on a line of " << line.length_mm - s0_mm
+            << " mm from " << v_in << " to " << end.speed_mm_s << " mm/s";
+        throw InternalError(msg.str());
+      }
+      jerk_profile_ = std::move(*profile);
+      if (push_sample) push(line.from_mm + s0_mm * line.dir, v_in * line.dir);
+      if (g_.lead && size_t(k) + 1 == g_.lines.size()) lead_out_begin_ = positions_.size() - 1;
+      return;
+    }
     std::optional<GridProfile> profile =
         line.prebuilt ? line.prebuilt
                       : plan_grid_profile(line.length_mm - s0_mm, v_in, end.speed_mm_s,
@@ -484,7 +615,8 @@ class PathSampler {
     const int k = line_of(piece_);
     const PathLine& line = g_.lines[k];
     const PathNode& end = g_.nodes[k + 1];
-    if (end.exact && step_ == profile_.total_steps()) {
+    const int total_steps = jerk_ ? jerk_profile_.total_steps() : profile_.total_steps();
+    if (end.exact && step_ == total_steps) {
       // the profile ends exactly at the line's end, on this sample
       positions_.back() = line.to_mm;
       velocities_.back() = end.speed_mm_s * line.dir;
@@ -494,26 +626,36 @@ class PathSampler {
       enter_line(k + 1, 0.0, end.speed_mm_s, false);
       return true;
     }
-    double v = 0.0, a = 0.0;
-    profile_.at_step(step_, period_, v, a);
-    if (!end.exact && v <= 0.0 && a <= 0.0)
+    double v = 0.0, a = 0.0, j = 0.0;
+    if (jerk_)
+      jerk_profile_.at_step(step_, period_, v, a, j);
+    else
+      profile_.at_step(step_, period_, v, a);
+    if (!end.exact && v <= 0.0 && a <= 0.0 && j <= 0.0)
       throw InternalError("bezier: stalled on a line before a moving joint");
     // eq. (5) on a line: |dp/du| = L and d2p/du2 = 0, so u advances by (v T + a T^2 / 2) / L
-    // exactly (the acceleration changes only at samples). The sum of these steps is taken in
-    // closed form from the line's entry, which keeps rounding from piling up over long lines.
-    const double step_mm = v * period_ + 0.5 * a * period_ * period_;
+    // exactly (the acceleration changes only at samples; under a jerk limit the jerk, and the
+    // step adds j T^3 / 6). The sum of these steps is taken in closed form from the line's
+    // entry, which keeps rounding from piling up over long lines.
+    const double step_mm = jerk_ ? period_ * (v + period_ * (0.5 * a + j * period_ / 6.0))
+                                 : v * period_ + 0.5 * a * period_ * period_;
     const double remaining_mm = line.length_mm * (1.0 - line_u_);
     if (end.exact || step_mm < remaining_mm) {
       ++step_;
-      const double s_mm = entry_mm_ + profile_.distance_after(step_, period_);
+      const double s_mm = entry_mm_ + (jerk_ ? jerk_profile_.distance_after(step_, period_)
+                                             : profile_.distance_after(step_, period_));
       line_u_ = s_mm / line.length_mm;
-      double v_next = 0.0, a_next = 0.0;
-      profile_.at_step(step_, period_, v_next, a_next);
+      double v_next = 0.0, a_next = 0.0, j_next = 0.0;
+      if (jerk_)
+        jerk_profile_.at_step(step_, period_, v_next, a_next, j_next);
+      else
+        profile_.at_step(step_, period_, v_next, a_next);
       push(line.from_mm + s_mm * line.dir, v_next * line.dir);
       return true;
     }
     // the joint falls inside this period: carry the rest of the step into the next pieces
-    cross_joint(piece_ + 1, step_mm - remaining_mm, v + a * period_);
+    const double v_end = jerk_ ? v + period_ * (a + 0.5 * j * period_) : v + a * period_;
+    cross_joint(piece_ + 1, step_mm - remaining_mm, v_end);
     return true;
   }
 
@@ -577,6 +719,8 @@ class PathSampler {
   size_t piece_ = 0;
   // line state
   GridProfile profile_;
+  JerkGridProfile jerk_profile_;  // under a jerk limit (jerk_), instead of profile_
+  bool jerk_ = false;
   int step_ = 0;
   double line_u_ = 0.0;
   double entry_mm_ = 0.0;  // where on the line the profile started
@@ -599,10 +743,15 @@ bool check_sampled_limits(const std::vector<Vec3>& positions, const std::vector<
   bool owned = true;
   slow_down.assign(g.nodes.size(), 1.0);
   const double h = period_s;
-  for (size_t k = 0; k + 1 < positions.size(); ++k) {
-    // the blend this interval belongs to (either end on it, or the joint between two lines)
+  const bool jerk_limited = !g.lines.empty() && g.lines.front().jerk_mm_s3 > 0.0;
+  // the blend interval k belongs to (either end on it, or the joint between two lines)
+  const auto owner = [&](size_t k) {
     int node = nodes[k] >= 0 ? nodes[k] : nodes[k + 1];
     if (node < 0 && nodes[k] != nodes[k + 1]) node = -1 - nodes[k] + 1;
+    return node;
+  };
+  for (size_t k = 0; k + 1 < positions.size(); ++k) {
+    const int node = owner(k);
     double factor = 1.0;
     for (int axis = 0; axis < 3; ++axis) {
       const double dp = positions[k + 1][axis] - positions[k][axis];
@@ -625,6 +774,29 @@ bool check_sampled_limits(const std::vector<Vec3>& positions, const std::vector<
       continue;
     }
     slow_down[node] = std::min(slow_down[node], factor);
+  }
+  if (!jerk_limited || positions.size() < 2) return owned;
+
+  // the jerk the plan's 1 ms finite differences see on the interpolated samples (see
+  // sampled_jerk.hpp); a period over j_max slows the blends it touches (the jerk goes with v^3)
+  constexpr double kJerkTolerance = 1e-3;
+  const Vec3 j_max(limits.axes[0].j_max_mm_s3, limits.axes[1].j_max_mm_s3,
+                   limits.axes[2].j_max_mm_s3);
+  std::vector<double> ratio;
+  if (sampled_jerk_ratio(positions, velocities, h, j_max, &ratio) <= 1.0 + kJerkTolerance)
+    return owned;
+  for (size_t k = 0; k < ratio.size(); ++k) {
+    if (ratio[k] <= 1.0 + kJerkTolerance) continue;
+    // the blends within a few periods of it (a window spans three fd periods)
+    bool found = false;
+    const size_t reach = static_cast<size_t>(std::ceil(0.003 / h)) + 1;
+    for (size_t i = k >= reach ? k - reach : 0; i <= std::min(ratio.size() - 1, k + reach); ++i) {
+      const int node = owner(i);
+      if (node < 0 || !g.nodes[node].blend) continue;
+      slow_down[node] = std::min(slow_down[node], std::cbrt(1.0 / ratio[k]));
+      found = true;
+    }
+    owned = owned && found;
   }
   return owned;
 }
@@ -747,6 +919,19 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
     throw InputError("planners.bezier.weight", msg.str());
   }
 
+  // a jerk limit in force anywhere on the job: S-curves on the lines, curvature-continuous
+  // blends, arcs as chords (see bezier.hpp)
+  Vec3 job_lo = toolpath.start_mm.cwiseMin(toolpath.end_mm);
+  Vec3 job_hi = toolpath.start_mm.cwiseMax(toolpath.end_mm);
+  for (const PrintPath& path : toolpath.paths) {
+    Vec3 lo, hi;
+    path.bounds(lo, hi);
+    job_lo = job_lo.cwiseMin(lo);
+    job_hi = job_hi.cwiseMax(hi);
+  }
+  const bool jerk_limited =
+      tcp_limits.requested().jerk_limited() || tcp_limits.over(job_lo, job_hi).jerk_limited();
+
   std::vector<TrajectoryPiece> pieces;
   std::vector<std::string> warnings;
   double t = 0.0;
@@ -759,13 +944,13 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
     // the path with the arcs it can traverse exactly, the others as chords
     std::vector<int> original_vertex;
-    const PrintPath path =
-        with_traversable_arcs(toolpath.paths[i], toolpath.chord_tolerance_mm, original_vertex);
+    const PrintPath path = with_traversable_arcs(toolpath.paths[i], toolpath.chord_tolerance_mm,
+                                                 original_vertex, !jerk_limited);
     // the limits over the path's own box (per path: its blends and ramps are planned together)
     const MachineLimits limits =
         path_limits(path, tcp_limits, settings_.lead_in, settings_.period_s);
-    PathGeometry geometry =
-        build_geometry(path, original_vertex, settings_, limits, next_weight, warnings);
+    PathGeometry geometry = build_geometry(path, original_vertex, settings_, limits, next_weight,
+                                           warnings, jerk_limited);
     next_weight += toolpath.paths[i].points.size() - 2;
 
     // the samples: Taylor update along the path; blends whose samples, interpolated,

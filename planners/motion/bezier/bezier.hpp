@@ -26,6 +26,29 @@
 // ends exactly at P_0 on a sample, printing stops at the first sample past P_n (less than
 // v T_s beyond it), so the flow runs only at print speed (unless a corner is slowed).
 // The extensions may leave the toolpath's bounds by v^2 / (2 a) plus a few samples.
+//
+// Under a jerk limit (the limits carry a j_max), what changes and what stays:
+// - lines: S-curves on the sample grid (bezier_profile.hpp: jerk +-j', 0 switching only at
+//   samples, zero acceleration at both ends of each), so the Taylor update stays exact on them
+//   (it adds j T^3 / 6 per step) and the cubic interpolation of the samples reproduces them;
+//   the passes ask each line for the room of its S-curve (jerk_grid_room);
+// - corners: Giberti et al.'s quadratic blend steps the curvature from 0 to kappa at its ends,
+//   so at speed v the acceleration would step by v^2 kappa, an infinite jerk. The blend becomes
+//   the rational quartic with the same entry, corner, exit and weight whose curvature is 0 at
+//   both ends (BezierBlend degree 4): crossed at constant speed, its acceleration ramps from 0
+//   and its jerk is v^3 d3p/ds3, capped per axis at kBlendJerkShare j_max (the blend speed
+//   v <= (0.9 j_max / |d3p/ds3|)^(1/3), with the a_max and v_max caps as before). Slowing and
+//   ramping around a quadratic blend cannot help: its curvature steps at any speed but zero.
+//   The stop-or-blend choice compares S-curve times;
+// - what stays of the paper: the fillet distance and the weight, constant speed on every blend
+//   by the Taylor update of u (eqs. 3-5) with the joint corrections (eqs. 11-13), the forward /
+//   backward passes, the sampled output. Exact arcs are chorded within chord_tolerance_mm (a
+//   circle entered from its tangent also steps the curvature) and their chords' corners
+//   blended;
+// - after sampling, the jerk the 1 ms finite differences see on the interpolated samples
+//   (sampled_jerk.hpp) is checked with the accelerations: a blend near an excess is slowed by
+//   the cube root of it and the path sampled again.
+// Without j_max the plan is the paper's, bit for bit as before.
 #pragma once
 
 #include <memory>

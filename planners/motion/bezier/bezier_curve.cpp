@@ -3,6 +3,8 @@
 #include <array>
 #include <cmath>
 
+#include <Eigen/Core>
+
 namespace depotwin {
 
 BezierBlend BezierBlend::at_corner(const Vec3& corner_mm, const Vec3& in_dir, const Vec3& out_dir,
@@ -18,6 +20,76 @@ BezierBlend BezierBlend::at_corner(const Vec3& corner_mm, const Vec3& in_dir, co
   return blend;
 }
 
+BezierBlend BezierBlend::curvature_continuous_at_corner(const Vec3& corner_mm, const Vec3& in_dir,
+                                                        const Vec3& out_dir, double delta_mm,
+                                                        double weight) {
+  BezierBlend blend = at_corner(corner_mm, in_dir, out_dir, delta_mm, weight);
+  blend.degree = 4;
+  return blend;
+}
+
+namespace {
+
+// A rational Bezier's derivatives with respect to u up to the third, from its homogeneous
+// control points (w_i P_i, w_i): the k-th derivative of a degree-n Bernstein sum is
+// n! / (n - k)! times the sum of the k-th forward differences over degree n - k (de Casteljau),
+// then the quotient rule for R = N / W.
+void rational_derivatives(const Vec3* points, const double* weights, int degree, double u, Vec3& p,
+                          Vec3& d1, Vec3& d2, Vec3& d3) {
+  using Vec4 = Eigen::Vector4d;
+  std::array<Vec4, 5> q;
+  for (int i = 0; i <= degree; ++i) q[i] << weights[i] * points[i], weights[i];
+  std::array<Vec4, 4> value;  // N^(k), W^(k) for k = 0..3
+  double falling = 1.0;       // n! / (n - k)!
+  for (int k = 0; k <= 3; ++k) {
+    const int m = degree - k;  // the degree of the k-th differences
+    if (m < 0) {
+      value[k].setZero();
+      continue;
+    }
+    // de Casteljau on the k-th differences
+    std::array<Vec4, 5> b;
+    for (int i = 0; i <= m; ++i) b[i] = q[i];
+    for (int level = 1; level <= m; ++level)
+      for (int i = 0; i <= m - level; ++i) b[i] = (1.0 - u) * b[i] + u * b[i + 1];
+    value[k] = falling * b[0];
+    falling *= m;
+    // the next differences
+    for (int i = 0; i < m; ++i) q[i] = q[i + 1] - q[i];
+  }
+  const double w = value[0][3], w1 = value[1][3], w2 = value[2][3], w3 = value[3][3];
+  p = value[0].head<3>() / w;
+  d1 = (value[1].head<3>() - p * w1) / w;
+  d2 = (value[2].head<3>() - 2.0 * d1 * w1 - p * w2) / w;
+  d3 = (value[3].head<3>() - 3.0 * d2 * w1 - 3.0 * d1 * w2 - p * w3) / w;
+}
+
+}  // namespace
+
+void BezierBlend::derivatives(double u, Vec3& p, Vec3& dp_du, Vec3& d2p_du2, Vec3& d3p_du3) const {
+  if (degree == 2) {
+    const Vec3 points[3] = {entry_mm, corner_mm, exit_mm};
+    const double weights[3] = {1.0, weight, 1.0};
+    rational_derivatives(points, weights, 2, u, p, dp_du, d2p_du2, d3p_du3);
+    return;
+  }
+  const Vec3 points[5] = {entry_mm, 0.5 * (entry_mm + corner_mm), corner_mm,
+                          0.5 * (corner_mm + exit_mm), exit_mm};
+  const double weights[5] = {1.0, 1.0, weight, 1.0, 1.0};
+  rational_derivatives(points, weights, 4, u, p, dp_du, d2p_du2, d3p_du3);
+}
+
+Vec3 BezierBlend::third_arc_derivative(double u) const {
+  // with s' = |p'|, T = p' / s', the curvature vector k = p''/s'^2 - g p'/s'^4 (g = p'.p''),
+  // and d3p/ds3 = (dk/du) / s'
+  Vec3 p, d1, d2, d3;
+  derivatives(u, p, d1, d2, d3);
+  const double s2 = d1.squaredNorm(), g = d1.dot(d2), g1 = d2.squaredNorm() + d1.dot(d3);
+  const Vec3 dk =
+      d3 / s2 - 3.0 * g * d2 / (s2 * s2) - g1 * d1 / (s2 * s2) + 4.0 * g * g * d1 / (s2 * s2 * s2);
+  return dk / std::sqrt(s2);
+}
+
 Vec3 BezierBlend::point(double u) const {
   Vec3 p, d1, d2;
   derivatives(u, p, d1, d2);
@@ -25,6 +97,11 @@ Vec3 BezierBlend::point(double u) const {
 }
 
 void BezierBlend::derivatives(double u, Vec3& p, Vec3& dp_du, Vec3& d2p_du2) const {
+  if (degree != 2) {
+    Vec3 d3p_du3;
+    derivatives(u, p, dp_du, d2p_du2, d3p_du3);
+    return;
+  }
   // eq. (18) as numerator N(u) over denominator D(u) (eq. (21) with w0 = w2 = 1)
   const double v = 1.0 - u;
   const double w = weight;

@@ -204,3 +204,250 @@ double reachable_speed(double v_mm_s, double length_mm, double a_max_mm_s2, doub
 }
 
 }  // namespace depotwin
+
+// ---------------------------------------------------------------------------------------
+// jerk-limited grid profiles
+
+namespace depotwin {
+
+namespace {
+
+// a step count beyond this is no plan (int steps, as the cruise's)
+constexpr double kMaxJerkSteps = 1e9;
+
+// distance of a grid S-curve between speeds va and vb
+double s_curve_distance(double va, double vb, const GridSCurve& curve, double period_s) {
+  return 0.5 * (va + vb) * curve.steps() * period_s;
+}
+
+}  // namespace
+
+bool GridSCurve::holds(double dv, double a_max, double j_max, double period_s) const {
+  dv = std::abs(dv);
+  if (steps() == 0) return dv <= 1e-12;
+  if (n_jerk <= 0) return false;
+  const double m = n_jerk + n_flat;
+  return dv / (m * period_s) <= a_max * (1 + 1e-9) &&
+         dv / (n_jerk * m * period_s * period_s) <= j_max * (1 + 1e-9);
+}
+
+GridSCurve grid_s_curve(double dv, double a_max, double j_max, double period_s) {
+  dv = std::abs(dv);
+  if (dv == 0.0) return {};
+  // n_jerk + n_flat >= dv / (a T), n_jerk (n_jerk + n_flat) >= dv / (j T^2); the continuous
+  // optimum has n_jerk = min(a / j, sqrt(dv / j)) / T, the grid's lies within a few steps of it
+  const double accel_steps = dv / (a_max * period_s);
+  const double jerk_area = dv / (j_max * period_s * period_s);
+  const double ideal = std::min(a_max / (j_max * period_s), std::sqrt(jerk_area));
+  if (!(ideal < kMaxJerkSteps) || !(accel_steps < kMaxJerkSteps))
+    return {static_cast<int>(kMaxJerkSteps), 0};
+  GridSCurve best;
+  long long best_total = -1;
+  const long long lo = std::max<long long>(1, static_cast<long long>(std::floor(ideal)) - 3);
+  const long long hi = static_cast<long long>(std::ceil(ideal)) + 3;
+  for (long long n1 = lo; n1 <= hi; ++n1) {
+    const long long m = std::max({n1, static_cast<long long>(std::ceil(accel_steps - 1e-9)),
+                                  static_cast<long long>(std::ceil(jerk_area / n1 - 1e-9))});
+    const long long total = n1 + m;
+    if (best_total < 0 || total < best_total) {
+      best_total = total;
+      best = {static_cast<int>(n1), static_cast<int>(m - n1)};
+    }
+  }
+  return best;
+}
+
+int JerkGridProfile::total_steps() const {
+  int total = 0;
+  for (const JerkPhase& phase : phases) total += phase.steps;
+  return total;
+}
+
+void JerkGridProfile::at_step(int step, double period_s, double& speed_mm_s, double& accel_mm_s2,
+                              double& jerk_mm_s3) const {
+  double v = v_start_mm_s, a = 0.0;
+  for (const JerkPhase& phase : phases) {
+    const double j = phase.jerk_mm_s3;
+    if (step < phase.steps) {
+      const double t = step * period_s;
+      speed_mm_s = v + t * (a + 0.5 * j * t);
+      accel_mm_s2 = a + j * t;
+      jerk_mm_s3 = j;
+      return;
+    }
+    const double t = phase.steps * period_s;
+    v += t * (a + 0.5 * j * t);
+    a += j * t;
+    step -= phase.steps;
+  }
+  speed_mm_s = v_after_mm_s;
+  accel_mm_s2 = 0.0;
+  jerk_mm_s3 = 0.0;
+}
+
+double JerkGridProfile::distance_mm(double period_s) const {
+  return distance_after(total_steps(), period_s);
+}
+
+double JerkGridProfile::distance_after(int steps, double period_s) const {
+  double v = v_start_mm_s, a = 0.0, distance = 0.0;
+  for (const JerkPhase& phase : phases) {
+    const int taken = std::min(steps, phase.steps);
+    const double j = phase.jerk_mm_s3, t = taken * period_s;
+    distance += t * (v + t * (0.5 * a + j * t / 6.0));
+    v += t * (a + 0.5 * j * t);
+    a += j * t;
+    steps -= taken;
+  }
+  return distance + v_after_mm_s * steps * period_s;
+}
+
+void JerkGridProfile::append_s_curve(const GridSCurve& curve, double dv, double period_s) {
+  if (curve.steps() == 0) return;
+  if (dv == 0.0 || curve.n_jerk == 0) {
+    append_cruise(curve.steps());
+    return;
+  }
+  const double jerk =
+      dv / (curve.n_jerk * double(curve.n_jerk + curve.n_flat) * period_s * period_s);
+  phases.push_back({curve.n_jerk, jerk});
+  if (curve.n_flat > 0) phases.push_back({curve.n_flat, 0.0});
+  phases.push_back({curve.n_jerk, -jerk});
+}
+
+void JerkGridProfile::append_cruise(int steps) {
+  if (steps > 0) phases.push_back({steps, 0.0});
+}
+
+std::optional<JerkGridProfile> plan_jerk_grid_profile(double distance_mm, double v_in_mm_s,
+                                                      double v_out_mm_s, double v_cap_mm_s,
+                                                      double a_max_mm_s2, double j_max_mm_s3,
+                                                      double period_s, bool exact_end) {
+  const double h = period_s, v_in = v_in_mm_s, v_out = v_out_mm_s;
+  exact_end = exact_end || !(v_out > 0.0);
+  // already at the end: only possible when no speed change is asked for
+  if (exact_end && distance_mm <= 1e-12) {
+    if (std::abs(v_in - v_out) > 1e-9) return std::nullopt;
+    JerkGridProfile profile;
+    profile.v_start_mm_s = v_in;
+    profile.v_after_mm_s = v_out;
+    return profile;
+  }
+  // the guards: kJerkGuardSteps at v_in after a moving entry and at v_out before an open end
+  // (the S-curves keep clear of the joints, where the curve's jerk begins inside a period)
+  const int lead_steps = v_in > 0.0 ? kJerkGuardSteps : 0;
+  const int tail_steps = !exact_end ? kJerkGuardSteps : 0;
+  const double guards_mm = (lead_steps * v_in + tail_steps * v_out) * h;
+  const double guarded_mm = distance_mm - guards_mm;
+  if (guarded_mm < 0.0) {
+    // no room for the guards: only a line crossed at one speed
+    if (std::abs(v_in - v_out) > 1e-12 * (1.0 + v_in) || exact_end) return std::nullopt;
+    JerkGridProfile profile;
+    profile.v_start_mm_s = v_in;
+    profile.v_after_mm_s = v_out;
+    return profile;
+  }
+  const auto curve = [&](double dv) { return grid_s_curve(dv, a_max_mm_s2, j_max_mm_s3, h); };
+  const auto ramps_mm = [&](double v_peak) {
+    return s_curve_distance(v_in, v_peak, curve(v_peak - v_in), h) +
+           s_curve_distance(v_peak, v_out, curve(v_peak - v_out), h);
+  };
+  const auto fits = [&](double v_peak) {
+    return v_peak > 0.0 && ramps_mm(v_peak) <= guarded_mm * (1 + 1e-12) + 1e-12;
+  };
+
+  // the highest peak whose two S-curves fit: candidates from the cap down, then bisection
+  // towards the infeasible one above the first that fits
+  constexpr int kScan = 256;
+  std::vector<double> candidates;
+  candidates.reserve(kScan + 3);
+  for (int i = 0; i < kScan; ++i) candidates.push_back(v_cap_mm_s * (1.0 - double(i) / kScan));
+  for (double v : {v_in, v_out, std::max(v_in, v_out)})
+    if (v > 0.0 && v <= v_cap_mm_s) candidates.push_back(v);
+  std::sort(candidates.begin(), candidates.end(), std::greater<double>());
+  double v_peak = -1.0;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    if (!fits(candidates[i])) continue;
+    v_peak = candidates[i];
+    if (i > 0) {
+      double high = candidates[i - 1];
+      for (int iteration = 0; iteration < 40; ++iteration) {
+        const double mid = 0.5 * (v_peak + high);
+        (fits(mid) ? v_peak : high) = mid;
+      }
+    }
+    break;
+  }
+  if (!(v_peak > 0.0)) return std::nullopt;
+
+  // a profile at this peak: S-curve up, whole cruise steps, S-curve down (exact end: through x)
+  const auto build = [&](double peak) -> std::optional<JerkGridProfile> {
+    const GridSCurve up = curve(peak - v_in), down = curve(peak - v_out);
+    const double rest = guarded_mm - ramps_mm(peak);
+    if (rest < -1e-12 * (1.0 + distance_mm)) return std::nullopt;
+    const double cruise_steps = std::floor(std::max(0.0, rest) / (peak * h));
+    if (!(cruise_steps < kMaxJerkSteps) || up.steps() >= kMaxJerkSteps ||
+        down.steps() >= kMaxJerkSteps)
+      return std::nullopt;
+    JerkGridProfile profile;
+    profile.v_start_mm_s = v_in;
+    profile.v_after_mm_s = v_out;
+    profile.append_cruise(lead_steps);
+    profile.append_s_curve(up, peak - v_in, h);
+    profile.append_cruise(static_cast<int>(cruise_steps));
+    const double left = std::max(0.0, rest) - cruise_steps * peak * h;
+    if (!exact_end || left <= 1e-12 * (1.0 + distance_mm)) {
+      profile.append_s_curve(down, v_out - peak, h);
+      profile.append_cruise(tail_steps);
+      return profile;
+    }
+    // the final S-curve through x: peak -> x (steps A), x -> v_out (steps B), covering its own
+    // distance plus `left`; with the step counts fixed the distance is affine in x
+    const double target = s_curve_distance(peak, v_out, down, h) + left;
+    GridSCurve a_curve = down, b_curve{1, 0};
+    for (int iteration = 0; iteration < 60; ++iteration) {
+      const double steps = a_curve.steps() + b_curve.steps();
+      const double x = (target - 0.5 * h * (peak * a_curve.steps() + v_out * b_curve.steps())) /
+                       (0.5 * h * steps);
+      const bool a_ok = a_curve.holds(peak - x, a_max_mm_s2, j_max_mm_s3, h);
+      const bool b_ok = b_curve.holds(x - v_out, a_max_mm_s2, j_max_mm_s3, h);
+      if (a_ok && b_ok && x >= 0.0 && x <= v_cap_mm_s * (1 + 1e-12) && a_curve.steps() > 0 &&
+          b_curve.steps() > 0) {
+        profile.append_s_curve(a_curve, x - peak, h);
+        profile.append_s_curve(b_curve, v_out - x, h);
+        return profile;
+      }
+      // the step counts x needs, at least one jerk step each
+      const double x_next = std::clamp(x, 0.0, v_cap_mm_s);
+      GridSCurve a_next = curve(peak - x_next), b_next = curve(x_next - v_out);
+      if (a_next.steps() == 0) a_next = {1, 0};
+      if (b_next.steps() == 0) b_next = {1, 0};
+      // grow only, so the counts settle
+      if (a_next.steps() < a_curve.steps()) a_next = a_curve;
+      if (b_next.steps() < b_curve.steps()) b_next = b_curve;
+      if (a_next.n_jerk == a_curve.n_jerk && a_next.n_flat == a_curve.n_flat &&
+          b_next.n_jerk == b_curve.n_jerk && b_next.n_flat == b_curve.n_flat)
+        break;
+      a_curve = a_next;
+      b_curve = b_next;
+    }
+    return std::nullopt;
+  };
+  // the peak found, or (exact end, when the final S-curve cannot take up the rest) a little less
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    const double peak = v_peak * (1.0 - 0.01 * attempt);
+    if (!(peak > 0.0)) break;
+    if (std::optional<JerkGridProfile> profile = build(peak)) return profile;
+  }
+  return std::nullopt;
+}
+
+double jerk_grid_room(double v_a_mm_s, double v_b_mm_s, double a_max_mm_s2, double j_max_mm_s3,
+                      double period_s) {
+  if (v_a_mm_s == v_b_mm_s) return 0.0;
+  const GridSCurve curve = grid_s_curve(v_b_mm_s - v_a_mm_s, a_max_mm_s2, j_max_mm_s3, period_s);
+  return s_curve_distance(v_a_mm_s, v_b_mm_s, curve, period_s) +
+         kJerkGridMarginSteps * std::max(v_a_mm_s, v_b_mm_s) * period_s;
+}
+
+}  // namespace depotwin

@@ -139,7 +139,7 @@ TEST(ConformalPlanner, DeclaresItsParametersWithRanges) {
   PlannerSpec spec;
   spec.name = "conformal";
   EXPECT_EQ(check_planner_spec(spec), "");
-  EXPECT_FALSE(find_planner("conformal")->honours_jerk_limit);
+  EXPECT_TRUE(find_planner("conformal")->honours_jerk_limit);
   spec.choices["control"] = "both";
   spec.params["zone_mm"] = {0.5};
   spec.params["zone_ori_deg"] = {3.0};

@@ -208,6 +208,122 @@ TEST(Firmware, ZigZagKeepsTheContract) {
   }
 }
 
+// ---------------------------------------------------------------------------------------
+// S_CURVE_ACCELERATION under a jerk limit
+
+// Marlin's quintic Bezier speed shape: 0 to 1 with zero slope and curvature at both ends,
+// peak slope 15/8 at the middle, peak |curvature| 10 / sqrt(3) at (1 -+ 1/sqrt(3)) / 2
+TEST(FirmwareSCurve, BezierShapeClosedForms) {
+  EXPECT_EQ(s_curve_shape(0.0), 0.0);
+  EXPECT_NEAR(s_curve_shape(1.0), 1.0, 1e-15);
+  EXPECT_NEAR(s_curve_shape(0.5), 0.5, 1e-15);
+  EXPECT_NEAR(s_curve_shape_integral(1.0), 0.5, 1e-15);       // mean speed (v0 + v1) / 2
+  EXPECT_NEAR(s_curve_shape_integral(0.5), 5.0 / 64, 1e-15);  // the corner cut 5 |dv| tau / 64
+  double slope = 0.0, curvature = 0.0;
+  const double dx = 1e-5;
+  for (double x = dx; x < 1.0; x += dx) {
+    slope = std::max(slope, (s_curve_shape(x + dx) - s_curve_shape(x - dx)) / (2 * dx));
+    curvature = std::max(
+        curvature,
+        std::abs(s_curve_shape(x + dx) - 2 * s_curve_shape(x) + s_curve_shape(x - dx)) / (dx * dx));
+  }
+  EXPECT_NEAR(slope, kSCurvePeakAccel, 1e-8);
+  EXPECT_NEAR(curvature, kSCurvePeakJerk, 1e-4);
+  // a 30 mm/s change at a = 1000, j = 200000: the acceleration binds (15/8 30 / 1000 / 0.97),
+  // at j = 2000 the jerk does (sqrt(10 / sqrt(3) 30 / 2000 / 0.97))
+  EXPECT_NEAR(s_curve_ramp_time(30, 1000, 200000), 1.875 * 30 / 970, 1e-15);
+  EXPECT_NEAR(s_curve_ramp_time(-30, 1000, 2000), std::sqrt(kSCurvePeakJerk * 30 / 1940), 1e-15);
+  EXPECT_EQ(s_curve_ramp_time(0, 1000, 2000), 0.0);
+  EXPECT_EQ(s_curve_ramp_time(1e-6, 1000, 2000), kSCurveMinTime_s);
+}
+
+// a single move rest to rest: two Bezier ramps and a cruise, (v / 2) T + d_cruise / v + (v / 2) T
+TEST(FirmwareSCurve, SingleMoveTimeIsTwoBezierRampsAndACruise) {
+  for (const double jerk : {20000.0, 500000.0}) {
+    SCOPED_TRACE(jerk);
+    const MachineLimits limits = MachineLimits::uniform(100, 1000, jerk);
+    const double T = s_curve_ramp_time(50, 1000, jerk);
+    const Trajectory plan =
+        plan_with({"firmware", {}, 0}, polyline({{0, 0, 0}, {10, 0, 0}}, 50), limits);
+    EXPECT_NEAR(plan.duration_s(), 2 * T + (10.0 - 50 * T) / 50, 1e-12);
+    // half-way through the ramp the speed is half the peak
+    EXPECT_NEAR(plan.at(0.5 * T).velocity_mm_s.x(), 25.0, 1e-4);
+    testing_support::expect_finite_difference_limits(plan, limits, 0.01);
+    // the peaks 15/8 v / T and 10/sqrt(3) v / T^2: one of them at 97 % of its limit
+    const auto peaks = testing_support::finite_difference_peaks(plan, limits);
+    EXPECT_NEAR(peaks.accel_ratio[0], kSCurvePeakAccel * 50 / T / 1000, 2e-3);
+    EXPECT_NEAR(peaks.jerk_ratio[0], kSCurvePeakJerk * 50 / (T * T) / jerk, 2e-3);
+    EXPECT_NEAR(std::max(peaks.accel_ratio[0], peaks.jerk_ratio[0]), kSCurveLimitShare, 2e-3);
+  }
+}
+
+// The 90 deg corner of an L under j_max: Marlin's junction speed, the blend's velocity turns by
+// the Bezier shape over tau (acceleration and jerk both within the limits), the corner is cut
+// by 5 |dv| tau / 64
+TEST(FirmwareSCurve, CornerBlendIsJerkLimited) {
+  const double a = 1000.0, j = 30000.0, jd = 0.013, s = std::sqrt(0.5);
+  const MachineLimits limits = MachineLimits::uniform(100, a, j);
+  const Toolpath toolpath = polyline({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const Trajectory plan = plan_with({"firmware", {}, 0}, toolpath, limits);
+  ASSERT_EQ(plan.pieces().size(), 2u);
+  const double v = std::sqrt(a * jd * s / (1 - s));
+  // per axis |dv_i| = v: tau = max(15/8 v / a, sqrt(10/sqrt 3 v / j), 8 ms) / share
+  const double tau =
+      std::max({kSCurvePeakAccel * v / (kSCurveLimitShare * a),
+                std::sqrt(kSCurvePeakJerk * v / (kSCurveLimitShare * j)), kSCurveMinTime_s});
+  // (the samples' cubic interpolation is within 1e-4 mm/s of the Bezier shape)
+  const TrajectorySample before = plan.at(plan.pieces()[0].t_end_s - 0.5 * tau - 1e-9);
+  EXPECT_NEAR(before.velocity_mm_s.x(), v, 1e-4);
+  EXPECT_NEAR(before.velocity_mm_s.y(), 0.0, 1e-4);
+  const TrajectorySample after = plan.at(plan.pieces()[1].t_begin_s + 0.5 * tau + 1e-9);
+  EXPECT_NEAR(after.velocity_mm_s.x(), 0.0, 1e-4);
+  EXPECT_NEAR(after.velocity_mm_s.y(), v, 1e-4);
+  double nearest = 1e300;
+  for (double t = 0; t < plan.duration_s(); t += 1e-5)
+    nearest = std::min(nearest, (plan.at(t).position_mm - Vec3(20, 0, 0)).norm());
+  EXPECT_NEAR(nearest, std::sqrt(2.0) * v * tau * 5 / 64, 1e-6);
+  testing_support::expect_contract(plan, toolpath, limits);
+  testing_support::expect_finite_difference_limits(plan, limits, 0.01);
+}
+
+// Random toolpaths (isolated segments and chains, travels between them) and a fine zig-zag, both
+// modes: every 1 ms sample within v_max, a_max and j_max by finite differences, the contract
+// kept, never faster than without the jerk limit
+TEST(FirmwareSCurve, RandomToolpathsStayWithinTheJerkLimit) {
+  double worst = 0.0;
+  for (const char* mode : {"marlin", "klipper"}) {
+    const auto planner = make_planner({"firmware", {}, 0, {{"mode", mode}}});
+    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+      SCOPED_TRACE(testing::Message() << mode << " seed " << seed);
+      const Toolpath toolpath = testing_support::random_toolpath(seed, 3.0);
+      for (const double jerk : {200.0, 3000.0}) {
+        const MachineLimits limits = MachineLimits::uniform(4.0, 30.0, jerk);
+        const Trajectory plan = planner->plan(toolpath, limits);
+        testing_support::expect_contract(plan, toolpath, limits);
+        testing_support::expect_finite_difference_limits(plan, limits, 0.01);
+        worst = std::max(worst,
+                         testing_support::finite_difference_peaks(plan, limits).max_jerk_ratio());
+        const Trajectory free = planner->plan(toolpath, MachineLimits::uniform(4.0, 30.0));
+        EXPECT_GE(plan.duration_s(), free.duration_s() - 1e-9);
+      }
+      if (HasFatalFailure()) return;
+    }
+  }
+  std::printf("firmware: largest finite-difference jerk / j_max on random toolpaths: %.4f\n",
+              worst);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 20; ++i) {
+    const double x0 = i % 2 == 0 ? 0.0 : 10.0;
+    points.emplace_back(x0, 0.4 * i, 0);
+    points.emplace_back(10.0 - x0, 0.4 * i, 0);
+  }
+  const Toolpath zigzag = polyline(points, 40);
+  const MachineLimits limits = MachineLimits::uniform(100, 1500, 20000);
+  const Trajectory plan = plan_with({"firmware", {}, 0}, zigzag, limits);
+  testing_support::expect_contract(plan, zigzag, limits);
+  testing_support::expect_finite_difference_limits(plan, limits, 0.01);
+}
+
 TEST(Firmware, ParametersOfTheOtherFirmwareAreRefused) {
   EXPECT_EQ(check_planner_spec({"firmware", {{"junction_deviation_mm", {0.02}}}, 0}), "");
   EXPECT_NE(check_planner_spec({"firmware", {}, 0, {{"mode", "grbl"}}}).find("marlin | klipper"),
