@@ -10,8 +10,8 @@ struct HeightMap {
   double origin_x_mm = 0.0;  // centre of cell (0, 0)
   double origin_y_mm = 0.0;
   double cell_mm = 0.0;
-  int nx = 0;  // columns (x)
-  int ny = 0;  // rows (y)
+  int nx = 0;                       // columns (x)
+  int ny = 0;                       // rows (y)
   std::vector<float> thickness_um;  // row-major, index = iy * nx + ix
 
   float at(int ix, int iy) const { return thickness_um[static_cast<size_t>(iy) * nx + ix]; }

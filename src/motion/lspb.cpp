@@ -25,8 +25,8 @@ std::optional<LspbSolution> check_candidate(int index, double v_c, double a0, do
   if (!std::isfinite(v_c)) return std::nullopt;  // eq. (17): imaginary or undefined
   const double tol = 1e-10 * std::max(1.0, duration_s);
   if (std::abs(v_c) > v_max * (1.0 + 1e-12)) return std::nullopt;  // beyond the paper
-  double t_b0 = (v_c - b.v0) / a0;                // eq. (5)
-  double t_b1 = (v_c - b.v1) / a1 + duration_s;   // eq. (6)
+  double t_b0 = (v_c - b.v0) / a0;                                 // eq. (5)
+  double t_b1 = (v_c - b.v1) / a1 + duration_s;                    // eq. (6)
   // eq. (18): t0 <= t_b0 <= t_b1 <= t1
   if (t_b0 < -tol || t_b1 > duration_s + tol || t_b0 > t_b1 + tol) return std::nullopt;
   t_b0 = std::clamp(t_b0, 0.0, duration_s);
@@ -77,8 +77,7 @@ std::optional<LspbSolution> solve_lspb(const AxisBoundary& b, double duration_s,
 
   // Case IV, a0 = a1 = -alpha, eq. (16)
   const double den6 = v0 - v1 - alpha * T;
-  consider(6, den6 != 0.0 ? (-alpha * d + 0.5 * (v0 * v0 - v1 * v1)) / den6 : nan, -alpha,
-           -alpha);
+  consider(6, den6 != 0.0 ? (-alpha * d + 0.5 * (v0 * v0 - v1 * v1)) / den6 : nan, -alpha, -alpha);
   return found;
 }
 

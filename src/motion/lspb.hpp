@@ -16,12 +16,12 @@ struct AxisBoundary {
 };
 
 struct LspbSolution {
-  int candidate = 0;    // which of v_c1..v_c6 (eqs. 11-16) was valid
-  double v_c = 0.0;     // cruise velocity
-  double a0 = 0.0;      // first blend acceleration (+-alpha)
-  double a1 = 0.0;      // second blend acceleration (+-alpha)
-  double t_b0 = 0.0;    // end of the first blend, eq. (5)
-  double t_b1 = 0.0;    // start of the second blend, eq. (6)
+  int candidate = 0;  // which of v_c1..v_c6 (eqs. 11-16) was valid
+  double v_c = 0.0;   // cruise velocity
+  double a0 = 0.0;    // first blend acceleration (+-alpha)
+  double a1 = 0.0;    // second blend acceleration (+-alpha)
+  double t_b0 = 0.0;  // end of the first blend, eq. (5)
+  double t_b1 = 0.0;  // start of the second blend, eq. (6)
   double duration_s = 0.0;
 
   AxisProfile profile(const AxisBoundary& b) const;

@@ -9,8 +9,8 @@
 #include <cstdio>
 
 #include "core/error.hpp"
-#include "core/interrupt.hpp"
 #include "core/input_ranges.hpp"
+#include "core/interrupt.hpp"
 #include "sim/closures.hpp"
 #include "sim/joint_reference.hpp"
 #include "sim/model_binding.hpp"

@@ -125,9 +125,8 @@ std::string file_hash(const std::string& path) {
   std::error_code error;
   if (!fs::is_regular_file(path, error)) return "missing";
   const std::string version =
-      path + "|" +
-      std::to_string(fs::last_write_time(path, error).time_since_epoch().count()) + "|" +
-      std::to_string(fs::file_size(path, error));
+      path + "|" + std::to_string(fs::last_write_time(path, error).time_since_epoch().count()) +
+      "|" + std::to_string(fs::file_size(path, error));
   {
     const std::lock_guard<std::mutex> lock(mutex);
     if (const auto found = known.find(version); found != known.end()) return found->second;

@@ -128,9 +128,9 @@ double integrate_envelope(double v0, double v1, double T, double V, double A, bo
   auto add = [&](double t) {
     if (t > 0 && t < T) knots.push_back(t);
   };
-  add((s * V - v0) / (s * A));                 // first line meets the limit
-  add(T - (s * V - v1) / (s * A));             // third line meets the limit
-  add((v1 - v0 + s * A * T) / (2 * s * A));    // first meets third
+  add((s * V - v0) / (s * A));               // first line meets the limit
+  add(T - (s * V - v1) / (s * A));           // third line meets the limit
+  add((v1 - v0 + s * A * T) / (2 * s * A));  // first meets third
   std::sort(knots.begin(), knots.end());
   double area = 0.0;
   for (size_t i = 1; i < knots.size(); ++i)
@@ -153,7 +153,7 @@ TEST(Mtt, RandomCasesAreFeasibleAndNothingShorterIs) {
   int overshoots = 0;
   for (int i = 0; i < 10000; ++i) {
     AxisBoundary b{pos(rng), pos(rng), vel(rng), vel(rng)};
-    if (i % 10 == 0) b.q1 = b.q0 + 0.01 * pos(rng);  // short moves: overshoot territory
+    if (i % 10 == 0) b.q1 = b.q0 + 0.01 * pos(rng);     // short moves: overshoot territory
     if (i % 50 == 0) b.v1 = (i % 100 == 0) ? kV : -kV;  // velocity at the limit
     SCOPED_TRACE(testing::Message() << "case " << i << " q0=" << b.q0 << " q1=" << b.q1
                                     << " v0=" << b.v0 << " v1=" << b.v1);

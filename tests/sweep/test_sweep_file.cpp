@@ -296,9 +296,10 @@ grid:
                              ":1: base: the scenario lists 2 planners (lspb_mtt, stop_and_go) "
                              "and a task runs one: sweep planner: in grid: (or choose one "
                              "under set:) (every task)");
-  EXPECT_EQ(problems[1], file +
-                             ":4: limits.a_max: must be in [1e-06, 1e+09], got -1 (2 tasks: 1, 3; task 1: "
-                             "toolpath.speed=2, limits.a_max=-1)");
+  EXPECT_EQ(problems[1],
+            file +
+                ":4: limits.a_max: must be in [1e-06, 1e+09], got -1 (2 tasks: 1, 3; task 1: "
+                "toolpath.speed=2, limits.a_max=-1)");
   EXPECT_EQ(problems[2].substr(0, problems[2].rfind(" (2 tasks")),
             scenario_path("thompson_fig7.yaml") +
                 ":21: toolpath.segments[0]: print speed 5 mm/s needs 5 mm/s on x, above limits "
