@@ -106,7 +106,10 @@ TEST_P(PlannerContract, ArmPathsWithRolls) {
       ASSERT_TRUE(solved) << "t " << t;
       if (!previous.empty()) {
         for (size_t j = 0; j < q.size(); ++j) {
-          ASSERT_LT(std::abs(q[j] - previous[j]), 0.05) << "joint " << j << " jumps at t " << t;
+          // a jump is a change of solution (a wrist flip turns a joint by about pi), not fast
+          // motion: near the wrist's singularity a TCP-limited plan (the papers' planners) may
+          // turn a wrist joint at tens of rad/s (README, Known gaps), 0.07 rad in 1 ms measured
+          ASSERT_LT(std::abs(q[j] - previous[j]), 0.2) << "joint " << j << " jumps at t " << t;
           if (joint_limited) {
             ASSERT_LE(std::abs(q[j] - previous[j]) / 0.001, joint_limits[j].v_max * 1.01)
                 << "joint " << j << " t " << t;
