@@ -275,7 +275,8 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
       s +=
           thickness_map_elements(job, display_maps[c], input.toolpath, format("map_%zu", c), false);
       colour_bar_drawn = true;
-      s += "unset title\nunset label 900\nunset object 800\nunset colorbox\n";
+      s += "unset title\nunset label 900\nunset object 800\nunset colorbox\n"
+           "set xtics autofreq\nset ytics autofreq\n";
       // the zoom: the same window in every column, at full resolution
       if (zoom.found && has_map(&zoom_maps[c])) {
         s += "set origin " + format("%.4f,%.4f\n", left, kZoomBottom);

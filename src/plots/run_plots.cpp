@@ -471,7 +471,24 @@ std::string map_ranges(const std::vector<const HeightMap*>& maps, const Toolpath
   if (toolpath != nullptr)
     for (const PrintPath& path : toolpath->paths)
       for (const Vec3& p : path.points) x.add(p.x()), y.add(p.y());
-  return "set xrange " + x.gnuplot(0.0, 0.05) + "\nset yrange " + y.gnuplot(0.0, 0.05) + "\n";
+  // one tic step on both axes (the map is drawn at 1:1), about four over the longer side, so a
+  // tall narrow map does not crowd its x axis with the step its own width would get
+  const double span = std::max(x.empty() ? 0.0 : x.hi - x.lo, y.empty() ? 0.0 : y.hi - y.lo);
+  std::string tics;
+  if (span > 0.0) {
+    const double rough = span / 4.0;
+    const double decade = std::pow(10.0, std::floor(std::log10(rough)));
+    double step = 10.0 * decade;
+    for (double m : {1.0, 2.0, 5.0}) {
+      if (m * decade >= rough) {
+        step = m * decade;
+        break;
+      }
+    }
+    tics = format("set xtics %.9g\nset ytics %.9g\n", step, step);
+  }
+  return "set xrange " + x.gnuplot(0.0, 0.05) + "\nset yrange " + y.gnuplot(0.0, 0.05) + "\n" +
+         tics;
 }
 
 namespace {
