@@ -45,11 +45,10 @@ struct CliResult {
   std::string output;  // stdout and stderr
 };
 
-// run the built CLI with arguments (shell-quoted by the caller where needed)
-inline CliResult depotwin(const std::string& arguments) {
-  const std::string command = std::string(DEPOTWIN_BINARY_DIR) + "/depotwin " + arguments + " 2>&1";
+// run a shell command: its stdout and stderr together, and its exit status
+inline CliResult shell(const std::string& command) {
   CliResult result;
-  FILE* pipe = ::popen(command.c_str(), "r");
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
   if (pipe == nullptr) return result;
   std::array<char, 4096> buffer;
   size_t n;
@@ -58,6 +57,11 @@ inline CliResult depotwin(const std::string& arguments) {
   const int status = ::pclose(pipe);
   result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// run the built CLI with arguments (shell-quoted by the caller where needed)
+inline CliResult depotwin(const std::string& arguments) {
+  return shell(std::string(DEPOTWIN_BINARY_DIR) + "/depotwin " + arguments);
 }
 
 }  // namespace depotwin::testing_support

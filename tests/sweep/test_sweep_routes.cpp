@@ -31,20 +31,8 @@ using testing_support::depotwin;
 using testing_support::fresh_directory;
 using testing_support::read_text;
 using testing_support::scenario_path;
+using testing_support::shell;
 using testing_support::write_text;
-
-// run a shell command, its stdout and stderr together
-CliResult shell(const std::string& command) {
-  CliResult result;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) result.output.append(buffer, n);
-  const int status = ::pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
 
 // results.csv as rows of named cells, without the wall-time columns
 using Table = std::vector<std::map<std::string, std::string>>;

@@ -19,19 +19,7 @@ using testing_support::CliResult;
 using testing_support::depotwin;
 using testing_support::fresh_directory;
 using testing_support::read_text;
-
-// a shell command's standard output and exit status
-CliResult shell(const std::string& command) {
-  CliResult result;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) result.output.append(buffer, n);
-  const int status = ::pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using testing_support::shell;
 
 bool has_program(const std::string& name) {
   return shell("command -v " + name + " >/dev/null").status == 0;
