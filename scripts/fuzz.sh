@@ -64,10 +64,13 @@ for target in "${targets[@]}"; do
   # such input would cost three quarters of the run, so the STL reader's are checked at exit only
   leaks=(-detect_leaks=1)
   if [ "$target" = stl ]; then leaks=(-detect_leaks=0); fi
+  # -entropic_scale_per_exec_time: inputs that run long (a random_segments bed packed to its
+  # last segment takes seconds) get less of the mutation budget, so the scenario loader runs at
+  # about 1 600 inputs/s instead of 90 while still reaching the same code
   echo "fuzz: $target for $what (corpus $corpus)"
   log="$build_dir/fuzz-$target${runs:+-$runs-runs}.log"
   if "$build_dir/tests/fuzz/fuzz_$target" "${limit[@]}" "${leaks[@]}" -timeout=60 -rss_limit_mb=2560 \
-    -malloc_limit_mb=1024 -dict="$root/tests/fuzz/$target.dict" -print_final_stats=1 \
+    -malloc_limit_mb=1024 -entropic_scale_per_exec_time=1 -dict="$root/tests/fuzz/$target.dict" -print_final_stats=1 \
     -artifact_prefix="$artifacts/" "$corpus" >"$log" 2>&1; then
     # libFuzzer's final stats: executions, rate, peak memory
     grep -E "^stat::(number_of_executed_units|average_exec_per_sec|peak_rss_mb)" "$log" |
