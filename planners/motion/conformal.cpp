@@ -13,6 +13,7 @@
 #include "core/interrupt.hpp"
 #include "core/number_text.hpp"
 #include "planners/motion/jerk_time_law.hpp"
+#include "planners/motion/path_check.hpp"
 #include "planners/motion/path_parametrization.hpp"
 
 namespace depotwin {
@@ -390,25 +391,6 @@ std::string path_name(const PrintPath& path, size_t index) {
               : std::string());
 }
 
-void validate_path(const PrintPath& path, const std::string& name) {
-  if (path.points.size() < 2) throw InputError(name, "a print path needs at least two points");
-  if (!(path.speed_mm_s > 0.0) || !std::isfinite(path.speed_mm_s))
-    throw InputError(name, "print speed must be positive");
-  if (!path.normals.empty() && path.normals.size() != path.points.size())
-    throw InputError(name, "needs one normal per point");
-  if (!path.rolls.empty() && path.rolls.size() != path.points.size())
-    throw InputError(name, "needs one roll per point");
-  for (size_t i = 0; i < path.points.size(); ++i) {
-    if (!path.points[i].allFinite())
-      throw InputError(name, "point " + std::to_string(i) + " is not finite");
-    if (i > 0 && (path.points[i] - path.points[i - 1]).norm() <= kSamePoint)
-      throw InputError(name, "segment " + std::to_string(i - 1) + " has zero length");
-    if (!path.normals.empty() &&
-        (!path.normals[i].allFinite() || std::abs(path.normals[i].norm() - 1.0) > 1e-6))
-      throw InputError(name, "normal " + std::to_string(i) + " is not a unit vector");
-  }
-}
-
 // how far the blended axis over corner i (blend size delta) strays from the axis the polyline
 // asks at the nearest point of its two edges
 double orientation_deviation(const PrintPath& path, size_t i, double delta) {
@@ -781,7 +763,7 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp)
     const PrintPath& path = toolpath.paths[index];
     const std::string name = path_name(path, index);
-    validate_path(path, name);
+    validate_print_path(path, name, kSamePoint);
     add_transition(position, orientation, path.front(), path.orientation(0),
                    "transition to " + name);
 

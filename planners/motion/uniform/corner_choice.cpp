@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/error.hpp"
 #include "deposition/thickness_field.hpp"
@@ -92,6 +93,29 @@ void nearest_on_window(const Vec3& a, const Vec3& c, const Vec3& b, const Eigen:
     }
     start += length;
   }
+}
+
+// the cells [first, last] of row y (within [ix_lo, ix_hi]) that may lie within r of the segment
+// p0-p1: the x range of the segment's points within r of the row, widened by r and a cell (an
+// empty range, first > last, when none is)
+std::pair<int, int> row_cells_near(const Vec3& p0, const Vec3& p1, double y, double r, double h,
+                                   int ix_lo, int ix_hi) {
+  const double dy = p1.y() - p0.y();
+  double t0 = 0.0, t1 = 1.0;
+  if (dy != 0.0) {
+    t0 = (y - r - p0.y()) / dy;
+    t1 = (y + r - p0.y()) / dy;
+    if (t0 > t1) std::swap(t0, t1);
+    t0 = std::max(t0, 0.0);
+    t1 = std::min(t1, 1.0);
+  } else if (std::abs(y - p0.y()) > r) {
+    t0 = 1.0, t1 = 0.0;
+  }
+  if (!(t0 <= t1)) return {ix_hi + 1, ix_hi};
+  const double x0 = p0.x() + t0 * (p1.x() - p0.x()), x1 = p0.x() + t1 * (p1.x() - p0.x());
+  const int first = static_cast<int>(std::floor((std::min(x0, x1) - r) / h)) - 1;
+  const int last = static_cast<int>(std::ceil((std::max(x0, x1) + r) / h)) + 1;
+  return {std::max(first, ix_lo), std::min(last, ix_hi)};
 }
 
 }  // namespace
@@ -194,20 +218,30 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
   const double areas[2] = {line_area_mm2(settings, v_in), line_area_mm2(settings, v_out)};
   const Vec3 lo = a.cwiseMin(b).cwiseMin(c) - Vec3::Constant(r + h);
   const Vec3 hi = a.cwiseMax(b).cwiseMax(c) + Vec3::Constant(r + h);
+  const int ix_lo = static_cast<int>(std::floor(lo.x() / h));
+  const int ix_hi = static_cast<int>(std::ceil(hi.x() / h));
   double error_mm = 0.0;
   for (int iy = static_cast<int>(std::floor(lo.y() / h));
        iy <= static_cast<int>(std::ceil(hi.y() / h)); ++iy) {
-    for (int ix = static_cast<int>(std::floor(lo.x() / h));
-         ix <= static_cast<int>(std::ceil(hi.x() / h)); ++ix) {
-      double distance = 0.0, arc = 0.0;
-      int edge = 0;
-      nearest_on_window(a, c, b, Eigen::Vector2d(ix * h, iy * h), distance, arc, edge);
-      if (distance > r || arc < kEndClearSigmas * sigma ||
-          arc > total_arc - kEndClearSigmas * sigma)
-        continue;
-      const double target =
-          areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma));
-      error_mm += std::abs(field.cell_thickness_mm(ix, iy) - target) * h * h / areas[edge];
+    // only the row's cells near either edge (in the same order as a scan of the whole row, so
+    // the sum is the same): most of the window's bounding box is far from its two lines
+    std::pair<int, int> spans[2];
+    for (int e = 0; e < 2; ++e)
+      spans[e] = row_cells_near(e == 0 ? a : c, e == 0 ? c : b, iy * h, r, h, ix_lo, ix_hi);
+    if (spans[1].first < spans[0].first) std::swap(spans[0], spans[1]);
+    for (int e = 0; e < 2; ++e) {
+      const int first = e == 1 ? std::max(spans[1].first, spans[0].second + 1) : spans[0].first;
+      for (int ix = first; ix <= spans[e].second; ++ix) {
+        double distance = 0.0, arc = 0.0;
+        int edge = 0;
+        nearest_on_window(a, c, b, Eigen::Vector2d(ix * h, iy * h), distance, arc, edge);
+        if (distance > r || arc < kEndClearSigmas * sigma ||
+            arc > total_arc - kEndClearSigmas * sigma)
+          continue;
+        const double target =
+            areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma));
+        error_mm += std::abs(field.cell_thickness_mm(ix, iy) - target) * h * h / areas[edge];
+      }
     }
   }
 

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "planners/motion/path_check.hpp"
 #include "planners/motion/transition.hpp"
 
 namespace depotwin {
@@ -85,19 +86,7 @@ std::vector<PrintChain> print_chains(const Toolpath& toolpath) {
   for (size_t index = 0; index < toolpath.paths.size(); ++index) {
     const PrintPath& path = toolpath.paths[index];
     const std::string name = "toolpath path " + std::to_string(path.source_index);
-    if (path.points.size() < 2) throw InputError(name, "a print path needs at least two points");
-    if (!(path.speed_mm_s > 0.0) || !std::isfinite(path.speed_mm_s))
-      throw InputError(name, "print speed must be positive");
-    if (!path.normals.empty() && path.normals.size() != path.points.size())
-      throw InputError(name, "needs one normal per point");
-    if (!path.rolls.empty() && path.rolls.size() != path.points.size())
-      throw InputError(name, "needs one roll per point");
-    for (size_t i = 0; i < path.points.size(); ++i) {
-      if (!path.points[i].allFinite())
-        throw InputError(name, "point " + std::to_string(i) + " is not finite");
-      if (i > 0 && !((path.points[i] - path.points[i - 1]).norm() > kJoinTolerance_mm))
-        throw InputError(name, "segment " + std::to_string(i - 1) + " has zero length");
-    }
+    validate_print_path(path, name, kJoinTolerance_mm);
     // a path whose start is the previous one's end goes on printing through the joint
     const bool joined =
         !chains.empty() &&

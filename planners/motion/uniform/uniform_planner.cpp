@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "core/error.hpp"
 #include "planners/motion/transition.hpp"
@@ -13,6 +14,45 @@ namespace {
 
 // arcs become chords within this share of the tolerance before their corners are blended
 constexpr double kArcChordShare = 0.1;
+// the look-ahead's blend resizing (resize_held_blends): a blend planned below this share of
+// the print speed is resized for kResizeGrowth times its planned speed, at most this many times
+constexpr double kResizeBelowShare = 0.9;
+constexpr double kResizeGrowth = 4.0;
+constexpr int kResizePasses = 12;
+
+// Blends sized for the print speed may fill short edges whole (a finely chorded arc leaves
+// its chords no straight remnant), and speed changes happen on the straight lines only. Where
+// the path must come to rest (an extruder's path end, a stop) the look-ahead then holds a
+// whole curve at the speed its last line can stop from: 3 mm/s over a 4.7 mm arc at 30 mm/s.
+// Each blend the look-ahead planned below kResizeBelowShare of its print speed is resized to
+// the least blend that allows kResizeGrowth times that speed, and never beyond the chosen one
+// (`chosen`): the smaller blend frees its lines to change speed, the larger lets the next pass
+// take the corner faster. True when some blend changed; the caller plans the chain again.
+bool resize_held_blends(const PrintChain& chain, const std::vector<CornerGeometry>& geometry,
+                        const std::vector<double>& corner_speeds, const TcpLimits& limits,
+                        const std::vector<CornerPlan>& chosen, std::vector<CornerPlan>& corners) {
+  bool changed = false;
+  for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
+    CornerPlan& plan = corners[i];
+    if (plan.treatment != CornerTreatment::blend) continue;
+    const double print_speed = std::min(chain.edge_speed_mm_s[i - 1], chain.edge_speed_mm_s[i]);
+    const double speed = corner_speeds[i];
+    if (!(speed < kResizeBelowShare * print_speed)) continue;
+    const CornerGeometry& g = geometry[i];
+    const double tangent = chosen[i].half_length_mm * g.tangent_per_length;
+    const Vec3 p0 = g.point - tangent * g.d_in, p1 = g.point + tangent * g.d_out;
+    const MachineLimits box = blend_limits(
+        limits.over(p0.cwiseMin(p1).cwiseMin(g.point), p0.cwiseMax(p1).cwiseMax(g.point)));
+    const double wanted = std::clamp(
+        blend_half_length_for_speed(g.shape, std::min(print_speed, kResizeGrowth * speed), box),
+        1e-9 * g.max_half_length_mm, chosen[i].half_length_mm);
+    if (std::abs(wanted - plan.half_length_mm) > 1e-9 * plan.half_length_mm) {
+      plan.half_length_mm = wanted;
+      changed = true;
+    }
+  }
+  return changed;
+}
 
 PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerGeometry& g,
                            const CornerDecision& decision) {
@@ -95,17 +135,37 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     const std::vector<CornerGeometry> geometry =
         corner_geometry(chain.points, settings_.tolerance_mm);
     std::vector<CornerPlan> corners(chain.points.size());
+    std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
     for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
       if (geometry[i].turn_rad <= 0.0 ||
           (geometry[i].max_half_length_mm <= 0.0 && geometry[i].turn_rad < 0.5 * kPi))
         continue;  // straight on
-      const CornerDecision decision = choose_corner(chain, i, geometry, jerk_limits, options, model,
-                                                    settings_.time_weight_mm_s);
-      corners[i] = decision.chosen.plan;
+      chain_decisions.emplace_back(i, choose_corner(chain, i, geometry, jerk_limits, options, model,
+                                                    settings_.time_weight_mm_s));
+      corners[i] = chain_decisions.back().second.chosen.plan;
+    }
+    // planned from 0, then placed after the transition that brings the nozzle to its start;
+    // blends that hold the look-ahead back are shrunk and the chain planned again
+    PlannedPath planned = plan_chain(chain, geometry, corners, jerk_limits, options, 0.0);
+    const std::vector<CornerPlan> chosen = corners;
+    std::vector<CornerPlan> trial = corners;
+    std::vector<double> trial_speeds = planned.corner_speed_mm_s;
+    for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
+                                                                  jerk_limits, chosen, trial);
+         ++pass) {
+      PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
+      trial_speeds = replanned.corner_speed_mm_s;
+      if (replanned.t_end_s < planned.t_end_s) {
+        planned = std::move(replanned);
+        corners = trial;  // the quickest plan so far is kept
+      }
+    }
+    // each corner reported as planned: its blend (deviation) and the speed it is taken at
+    for (auto& [i, decision] : chain_decisions) {
+      decision.chosen.plan = corners[i];
+      decision.chosen.speed_mm_s = planned.corner_speed_mm_s[i];
       decisions.push_back(corner_report(chain, i, geometry[i], decision));
     }
-    // planned from 0, then placed after the transition that brings the nozzle to its start
-    PlannedPath planned = plan_chain(chain, geometry, corners, jerk_limits, options, 0.0);
     add_transition(chain.points.front(), planned.start_velocity, chain.orientations.front());
     for (TrajectoryPiece& piece : planned.pieces) {
       piece.t_begin_s += t;

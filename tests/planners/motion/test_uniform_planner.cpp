@@ -170,6 +170,47 @@ TEST(UniformPlanner, BlendsStayInsideTheToleranceBand) {
   }
 }
 
+// A slicer's arc is a run of short chords; blends sized for the print speed fill them whole,
+// and speed changes happen on straight lines only. An extruder's path that ends on such an arc
+// (a perimeter's last corner, rounded_square_3_layers.gcode) must still slow down only near
+// its end: the arc's 4.7 mm (a quarter circle of radius 3 in 14 chords, at 30 mm/s, the
+// clothoids holding it at 29 mm/s) take at most twice what the same length of straight line
+// ending at rest takes (0.34 s; 0.58 s measured). Before the planner resized the blends the
+// look-ahead held back, the arc crawled at 3 mm/s: 1.64 s.
+TEST(UniformPlanner, PathEndingOnAChordedArcSlowsDownOnlyNearItsEnd) {
+  const MachineLimits limits = MachineLimits::uniform(100.0, 1000.0);
+  const auto print_time_from = [&](const std::vector<Vec3>& points, const Vec3& from) {
+    Toolpath toolpath;
+    PrintPath path;
+    path.points = points;
+    path.speed_mm_s = 30.0;
+    toolpath.paths.push_back(path);
+    toolpath.start_mm = points.front();
+    toolpath.end_mm = points.back();
+    const Trajectory plan = UniformPlanner{UniformSettings{}}.plan_in_context(
+        toolpath, limits, context_for(ProcessType::extrusion));
+    // from the first sample at `from` to the end of the printed part
+    double t_from = -1.0, t_end = 0.0;
+    for (const TrajectoryPiece& piece : plan.pieces())
+      if (piece.depositing) t_end = std::max(t_end, piece.t_end_s);
+    for (double t = 0.0; t <= t_end && t_from < 0.0; t += 1e-4)
+      if ((plan.at(t).position_mm - from).norm() < 0.01) t_from = t;
+    EXPECT_GE(t_from, 0.0);
+    return t_end - t_from;
+  };
+  const double radius = 3.0, quarter = 0.5 * kPi * radius;
+  std::vector<Vec3> arc = {Vec3(0, 0, 0)};
+  for (int k = 0; k <= 14; ++k) {
+    const double angle = 0.5 * kPi * k / 14.0;
+    arc.push_back(Vec3(14.0 + radius * std::sin(angle), radius - radius * std::cos(angle), 0));
+  }
+  const double on_arc = print_time_from(arc, Vec3(14, 0, 0));
+  const double on_line =
+      print_time_from({Vec3(0, 0, 0), Vec3(14.0 + quarter, 0, 0)}, Vec3(14, 0, 0));
+  EXPECT_GT(on_line, quarter / 30.0);
+  EXPECT_LE(on_arc, 2.0 * on_line) << "arc " << on_arc << " s, line " << on_line << " s";
+}
+
 // Extrusion: the commanded flow leads the planned speed by the lag, so the nozzle's lagging
 // flow (dQ/dt = (Qc - Q) / tau, integrated exactly per 0.1 ms with Qc held) keeps the material
 // per millimetre at w h through the start, the corners and the stop: within 1 % wherever the
