@@ -37,7 +37,7 @@ bool resize_held_blends(const PrintChain& chain, const std::vector<CornerGeometr
     if (plan.treatment != CornerTreatment::blend) continue;
     const double print_speed = std::min(chain.edge_speed_mm_s[i - 1], chain.edge_speed_mm_s[i]);
     const double speed = corner_speeds[i];
-    if (!(speed < kResizeBelowShare * print_speed)) continue;
+    if (!(speed > 0.0 && speed < kResizeBelowShare * print_speed)) continue;
     const CornerGeometry& g = geometry[i];
     const double tangent = chosen[i].half_length_mm * g.tangent_per_length;
     const Vec3 p0 = g.point - tangent * g.d_in, p1 = g.point + tangent * g.d_out;
