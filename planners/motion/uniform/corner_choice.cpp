@@ -118,24 +118,44 @@ std::pair<int, int> row_cells_near(const Vec3& p0, const Vec3& p1, double y, dou
   return {std::max(first, ix_lo), std::min(last, ix_hi)};
 }
 
-}  // namespace
+// What every candidate at one corner shares: the window of the path around it (planned alone,
+// entering and leaving at print speed), and the even deposit it is compared with.
+struct CornerWindow {
+  PrintChain chain;  // a - c - b
+  std::vector<CornerGeometry> geometry;
+  Vec3 a, c, b;
+  Vec3 d_in, d_out;
+  double v_in = 0.0, v_out = 0.0;
+  double cell_mm = 0.0;
+  // the target cells (within half a line width of the centreline, clear of the window's ends)
+  // and the centreline's samples, in the order their errors are summed
+  struct TargetCell {
+    int ix = 0, iy = 0;
+    double thickness_mm = 0.0, line_area_mm2 = 0.0;
+  };
+  struct CentreSample {
+    double x_mm = 0.0, y_mm = 0.0, peak_mm = 0.0;
+  };
+  std::vector<TargetCell> cells;
+  std::vector<CentreSample> centre;
+  bool has_targets = false;  // cells and centre are filled (add_targets)
+};
 
-CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
-                                const CornerGeometry& geometry, const CornerPlan& plan,
-                                const TcpLimits& limits, const PathMotionOptions& options,
-                                const DepositModel& model, double time_weight_mm_s,
-                                double prune_above_mm) {
-  const DepositionSettings& settings = model.settings;
-  const double sigma = settings.footprint_sigma_mm();
+CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerGeometry& geometry,
+                           const TcpLimits& limits, const PathMotionOptions& options,
+                           const DepositModel& model) {
   const double reach = window_reach_mm(chain, corner, geometry, limits, options, model);
 
   // the window: the two edges around the corner, cut at `reach`
-  PrintChain window;
+  CornerWindow w;
   const Vec3& c = chain.points[corner];
   const double edge_in = (c - chain.points[corner - 1]).norm();
   const double edge_out = (chain.points[corner + 1] - c).norm();
   const Vec3 a = edge_in <= reach ? chain.points[corner - 1] : Vec3(c - reach * geometry.d_in);
   const Vec3 b = edge_out <= reach ? chain.points[corner + 1] : Vec3(c + reach * geometry.d_out);
+  w.a = a, w.b = b, w.c = c;
+  w.d_in = geometry.d_in, w.d_out = geometry.d_out;
+  PrintChain& window = w.chain;
   window.points = {a, c, b};
   window.orientations.assign(3, ToolOrientation{});
   window.edge_speed_mm_s = {chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]};
@@ -143,16 +163,83 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
   window.edge_source = {chain.edge_source[corner - 1], chain.edge_source[corner]};
   window.point_path = {0, 0, 0};
   window.point_index = {0, 1, 2};
-  std::vector<CornerGeometry> window_geometry = corner_geometry(window.points, kInf);
+  w.geometry = corner_geometry(window.points, kInf);
+  w.v_in = window.edge_speed_mm_s[0], w.v_out = window.edge_speed_mm_s[1];
+  return w;
+}
+
+// The window's target cells and centreline samples (needed once a candidate's deposit is
+// predicted).
+void add_targets(CornerWindow& w, const DepositModel& model) {
+  const DepositionSettings& settings = model.settings;
+  const double sigma = settings.footprint_sigma_mm();
+  const Vec3 &a = w.a, &b = w.b, &c = w.c;
+  w.has_targets = true;
+
+  // the even deposit over the window's target cells: the steady line's cross section at the
+  // cell's distance from the nearest centreline point
+  const double h = kCellSigmas * sigma;
+  w.cell_mm = h;
+  const double r = 0.5 * settings.resolved_line_width_mm();
+  const double total_arc = (c - a).norm() + (b - c).norm();
+  const double peak_per_area = 1.0 / (sigma * std::sqrt(2.0 * kPi));
+  const double areas[2] = {line_area_mm2(settings, w.v_in), line_area_mm2(settings, w.v_out)};
+  const Vec3 lo = a.cwiseMin(b).cwiseMin(c) - Vec3::Constant(r + h);
+  const Vec3 hi = a.cwiseMax(b).cwiseMax(c) + Vec3::Constant(r + h);
+  const int ix_lo = static_cast<int>(std::floor(lo.x() / h));
+  const int ix_hi = static_cast<int>(std::ceil(hi.x() / h));
+  for (int iy = static_cast<int>(std::floor(lo.y() / h));
+       iy <= static_cast<int>(std::ceil(hi.y() / h)); ++iy) {
+    // only the row's cells near either edge (in the same order as a scan of the whole row):
+    // most of the window's bounding box is far from its two lines
+    std::pair<int, int> spans[2];
+    for (int e = 0; e < 2; ++e)
+      spans[e] = row_cells_near(e == 0 ? a : c, e == 0 ? c : b, iy * h, r, h, ix_lo, ix_hi);
+    if (spans[1].first < spans[0].first) std::swap(spans[0], spans[1]);
+    for (int e = 0; e < 2; ++e) {
+      const int first = e == 1 ? std::max(spans[1].first, spans[0].second + 1) : spans[0].first;
+      for (int ix = first; ix <= spans[e].second; ++ix) {
+        double distance = 0.0, arc = 0.0;
+        int edge = 0;
+        nearest_on_window(a, c, b, Eigen::Vector2d(ix * h, iy * h), distance, arc, edge);
+        if (distance > r || arc < kEndClearSigmas * sigma ||
+            arc > total_arc - kEndClearSigmas * sigma)
+          continue;
+        CornerWindow::TargetCell cell;
+        cell.ix = ix, cell.iy = iy;
+        cell.thickness_mm =
+            areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma));
+        cell.line_area_mm2 = areas[edge];
+        w.cells.push_back(cell);
+      }
+    }
+  }
+  // and along the centreline itself (where a line's thickness is measured), every cell
+  const double leg[2] = {(c - a).norm(), (b - c).norm()};
+  for (double arc = kEndClearSigmas * sigma; arc <= total_arc - kEndClearSigmas * sigma; arc += h) {
+    const int edge = arc < leg[0] ? 0 : 1;
+    const Vec3 p = edge == 0 ? Vec3(a + arc * w.d_in) : Vec3(c + (arc - leg[0]) * w.d_out);
+    w.centre.push_back({p.x(), p.y(), areas[edge] * peak_per_area});
+  }
+}
+
+// The predicted error and extra time of one corner plan in its window (see the header). A plan
+// whose extra time alone costs at least prune_above_mm is not deposited (pruned).
+CornerCandidate evaluate_corner(const CornerWindow& w, const CornerPlan& plan,
+                                const TcpLimits& limits, const PathMotionOptions& options,
+                                const DepositModel& model, double time_weight_mm_s,
+                                double prune_above_mm) {
+  const DepositionSettings& settings = model.settings;
+  const double sigma = settings.footprint_sigma_mm();
+  const Vec3 &a = w.a, &b = w.b, &c = w.c;
   std::vector<CornerPlan> plans(3);
   plans[1] = plan;
   PathMotionOptions window_options = options;
   window_options.enter_at_speed = window_options.leave_at_speed = true;
-  const PlannedPath planned =
-      plan_chain(window, window_geometry, plans, limits, window_options, 0.0);
+  const PlannedPath planned = plan_chain(w.chain, w.geometry, plans, limits, window_options, 0.0);
   const Trajectory motion("uniform", planned.pieces);
   const double duration = motion.duration_s();
-  const double v_in = window.edge_speed_mm_s[0], v_out = window.edge_speed_mm_s[1];
+  const double v_in = w.v_in, v_out = w.v_out;
   CornerCandidate candidate;
   candidate.plan = plan;
   candidate.extra_time_s = duration - ((c - a).norm() / v_in + (b - c).norm() / v_out);
@@ -165,7 +252,7 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
   }
 
   // the deposit: a pre-roll at print speed, the window's plan, a post-roll
-  std::unique_ptr<Process> process = make_process(settings, kCellSigmas * sigma);
+  std::unique_ptr<Process> process = make_process(settings, w.cell_mm);
   const double roll = std::max(kRollSigmas * sigma, 6.0 * options.lag_s * std::max(v_in, v_out));
   const double step_s = std::min(kStepS, kStepSigmas * sigma / std::max(v_in, v_out));
   const auto steady = [&](const Vec3& from, const Vec3& to, double speed, double t0) {
@@ -186,7 +273,7 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
     return t0 + length / speed;
   };
   const double t_pre = roll / v_in;
-  steady(a - roll * geometry.d_in, a, v_in, -t_pre);
+  steady(a - roll * w.d_in, a, v_in, -t_pre);
   const auto closed = closed_spans(motion);
   const int steps = std::max(1, static_cast<int>(std::ceil(duration / step_s)));
   const double dt = duration / steps;
@@ -207,58 +294,26 @@ CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
     process->advance(step);
     before = after;
   }
-  steady(b, b + roll * geometry.d_out, v_out, duration);
+  steady(b, b + roll * w.d_out, v_out, duration);
   const ThicknessField& field = process->field();
 
-  // the error against the even deposit over the window's target cells
+  // the error against the even deposit over the window's target cells, then along its
+  // centreline
   const double h = field.cell_mm();
-  const double r = 0.5 * settings.resolved_line_width_mm();
-  const double total_arc = (c - a).norm() + (b - c).norm();
-  const double peak_per_area = 1.0 / (sigma * std::sqrt(2.0 * kPi));
-  const double areas[2] = {line_area_mm2(settings, v_in), line_area_mm2(settings, v_out)};
-  const Vec3 lo = a.cwiseMin(b).cwiseMin(c) - Vec3::Constant(r + h);
-  const Vec3 hi = a.cwiseMax(b).cwiseMax(c) + Vec3::Constant(r + h);
-  const int ix_lo = static_cast<int>(std::floor(lo.x() / h));
-  const int ix_hi = static_cast<int>(std::ceil(hi.x() / h));
   double error_mm = 0.0;
-  for (int iy = static_cast<int>(std::floor(lo.y() / h));
-       iy <= static_cast<int>(std::ceil(hi.y() / h)); ++iy) {
-    // only the row's cells near either edge (in the same order as a scan of the whole row, so
-    // the sum is the same): most of the window's bounding box is far from its two lines
-    std::pair<int, int> spans[2];
-    for (int e = 0; e < 2; ++e)
-      spans[e] = row_cells_near(e == 0 ? a : c, e == 0 ? c : b, iy * h, r, h, ix_lo, ix_hi);
-    if (spans[1].first < spans[0].first) std::swap(spans[0], spans[1]);
-    for (int e = 0; e < 2; ++e) {
-      const int first = e == 1 ? std::max(spans[1].first, spans[0].second + 1) : spans[0].first;
-      for (int ix = first; ix <= spans[e].second; ++ix) {
-        double distance = 0.0, arc = 0.0;
-        int edge = 0;
-        nearest_on_window(a, c, b, Eigen::Vector2d(ix * h, iy * h), distance, arc, edge);
-        if (distance > r || arc < kEndClearSigmas * sigma ||
-            arc > total_arc - kEndClearSigmas * sigma)
-          continue;
-        const double target =
-            areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma));
-        error_mm += std::abs(field.cell_thickness_mm(ix, iy) - target) * h * h / areas[edge];
-      }
-    }
-  }
-
-  // and along the centreline itself (where a line's thickness is measured), every cell
-  const double leg[2] = {(c - a).norm(), (b - c).norm()};
-  for (double arc = kEndClearSigmas * sigma; arc <= total_arc - kEndClearSigmas * sigma; arc += h) {
-    const int edge = arc < leg[0] ? 0 : 1;
-    const Vec3 p =
-        edge == 0 ? Vec3(a + arc * geometry.d_in) : Vec3(c + (arc - leg[0]) * geometry.d_out);
-    const double peak = areas[edge] * peak_per_area;
-    error_mm += std::abs(field.thickness_mm_at(p.x(), p.y()) - peak) / peak * h;
-  }
+  for (const CornerWindow::TargetCell& cell : w.cells)
+    error_mm += std::abs(field.cell_thickness_mm(cell.ix, cell.iy) - cell.thickness_mm) * h * h /
+                cell.line_area_mm2;
+  for (const CornerWindow::CentreSample& sample : w.centre)
+    error_mm += std::abs(field.thickness_mm_at(sample.x_mm, sample.y_mm) - sample.peak_mm) /
+                sample.peak_mm * h;
 
   candidate.error_mm = error_mm;
   candidate.cost = error_mm + time_weight_mm_s * candidate.extra_time_s;
   return candidate;
 }
+
+}  // namespace
 
 CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              const std::vector<CornerGeometry>& geometry, const TcpLimits& limits,
@@ -266,13 +321,14 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              double time_weight_mm_s) {
   const CornerGeometry& g = geometry[corner];
   const double speed = std::min(chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]);
+  CornerWindow window = corner_window(chain, corner, g, limits, options, model);
   std::vector<CornerCandidate> candidates;
   double best = std::numeric_limits<double>::infinity();
   // evaluates a candidate (its deposit only when its time alone does not already cost more
   // than the best so far) and returns its cost
   const auto add = [&](const std::string& name, const CornerPlan& plan) {
     CornerCandidate candidate =
-        evaluate_corner(chain, corner, g, plan, limits, options, model, time_weight_mm_s, best);
+        evaluate_corner(window, plan, limits, options, model, time_weight_mm_s, best);
     candidate.name = name;
     candidates.push_back(candidate);
     if (!candidate.pruned) best = std::min(best, candidate.cost);
@@ -282,10 +338,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
   // the blends: the least that keeps the print speed, else the largest within the tolerance
   bool full_speed_blend = false;
   if (g.max_half_length_mm > 0.0) {
-    const double tangent_max = g.max_half_length_mm * g.tangent_per_length;
-    const Vec3 p0 = g.point - tangent_max * g.d_in, p1 = g.point + tangent_max * g.d_out;
-    const MachineLimits box = blend_limits(
-        limits.over(p0.cwiseMin(p1).cwiseMin(g.point), p0.cwiseMax(p1).cwiseMax(g.point)));
+    const MachineLimits box = corner_blend_limits(g, g.max_half_length_mm, limits);
     const double needed = blend_half_length_for_speed(g.shape, speed, box);
     CornerPlan plan;
     plan.treatment = CornerTreatment::blend;
@@ -294,11 +347,12 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
       // against (its deposit is not predicted; its time is)
       plan.half_length_mm = std::max(needed, 1e-9 * g.max_half_length_mm);
       CornerCandidate candidate =
-          evaluate_corner(chain, corner, g, plan, limits, options, model, time_weight_mm_s, -kInf);
+          evaluate_corner(window, plan, limits, options, model, time_weight_mm_s, -kInf);
       candidate.name = "blend";
       candidates.push_back(candidate);
       full_speed_blend = true;
     } else {
+      add_targets(window, model);
       // smaller blends while they pay (the cost is unimodal in the size here)
       double previous = std::numeric_limits<double>::infinity();
       for (const double share : kSlowBlendShares) {
@@ -310,6 +364,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
     }
   }
   if (!full_speed_blend) {
+    if (!window.has_targets) add_targets(window, model);
     if (model.aerosol()) {
       // loops, printing resuming past the overlap of the two lines at a sharp corner
       const double alpha = deg_to_rad(g.interior_deg);

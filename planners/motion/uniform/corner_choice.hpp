@@ -71,12 +71,4 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              const PathMotionOptions& options, const DepositModel& model,
                              double time_weight_mm_s);
 
-// The predicted error and extra time of one corner plan (the window and the deposit as above).
-// A plan whose extra time alone costs at least prune_above_mm is not deposited (pruned).
-CornerCandidate evaluate_corner(const PrintChain& chain, size_t corner,
-                                const CornerGeometry& geometry, const CornerPlan& plan,
-                                const TcpLimits& limits, const PathMotionOptions& options,
-                                const DepositModel& model, double time_weight_mm_s,
-                                double prune_above_mm = std::numeric_limits<double>::infinity());
-
 }  // namespace depotwin

@@ -57,6 +57,14 @@ MachineLimits blend_limits(MachineLimits limits) {
   return limits;
 }
 
+MachineLimits corner_blend_limits(const CornerGeometry& g, double half_length_mm,
+                                  const TcpLimits& limits) {
+  const double tangent = half_length_mm * g.tangent_per_length;
+  const Vec3 p0 = g.point - tangent * g.d_in, p1 = g.point + tangent * g.d_out;
+  return blend_limits(
+      limits.over(p0.cwiseMin(p1).cwiseMin(g.point), p0.cwiseMax(p1).cwiseMax(g.point)));
+}
+
 ToolOrientation PrintChain::edge_orientation(size_t e, double fraction) const {
   const ToolOrientation& a = orientations[e];
   const ToolOrientation& b = orientations[e + 1];

@@ -127,6 +127,10 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
 // the limits blends are held to: kBlendLimitShare of the acceleration and jerk limits (the
 // slack the cubic interpolation of a blend's samples needs)
 MachineLimits blend_limits(MachineLimits limits);
+// the limits a blend of the given half-length at corner g is held to: blend_limits over the
+// box of its two tangent points and the corner (the triangle it lies in)
+MachineLimits corner_blend_limits(const CornerGeometry& g, double half_length_mm,
+                                  const TcpLimits& limits);
 
 // the straight line's limits along direction u (unit) under per-axis limits, capped at speed
 LineLimits line_limits(const Vec3& u, const MachineLimits& limits, double speed_cap_mm_s,

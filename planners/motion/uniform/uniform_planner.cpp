@@ -39,10 +39,7 @@ bool resize_held_blends(const PrintChain& chain, const std::vector<CornerGeometr
     const double speed = corner_speeds[i];
     if (!(speed > 0.0 && speed < kResizeBelowShare * print_speed)) continue;
     const CornerGeometry& g = geometry[i];
-    const double tangent = chosen[i].half_length_mm * g.tangent_per_length;
-    const Vec3 p0 = g.point - tangent * g.d_in, p1 = g.point + tangent * g.d_out;
-    const MachineLimits box = blend_limits(
-        limits.over(p0.cwiseMin(p1).cwiseMin(g.point), p0.cwiseMax(p1).cwiseMax(g.point)));
+    const MachineLimits box = corner_blend_limits(g, chosen[i].half_length_mm, limits);
     const double wanted = std::clamp(
         blend_half_length_for_speed(g.shape, std::min(print_speed, kResizeGrowth * speed), box),
         1e-9 * g.max_half_length_mm, chosen[i].half_length_mm);
