@@ -38,8 +38,27 @@ double line_area_mm2(const DepositionSettings& s, double speed_mm_s) {
   return s.bead_width_mm * s.layer_height_mm;
 }
 
+// the length over which the two lines of a sharp corner overlap (2 sigma / sin(alpha) for an
+// interior angle alpha below 90 deg, else 0): the loops' trims are fractions of it
+double overlap_mm(const CornerGeometry& g, const DepositModel& model) {
+  const double alpha = deg_to_rad(g.interior_deg);
+  const double sigma = model.settings.footprint_sigma_mm();
+  return alpha < 0.5 * kPi ? 2.0 * sigma / std::max(std::sin(alpha), 1e-3) : 0.0;
+}
+
+// the largest trim a loop candidate tries on an edge of this length (0 without loops)
+double largest_trim_mm(const CornerGeometry& g, double edge_mm, const DepositModel& model) {
+  if (!model.aerosol()) return 0.0;
+  const double fraction = std::max(*std::max_element(std::begin(kTrimFractions),
+                                                     std::end(kTrimFractions)),
+                                   *std::max_element(std::begin(kTrimInFractions),
+                                                     std::end(kTrimInFractions)));
+  return std::min(fraction * overlap_mm(g, model), kMaxTrimShare * edge_mm);
+}
+
 // how far on each side of the corner the window reaches: the slowest candidate's speed
-// change (to rest), the largest blend or trim, and kWindowSigmas
+// change (to rest) and the flow lag's settling after it, the largest blend or trim, and
+// kWindowSigmas
 double window_reach_mm(const PrintChain& chain, size_t corner, const CornerGeometry& g,
                        const TcpLimits& limits, const PathMotionOptions& options,
                        const DepositModel& model) {
@@ -50,8 +69,10 @@ double window_reach_mm(const PrintChain& chain, size_t corner, const CornerGeome
     const Vec3& b = chain.points[e + 1];
     const LineLimits line = line_limits((b - a).normalized(), limits.along(a, b),
                                         chain.edge_speed_mm_s[e], options.lag_s);
-    reach = std::max(reach, speed_change_distance(line.v_max_mm_s, 0.0, line));
-    reach = std::max(reach, kMaxTrimShare * (b - a).norm());
+    // (and the extruder's flow settling after it, as the post-roll allows for)
+    reach = std::max(reach, speed_change_distance(line.v_max_mm_s, 0.0, line) +
+                                6.0 * options.lag_s * line.v_max_mm_s);
+    reach = std::max(reach, largest_trim_mm(g, (b - a).norm(), model));
   }
   return reach + g.max_half_length_mm * g.tangent_per_length + kWindowSigmas * sigma;
 }
@@ -367,10 +388,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
     if (!window.has_targets) add_targets(window, model);
     if (model.aerosol()) {
       // loops, printing resuming past the overlap of the two lines at a sharp corner
-      const double alpha = deg_to_rad(g.interior_deg);
-      const double sigma = model.settings.footprint_sigma_mm();
-      const double overlap =
-          alpha < 0.5 * kPi ? 2.0 * sigma / std::max(std::sin(alpha), 1e-3) : 0.0;
+      const double overlap = overlap_mm(g, model);
       const double edge_in = (chain.points[corner] - chain.points[corner - 1]).norm();
       const double edge_out = (chain.points[corner + 1] - chain.points[corner]).norm();
       double last_in = -1.0;
