@@ -167,16 +167,25 @@ void AerosolProcess::advance(const DepositionStep& step) {
 ExtrusionProcess::ExtrusionProcess(const DepositionSettings& settings, double cell_mm)
     : Process(settings, cell_mm) {}
 
-void ExtrusionProcess::advance(const DepositionStep& step) {
-  check_step(step);
-  const double dt_s = step.t1_s - step.t0_s;
-
-  // commanded flow: a fraction of the nominal bead flow (speed x width x height)
+// commanded flow: a fraction of the nominal bead flow (speed x width x height)
+double ExtrusionProcess::command_mm3_s(const DepositionStep& step) const {
   const double nominal_mm3_s = settings_.flow_mm3_s > 0.0
                                    ? settings_.flow_mm3_s
                                    : std::max(0.0, step.desired_speed_mm_s) *
                                          settings_.bead_width_mm * settings_.layer_height_mm;
-  const double command_mm3_s = std::max(0.0, step.flow_command) * nominal_mm3_s;
+  return std::max(0.0, step.flow_command) * nominal_mm3_s;
+}
+
+void ExtrusionProcess::start_steady(const DepositionStep& step) {
+  check_step(step);
+  flow_mm3_s_ = command_mm3_s(step);
+  peak_command_mm3_s_ = std::max(peak_command_mm3_s_, flow_mm3_s_);
+}
+
+void ExtrusionProcess::advance(const DepositionStep& step) {
+  check_step(step);
+  const double dt_s = step.t1_s - step.t0_s;
+  const double command_mm3_s = this->command_mm3_s(step);
   peak_command_mm3_s_ = std::max(peak_command_mm3_s_, command_mm3_s);
 
   // first-order lag, exact over the step: Q(t) = Qc + (Q0 - Qc) exp(-(t - t0) / tau)

@@ -112,6 +112,9 @@ class Process {
   virtual void advance(const DepositionStep& step) = 0;
   // flow leaving the nozzle now (mm^3/s): aerosol stream Q, extrusion lagged flow
   virtual double nozzle_flow_mm3_s() const = 0;
+  // as if the step's flow command had been held long enough to settle (extrusion: the lagged
+  // flow equals it; aerosol: nothing to settle); nothing is deposited
+  virtual void start_steady(const DepositionStep& /*step*/) {}
 
   // the deposit of every step advanced so far (pending batched steps are put down first;
   // not thread-safe while steps are pending: call flush() before sharing the process)
@@ -164,9 +167,11 @@ class ExtrusionProcess : public Process {
  public:
   ExtrusionProcess(const DepositionSettings& settings, double cell_mm);
   void advance(const DepositionStep& step) override;
+  void start_steady(const DepositionStep& step) override;
   double nozzle_flow_mm3_s() const override { return flow_mm3_s_; }
 
  private:
+  double command_mm3_s(const DepositionStep& step) const;  // the step's commanded flow
   double flow_mm3_s_ = 0.0;          // lagged nozzle flow at the end of the last step
   double peak_command_mm3_s_ = 0.0;  // largest commanded flow so far (for the ooze cut-off)
 };

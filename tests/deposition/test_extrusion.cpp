@@ -136,5 +136,36 @@ TEST(Extrusion, ZeroTauFollowsTheCommandInstantly) {
   EXPECT_NEAR(cross_section_mm2(process.field(), 0.5) / (kBeadWidth * kLayerHeight), 1.0, 1e-4);
 }
 
+// start_steady: the lagged flow starts settled at the step's command, so a line printed from
+// there lands exactly command x time (no thin start), and nothing lands before it
+TEST(Extrusion, StartSteadySettlesTheLagWithoutDepositing) {
+  ExtrusionProcess process(extrusion_settings(), 0.0);
+  DepositionStep step;
+  step.flow_command = 1.0;
+  step.desired_speed_mm_s = kSpeed;
+  process.start_steady(step);
+  const double command = kSpeed * kBeadWidth * kLayerHeight;
+  EXPECT_DOUBLE_EQ(process.nozzle_flow_mm3_s(), command);
+  EXPECT_EQ(process.account().emitted_mm3, 0.0);
+  EXPECT_EQ(process.field().total_volume_mm3(), 0.0);
+  const double t_print = kLength / kSpeed;
+  drive(
+      process, 0.0, t_print, 1e-3, [&](double t) { return Vec3(kSpeed * t, 0.0, 0.0); },
+      [](double) { return 0.0; }, [](double) { return 1.0; }, [](double) { return kSpeed; });
+  EXPECT_NEAR(process.account().emitted_mm3, command * t_print, 1e-9 * command * t_print);
+  // the same line from rest: the lag withholds about Q tau at its start
+  ExtrusionProcess from_rest(extrusion_settings(), 0.0);
+  drive(
+      from_rest, 0.0, t_print, 1e-3, [&](double t) { return Vec3(kSpeed * t, 0.0, 0.0); },
+      [](double) { return 0.0; }, [](double) { return 1.0; }, [](double) { return kSpeed; });
+  EXPECT_NEAR(command * t_print - from_rest.account().emitted_mm3, command * kTau,
+              1e-3 * command * kTau);
+  // 2 mm in (two lag lengths v tau): the settled start lays the full bead, the one from rest
+  // is still about exp(-2) = 14 % thin
+  const double bead_mm2 = kBeadWidth * kLayerHeight;
+  EXPECT_NEAR(cross_section_mm2(process.field(), 2.0) / bead_mm2, 1.0, 1e-3);
+  EXPECT_NEAR(cross_section_mm2(from_rest.field(), 2.0) / bead_mm2, 1.0 - std::exp(-2.0), 0.01);
+}
+
 }  // namespace
 }  // namespace depotwin

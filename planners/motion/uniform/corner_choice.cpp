@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <utility>
 
 #include "core/error.hpp"
@@ -19,6 +20,14 @@ constexpr double kStepS = 0.004;
 constexpr double kStepSigmas = 0.25;
 constexpr double kWindowSigmas = 6.0;  // window beyond what the candidates change
 constexpr double kRollSigmas = 6.0;    // pre- and post-rolls (the footprint ends at 5 sigma)
+// the prediction's footprint ends here (the simulation's default: 5 sigma); the tail beyond
+// holds exp(-8) = 3e-4 of the peak, renormalised onto the footprint's square, alike for every
+// candidate
+constexpr double kPredictionTruncationSigmas = 4.0;
+// and its steps are batched over 2 sigma of path (the simulation's default: 1), 4 quadrature
+// nodes a batch: at most 5.9e-8 2^8 = 1.5e-5 of a batch's peak on smooth motion
+// (deposition/step_batch.hpp)
+constexpr double kPredictionBatchSigmas = 2.0;
 // error cells this far (arc length) from the window's ends
 constexpr double kEndClearSigmas = 1.0;
 // the prediction's cells: half a sigma (every cell's volume is exact at any size; the error
@@ -49,10 +58,9 @@ double overlap_mm(const CornerGeometry& g, const DepositModel& model) {
 // the largest trim a loop candidate tries on an edge of this length (0 without loops)
 double largest_trim_mm(const CornerGeometry& g, double edge_mm, const DepositModel& model) {
   if (!model.aerosol()) return 0.0;
-  const double fraction = std::max(*std::max_element(std::begin(kTrimFractions),
-                                                     std::end(kTrimFractions)),
-                                   *std::max_element(std::begin(kTrimInFractions),
-                                                     std::end(kTrimInFractions)));
+  const double fraction =
+      std::max(*std::max_element(std::begin(kTrimFractions), std::end(kTrimFractions)),
+               *std::max_element(std::begin(kTrimInFractions), std::end(kTrimInFractions)));
   return std::min(fraction * overlap_mm(g, model), kMaxTrimShare * edge_mm);
 }
 
@@ -139,6 +147,27 @@ std::pair<int, int> row_cells_near(const Vec3& p0, const Vec3& p1, double y, dou
   return {std::max(first, ix_lo), std::min(last, ix_hi)};
 }
 
+// the process as predicted: the footprint ends at kPredictionTruncationSigmas at most
+DepositionSettings prediction_settings(DepositionSettings settings) {
+  settings.truncation_sigmas = std::min(settings.truncation_sigmas, kPredictionTruncationSigmas);
+  settings.batch_length_sigmas = kPredictionBatchSigmas;
+  return settings;
+}
+
+// the prediction's step: at most kStepS, and at most kStepSigmas of travel at the speed
+double prediction_step_s(double sigma_mm, double speed_mm_s) {
+  return std::min(kStepS, kStepSigmas * sigma_mm / speed_mm_s);
+}
+
+// a step of the steady line at print speed (its command: the whole flow, shutter open)
+DepositionStep steady_step(double speed_mm_s) {
+  DepositionStep step;
+  step.open0 = step.open1 = 1.0;
+  step.flow_command = 1.0;
+  step.desired_speed_mm_s = speed_mm_s;
+  return step;
+}
+
 // What every candidate at one corner shares: the window of the path around it (planned alone,
 // entering and leaving at print speed), and the even deposit it is compared with.
 struct CornerWindow {
@@ -147,6 +176,7 @@ struct CornerWindow {
   Vec3 a, c, b;
   Vec3 d_in, d_out;
   double v_in = 0.0, v_out = 0.0;
+  double lag_s = 0.0;  // the extruder's flow lag (0: aerosol)
   double cell_mm = 0.0;
   // the target cells (within half a line width of the centreline, clear of the window's ends)
   // and the centreline's samples, in the order their errors are summed
@@ -160,6 +190,9 @@ struct CornerWindow {
   std::vector<TargetCell> cells;
   std::vector<CentreSample> centre;
   bool has_targets = false;  // cells and centre are filled (add_targets)
+  // the deposit of the pre- and post-roll at print speed before a and after b, the lines
+  // continuing beyond the window (add_targets)
+  std::shared_ptr<Process> rolls;
 };
 
 CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerGeometry& geometry,
@@ -186,6 +219,8 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   window.point_index = {0, 1, 2};
   w.geometry = corner_geometry(window.points, kInf);
   w.v_in = window.edge_speed_mm_s[0], w.v_out = window.edge_speed_mm_s[1];
+  w.lag_s = options.lag_s;
+  w.cell_mm = kCellSigmas * model.settings.footprint_sigma_mm();
   return w;
 }
 
@@ -197,10 +232,31 @@ void add_targets(CornerWindow& w, const DepositModel& model) {
   const Vec3 &a = w.a, &b = w.b, &c = w.c;
   w.has_targets = true;
 
+  // the rolls: from the extruder's settled state, long enough for the footprint and the lag
+  w.rolls = make_process(prediction_settings(settings), w.cell_mm);
+  const double roll_mm = std::max(kRollSigmas * sigma, 6.0 * w.lag_s * std::max(w.v_in, w.v_out));
+  const double step_s = prediction_step_s(sigma, std::max(w.v_in, w.v_out));
+  const auto steady = [&](const Vec3& from, const Vec3& to, double speed, double t0) {
+    const double length = (to - from).norm();
+    const int steps = std::max(1, static_cast<int>(std::ceil(length / (speed * step_s))));
+    const double dt = length / speed / steps;
+    w.rolls->start_steady(steady_step(speed));
+    for (int k = 0; k < steps; ++k) {
+      DepositionStep step = steady_step(speed);
+      step.t0_s = t0 + k * dt;
+      step.t1_s = t0 + (k + 1) * dt;
+      step.p0_mm = from + (to - from) * (static_cast<double>(k) / steps);
+      step.p1_mm = from + (to - from) * (static_cast<double>(k + 1) / steps);
+      w.rolls->advance(step);
+    }
+  };
+  steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
+  steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
+  w.rolls->flush();
+
   // the even deposit over the window's target cells: the steady line's cross section at the
   // cell's distance from the nearest centreline point
-  const double h = kCellSigmas * sigma;
-  w.cell_mm = h;
+  const double h = w.cell_mm;
   const double r = 0.5 * settings.resolved_line_width_mm();
   const double total_arc = (c - a).norm() + (b - c).norm();
   const double peak_per_area = 1.0 / (sigma * std::sqrt(2.0 * kPi));
@@ -272,29 +328,11 @@ CornerCandidate evaluate_corner(const CornerWindow& w, const CornerPlan& plan,
     return candidate;
   }
 
-  // the deposit: a pre-roll at print speed, the window's plan, a post-roll
-  std::unique_ptr<Process> process = make_process(settings, w.cell_mm);
-  const double roll = std::max(kRollSigmas * sigma, 6.0 * options.lag_s * std::max(v_in, v_out));
-  const double step_s = std::min(kStepS, kStepSigmas * sigma / std::max(v_in, v_out));
-  const auto steady = [&](const Vec3& from, const Vec3& to, double speed, double t0) {
-    const double length = (to - from).norm();
-    const int steps = std::max(1, static_cast<int>(std::ceil(length / (speed * step_s))));
-    const double dt = length / speed / steps;
-    for (int k = 0; k < steps; ++k) {
-      DepositionStep step;
-      step.t0_s = t0 + k * dt;
-      step.t1_s = t0 + (k + 1) * dt;
-      step.p0_mm = from + (to - from) * (static_cast<double>(k) / steps);
-      step.p1_mm = from + (to - from) * (static_cast<double>(k + 1) / steps);
-      step.open0 = step.open1 = 1.0;
-      step.flow_command = 1.0;
-      step.desired_speed_mm_s = speed;
-      process->advance(step);
-    }
-    return t0 + length / speed;
-  };
-  const double t_pre = roll / v_in;
-  steady(a - roll * w.d_in, a, v_in, -t_pre);
+  // the deposit of the window's plan, the extruder settled at print speed as the pre-roll
+  // leaves it (the rolls' deposit, shared by every candidate, is added where it is read)
+  std::unique_ptr<Process> process = make_process(prediction_settings(settings), w.cell_mm);
+  process->start_steady(steady_step(v_in));
+  const double step_s = prediction_step_s(sigma, std::max(v_in, v_out));
   const auto closed = closed_spans(motion);
   const int steps = std::max(1, static_cast<int>(std::ceil(duration / step_s)));
   const double dt = duration / steps;
@@ -315,18 +353,20 @@ CornerCandidate evaluate_corner(const CornerWindow& w, const CornerPlan& plan,
     process->advance(step);
     before = after;
   }
-  steady(b, b + roll * w.d_out, v_out, duration);
   const ThicknessField& field = process->field();
+  const ThicknessField& rolls = w.rolls->field();
 
   // the error against the even deposit over the window's target cells, then along its
   // centreline
   const double h = field.cell_mm();
   double error_mm = 0.0;
   for (const CornerWindow::TargetCell& cell : w.cells)
-    error_mm += std::abs(field.cell_thickness_mm(cell.ix, cell.iy) - cell.thickness_mm) * h * h /
-                cell.line_area_mm2;
+    error_mm += std::abs(field.cell_thickness_mm(cell.ix, cell.iy) +
+                         rolls.cell_thickness_mm(cell.ix, cell.iy) - cell.thickness_mm) *
+                h * h / cell.line_area_mm2;
   for (const CornerWindow::CentreSample& sample : w.centre)
-    error_mm += std::abs(field.thickness_mm_at(sample.x_mm, sample.y_mm) - sample.peak_mm) /
+    error_mm += std::abs(field.thickness_mm_at(sample.x_mm, sample.y_mm) +
+                         rolls.thickness_mm_at(sample.x_mm, sample.y_mm) - sample.peak_mm) /
                 sample.peak_mm * h;
 
   candidate.error_mm = error_mm;

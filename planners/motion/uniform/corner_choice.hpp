@@ -14,9 +14,12 @@
 //   stop    extrusion only: the path comes to rest at the corner (the flow follows the speed).
 // A corner the least blend takes at print speed has that one candidate: its deposit is not
 // predicted. Otherwise, for each candidate, a window of the path around the corner (the two edges,
-// up to what the slowest candidate's speed change needs plus 8 sigma) is planned as the planner
-// will plan it (entering and leaving at print speed), its deposit predicted step by step (1 ms)
-// with pre- and post-rolls at print speed so the window's ends deposit as a continuing line would,
+// as far as the slowest candidate's speed change and the flow lag's settling after it, the
+// largest blend and the largest trim its loops try, plus 6 sigma) is planned as the planner
+// will plan it (entering and leaving at print speed), its deposit predicted step by step (at
+// most 4 ms and a quarter sigma of travel; the footprint cut at 4 sigma) from the extruder's
+// settled state, plus pre- and post-rolls at print speed so the window's ends deposit as a
+// continuing line would (the rolls' deposit is the same for every candidate: predicted once),
 // and compared with the even deposit the process engineer asks for: on every cell within half a
 // line width of the window's centreline (4 sigma clear of its ends), the steady line's cross
 // section at the cell's distance from the nearest centreline point (the union of the lines:
