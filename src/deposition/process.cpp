@@ -126,6 +126,12 @@ void Process::deposit_step(const DepositionStep& step, double volume_mm3, const 
   batch_.add(footprint_, field_, batch_step);
 }
 
+void Process::restart() {
+  batch_.discard();
+  field_.zero();
+  account_ = MaterialAccount{};
+}
+
 void Process::check_step(const DepositionStep& step) {
   const bool finite = std::isfinite(step.t0_s) && std::isfinite(step.t1_s) &&
                       step.p0_mm.allFinite() && step.p1_mm.allFinite() &&
@@ -174,6 +180,12 @@ double ExtrusionProcess::command_mm3_s(const DepositionStep& step) const {
                                    : std::max(0.0, step.desired_speed_mm_s) *
                                          settings_.bead_width_mm * settings_.layer_height_mm;
   return std::max(0.0, step.flow_command) * nominal_mm3_s;
+}
+
+void ExtrusionProcess::restart() {
+  Process::restart();
+  flow_mm3_s_ = 0.0;
+  peak_command_mm3_s_ = 0.0;
 }
 
 void ExtrusionProcess::start_steady(const DepositionStep& step) {

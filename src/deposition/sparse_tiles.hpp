@@ -45,6 +45,10 @@ class SparseTiles {
   size_t tile_count() const { return tiles_.size(); }
   size_t allocated_cells() const { return tiles_.size() * static_cast<size_t>(kCells); }
   void clear() { tiles_.clear(); }
+  // every cell back to its initial value, the tiles kept for reuse (no allocation)
+  void zero() {
+    for (auto& [key, cells] : tiles_) std::fill(cells.get(), cells.get() + kCells, Cell{});
+  }
 
   // (tx, ty) of every tile, ordered by ty then tx: the deterministic output order
   std::vector<std::pair<int, int>> sorted_tiles() const {

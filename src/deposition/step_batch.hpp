@@ -89,6 +89,11 @@ class StepBatch {
   void add(GaussianFootprint& footprint, ThicknessField& field, const BatchStep& step);
   // deposit the steps held so far
   void flush(GaussianFootprint& footprint, ThicknessField& field);
+  // forget the steps held so far (nothing is deposited)
+  void discard() {
+    count_ = 0;
+    length_mm_ = duration_s_ = 0.0;
+  }
 
   int pending_steps() const { return count_; }
   double batch_length_mm() const { return batch_length_mm_; }

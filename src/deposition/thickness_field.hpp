@@ -68,6 +68,8 @@ class ThicknessField {
   // deposit on a sloped surface turned into the thickness along the surface normal
   void scale_cells(const std::function<double(double x_mm, double y_mm)>& factor);
   void clear() { tiles_.clear(); }
+  // every cell 0, its memory kept for the next deposit (a scratch field reused)
+  void zero() { tiles_.zero(); }
 
   // raw tile access for the deposition kernel and the metrics
   Tiles& tiles() { return tiles_; }

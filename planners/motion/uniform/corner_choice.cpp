@@ -193,6 +193,9 @@ struct CornerWindow {
   // the deposit of the pre- and post-roll at print speed before a and after b, the lines
   // continuing beyond the window (add_targets)
   std::shared_ptr<Process> rolls;
+  // the process each candidate's window deposit is predicted with, restarted for each (its
+  // field's memory reused)
+  std::shared_ptr<Process> scratch;
 };
 
 CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerGeometry& geometry,
@@ -253,6 +256,7 @@ void add_targets(CornerWindow& w, const DepositModel& model) {
   steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
   steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
   w.rolls->flush();
+  w.scratch = make_process(prediction_settings(settings), w.cell_mm);
 
   // the even deposit over the window's target cells: the steady line's cross section at the
   // cell's distance from the nearest centreline point
@@ -302,10 +306,9 @@ void add_targets(CornerWindow& w, const DepositModel& model) {
 
 // The predicted error and extra time of one corner plan in its window (see the header). A plan
 // whose extra time alone costs at least prune_above_mm is not deposited (pruned).
-CornerCandidate evaluate_corner(const CornerWindow& w, const CornerPlan& plan,
-                                const TcpLimits& limits, const PathMotionOptions& options,
-                                const DepositModel& model, double time_weight_mm_s,
-                                double prune_above_mm) {
+CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const TcpLimits& limits,
+                                const PathMotionOptions& options, const DepositModel& model,
+                                double time_weight_mm_s, double prune_above_mm) {
   const DepositionSettings& settings = model.settings;
   const double sigma = settings.footprint_sigma_mm();
   const Vec3 &a = w.a, &b = w.b, &c = w.c;
@@ -330,7 +333,8 @@ CornerCandidate evaluate_corner(const CornerWindow& w, const CornerPlan& plan,
 
   // the deposit of the window's plan, the extruder settled at print speed as the pre-roll
   // leaves it (the rolls' deposit, shared by every candidate, is added where it is read)
-  std::unique_ptr<Process> process = make_process(prediction_settings(settings), w.cell_mm);
+  Process* process = w.scratch.get();
+  process->restart();
   process->start_steady(steady_step(v_in));
   const double step_s = prediction_step_s(sigma, std::max(v_in, v_out));
   const auto closed = closed_spans(motion);
