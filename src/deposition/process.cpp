@@ -128,7 +128,11 @@ void Process::deposit_step(const DepositionStep& step, double volume_mm3, const 
 
 void Process::restart() {
   batch_.discard();
-  field_.zero();
+  // the memory of a few tiles is kept for the next deposit; a field grown larger is freed
+  if (field_.allocated_tiles() <= kRestartKeptTiles)
+    field_.zero();
+  else
+    field_.clear();
   account_ = MaterialAccount{};
 }
 

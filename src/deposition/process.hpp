@@ -112,9 +112,11 @@ class Process {
   virtual void advance(const DepositionStep& step) = 0;
   // flow leaving the nozzle now (mm^3/s): aerosol stream Q, extrusion lagged flow
   virtual double nozzle_flow_mm3_s() const = 0;
-  // forget every step: the field back to 0 (its memory kept for reuse), the account and the
-  // process' own state as new (a scratch process predicting one deposit after another)
+  // forget every step: the field back to 0 (the memory of up to kRestartKeptTiles tiles kept
+  // for reuse), the account and the process' own state as new (a scratch process predicting
+  // one deposit after another)
   virtual void restart();
+  static constexpr size_t kRestartKeptTiles = 16;
   // as if the step's flow command had been held long enough to settle (extrusion: the lagged
   // flow equals it; aerosol: nothing to settle); nothing is deposited
   virtual void start_steady(const DepositionStep& /*step*/) {}

@@ -192,10 +192,9 @@ struct CornerWindow {
   bool has_targets = false;  // cells and centre are filled (add_targets)
   // the deposit of the pre- and post-roll at print speed before a and after b, the lines
   // continuing beyond the window (add_targets)
-  std::shared_ptr<Process> rolls;
-  // the process each candidate's window deposit is predicted with, restarted for each (its
-  // field's memory reused)
-  std::shared_ptr<Process> scratch;
+  Process* rolls = nullptr;
+  // the process each candidate's window deposit is predicted with, restarted for each
+  Process* scratch = nullptr;
 };
 
 CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerGeometry& geometry,
@@ -229,14 +228,23 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
 
 // The window's target cells and centreline samples (needed once a candidate's deposit is
 // predicted).
-void add_targets(CornerWindow& w, const DepositModel& model) {
+void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& scratch) {
   const DepositionSettings& settings = model.settings;
   const double sigma = settings.footprint_sigma_mm();
-  const Vec3 &a = w.a, &b = w.b, &c = w.c;
+  // (in the corner's own frame: the corner at the origin, so every corner's prediction
+  // reuses the same few tiles of the scratch fields, and equal corners predict alike wherever
+  // they are)
+  const Vec3 a = w.a - w.c, b = w.b - w.c, c = Vec3::Zero();
   w.has_targets = true;
 
   // the rolls: from the extruder's settled state, long enough for the footprint and the lag
-  w.rolls = make_process(prediction_settings(settings), w.cell_mm);
+  if (!scratch.rolls) {
+    scratch.rolls = make_process(prediction_settings(settings), w.cell_mm);
+    scratch.window = make_process(prediction_settings(settings), w.cell_mm);
+  }
+  w.rolls = scratch.rolls.get();
+  w.scratch = scratch.window.get();
+  w.rolls->restart();
   const double roll_mm = std::max(kRollSigmas * sigma, 6.0 * w.lag_s * std::max(w.v_in, w.v_out));
   const double step_s = prediction_step_s(sigma, std::max(w.v_in, w.v_out));
   const auto steady = [&](const Vec3& from, const Vec3& to, double speed, double t0) {
@@ -256,7 +264,6 @@ void add_targets(CornerWindow& w, const DepositModel& model) {
   steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
   steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
   w.rolls->flush();
-  w.scratch = make_process(prediction_settings(settings), w.cell_mm);
 
   // the even deposit over the window's target cells: the steady line's cross section at the
   // cell's distance from the nearest centreline point
@@ -333,7 +340,7 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
 
   // the deposit of the window's plan, the extruder settled at print speed as the pre-roll
   // leaves it (the rolls' deposit, shared by every candidate, is added where it is read)
-  Process* process = w.scratch.get();
+  Process* process = w.scratch;
   process->restart();
   process->start_steady(steady_step(v_in));
   const double step_s = prediction_step_s(sigma, std::max(v_in, v_out));
@@ -348,8 +355,8 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
     DepositionStep step;
     step.t0_s = t0;
     step.t1_s = t1;
-    step.p0_mm = before.position_mm;
-    step.p1_mm = after.position_mm;
+    step.p0_mm = before.position_mm - c;  // the corner's frame (add_targets)
+    step.p1_mm = after.position_mm - c;
     step.open0 = open_fraction(closed, t0, model.shutter_time_s);
     step.open1 = open_fraction(closed, t1, model.shutter_time_s);
     step.flow_command = before.depositing ? before.flow_fraction : 0.0;
@@ -383,7 +390,7 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
 CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              const std::vector<CornerGeometry>& geometry, const TcpLimits& limits,
                              const PathMotionOptions& options, const DepositModel& model,
-                             double time_weight_mm_s) {
+                             double time_weight_mm_s, PredictionScratch& scratch) {
   const CornerGeometry& g = geometry[corner];
   const double speed = std::min(chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]);
   CornerWindow window = corner_window(chain, corner, g, limits, options, model);
@@ -417,7 +424,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
       candidates.push_back(candidate);
       full_speed_blend = true;
     } else {
-      add_targets(window, model);
+      add_targets(window, model, scratch);
       // smaller blends while they pay (the cost is unimodal in the size here)
       double previous = std::numeric_limits<double>::infinity();
       for (const double share : kSlowBlendShares) {
@@ -429,7 +436,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
     }
   }
   if (!full_speed_blend) {
-    if (!window.has_targets) add_targets(window, model);
+    if (!window.has_targets) add_targets(window, model, scratch);
     if (model.aerosol()) {
       // loops, printing resuming past the overlap of the two lines at a sharp corner
       const double overlap = overlap_mm(g, model);

@@ -62,6 +62,12 @@ struct CornerCandidate {
   bool pruned = false;
 };
 
+// The processes the corner predictions reuse, restarted for each corner and candidate (one per
+// planning: not to be shared between threads).
+struct PredictionScratch {
+  std::unique_ptr<Process> rolls, window;
+};
+
 struct CornerDecision {
   CornerCandidate chosen;
   std::vector<CornerCandidate> candidates;  // every one evaluated, the chosen among them
@@ -72,6 +78,6 @@ struct CornerDecision {
 CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              const std::vector<CornerGeometry>& geometry, const TcpLimits& limits,
                              const PathMotionOptions& options, const DepositModel& model,
-                             double time_weight_mm_s);
+                             double time_weight_mm_s, PredictionScratch& scratch);
 
 }  // namespace depotwin

@@ -127,6 +127,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
                                       orientation, to_orientation));
     t = pieces.back().t_end_s;
   };
+  PredictionScratch scratch;  // the corner predictions' processes, reused
   for (const PrintChain& chain : print_chains(chorded)) {
     // each corner's treatment, by the predicted deposit
     const std::vector<CornerGeometry> geometry =
@@ -138,7 +139,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
           (geometry[i].max_half_length_mm <= 0.0 && geometry[i].turn_rad < 0.5 * kPi))
         continue;  // straight on
       chain_decisions.emplace_back(i, choose_corner(chain, i, geometry, jerk_limits, options, model,
-                                                    settings_.time_weight_mm_s));
+                                                    settings_.time_weight_mm_s, scratch));
       corners[i] = chain_decisions.back().second.chosen.plan;
     }
     // planned from 0, then placed after the transition that brings the nozzle to its start;
