@@ -196,7 +196,7 @@ std::vector<PlannerParameter> uniform_parameters() {
        {},
        "mm"},
       {"time_weight",
-       1.0,
+       0.7,
        0.0,
        1e6,
        "what a second of extra time is worth in mm of misplaced line when a corner's treatment "
