@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # scripts/render-examples.sh is deterministic: two runs into two fresh folders give the same
-# file list and the same bytes in every file (so regenerating renders/ leaves git clean).
+# file list and the same bytes in every file (so regenerating renders/ leaves git clean), and in
+# the normal build its comparison tables equal the committed renders/ ones (not stale).
 # Every scenario but the two long arm jobs (shembekar_beam, shembekar_bonnet: minutes each; the
 # arm's determinism is checked on shembekar_fillet here and by the arm pipeline tests).
 set -euo pipefail
@@ -48,3 +49,25 @@ while IFS= read -r md; do
   done < <(grep -o '](\([^)]*\))' "$md" | sed 's/^](\(.*\))$/\1/')
 done < <(find "$work/first" -name comparison.md)
 echo "identical: $(listing "$work/first" | wc -l) files"
+
+# and the committed renders/ is what the code gives now: every comparison table regenerated
+# equals the committed one (DEPOTWIN_RENDER_CHECK_COMMITTED=1, set for the normal build: a
+# sanitizer or fuzz build's optimisation may round a last printed digit differently)
+if [[ "${DEPOTWIN_RENDER_CHECK_COMMITTED:-0}" == 1 ]]; then
+  stale=0
+  for name in $DEPOTWIN_RENDER_SCENARIOS; do
+    committed="$root/renders/$name/comparison.md"
+    if [[ ! -f "$committed" ]]; then
+      echo "FAIL: renders/$name/comparison.md is not committed"
+      stale=1
+    elif ! diff -u "$committed" "$work/first/$name/comparison.md"; then
+      echo "FAIL: renders/$name/comparison.md is stale"
+      stale=1
+    fi
+  done
+  if [[ $stale == 1 ]]; then
+    echo "regenerate with scripts/render-examples.sh and commit renders/"
+    exit 1
+  fi
+  echo "committed comparison tables current: $DEPOTWIN_RENDER_SCENARIOS"
+fi
