@@ -1,8 +1,9 @@
 // Speed of `uniform` (issue 16): planning time per segment against lspb_mtt on the same
 // toolpaths in the same run, 10^3, 10^4 and 10^5 segments (chains of 1..4
 // connected segments on a 90 mm bed, random turns at every joint). Each of uniform's corners plans
-// and deposits its candidates (deposition model), which is what its time goes to; `corner_share`
-// runs the same toolpath as isolated segments (no corners: the time law and the transitions alone).
+// and deposits its candidates (deposition model), which is what its time goes to;
+// `BM_UniformIsolated` runs the same toolpath as isolated segments (no corners: the time law and
+// the transitions alone).
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -60,7 +61,12 @@ void BM_UniformIsolated(benchmark::State& state) {
   plan(state, UniformPlanner(UniformSettings{}), false);
 }
 
-BENCHMARK(BM_LspbMtt)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->Complexity();
+BENCHMARK(BM_LspbMtt)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity();
 BENCHMARK(BM_Uniform)
     ->Arg(1000)
     ->Arg(10000)
