@@ -34,12 +34,12 @@
 namespace depotwin {
 
 struct UniformSettings {
-  double tolerance_mm = 0.05;     // the blended path stays this close to the polyline
+  double tolerance_mm = 0.05;  // the blended path stays this close to the polyline
   // a second of extra time is worth this many mm of misplaced line (README, "Beyond the papers":
   // the default from a sweep over the comparison scenarios)
   double time_weight_mm_s = 0.7;
-  double jerk_ramp_s = 0.01;      // without j_max: the acceleration ramps up in this time
-  double period_s = 0.001;        // longest sample period of a blend
+  double jerk_ramp_s = 0.01;  // without j_max: the acceleration ramps up in this time
+  double period_s = 0.001;    // longest sample period of a blend
 };
 
 class UniformPlanner : public Planner {
