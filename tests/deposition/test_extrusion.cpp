@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
 
 #include "deposition/deposition_metrics.hpp"
 #include "deposition/process.hpp"
@@ -165,6 +167,45 @@ TEST(Extrusion, StartSteadySettlesTheLagWithoutDepositing) {
   const double bead_mm2 = kBeadWidth * kLayerHeight;
   EXPECT_NEAR(cross_section_mm2(process.field(), 2.0) / bead_mm2, 1.0, 1e-3);
   EXPECT_NEAR(cross_section_mm2(from_rest.field(), 2.0) / bead_mm2, 1.0 - std::exp(-2.0), 0.01);
+}
+
+// restart: a process that printed something, restarted, then given a line lays exactly what a
+// new process lays for it (field cell for cell, account, lag state), aerosol and extrusion,
+// with a few tiles' memory kept (the first print near the second) or freed (a print spread over
+// more tiles than restart keeps)
+TEST(Process, RestartedProcessDepositsLikeANewOne) {
+  for (const ProcessType type : {ProcessType::aerosol, ProcessType::extrusion}) {
+    for (const double first_length_mm : {3.0, 400.0}) {
+      SCOPED_TRACE(std::string(process_type_name(type)) + " " + std::to_string(first_length_mm));
+      DepositionSettings settings = extrusion_settings();
+      settings.type = type;
+      const auto print_line = [&](Process& process, const Vec3& from, const Vec3& to,
+                                  double pause_fraction) {
+        const double duration = (to - from).norm() / kSpeed;
+        drive(
+            process, 0.0, duration, 1e-3,
+            [&](double t) { return Vec3(from + (to - from) * (t / duration)); },
+            [&](double t) { return t < pause_fraction * duration ? 1.0 : 0.0; },
+            [&](double t) { return t < pause_fraction * duration ? 1.0 : 0.0; },
+            [](double) { return kSpeed; });
+      };
+      std::unique_ptr<Process> reused = make_process(settings);
+      // the first print ends with the material off (extrusion: an oozing lag state)
+      print_line(*reused, Vec3(-1, -1, 0), Vec3(-1 + first_length_mm, 2, 0), 0.97);
+      ASSERT_GT(reused->account().landed_mm3, 0.0);  // (some steps still batched, not yet put down)
+      reused->restart();
+      EXPECT_EQ(reused->field().total_volume_mm3(), 0.0);
+      EXPECT_EQ(reused->account().emitted_mm3, 0.0);
+      EXPECT_EQ(reused->nozzle_flow_mm3_s(), make_process(settings)->nozzle_flow_mm3_s());
+      std::unique_ptr<Process> fresh = make_process(settings);
+      for (Process* process : {reused.get(), fresh.get()})
+        print_line(*process, Vec3(0, 0, 0), Vec3(4, 1, 0), 1.0);
+      EXPECT_EQ(test::max_abs_difference(reused->field(), fresh->field()), 0.0);
+      EXPECT_EQ(reused->account().emitted_mm3, fresh->account().emitted_mm3);
+      EXPECT_EQ(reused->account().landed_mm3, fresh->account().landed_mm3);
+      EXPECT_EQ(reused->field().total_volume_mm3(), fresh->field().total_volume_mm3());
+    }
+  }
 }
 
 }  // namespace
