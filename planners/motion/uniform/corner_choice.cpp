@@ -168,6 +168,26 @@ DepositionStep steady_step(double speed_mm_s) {
   return step;
 }
 
+// Reads a field's cells in runs (rows of cells): the tile of the last read is kept, so most
+// reads skip the tile lookup. The values of ThicknessField::cell_thickness_mm.
+class CellReader {
+ public:
+  explicit CellReader(const ThicknessField& field) : field_(field) {}
+  double at(int ix, int iy) {
+    const int tx = ThicknessField::Tiles::tile_of(ix), ty = ThicknessField::Tiles::tile_of(iy);
+    if (tx != tx_ || ty != ty_) {
+      tx_ = tx, ty_ = ty;
+      tile_ = field_.tiles().find(tx, ty);
+    }
+    return tile_ ? tile_[ThicknessField::Tiles::local_index(ix, iy)] : 0.0;
+  }
+
+ private:
+  const ThicknessField& field_;
+  int tx_ = std::numeric_limits<int>::min(), ty_ = std::numeric_limits<int>::min();
+  const double* tile_ = nullptr;
+};
+
 // What every candidate at one corner shares: the window of the path around it (planned alone,
 // entering and leaving at print speed), and the even deposit it is compared with.
 struct CornerWindow {
@@ -179,13 +199,14 @@ struct CornerWindow {
   double lag_s = 0.0;  // the extruder's flow lag (0: aerosol)
   double cell_mm = 0.0;
   // the target cells (within half a line width of the centreline, clear of the window's ends)
-  // and the centreline's samples, in the order their errors are summed
+  // and the centreline's samples, in the order their errors are summed; each holds what the
+  // window's own deposit should add to the rolls' (the target less the rolls' deposit there)
   struct TargetCell {
     int ix = 0, iy = 0;
-    double thickness_mm = 0.0, line_area_mm2 = 0.0;
+    double missing_mm = 0.0, line_area_mm2 = 0.0;
   };
   struct CentreSample {
-    double x_mm = 0.0, y_mm = 0.0, peak_mm = 0.0;
+    double x_mm = 0.0, y_mm = 0.0, peak_mm = 0.0, missing_mm = 0.0;
   };
   std::vector<TargetCell> cells;
   std::vector<CentreSample> centre;
@@ -263,7 +284,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   };
   steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
   steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
-  w.rolls->flush();
+  const ThicknessField& rolls = w.rolls->field();
 
   // the even deposit over the window's target cells: the steady line's cross section at the
   // cell's distance from the nearest centreline point
@@ -295,8 +316,9 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
           continue;
         CornerWindow::TargetCell cell;
         cell.ix = ix, cell.iy = iy;
-        cell.thickness_mm =
-            areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma));
+        cell.missing_mm =
+            areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma)) -
+            rolls.cell_thickness_mm(ix, iy);
         cell.line_area_mm2 = areas[edge];
         w.cells.push_back(cell);
       }
@@ -307,7 +329,8 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   for (double arc = kEndClearSigmas * sigma; arc <= total_arc - kEndClearSigmas * sigma; arc += h) {
     const int edge = arc < leg[0] ? 0 : 1;
     const Vec3 p = edge == 0 ? Vec3(a + arc * w.d_in) : Vec3(c + (arc - leg[0]) * w.d_out);
-    w.centre.push_back({p.x(), p.y(), areas[edge] * peak_per_area});
+    const double peak = areas[edge] * peak_per_area;
+    w.centre.push_back({p.x(), p.y(), peak, peak - rolls.thickness_mm_at(p.x(), p.y())});
   }
 }
 
@@ -365,19 +388,16 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
     before = after;
   }
   const ThicknessField& field = process->field();
-  const ThicknessField& rolls = w.rolls->field();
 
   // the error against the even deposit over the window's target cells, then along its
-  // centreline
+  // centreline (the rolls' deposit is in the targets' missing_mm)
   const double h = field.cell_mm();
+  CellReader cells(field);
   double error_mm = 0.0;
   for (const CornerWindow::TargetCell& cell : w.cells)
-    error_mm += std::abs(field.cell_thickness_mm(cell.ix, cell.iy) +
-                         rolls.cell_thickness_mm(cell.ix, cell.iy) - cell.thickness_mm) *
-                h * h / cell.line_area_mm2;
+    error_mm += std::abs(cells.at(cell.ix, cell.iy) - cell.missing_mm) * h * h / cell.line_area_mm2;
   for (const CornerWindow::CentreSample& sample : w.centre)
-    error_mm += std::abs(field.thickness_mm_at(sample.x_mm, sample.y_mm) +
-                         rolls.thickness_mm_at(sample.x_mm, sample.y_mm) - sample.peak_mm) /
+    error_mm += std::abs(field.thickness_mm_at(sample.x_mm, sample.y_mm) - sample.missing_mm) /
                 sample.peak_mm * h;
 
   candidate.error_mm = error_mm;
