@@ -147,7 +147,8 @@ std::pair<int, int> row_cells_near(const Vec3& p0, const Vec3& p1, double y, dou
   return {std::max(first, ix_lo), std::min(last, ix_hi)};
 }
 
-// the process as predicted: the footprint ends at kPredictionTruncationSigmas at most
+// the process as predicted: the footprint ends at kPredictionTruncationSigmas at most, the
+// steps batched over kPredictionBatchSigmas
 DepositionSettings prediction_settings(DepositionSettings settings) {
   settings.truncation_sigmas = std::min(settings.truncation_sigmas, kPredictionTruncationSigmas);
   settings.batch_length_sigmas = kPredictionBatchSigmas;

@@ -21,7 +21,7 @@
 // settled state, plus pre- and post-rolls at print speed so the window's ends deposit as a
 // continuing line would (the rolls' deposit is the same for every candidate: predicted once),
 // and compared with the even deposit the process engineer asks for: on every cell within half a
-// line width of the window's centreline (4 sigma clear of its ends), the steady line's cross
+// line width of the window's centreline (1 sigma clear of its ends), the steady line's cross
 // section at the cell's distance from the nearest centreline point (the union of the lines:
 // where two lines meet at a sharp corner the target is not their doubled sum). The predicted
 // thickness error is
