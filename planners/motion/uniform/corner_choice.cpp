@@ -55,9 +55,8 @@ double overlap_mm(const CornerGeometry& g, const DepositModel& model) {
   return alpha < 0.5 * kPi ? 2.0 * sigma / std::max(std::sin(alpha), 1e-3) : 0.0;
 }
 
-// the largest trim a loop candidate tries on an edge of this length (0 without loops)
+// the largest trim a loop candidate tries on an edge of this length
 double largest_trim_mm(const CornerGeometry& g, double edge_mm, const DepositModel& model) {
-  if (!model.aerosol()) return 0.0;
   const double fraction =
       std::max(*std::max_element(std::begin(kTrimFractions), std::end(kTrimFractions)),
                *std::max_element(std::begin(kTrimInFractions), std::end(kTrimInFractions)));
@@ -458,9 +457,16 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
   }
   if (!full_speed_blend) {
     if (!window.has_targets) add_targets(window, model, scratch);
-    if (model.aerosol()) {
-      // loops, printing resuming past the overlap of the two lines at a sharp corner
-      const double overlap = overlap_mm(g, model);
+    if (!model.aerosol()) {
+      CornerPlan plan;
+      plan.treatment = CornerTreatment::stop;
+      add("stop", plan);
+    }
+    // loops, printing resuming past the overlap of the two lines at a sharp corner (aerosol:
+    // at print speed, the shutter closed; extrusion: the line ends at rest, the nozzle travels
+    // with the flow off and the next line starts from rest, where the overlap calls for a trim)
+    const double overlap = overlap_mm(g, model);
+    if (model.aerosol() || overlap > 0.0) {
       const double edge_in = (chain.points[corner] - chain.points[corner - 1]).norm();
       const double edge_out = (chain.points[corner + 1] - chain.points[corner]).norm();
       double last_in = -1.0;
@@ -476,15 +482,13 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
           plan.trim_out_mm = std::min(fraction * overlap, kMaxTrimShare * edge_out);
           if (plan.trim_out_mm <= last_out) continue;
           last_out = plan.trim_out_mm;
+          // (an extruder's loop without trims is the stop)
+          if (!model.aerosol() && plan.trim_in_mm + plan.trim_out_mm <= 0.0) continue;
           const double cost = add("loop", plan);
           if (cost > previous) break;
           previous = cost;
         }
       }
-    } else {
-      CornerPlan plan;
-      plan.treatment = CornerTreatment::stop;
-      add("stop", plan);
     }
   }
   if (candidates.empty()) throw InternalError("uniform: a corner without candidates");

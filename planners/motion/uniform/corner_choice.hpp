@@ -7,10 +7,13 @@
 //           fits the tolerance and the room on the edges;
 //   slow    the largest blend within the tolerance, at the lower constant speed its curvature
 //           allows (a slowed corner: the lines slow down to it and speed up after it);
-//   loop    aerosol only: the shutter closes, the nozzle loops with the shutter closed and the
-//           next line resumes at print speed; printing resumes trim_out past the corner, where
-//           that evens the overlap of the two lines at a sharp corner (trim_out is searched
-//           over fractions of 2 sigma / sin(alpha), the length over which the lines overlap);
+//   loop    printing stops trim_in before the corner and resumes trim_out past it, where that
+//           evens the overlap of the two lines at a sharp corner (the trims are searched over
+//           fractions of 2 sigma / sin(alpha), the length over which the lines overlap).
+//           Aerosol: the shutter closes, the nozzle loops with the shutter closed and the next
+//           line resumes at print speed. Extrusion, at joints sharper than 90 deg and with a
+//           trim: the line ends at rest, the nozzle travels with the flow off and the next line
+//           starts from rest (the flow follows the speed at both);
 //   stop    extrusion only: the path comes to rest at the corner (the flow follows the speed).
 // A corner the least blend takes at print speed has that one candidate: its deposit is not
 // predicted. Otherwise, for each candidate, a window of the path around the corner (the two edges,

@@ -268,8 +268,8 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     if (c.treatment == CornerTreatment::stop) cap = 0.0;
     if (c.treatment == CornerTreatment::loop) {
       split[k] = 1;
-      cap_after[k] = lines[k - 1].limits.v_max_mm_s;
-      cap_before[k] = lines[k].limits.v_max_mm_s;
+      cap_after[k] = options.loops_at_rest ? 0.0 : lines[k - 1].limits.v_max_mm_s;
+      cap_before[k] = options.loops_at_rest ? 0.0 : lines[k].limits.v_max_mm_s;
     } else {
       cap_after[k] = cap_before[k] = cap;
     }

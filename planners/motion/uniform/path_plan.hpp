@@ -85,6 +85,9 @@ struct PathMotionOptions {
   double lag_s = 0.0;               // extruder flow lag: the deceleration rule and the flow lead
   bool flow_follows_speed = false;  // pieces carry flow_lead_s = lag_s
   double period_s = 0.001;          // longest sample period of a blend
+  // loops leave and re-enter their lines at rest (extrusion: the line ends at rest, the nozzle
+  // travels with the flow off, the next line starts from rest); else at the lines' speeds
+  bool loops_at_rest = false;
 };
 
 // A corner's geometry (interior points only): its directions, turn and blend shape.

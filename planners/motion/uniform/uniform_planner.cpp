@@ -72,6 +72,7 @@ PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerG
                                ? c.plan.half_length_mm * g.deviation_per_length
                                : 0.0;
   d.figures.push_back({"deviation_mm", deviation, "mm"});
+  d.figures.push_back({"trim_in_mm", c.plan.trim_in_mm, "mm"});
   d.figures.push_back({"trim_out_mm", c.plan.trim_out_mm, "mm"});
   // the best of each other kind, for comparison
   int pruned = 0;
@@ -108,6 +109,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
   options.enter_at_speed = options.leave_at_speed = aerosol;
   options.lag_s = aerosol ? 0.0 : model.settings.tau_s;
   options.flow_follows_speed = !aerosol;
+  options.loops_at_rest = !aerosol;
   options.period_s = settings_.period_s;
 
   // arcs as fine chords (their corners are blended like any other)
@@ -196,7 +198,7 @@ std::vector<PlannerParameter> uniform_parameters() {
        {},
        "mm"},
       {"time_weight",
-       0.7,
+       0.2,
        0.0,
        1e6,
        "what a second of extra time is worth in mm of misplaced line when a corner's treatment "

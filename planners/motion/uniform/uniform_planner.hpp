@@ -11,7 +11,8 @@
 //    look-ahead that makes every line's profile feasible; j_max from the limits, else
 //    a_max / `jerk_ramp_s` on each axis.
 //  - Deposition coupling (corner_choice.hpp): per corner, a constant-speed blend, a slowed
-//    corner, a shutter-closed loop (aerosol) or a stop (extrusion), by the predicted thickness
+//    corner, a loop (aerosol: the shutter closed at print speed; extrusion: rest to rest with
+//    the flow off) or a stop (extrusion), by the predicted thickness
 //    error over the target region plus `time_weight` times the time; extrusion's commanded flow
 //    leads the planned speed by the flow lag (pressure advance), and its decelerations stay
 //    within what the lagging flow can follow (line_profile.hpp).
@@ -37,7 +38,7 @@ struct UniformSettings {
   double tolerance_mm = 0.05;  // the blended path stays this close to the polyline
   // a second of extra time is worth this many mm of misplaced line (README, "Beyond the papers":
   // the default from a sweep over the comparison scenarios)
-  double time_weight_mm_s = 0.7;
+  double time_weight_mm_s = 0.2;
   double jerk_ramp_s = 0.01;  // without j_max: the acceleration ramps up in this time
   double period_s = 0.001;    // longest sample period of a blend
 };

@@ -184,6 +184,35 @@ TEST(UniformPlanner, CornerChoiceDoesNotDependOnWhereTheCornerLies) {
   }
 }
 
+// An extruder cannot close a shutter, but it can stop: at a sharp joint its loop ends the line
+// at rest short of the corner, travels with the flow off and starts the next line from rest
+// past it, so the two beads do not double up where they overlap. Weighed against the stop and
+// the slowed blends; chosen here when the deposit alone decides (time_weight 0).
+TEST(UniformPlanner, SharpExtrusionJointLoopsAtRestPastTheOverlap) {
+  UniformSettings settings;
+  settings.time_weight_mm_s = 0.0;
+  const Trajectory plan = UniformPlanner{settings}.plan_in_context(
+      joint(20.0), kLimits, context_for(ProcessType::extrusion));
+  const PlanDecision& corner = only_corner(plan);
+  EXPECT_EQ(corner.choice, "loop");
+  EXPECT_GT(figure(corner, "trim_in_mm") + figure(corner, "trim_out_mm"), 0.0);
+  // the loop's cost beats the stop's (both weighed)
+  EXPECT_LT(figure(corner, "loop_cost_mm"), figure(corner, "stop_cost_mm"));
+  // one piece with the flow off between the two printed lines, from rest to rest
+  int loops = 0;
+  bool printed = false;
+  for (const TrajectoryPiece& piece : plan.pieces()) {
+    if (piece.depositing) printed = true;
+    if (!piece.depositing && printed && piece.t_end_s < plan.duration_s()) {
+      ++loops;
+      TrajectoryCursor cursor(plan);
+      EXPECT_LT(cursor.at(piece.t_begin_s).velocity_mm_s.norm(), 1e-9);
+      EXPECT_LT(cursor.at(piece.t_end_s).velocity_mm_s.norm(), 1e-9);
+    }
+  }
+  EXPECT_EQ(loops, 1);
+}
+
 // Every deposited sample lies within the tolerance of its path (blends and lines), for several
 // tolerances and joint angles.
 TEST(UniformPlanner, BlendsStayInsideTheToleranceBand) {
