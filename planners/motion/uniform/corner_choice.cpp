@@ -20,6 +20,9 @@ constexpr double kStepS = 0.004;
 constexpr double kStepSigmas = 0.25;
 constexpr double kWindowSigmas = 6.0;  // window beyond what the candidates change
 constexpr double kRollSigmas = 6.0;    // pre- and post-rolls (the footprint ends at 5 sigma)
+// an extruder's flow settles within this many lags (exp(-6) = 0.25 %): the rolls and the window
+// reach that far at print speed
+constexpr double kLagSettlingLags = 6.0;
 // the prediction's footprint ends here (the simulation's default: 5 sigma); the tail beyond
 // holds exp(-8) = 3e-4 of the peak, renormalised onto the footprint's square, alike for every
 // candidate
@@ -78,7 +81,7 @@ double window_reach_mm(const PrintChain& chain, size_t corner, const CornerGeome
                                         chain.edge_speed_mm_s[e], options.lag_s);
     // (and the extruder's flow settling after it, as the post-roll allows for)
     reach = std::max(reach, speed_change_distance(line.v_max_mm_s, 0.0, line) +
-                                6.0 * options.lag_s * line.v_max_mm_s);
+                                kLagSettlingLags * options.lag_s * line.v_max_mm_s);
     reach = std::max(reach, largest_trim_mm(g, (b - a).norm(), model));
   }
   return reach + g.max_half_length_mm * g.tangent_per_length + kWindowSigmas * sigma;
@@ -210,10 +213,6 @@ struct CornerWindow {
   };
   std::vector<TargetCell> cells;
   std::vector<CentreSample> centre;
-  bool has_targets = false;  // cells and centre are filled (add_targets)
-  // the deposit of the pre- and post-roll at print speed before a and after b, the lines
-  // continuing beyond the window (add_targets)
-  Process* rolls = nullptr;
   // the process each candidate's window deposit is predicted with, restarted for each
   Process* scratch = nullptr;
 };
@@ -248,7 +247,8 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
 }
 
 // The window's target cells and centreline samples (needed once a candidate's deposit is
-// predicted).
+// predicted), less the deposit of the pre- and post-roll at print speed before a and after b
+// (the lines continuing beyond the window).
 void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& scratch) {
   const DepositionSettings& settings = model.settings;
   const double sigma = settings.footprint_sigma_mm();
@@ -256,35 +256,35 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   // reuses the same few tiles of the scratch fields, and equal corners predict alike wherever
   // they are)
   const Vec3 a = w.a - w.c, b = w.b - w.c, c = Vec3::Zero();
-  w.has_targets = true;
 
   // the rolls: from the extruder's settled state, long enough for the footprint and the lag
   if (!scratch.rolls) {
     scratch.rolls = make_process(prediction_settings(settings), w.cell_mm);
     scratch.window = make_process(prediction_settings(settings), w.cell_mm);
   }
-  w.rolls = scratch.rolls.get();
+  Process& rolls_process = *scratch.rolls;
   w.scratch = scratch.window.get();
-  w.rolls->restart();
-  const double roll_mm = std::max(kRollSigmas * sigma, 6.0 * w.lag_s * std::max(w.v_in, w.v_out));
+  rolls_process.restart();
+  const double roll_mm =
+      std::max(kRollSigmas * sigma, kLagSettlingLags * w.lag_s * std::max(w.v_in, w.v_out));
   const double step_s = prediction_step_s(sigma, std::max(w.v_in, w.v_out));
   const auto steady = [&](const Vec3& from, const Vec3& to, double speed, double t0) {
     const double length = (to - from).norm();
     const int steps = std::max(1, static_cast<int>(std::ceil(length / (speed * step_s))));
     const double dt = length / speed / steps;
-    w.rolls->start_steady(steady_step(speed));
+    rolls_process.start_steady(steady_step(speed));
     for (int k = 0; k < steps; ++k) {
       DepositionStep step = steady_step(speed);
       step.t0_s = t0 + k * dt;
       step.t1_s = t0 + (k + 1) * dt;
       step.p0_mm = from + (to - from) * (static_cast<double>(k) / steps);
       step.p1_mm = from + (to - from) * (static_cast<double>(k + 1) / steps);
-      w.rolls->advance(step);
+      rolls_process.advance(step);
     }
   };
   steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
   steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
-  const ThicknessField& rolls = w.rolls->field();
+  const ThicknessField& rolls = rolls_process.field();
 
   // the even deposit over the window's target cells: the steady line's cross section at the
   // cell's distance from the nearest centreline point
@@ -362,7 +362,7 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   }
 
   // the deposit of the window's plan, the extruder settled at print speed as the pre-roll
-  // leaves it (the rolls' deposit, shared by every candidate, is added where it is read)
+  // leaves it (the rolls' deposit, shared by every candidate, is taken off the targets)
   Process* process = w.scratch;
   process->restart();
   process->start_steady(steady_step(v_in));
@@ -432,20 +432,25 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
   if (g.max_half_length_mm > 0.0) {
     const MachineLimits box = corner_blend_limits(g, g.max_half_length_mm, limits);
     const double needed = blend_half_length_for_speed(g.shape, speed, box);
-    CornerPlan plan;
-    plan.treatment = CornerTreatment::blend;
     if (needed <= g.max_half_length_mm) {
       // the only candidate: the print speed kept within the tolerance, nothing to weigh it
       // against (its deposit is not predicted; its time is)
+      CornerPlan plan;
+      plan.treatment = CornerTreatment::blend;
       plan.half_length_mm = std::max(needed, 1e-9 * g.max_half_length_mm);
       CornerCandidate candidate =
           evaluate_corner(window, plan, limits, options, model, time_weight_mm_s, -kInf);
       candidate.name = "blend";
       candidates.push_back(candidate);
       full_speed_blend = true;
-    } else {
-      add_targets(window, model, scratch);
+    }
+  }
+  if (!full_speed_blend) {
+    add_targets(window, model, scratch);
+    if (g.max_half_length_mm > 0.0) {
       // smaller blends while they pay (the cost is unimodal in the size here)
+      CornerPlan plan;
+      plan.treatment = CornerTreatment::blend;
       double previous = std::numeric_limits<double>::infinity();
       for (const double share : kSlowBlendShares) {
         plan.half_length_mm = share * g.max_half_length_mm;
@@ -454,9 +459,6 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
         previous = cost;
       }
     }
-  }
-  if (!full_speed_blend) {
-    if (!window.has_targets) add_targets(window, model, scratch);
     if (!model.aerosol()) {
       CornerPlan plan;
       plan.treatment = CornerTreatment::stop;
