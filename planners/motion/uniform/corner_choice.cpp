@@ -239,7 +239,14 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   window.edge_source = {chain.edge_source[corner - 1], chain.edge_source[corner]};
   window.point_path = {0, 0, 0};
   window.point_index = {0, 1, 2};
-  w.geometry = corner_geometry(window.points, kInf);
+  // the corner's own geometry (its blend shape is the costly part), its blends bounded by the
+  // window's edges alone (corner_geometry with no tolerance)
+  w.geometry.resize(3);
+  for (int i = 0; i < 3; ++i) w.geometry[i].point = window.points[i];
+  w.geometry[1] = geometry;
+  if (geometry.tangent_per_length > 0.0)
+    w.geometry[1].max_half_length_mm =
+        0.5 * std::min((c - a).norm(), (b - c).norm()) / geometry.tangent_per_length;
   w.v_in = window.edge_speed_mm_s[0], w.v_out = window.edge_speed_mm_s[1];
   w.lag_s = options.lag_s;
   w.cell_mm = kCellSigmas * model.settings.footprint_sigma_mm();

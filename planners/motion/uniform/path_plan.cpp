@@ -206,7 +206,6 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     const Vec3& p0 = chain.points[e];
     const Vec3& p1 = chain.points[e + 1];
     const double speed = chain.edge_speed_mm_s[e];
-    const std::string where = "toolpath path " + std::to_string(chain.edge_source[e]);
     Line& line = lines[e];
     const double edge_length = (p1 - p0).norm();
     line.u = (p1 - p0) / edge_length;
@@ -218,7 +217,7 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
         msg << "segment " << e << " needs " << std::abs(speed * line.u[axis]) << " mm/s on axis "
             << kAxisName[axis] << " at print speed " << speed << " mm/s, above v_max "
             << edge_limits.axes[axis].v_max_mm_s;
-        throw InputError(where, msg.str());
+        throw InputError("toolpath path " + std::to_string(chain.edge_source[e]), msg.str());
       }
     }
     double trim0 = 0.0, trim1 = 0.0;
