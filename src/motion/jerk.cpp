@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -21,37 +23,67 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// a double's place in the order of all doubles (-0 and +0 alike), and back: adjacent doubles
+// have adjacent keys
+int64_t order_key(double x) {
+  int64_t bits = 0;
+  std::memcpy(&bits, &x, sizeof bits);
+  return bits >= 0 ? bits : -(bits & std::numeric_limits<int64_t>::max());
+}
+double from_order_key(int64_t key) {
+  const int64_t bits = key >= 0 ? key : (-key) | std::numeric_limits<int64_t>::min();
+  double x = 0.0;
+  std::memcpy(&x, &bits, sizeof x);
+  return x;
+}
+
 // The point where a predicate that holds left of it and fails right of it flips, to full
-// double precision; returns the side where it holds (so a profile built from it never needs
-// a negative cruise).
+// double precision (the two adjacent doubles it flips between); returns the side where it
+// holds (so a profile built from it never needs a negative cruise). Bisects the doubles
+// themselves, in their order: at most 64 probes however small the flip point (halving the
+// value takes over a thousand to reach a flip near 0).
 template <class Predicate>
 double bisect(double lo, double hi, Predicate holds) {
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    if (mid <= lo || mid >= hi) break;
-    (holds(mid) ? lo : hi) = mid;
+  if (!(lo < hi)) return lo;
+  int64_t lo_key = order_key(lo), hi_key = order_key(hi);
+  // a flip at either end of the bracket (common: a limit reached exactly) in one probe each
+  if (hi_key - lo_key > 2) {
+    if (!holds(from_order_key(lo_key + 1))) return lo;
+    if (holds(from_order_key(hi_key - 1))) return from_order_key(hi_key - 1);
   }
-  return lo;
+  while (static_cast<uint64_t>(hi_key) - static_cast<uint64_t>(lo_key) > 1) {
+    const int64_t mid_key =
+        lo_key +
+        static_cast<int64_t>((static_cast<uint64_t>(hi_key) - static_cast<uint64_t>(lo_key)) / 2);
+    (holds(from_order_key(mid_key)) ? lo_key : hi_key) = mid_key;
+  }
+  return from_order_key(lo_key);
 }
 
 // The same point as bisect(lo, hi, holds) with holds(x) = residual(x) <= 0 (or < 0 when
-// strict), found in far fewer evaluations: Illinois steps on the residual narrow the bracket
-// (each probe decided by the predicate, so the bracket always has it holding at lo and failing
-// at hi), then bisect finishes it to adjacent doubles. For a predicate that flips once, the
-// result is bisect's to the last bit; where the residual's signs at the ends disagree with
-// that (no flip in between), it is plain bisect.
+// strict), found in far fewer probes: Illinois steps on the residual (a midpoint where it is
+// not finite or two steps have not halved the bracket) narrow the bracket, each probe decided
+// by the predicate, so it always holds at lo and fails at hi; bisect finishes to adjacent
+// doubles. For a predicate that flips once, the result is bisect's to the last bit.
 template <class Residual>
 double bisect_residual(double lo, double hi, Residual residual, bool strict) {
   const auto holds = [strict](double r) { return strict ? r < 0.0 : r <= 0.0; };
   double r_lo = residual(lo), r_hi = residual(hi);
-  if (holds(r_lo) && !holds(r_hi) && std::isfinite(r_lo) && std::isfinite(r_hi)) {
-    int side = 0;  // which end the last two probes moved (Illinois: halve the other's residual)
-    for (int i = 0; i < 40; ++i) {
+  if (holds(r_lo) && !holds(r_hi)) {
+    int side = 0;  // which end the last probe moved (Illinois: halve the other's residual)
+    double width_before = 2.0 * (hi - lo);
+    for (int i = 0; i < 16; ++i) {
       const double width = hi - lo;
       if (!(width > 1e-13 * std::max(std::abs(lo), std::abs(hi)))) break;
-      double x = lo + width * (r_lo / (r_lo - r_hi));
-      // keep the probe inside, a little away from the ends (a root at an end converges there)
-      x = std::clamp(x, lo + 1e-3 * width, hi - 1e-3 * width);
+      double x = 0.5 * (lo + hi);
+      if (std::isfinite(r_lo) && std::isfinite(r_hi)) {
+        // the interpolated probe, a little away from the ends
+        x = std::clamp(lo + width * (r_lo / (r_lo - r_hi)), lo + 1e-3 * width, hi - 1e-3 * width);
+      }
+      if (i % 2 == 1) {
+        if (width > 0.5 * width_before) x = 0.5 * (lo + hi);
+        width_before = width;
+      }
       if (!(x > lo && x < hi)) break;
       const double r = residual(x);
       if (holds(r)) {
@@ -63,7 +95,6 @@ double bisect_residual(double lo, double hi, Residual residual, bool strict) {
         if (side == 1) r_lo *= 0.5;
         side = 1;
       }
-      if (!std::isfinite(r_lo) || !std::isfinite(r_hi) || r_lo == r_hi) break;
     }
   }
   return bisect(lo, hi, [&](double x) { return holds(residual(x)); });

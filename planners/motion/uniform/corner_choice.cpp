@@ -36,6 +36,8 @@ constexpr double kEndClearSigmas = 1.0;
 // the prediction's cells: half a sigma (every cell's volume is exact at any size; the error
 // sums compare candidates, which this resolves)
 constexpr double kCellSigmas = 0.5;
+// the corner's cell in its own frame: the middle of a scratch field's tile
+constexpr double kFrameCornerCells = 0.5 * ThicknessField::Tiles::kSize;
 constexpr double kMaxTrimShare = 0.3;  // a loop's trim leaves most of the edge printed
 constexpr double kTrimFractions[] = {0.0, 0.25, 0.5, 0.75, 1.0};
 constexpr double kTrimInFractions[] = {0.0, 0.25};
@@ -201,6 +203,13 @@ struct CornerWindow {
   double v_in = 0.0, v_out = 0.0;
   double lag_s = 0.0;  // the extruder's flow lag (0: aerosol)
   double cell_mm = 0.0;
+  // the corner's own frame, where the predictions run: the corner at cell (kFrameCornerCells,
+  // kFrameCornerCells), so every corner's prediction reuses the same few tiles of the scratch
+  // fields (a small window: one), and equal corners predict alike wherever they are (a point
+  // is first taken relative to the corner, then shifted: points on a line through the corner
+  // keep their exact offsets from it)
+  Vec3 frame_corner = Vec3::Zero();
+  Vec3 in_frame(const Vec3& p) const { return (p - c) + frame_corner; }
   // the target cells (within half a line width of the centreline, clear of the window's ends)
   // and the centreline's samples, in the order their errors are summed; each holds what the
   // window's own deposit should add to the rolls' (the target less the rolls' deposit there)
@@ -230,6 +239,8 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   const Vec3 a = edge_in <= reach ? chain.points[corner - 1] : Vec3(c - reach * geometry.d_in);
   const Vec3 b = edge_out <= reach ? chain.points[corner + 1] : Vec3(c + reach * geometry.d_out);
   w.a = a, w.b = b, w.c = c;
+  w.cell_mm = kCellSigmas * model.settings.footprint_sigma_mm();
+  w.frame_corner = Vec3(kFrameCornerCells * w.cell_mm, kFrameCornerCells * w.cell_mm, 0.0);
   w.d_in = geometry.d_in, w.d_out = geometry.d_out;
   PrintChain& window = w.chain;
   window.points = {a, c, b};
@@ -249,7 +260,6 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
         0.5 * std::min((c - a).norm(), (b - c).norm()) / geometry.tangent_per_length;
   w.v_in = window.edge_speed_mm_s[0], w.v_out = window.edge_speed_mm_s[1];
   w.lag_s = options.lag_s;
-  w.cell_mm = kCellSigmas * model.settings.footprint_sigma_mm();
   return w;
 }
 
@@ -259,10 +269,8 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
 void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& scratch) {
   const DepositionSettings& settings = model.settings;
   const double sigma = settings.footprint_sigma_mm();
-  // (in the corner's own frame: the corner at the origin, so every corner's prediction
-  // reuses the same few tiles of the scratch fields, and equal corners predict alike wherever
-  // they are)
-  const Vec3 a = w.a - w.c, b = w.b - w.c, c = Vec3::Zero();
+  // (in the corner's own frame)
+  const Vec3 a = w.in_frame(w.a), b = w.in_frame(w.b), c = w.in_frame(w.c);
 
   // the rolls: from the extruder's settled state, long enough for the footprint and the lag
   if (!scratch.rolls) {
@@ -353,8 +361,8 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   plans[1] = plan;
   PathMotionOptions window_options = options;
   window_options.enter_at_speed = window_options.leave_at_speed = true;
-  const PlannedPath planned = plan_chain(w.chain, w.geometry, plans, limits, window_options, 0.0);
-  const Trajectory motion("uniform", planned.pieces);
+  PlannedPath planned = plan_chain(w.chain, w.geometry, plans, limits, window_options, 0.0);
+  const Trajectory motion("uniform", std::move(planned.pieces));
   const double duration = motion.duration_s();
   const double v_in = w.v_in, v_out = w.v_out;
   CornerCandidate candidate;
@@ -385,8 +393,8 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
     DepositionStep step;
     step.t0_s = t0;
     step.t1_s = t1;
-    step.p0_mm = before.position_mm - c;  // the corner's frame (add_targets)
-    step.p1_mm = after.position_mm - c;
+    step.p0_mm = w.in_frame(before.position_mm);  // the corner's frame (add_targets)
+    step.p1_mm = w.in_frame(after.position_mm);
     step.open0 = open_fraction(closed, t0, model.shutter_time_s);
     step.open1 = open_fraction(closed, t1, model.shutter_time_s);
     step.flow_command = before.depositing ? before.flow_fraction : 0.0;
