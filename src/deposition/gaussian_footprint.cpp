@@ -170,6 +170,7 @@ void GaussianFootprint::deposit_nodes(ThicknessField& field, const FootprintNode
   const double* gy3 = gy2 + capacity_;
 
   // rank-count update of every tile the box overlaps: cell += sum_k gy_k[row] gx_k[col]
+  ThicknessField::Tiles& tiles = field.tiles_for_writing(ix_lo, ix_hi, iy_lo, iy_hi);
   for (int ty = Tiles::tile_of(iy_lo); ty <= Tiles::tile_of(iy_hi); ++ty) {
     const int row_lo = std::max(iy_lo, ty * kTile);
     const int row_hi = std::min(iy_hi, ty * kTile + kTile - 1);
@@ -178,7 +179,7 @@ void GaussianFootprint::deposit_nodes(ThicknessField& field, const FootprintNode
       const int col_hi = std::min(ix_hi, tx * kTile + kTile - 1);
       const int cols = col_hi - col_lo + 1;
       const int c0 = col_lo - ix_lo;
-      double* tile = field.tiles().get_or_create(tx, ty);
+      double* tile = tiles.get_or_create(tx, ty);
       for (int iy = row_lo; iy <= row_hi; ++iy) {
         const int r = iy - iy_lo;
         double* __restrict dst = tile + Tiles::local_of(iy) * kTile + Tiles::local_of(col_lo);

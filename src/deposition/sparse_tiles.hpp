@@ -45,6 +45,11 @@ class SparseTiles {
   size_t tile_count() const { return tiles_.size(); }
   size_t allocated_cells() const { return tiles_.size() * static_cast<size_t>(kCells); }
   void clear() { tiles_.clear(); }
+  // f(tx, ty, cells) for every tile, in no particular order (for order-free updates)
+  template <class F>
+  void for_each_tile(F f) {
+    for (auto& [key, cells] : tiles_) f(tile_x(key), tile_y(key), cells.get());
+  }
   // every cell back to its initial value, the tiles kept for reuse (no allocation)
   void zero() {
     for (auto& [key, cells] : tiles_) std::fill(cells.get(), cells.get() + kCells, Cell{});

@@ -166,9 +166,29 @@ int ThicknessField::stride_for_max_cells(double x_lo_mm, double y_lo_mm, double 
   return stride;
 }
 
+void ThicknessField::zero() {
+  if (written_.everything) {
+    tiles_.zero();
+  } else if (written_.ix_lo <= written_.ix_hi) {
+    // each tile's rows and columns within the written box
+    tiles_.for_each_tile([this](int tx, int ty, double* cells) {
+      const int row_lo = std::max(written_.iy_lo, ty * Tiles::kSize);
+      const int row_hi = std::min(written_.iy_hi, ty * Tiles::kSize + Tiles::kSize - 1);
+      const int col_lo = std::max(written_.ix_lo, tx * Tiles::kSize);
+      const int col_hi = std::min(written_.ix_hi, tx * Tiles::kSize + Tiles::kSize - 1);
+      if (row_lo > row_hi || col_lo > col_hi) return;
+      for (int iy = row_lo; iy <= row_hi; ++iy)
+        std::fill(cells + Tiles::local_index(col_lo, iy),
+                  cells + Tiles::local_index(col_hi, iy) + 1, 0.0);
+    });
+  }
+  written_ = CellBox{};
+}
+
 void ThicknessField::add(const ThicknessField& other) {
   if (other.cell_mm_ != cell_mm_)
     throw InternalError("ThicknessField::add: fields with different cells");
+  written_.everything = true;
   for (const auto& [tx, ty] : other.tiles_.sorted_tiles()) {
     const double* from = other.tiles_.find(tx, ty);
     double* to = tiles_.get_or_create(tx, ty);
@@ -189,6 +209,7 @@ void ThicknessField::scale_cells(const std::function<double(double x_mm, double 
 }
 
 void ThicknessField::add_to_cell(int ix, int iy, double thickness_mm) {
+  written_.include(ix, ix, iy, iy);
   tiles_.get_or_create(Tiles::tile_of(ix), Tiles::tile_of(iy))[Tiles::local_index(ix, iy)] +=
       thickness_mm;
 }

@@ -9,6 +9,7 @@
 // near them; a 100 x 100 mm bed at 10 um cells only pays for the printed band.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <functional>
 
@@ -67,17 +68,45 @@ class ThicknessField {
   // every cell multiplied by factor(x, y) at its centre (mm): e.g. the vertical thickness of a
   // deposit on a sloped surface turned into the thickness along the surface normal
   void scale_cells(const std::function<double(double x_mm, double y_mm)>& factor);
-  void clear() { tiles_.clear(); }
-  // every cell 0, its memory kept for the next deposit (a scratch field reused)
-  void zero() { tiles_.zero(); }
+  void clear() {
+    tiles_.clear();
+    written_ = CellBox{};
+  }
+  // every cell 0, its memory kept for the next deposit (a scratch field reused): only the
+  // cells written since the last zero() are cleared (their bounding box)
+  void zero();
 
-  // raw tile access for the deposition kernel and the metrics
-  Tiles& tiles() { return tiles_; }
+  // raw tile access for the metrics; writing through it (non-const) makes the next zero()
+  // clear every tile
+  Tiles& tiles() {
+    written_.everything = true;
+    return tiles_;
+  }
   const Tiles& tiles() const { return tiles_; }
+  // tile access for a writer that changes cells [ix_lo, ix_hi] x [iy_lo, iy_hi] only (the
+  // deposition kernel)
+  Tiles& tiles_for_writing(int ix_lo, int ix_hi, int iy_lo, int iy_hi) {
+    written_.include(ix_lo, ix_hi, iy_lo, iy_hi);
+    return tiles_;
+  }
 
  private:
+  // the bounding box of the cells written since the last zero() (empty: lo > hi)
+  struct CellBox {
+    int ix_lo = 1, ix_hi = 0, iy_lo = 1, iy_hi = 0;
+    bool everything = false;
+    void include(int x_lo, int x_hi, int y_lo, int y_hi) {
+      if (ix_lo > ix_hi) {
+        ix_lo = x_lo, ix_hi = x_hi, iy_lo = y_lo, iy_hi = y_hi;
+        return;
+      }
+      ix_lo = std::min(ix_lo, x_lo), ix_hi = std::max(ix_hi, x_hi);
+      iy_lo = std::min(iy_lo, y_lo), iy_hi = std::max(iy_hi, y_hi);
+    }
+  };
   double cell_mm_;
   Tiles tiles_;
+  CellBox written_;
 };
 
 }  // namespace depotwin

@@ -127,5 +127,53 @@ TEST(ThicknessField, ScaleCellsUsesEachCellCentre) {
   EXPECT_EQ(field.cell_thickness_mm(0, 0), 0.0);
 }
 
+// zero() clears only the cells written since the last zero() (their bounding box), so every way
+// of writing must widen that box: the kernel's footprints, add_to_cell, add() and raw tile
+// writes. After each, every cell reads 0 again and the tiles stay allocated.
+TEST(ThicknessField, ZeroClearsEveryWrittenCellWhateverWroteIt) {
+  DepositionSettings settings;
+  settings.sigma_mm = 0.1;
+  AerosolProcess process(settings, 0.025);
+  ThicknessField field(0.025);
+  const auto all_zero = [](const ThicknessField& f) {
+    bool zero = true;
+    for (const auto& [tx, ty] : f.tiles().sorted_tiles()) {
+      const double* cells = f.tiles().find(tx, ty);
+      for (int k = 0; k < ThicknessField::Tiles::kCells; ++k) zero = zero && cells[k] == 0.0;
+    }
+    return zero && f.total_volume_mm3() == 0.0;
+  };
+  // footprints along a line crossing several tiles, then a cell far outside their box
+  test::drive(
+      process, 0.0, 1.0, 1e-3, [](double t) { return Vec3(-1.0 + 3.0 * t, 0.5 - t, 0.0); },
+      [](double) { return 1.0; }, [](double) { return 0.0; }, [](double) { return 0.0; });
+  field.add(process.field());
+  const size_t tiles = field.allocated_tiles();
+  ASSERT_GT(tiles, 2u);
+  ASSERT_GT(field.total_volume_mm3(), 0.0);
+  field.zero();
+  EXPECT_TRUE(all_zero(field));
+  EXPECT_EQ(field.allocated_tiles(), tiles);
+  // the kernel's own box (a process restarted: its field zeroed, its tiles kept)
+  process.restart();
+  EXPECT_TRUE(all_zero(process.field()));
+  test::drive(
+      process, 0.0, 0.5, 1e-3, [](double t) { return Vec3(2.0 * t, 0.2, 0.0); },
+      [](double) { return 1.0; }, [](double) { return 0.0; }, [](double) { return 0.0; });
+  ASSERT_GT(process.field().total_volume_mm3(), 0.0);
+  process.restart();
+  EXPECT_TRUE(all_zero(process.field()));
+  EXPECT_GT(process.field().allocated_tiles(), 0u);
+  // single cells, one far beyond the other
+  field.add_to_cell(3, 4, 0.001);
+  field.add_to_cell(-90, 170, 0.003);
+  field.zero();
+  EXPECT_TRUE(all_zero(field));
+  // a raw write through the tiles
+  field.tiles().get_or_create(-2, 1)[17] = 0.5;
+  field.zero();
+  EXPECT_TRUE(all_zero(field));
+}
+
 }  // namespace
 }  // namespace depotwin

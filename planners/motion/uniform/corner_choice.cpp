@@ -387,16 +387,30 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   const double dt = duration / steps;
   TrajectoryCursor cursor(motion);
   TrajectorySample before = cursor.at(0.0);
+  bool shut_before = false, before_stale = false;
   for (int k = 0; k < steps; ++k) {
     const double t0 = k * dt, t1 = k + 1 == steps ? duration : (k + 1) * dt;
+    const double open0 = open_fraction(closed, t0, model.shutter_time_s);
+    const double open1 = open_fraction(closed, t1, model.shutter_time_s);
+    // an aerosol's shut shutter lets nothing through: after the first such step (which ends
+    // the run of batched steps), the rest of the loop need not be followed
+    const bool shut = model.aerosol() && open0 == 0.0 && open1 == 0.0;
+    const bool skip = shut && shut_before;
+    shut_before = shut;
+    if (skip) {
+      before_stale = true;
+      continue;
+    }
+    if (before_stale) before = cursor.at(t0);
+    before_stale = false;
     const TrajectorySample after = cursor.at(t1);
     DepositionStep step;
     step.t0_s = t0;
     step.t1_s = t1;
     step.p0_mm = w.in_frame(before.position_mm);  // the corner's frame (add_targets)
     step.p1_mm = w.in_frame(after.position_mm);
-    step.open0 = open_fraction(closed, t0, model.shutter_time_s);
-    step.open1 = open_fraction(closed, t1, model.shutter_time_s);
+    step.open0 = open0;
+    step.open1 = open1;
     step.flow_command = before.depositing ? before.flow_fraction : 0.0;
     step.desired_speed_mm_s = before.desired_speed_mm_s;
     process->advance(step);
