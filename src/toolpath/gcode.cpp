@@ -26,8 +26,9 @@ constexpr double kMmPerInch = 25.4;
 constexpr double kSecondsPerMinute = 60.0;
 // report this many malformed lines, then only count the rest
 constexpr std::size_t kMaxListedProblems = 20;
-// a move shorter than this is no move (mm)
-constexpr double kMinMove_mm = 1e-9;
+// a move shorter than this is no move (mm): the toolpath's own tolerance for one point
+// (kJoinTolerance_mm), so a CAM program's sub-micron move is not a zero-length segment
+constexpr double kMinMove_mm = kJoinTolerance_mm;
 // the largest magnitude a number may have (beyond: a typo or garbage)
 constexpr double kMaxMagnitude = 1e9;
 // z levels closer than this are one layer (mm)

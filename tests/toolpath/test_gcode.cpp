@@ -85,6 +85,18 @@ TEST(Gcode, RetractionIsNotAPrintMove) {
   expect_points(imported.toolpath.paths[1], {Vec3(2, 0, 0), Vec3(3, 0, 0)});
 }
 
+// a move shorter than the toolpath's tolerance for one point (kJoinTolerance_mm) is no move: a
+// CAM program's rounding does not become a zero-length segment the scenario check refuses
+TEST(Gcode, SubMicronMoveIsNoSegment) {
+  const GcodeImport imported = parse("G1 X1 E1 F600\nG1 X1.0000002 E1\nG1 X2 E2\n");
+  ASSERT_EQ(imported.toolpath.paths.size(), 1u);
+  const PrintPath& path = imported.toolpath.paths[0];
+  ASSERT_EQ(path.points.size(), 3u);
+  expect_points(path, {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0)});
+  for (std::size_t k = 0; k + 1 < path.points.size(); ++k)
+    EXPECT_GT((path.points[k + 1] - path.points[k]).norm(), kJoinTolerance_mm);
+}
+
 TEST(Gcode, InchesAndSetPosition) {
   // G20: 1 inch = 25.4 mm; F60 in/min = 25.4 mm/s
   const GcodeImport inches = parse("G20\nG1 X1 Y0 E0.1 F60\n");
