@@ -46,15 +46,15 @@ template <class Predicate>
 double bisect(double lo, double hi, Predicate holds) {
   if (!(lo < hi)) return lo;
   int64_t lo_key = order_key(lo), hi_key = order_key(hi);
+  // the doubles strictly between hi and lo, plus one (unsigned: no overflow for any bracket)
+  const auto gap = [&] { return static_cast<uint64_t>(hi_key) - static_cast<uint64_t>(lo_key); };
   // a flip at either end of the bracket (common: a limit reached exactly) in one probe each
-  if (hi_key - lo_key > 2) {
+  if (gap() > 2) {
     if (!holds(from_order_key(lo_key + 1))) return lo;
     if (holds(from_order_key(hi_key - 1))) return from_order_key(hi_key - 1);
   }
-  while (static_cast<uint64_t>(hi_key) - static_cast<uint64_t>(lo_key) > 1) {
-    const int64_t mid_key =
-        lo_key +
-        static_cast<int64_t>((static_cast<uint64_t>(hi_key) - static_cast<uint64_t>(lo_key)) / 2);
+  while (gap() > 1) {
+    const int64_t mid_key = lo_key + static_cast<int64_t>(gap() / 2);
     (holds(from_order_key(mid_key)) ? lo_key : hi_key) = mid_key;
   }
   return from_order_key(lo_key);
