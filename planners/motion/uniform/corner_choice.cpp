@@ -255,9 +255,8 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   w.geometry.resize(3);
   for (int i = 0; i < 3; ++i) w.geometry[i].point = window.points[i];
   w.geometry[1] = geometry;
-  if (geometry.tangent_per_length > 0.0)
-    w.geometry[1].max_half_length_mm =
-        0.5 * std::min((c - a).norm(), (b - c).norm()) / geometry.tangent_per_length;
+  w.geometry[1].max_half_length_mm =
+      max_blend_half_length(geometry, (c - a).norm(), (b - c).norm(), kInf);
   w.v_in = window.edge_speed_mm_s[0], w.v_out = window.edge_speed_mm_s[1];
   w.lag_s = options.lag_s;
   return w;

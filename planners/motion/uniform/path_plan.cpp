@@ -180,12 +180,17 @@ std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, dou
     c.tangent_per_length = ClothoidBlend::tangent_per_length(c.turn_rad);
     c.deviation_per_length = ClothoidBlend::deviation_per_length(c.turn_rad);
     c.shape = ClothoidBlend::unit_shape(c.d_in, c.d_out);
-    // within the tolerance, and leaving each adjacent edge at least half for its other end
-    const double room = 0.5 * std::min(in.norm(), out.norm());
-    c.max_half_length_mm =
-        std::min(tolerance_mm / c.deviation_per_length, room / c.tangent_per_length);
+    c.max_half_length_mm = max_blend_half_length(c, in.norm(), out.norm(), tolerance_mm);
   }
   return corners;
+}
+
+double max_blend_half_length(const CornerGeometry& g, double edge_in_mm, double edge_out_mm,
+                             double tolerance_mm) {
+  if (!(g.tangent_per_length > 0.0)) return 0.0;
+  // within the tolerance, and leaving each adjacent edge at least half for its other end
+  const double room = 0.5 * std::min(edge_in_mm, edge_out_mm);
+  return std::min(tolerance_mm / g.deviation_per_length, room / g.tangent_per_length);
 }
 
 PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry>& geometry,

@@ -105,6 +105,10 @@ struct CornerGeometry {
 // with the largest blend within tolerance_mm that leaves each adjacent edge at least half for
 // its other end
 std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm);
+// that largest blend at corner g (its turn set: tangent and deviation per length) between
+// edges of the given lengths; 0 for a corner taken straight or as a reversal
+double max_blend_half_length(const CornerGeometry& g, double edge_in_mm, double edge_out_mm,
+                             double tolerance_mm);
 
 // A planned print path: pieces from t_begin, and its boundary velocities.
 struct PlannedPath {
