@@ -7,7 +7,8 @@
 // them (sampled_setpoint_references) and q_held, v_held, v_end are what the plant's
 // semi-implicit Euler steps see over the held period (held_reference). The friction term is
 // the model's own friction-loss law (friction_law: Coulomb above v_s, a velocity servo of
-// rate B below; v_s capped at 0.1 mm/s). So the actuator force
+// rate B below, the plant's own v_s: a narrower switch kicks the axis at every velocity
+// reversal). So the actuator force
 // kp (ctrl - q) - kv qdot = kp (q_held - q) + kv (v_held - qdot) + f_ff: PD on the reference
 // plus inertia, bias (gravity, Coriolis), viscous, Coulomb friction and an optional
 // machine-specific load feed-forward.
@@ -34,13 +35,13 @@ struct Servo {
   double damping = 0.0;   // joint damping, same units as kv
   double friction = 0.0;  // joint Coulomb friction (frictionloss), N or N m
   // the plant's friction law on this dof (friction_law), fixed once the timestep is set:
-  // its regularisation speed capped at kFrictionFadeSpeed_si, and its rate B
+  // its regularisation speed v_s and its rate B
   double friction_speed_si = 0.0;
   double friction_rate_per_s = 0.0;
 };
 
-// the friction feed-forward switches sign over at most this reference speed (SI), so a
-// reversal does not kick the servo
+// the friction feed-forward's switching speed (SI) where the model's friction law has no rate
+// to give one (friction_law)
 constexpr double kFrictionFadeSpeed_si = 1e-4;
 
 // The joint `name` and its actuator of the same name, which must be a position servo on it

@@ -188,9 +188,13 @@ namespace depotwin {
 namespace {
 
 // Thompson & Yoon's Fig. 7 with and without a jerk limit: the plan's own peak joint
-// acceleration is the TCP limit the plan keeps (30 mm/s^2), the simulated peak is reported
-// against it, and a jerk limit lengthens the plan and lowers the servo's overshoot.
-TEST(XyPipeline, JerkLimitLengthensThePlanAndLowersTheAccelerationOvershoot) {
+// acceleration is the TCP limit the plan keeps (30 mm/s^2), and the simulated peak stays within
+// 5 % of it (issue 16) on both carriages, the velocity reversals included: the servo's friction
+// feed-forward is the plant's friction law (an earlier feed-forward, switching over a narrower
+// speed than the plant's friction, kicked the y carriage to 42.5 mm/s^2 at each reversal).
+// A jerk limit lengthens the plan and never raises the simulated peak; stop_and_go's
+// double-S moves bring it within 1 % of the plan's.
+TEST(XyPipeline, JerkLimitLengthensThePlanAndTheSimulationFollowsTheAcceleration) {
   const Scenario fig7 = load_scenario(testing_support::scenario_path("thompson_fig7.yaml"));
   Scenario jerk_limited = fig7;
   for (AxisLimits& axis : jerk_limited.limits.axes) axis.j_max_mm_s3 = 300.0;
@@ -204,17 +208,24 @@ TEST(XyPipeline, JerkLimitLengthensThePlanAndLowersTheAccelerationOvershoot) {
     ASSERT_TRUE(free.report.actuators && jerk.report.actuators);
     const ActuatorStats& a = *free.report.actuators;
     const ActuatorStats& b = *jerk.report.actuators;
-    // the plan asks each carriage for at most the TCP's a_max, and reaches it
+    // the plan asks each carriage for at most the TCP's a_max, and reaches it; the simulation
+    // follows within 5 %
     for (size_t j = 0; j < a.plan_peak_acc.size(); ++j) {
       EXPECT_NEAR(a.plan_peak_acc[j], 30.0, 0.3) << a.joint_names[j];
       EXPECT_LE(b.plan_peak_acc[j], 30.0 * (1 + 1e-6)) << a.joint_names[j];
       EXPECT_DOUBLE_EQ(a.peak_acc_over_plan[j], a.peak_acc[j] / a.plan_peak_acc[j]);
+      EXPECT_LE(a.peak_acc_over_plan[j], 1.05) << a.joint_names[j];
+      EXPECT_LE(b.peak_acc_over_plan[j], 1.05) << a.joint_names[j];
     }
-    // today's overshoot on y: 42.5 mm/s^2 against 30 (the acceleration steps of the plan)
-    EXPECT_GT(a.peak_acc_over_plan[1], 1.3);
-    // the jerk limit costs time and lowers the simulated peak on the y carriage
+    // the jerk limit costs time and does not raise the simulated peak (lspb_mtt's, at a velocity
+    // reversal within a transition's constant deceleration, which the limit leaves as it is,
+    // stays at 31.04 mm/s^2; stop_and_go's falls to 30.24)
     EXPECT_GT(jerk.report.time.total_s, free.report.time.total_s);
-    EXPECT_LT(b.peak_acc[1], a.peak_acc[1]);
+    for (size_t j = 0; j < a.peak_acc.size(); ++j)
+      EXPECT_LE(b.peak_acc[j], a.peak_acc[j] * (1.0 + 1e-9)) << a.joint_names[j];
+    if (std::string(name) == "stop_and_go") {
+      EXPECT_LE(b.peak_acc_over_plan[1], 1.01);
+    }
   }
 }
 
