@@ -56,6 +56,10 @@ struct JointMap {
   std::function<bool(const std::vector<Pose>& poses, std::vector<JointVector>& joints,
                      std::string* why)>
       solve;
+  // the joints also turn the tool (an arm's wrist: more joints than the TCP's three axes), so
+  // TCP limits over a box bound the translation only: a planner that moves the tool axis must
+  // time the path on the joints themselves
+  bool turns_tool = false;
 };
 
 // The TCP limits a planner must honour, which may depend on where the move is.
@@ -87,6 +91,8 @@ class TcpLimits {
   bool uniform() const { return !over_box_; }
   // the machine's joints along a path; null when the limits come without a machine
   const JointMap* joint_map() const { return joint_map_.get(); }
+  // the same, to share with limits derived from these
+  const std::shared_ptr<const JointMap>& shared_joint_map() const { return joint_map_; }
 
  private:
   MachineLimits requested_;

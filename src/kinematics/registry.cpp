@@ -56,6 +56,7 @@ bool Machine::inverse_near(const Pose& pose, const JointVector& /*seed*/, JointV
 TcpLimits Machine::tcp_limits(const MachineLimits& requested) const {
   auto joint_map = std::make_shared<JointMap>();
   joint_map->limits = joint_limits();
+  joint_map->turns_tool = joint_count() > 3;
   joint_map->solve = [this](const std::vector<Pose>& poses, std::vector<JointVector>& joints,
                             std::string* why) {
     joints.resize(poses.size());

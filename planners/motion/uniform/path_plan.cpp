@@ -160,9 +160,10 @@ TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s) {
     return m;
   };
   if (limits.uniform()) return TcpLimits(fill(limits.requested()));
-  return TcpLimits(fill(limits.requested()), [limits, fill](const Vec3& lo, const Vec3& hi) {
-    return fill(limits.over(lo, hi));
-  });
+  return TcpLimits(
+      fill(limits.requested()),
+      [limits, fill](const Vec3& lo, const Vec3& hi) { return fill(limits.over(lo, hi)); },
+      limits.shared_joint_map());
 }
 
 std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm) {
