@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "planners/motion/conformal.hpp"
 #include "planners/motion/transition.hpp"
 
 namespace depotwin {
@@ -89,6 +90,106 @@ PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerG
   return d;
 }
 
+// The misplaced line (mm) an extrusion path leaves, predicted from its plan: the extruder's
+// flow lags its command by tau (first order, as the simulated extruder), so the flow f (a
+// fraction of the nominal) drifts from |v| / v_desired where the commanded lead cannot make up
+// for the lag (a command clamped at 0 under a deceleration faster than |v| / tau). The error is
+// the integral of |f v_desired - |v|| dt, plus what the flow still lays at rest after the path
+// ends (f_end tau v_desired).
+double predicted_line_error_mm(const TrajectoryPiece& piece, double tau_s) {
+  constexpr double kStep_s = 5e-4;
+  const double duration_s = piece.t_end_s - piece.t_begin_s;
+  const double desired = piece.desired_speed_mm_s;
+  const double keep = tau_s > 0.0 ? std::exp(-kStep_s / tau_s) : 0.0;
+  double flow = 0.0, error_mm = 0.0;
+  Vec3 position, velocity, acceleration;
+  for (double t = 0.5 * kStep_s; t < duration_s; t += kStep_s) {
+    evaluate_motion(piece, t, position, velocity, acceleration);
+    const double command = evaluate_flow_fraction(piece, t, velocity, acceleration);
+    flow = keep * flow + (1.0 - keep) * command;
+    error_mm += std::abs(flow * desired - velocity.norm()) *
+                std::min(kStep_s, duration_s - t + 0.5 * kStep_s);
+  }
+  return error_mm + flow * tau_s * desired;
+}
+
+// On a machine whose joints turn the tool (an arm) the TCP limits over a box bound the
+// translation only: following each edge's tool axis at print speed asked the fillet's wrist for
+// 1000x its acceleration limit. There each print path is timed on the joints by the TOPP-RA law
+// `conformal` uses (path_parametrization.hpp, jerk_time_law.hpp: every joint's speed and
+// acceleration limit along the path, the TCP jerk limits of `jerk_limits`), its corners flown
+// by within the tolerance (zone_mm = 2 x tolerance: a blend passes zone_mm / 2 from its point)
+// by curvature-continuous blends. Per path, two time laws:
+//   flow   time-optimal, the flow following the planned speed led by the lag (pressure
+//          advance): even unless the joints force a deceleration faster than |v| / tau;
+//   speed  the path at the largest constant speed no joint slows (Shembekar's scale-down), the
+//          flow scaled and led the same way: even, and slower.
+// Extrusion takes the one of less predicted line error + time_weight x time; aerosol, whose
+// stream cannot follow a speed, the constant speed. One decision per path reports it.
+Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits,
+                          const UniformSettings& settings, const DepositModel& model) {
+  const bool aerosol = model.aerosol();
+  const double tau_s = aerosol ? 0.0 : model.settings.tau_s;
+  const auto plan_with = [&](ConformalControl control, ConformalPlanReport& report) {
+    ConformalSettings conformal;
+    conformal.zone_mm = 2.0 * settings.tolerance_mm;
+    conformal.period_s = settings.period_s;
+    conformal.control = control;
+    Trajectory timed = ConformalPlanner(conformal).plan(toolpath, jerk_limits, &report);
+    std::vector<TrajectoryPiece> pieces = timed.pieces();
+    if (!aerosol)
+      for (TrajectoryPiece& piece : pieces)
+        if (piece.depositing) piece.flow_lead_s = tau_s;  // pressure advance
+    return std::make_pair(std::move(pieces), timed.warnings());
+  };
+  ConformalPlanReport constant_report, follow_report;
+  auto [constant, warnings] =
+      plan_with(aerosol ? ConformalControl::speed : ConformalControl::both, constant_report);
+  std::vector<TrajectoryPiece> follow;
+  if (!aerosol) follow = plan_with(ConformalControl::flow, follow_report).first;
+  // both plans share their transitions (rest to rest between the same poses): per path, the
+  // chosen piece; then every piece placed after the one before
+  const bool comparable = follow.size() == constant.size();
+  std::vector<PlanDecision> decisions;
+  size_t path = 0;
+  double t = 0.0;
+  for (size_t k = 0; k < constant.size(); ++k) {
+    TrajectoryPiece& piece = constant[k];
+    if (piece.depositing && path < constant_report.paths.size()) {
+      const ConformalPathReport& report = constant_report.paths[path];
+      PlanDecision d;
+      d.path_index = piece.path_index;
+      d.kind = "path";
+      d.choice = "constant_speed";
+      d.figures.push_back({"print_speed_mm_s", report.desired_speed_mm_s, "mm/s"});
+      d.figures.push_back({"constant_speed_mm_s", report.line_speed_mm_s, "mm/s"});
+      d.figures.push_back({"deviation_mm", report.max_blend_deviation_mm, "mm"});
+      if (comparable && follow[k].depositing && follow[k].path_index == piece.path_index) {
+        const double constant_error = predicted_line_error_mm(piece, tau_s);
+        const double follow_error = predicted_line_error_mm(follow[k], tau_s);
+        const double constant_time = piece.t_end_s - piece.t_begin_s;
+        const double follow_time = follow[k].t_end_s - follow[k].t_begin_s;
+        const double constant_cost = constant_error + settings.time_weight_mm_s * constant_time;
+        const double follow_cost = follow_error + settings.time_weight_mm_s * follow_time;
+        d.figures.push_back({"constant_speed_error_mm", constant_error, "mm"});
+        d.figures.push_back({"constant_speed_time_s", constant_time, "s"});
+        d.figures.push_back({"flow_follows_error_mm", follow_error, "mm"});
+        d.figures.push_back({"flow_follows_time_s", follow_time, "s"});
+        if (follow_cost < constant_cost) {
+          d.choice = "flow_follows_speed";
+          piece = std::move(follow[k]);
+        }
+      }
+      decisions.push_back(std::move(d));
+      ++path;
+    }
+    const double duration_s = piece.t_end_s - piece.t_begin_s;
+    piece.t_begin_s = t;
+    piece.t_end_s = t += duration_s;
+  }
+  return Trajectory("uniform", std::move(constant), std::move(warnings), std::move(decisions));
+}
+
 }  // namespace
 
 Trajectory UniformPlanner::plan(const Toolpath& toolpath, const TcpLimits& limits) const {
@@ -104,6 +205,8 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
   model.shutter_time_s = context.shutter_time_s;
   const bool aerosol = model.aerosol();
   const TcpLimits jerk_limits = with_jerk_limits(limits, settings_.jerk_ramp_s);
+  if (const JointMap* joints = limits.joint_map(); joints != nullptr && joints->turns_tool)
+    return plan_on_joints(toolpath, jerk_limits, settings_, model);
 
   PathMotionOptions options;
   options.enter_at_speed = options.leave_at_speed = aerosol;
