@@ -30,6 +30,10 @@ constexpr int kRestGrading = 12;     // grid steps halve this many times towards
 constexpr double kMinLineMm = 1e-4;  // the shortest line left between two blends
 constexpr double kTurnInPlaceLiftMm = 1.0;
 constexpr double kSamePoint = 1e-9;  // mm
+// flow_lag_s: the rounds of lowered speed bounds, and the speed they stop at (below it the law
+// brakes to rest as the limits allow: the flow left is at most this share of the nominal)
+constexpr int kLagRounds = 4;
+constexpr double kLagFloorShare = 0.02;
 // detailed warnings per plan; the rest are counted
 constexpr size_t kMaxDetailedWarnings = 20;
 
@@ -640,6 +644,36 @@ void set_cruise_speed(PathGrid& grid, double speed_mm_s) {
 
 }  // namespace
 
+// Lowers the grid's speed bounds ahead of every slow-down of the law (its samples) so that the
+// speed falls by at most 1 / lag_s per mm: dv/dt = v dv/ds >= -v / lag_s, the deceleration a
+// flow lagging by lag_s can follow when its command leads the speed ((v + lag_s dv/dt) stays
+// >= 0). The bound at s is min over the later samples k of (sdot_k + (s_k - s) / lag_s), never
+// below floor_mm_s (an exponential approach to rest would never arrive). True when some bound
+// was lowered.
+bool cap_decelerations(PathGrid& grid, const PathSamples& samples, double lag_s,
+                       double floor_mm_s) {
+  const size_t n = samples.s_mm.size();
+  std::vector<double> later_min(n);  // min over samples k' >= k of sdot + s / lag_s
+  double running = kInf;
+  for (size_t k = n; k-- > 0;) {
+    running = std::min(running, samples.sdot[k] + samples.s_mm[k] / lag_s);
+    later_min[k] = running;
+  }
+  bool lowered = false;
+  size_t k = 0;
+  for (PathPoint& point : grid.points) {
+    while (k < n && samples.s_mm[k] < point.s_mm) ++k;
+    if (k == n) break;
+    if (!(point.speed_mm_s > 0.0)) continue;  // a stop stays one
+    const double bound = std::max(later_min[k] - point.s_mm / lag_s, floor_mm_s);
+    if (bound < point.speed_mm_s * (1 - 1e-9)) {
+      point.speed_mm_s = bound;
+      lowered = true;
+    }
+  }
+  return lowered;
+}
+
 // ---------------------------------------------------------------------------------------
 
 GapReport conformal_report(const Toolpath& toolpath, double gap_offset_mm) {
@@ -817,6 +851,15 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
       line_speed = lowered;
       options.tcp_accel_scale = timed.repair_scale;  // time_path adds its margins again
     }
+
+    // decelerations the lagging flow can follow (flow_lag_s): bounds ahead of each slow-down,
+    // planned again until none is lowered (down to kLagFloorShare of the line speed)
+    if (settings.flow_lag_s > 0.0)
+      for (int round = 0;
+           round < kLagRounds &&
+           cap_decelerations(grid, timed.samples, settings.flow_lag_s, kLagFloorShare * line_speed);
+           ++round)
+        timed = time_law(grid, interval_limits, options);
 
     TrajectoryPiece piece = sampled_piece(timed.samples, t);
     piece.path_index = static_cast<int>(index);

@@ -85,6 +85,10 @@ struct ConformalSettings {
   double lift_mm = 1.0;        // transitions lift along the tool axis (0: straight)
   double period_s = 0.001;     // sample period
   double ds_mm = 0.05;         // grid step of the time law
+  // > 0: print paths decelerate at most by |v| / flow_lag_s, what an extruder's flow lagging
+  // its command by this time can follow when the command leads the speed (`uniform` sets it;
+  // not a scenario parameter). 0: no such bound.
+  double flow_lag_s = 0.0;
 };
 
 // The gap test over a toolpath: every pair of consecutive points of every path.

@@ -5,11 +5,13 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 
 #include "core/error.hpp"
 #include "planners/motion/conformal.hpp"
 #include "planners/motion/path_parametrization.hpp"
+#include "planners/motion/uniform/uniform_planner.hpp"
 
 namespace depotwin {
 namespace {
@@ -52,6 +54,7 @@ std::shared_ptr<JointMap> tilt_joint_map() {
   map->limits = {JointLimit{"x", -1e3, 1e3, 1e4, 1e6, 0}, JointLimit{"y", -1e3, 1e3, 1e4, 1e6, 0},
                  JointLimit{"z", -1e3, 1e3, 1e4, 1e6, 0},
                  JointLimit{"tilt", -kPi, kPi, kTiltVmax, kTiltAmax, 0}};
+  map->turns_tool = true;
   map->solve = [](const std::vector<Pose>& poses, std::vector<JointVector>& joints, std::string*) {
     joints.resize(poses.size());
     for (size_t i = 0; i < poses.size(); ++i) {
@@ -519,6 +522,103 @@ TEST(ConformalPlanner, BadPathsAreInputErrors) {
   path.normals.clear();
   path.speed_mm_s = 0.0;
   EXPECT_THROW(planner.plan(one_path(path), MachineLimits::uniform(10, 100)), InputError);
+}
+
+// The worst deceleration of a print piece's samples against |v| / lag (by differences of the
+// 1 ms samples), above a speed floor; 0 when it never decelerates there
+double worst_deceleration_over_lag(const Trajectory& trajectory, double lag_s, double floor_mm_s) {
+  double worst = 0.0;
+  for (const TrajectoryPiece* piece : print_pieces(trajectory)) {
+    const SampledMotion& motion = samples_of(*piece);
+    const double h = motion.period_s;
+    for (size_t k = 1; k + 1 < motion.velocity_mm_s.size(); ++k) {
+      const double speed = motion.velocity_mm_s[k].norm();
+      const double rate =
+          (motion.velocity_mm_s[k + 1].norm() - motion.velocity_mm_s[k - 1].norm()) / (2 * h);
+      if (speed > floor_mm_s && rate < 0.0) worst = std::max(worst, -rate * lag_s / speed);
+    }
+  }
+  return worst;
+}
+
+// flow_lag_s (what `uniform` sets for an extruder): the speed falls at most by |v| / lag, which
+// the lagging flow can follow when its command leads the speed; without it the law brakes into
+// the fillet and to rest as hard as the limits allow
+TEST(ConformalPlanner, FlowLagBoundsTheDecelerations) {
+  const double lag_s = 0.02, speed_mm_s = 20.0;
+  ConformalSettings settings;
+  settings.control = ConformalControl::flow;
+  settings.ds_mm = 0.01;
+  const Toolpath toolpath = one_path(fillet_path(speed_mm_s));
+  const Trajectory free = ConformalPlanner(settings).plan(toolpath, with_tilt_joint());
+  settings.flow_lag_s = lag_s;
+  const Trajectory bounded = ConformalPlanner(settings).plan(toolpath, with_tilt_joint());
+  // above 2.5 x kLagFloorShare of the speed (below it the law brakes to rest); the bound holds
+  // on the grid (0.01 mm), so between its points a low speed may fall a little faster
+  // (measured: at most 1.13 x |v| / lag above this floor; 20.2 x without the bound)
+  const double floor_mm_s = 0.05 * speed_mm_s;
+  const double free_worst = worst_deceleration_over_lag(free, lag_s, floor_mm_s);
+  const double bounded_worst = worst_deceleration_over_lag(bounded, lag_s, floor_mm_s);
+  std::printf("[ lag ] worst deceleration / (|v| / lag): %.3f free, %.3f bounded; %.3f s, %.3f s\n",
+              free_worst, bounded_worst, free.duration_s(), bounded.duration_s());
+  EXPECT_GT(free_worst, 5.0);
+  EXPECT_LE(bounded_worst, 1.25);
+  double velocity = 0.0, acceleration = 0.0;
+  tilt_excess(bounded, velocity, acceleration);
+  EXPECT_LE(velocity, 5e-3);
+  EXPECT_LE(acceleration, 5e-3);
+}
+
+// ---------------------------------------------------------------------------------------
+// `uniform` on a machine whose joints turn the tool (uniform_planner.cpp, plan_on_joints)
+
+// On the fillet the tool turns, so `uniform` times the path on the joints: the tilt joint within
+// its limits at every 1 ms sample, the corners within the tolerance, and per path the law of
+// less predicted line error + time_weight x time (time_weight 0: the constant speed; a second
+// worth 1000 mm: the time-optimal law with the flow following the speed). The same path with a
+// vertical tool keeps the TCP law and its per-corner choices.
+TEST(UniformOnJoints, TimesATurningToolOnTheJointsAndChoosesTheLawPerPath) {
+  DepositionSettings extrusion;
+  extrusion.type = ProcessType::extrusion;
+  extrusion.tau_s = 0.02;
+  extrusion.bead_width_mm = 0.4;
+  PlanningContext context;
+  context.process = std::make_shared<const DepositionSettings>(extrusion);
+  const Toolpath toolpath = one_path(fillet_path(20.0));
+
+  std::vector<double> durations;
+  for (const auto& [weight, expected] :
+       {std::pair<double, const char*>{0.0, "constant_speed"}, {1e3, "flow_follows_speed"}}) {
+    UniformSettings settings;
+    settings.time_weight_mm_s = weight;
+    const Trajectory plan =
+        UniformPlanner(settings).plan_in_context(toolpath, with_tilt_joint(), context);
+    double velocity = 0.0, acceleration = 0.0;
+    tilt_excess(plan, velocity, acceleration);
+    EXPECT_LE(velocity, 5e-3) << expected;
+    EXPECT_LE(acceleration, 5e-3) << expected;
+    ASSERT_EQ(plan.decisions().size(), 1u) << expected;
+    const PlanDecision& decision = plan.decisions()[0];
+    EXPECT_EQ(decision.kind, "path");
+    EXPECT_EQ(decision.choice, expected);
+    for (const PlanFigure& figure : decision.figures)
+      if (figure.name == "deviation_mm") {
+        EXPECT_LE(figure.value, settings.tolerance_mm * (1 + 1e-9));
+      }
+    // the flow leads the planned speed by the lag
+    for (const TrajectoryPiece* piece : print_pieces(plan)) EXPECT_EQ(piece->flow_lead_s, 0.02);
+    durations.push_back(plan.duration_s());
+  }
+  // the time-optimal law is the quicker (the constant speed is the fillet's ~2 mm/s throughout)
+  EXPECT_LT(durations[1], 0.5 * durations[0]);
+
+  // a vertical tool throughout: nothing turns, the TCP law with its corner choices
+  PrintPath vertical = fillet_path(20.0);
+  vertical.normals.clear();
+  const Trajectory plan = UniformPlanner(UniformSettings{})
+                              .plan_in_context(one_path(vertical), with_tilt_joint(), context);
+  ASSERT_FALSE(plan.decisions().empty());
+  for (const PlanDecision& decision : plan.decisions()) EXPECT_EQ(decision.kind, "corner");
 }
 
 }  // namespace
