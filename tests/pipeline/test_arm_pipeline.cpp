@@ -390,14 +390,14 @@ TEST(ArmPipeline, FilletBlobWithoutControlAndAnEvenLineWithSpeedAndFlowControl) 
     EXPECT_EQ(result->limit_violations, 0);
   }
   // uniform: timed on the joints within its 0.05 mm tolerance (+ the 0.01 mm), the
-  // flow led by the lag. At the default time_weight it lets the speed follow the joints
-  // (measured: line_cv 0.037, blob 1.32 where the joints decelerate faster than the flow can,
-  // 11.3 s), a third of flow control's line_cv in a quarter of the scale-down's time; with
-  // time_weight 0 the deposit alone decides: the constant speed, evener than `both` (0.0029 on
-  // the whole scenario)
+  // flow led by the lag. At the default time_weight the speed follows the joints, its
+  // decelerations within what the lagging flow can follow on the law's grid (measured: line_cv
+  // 0.0138, blob 1.15, 12.0 s): an eighth of flow control's line_cv in under a third of
+  // `both`'s time; with time_weight 0 the deposit alone decides: the constant speed, evener
+  // than `both` (0.0030)
   for (const Result* result : {&uniform, &even}) EXPECT_LE(result->path_error_mm, 0.06);
-  EXPECT_LT(uniform.thickness.line_cv, flow.thickness.line_cv / 3);
-  EXPECT_LT(uniform.profile.blob, flow.profile.blob / 1.5);
+  EXPECT_LT(uniform.thickness.line_cv, flow.thickness.line_cv / 8);
+  EXPECT_LT(uniform.profile.blob, 1.25);
   EXPECT_GT(uniform.profile.starved, 0.95);
   EXPECT_LT(uniform.time_s, both.time_s / 3);
   EXPECT_LE(even.thickness.line_cv, both.thickness.line_cv);

@@ -113,17 +113,35 @@ double predicted_line_error_mm(const TrajectoryPiece& piece, double tau_s) {
   return error_mm + flow * tau_s * desired;
 }
 
-// On a machine whose joints turn the tool (an arm) the TCP limits over a box bound the
-// translation only: following each edge's tool axis at print speed asked the fillet's wrist for
-// 1000x its acceleration limit. There each print path is timed on the joints by the TOPP-RA law
-// `conformal` uses (path_parametrization.hpp, jerk_time_law.hpp: every joint's speed and
-// acceleration limit along the path, the TCP jerk limits of `jerk_limits`), its corners flown
-// by within the tolerance (zone_mm = 2 x tolerance: a blend passes zone_mm / 2 from its point)
-// by curvature-continuous blends. Per path, two time laws:
-//   flow   time-optimal, the flow following the planned speed led by the lag (pressure
-//          advance): even unless the joints force a deceleration faster than |v| / tau;
+// true when the job turns the tool: some pose (a path's point, the end) holds another tool axis
+// or roll than the start's
+bool turns_tool(const Toolpath& toolpath) {
+  const ToolOrientation start = toolpath.start_orientation();
+  const auto turned = [&start](const ToolOrientation& o) {
+    return std::abs(o.roll_rad - start.roll_rad) > 1e-12 || (o.axis - start.axis).norm() > 1e-12;
+  };
+  if (turned(toolpath.end_orientation())) return true;
+  for (const PrintPath& path : toolpath.paths)
+    for (size_t i = 0; i < path.points.size(); ++i)
+      if (turned(path.orientation(i))) return true;
+  return false;
+}
+
+// On a machine whose joints turn the tool (an arm), in a job that turns it, the TCP limits over
+// a box bound the translation only: following each edge's tool axis at print speed asked the
+// fillet's wrist for 1000x its acceleration limit. There each print path is timed on the joints by
+// the TOPP-RA law `conformal` uses (path_parametrization.hpp, jerk_time_law.hpp: every joint's
+// speed and acceleration limit along the path, the TCP jerk limits of `jerk_limits`), its corners
+// flown by within the tolerance (zone_mm = 2 x tolerance: a blend passes zone_mm / 2 from its
+// point) by curvature-continuous blends. Per path, two time laws:
+//   flow   time-optimal under one more bound, decelerations of at most |v| / tau
+//          (ConformalSettings::flow_lag_s), the flow following the planned speed led by the
+//          lag (pressure advance, never a negative command): the lagging flow keeps up;
 //   speed  the path at the largest constant speed no joint slows (Shembekar's scale-down), the
 //          flow scaled and led the same way: even, and slower.
+// The bound holds on the time law's grid (0.05 mm): where the joints slow the nozzle to a few
+// mm/s (|v| tau = 0.03 mm at 1.4 mm/s on the fillet) the speed falls faster between its points,
+// and the prediction sees what that leaves.
 // Extrusion takes the one of less predicted line error + time_weight x time; aerosol, whose
 // stream cannot follow a speed, the constant speed. One decision per path reports it.
 Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits,
@@ -135,6 +153,7 @@ Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits
     conformal.zone_mm = 2.0 * settings.tolerance_mm;
     conformal.period_s = settings.period_s;
     conformal.control = control;
+    conformal.flow_lag_s = tau_s;  // decelerations the led flow can follow
     Trajectory timed = ConformalPlanner(conformal).plan(toolpath, jerk_limits, &report);
     std::vector<TrajectoryPiece> pieces = timed.pieces();
     if (!aerosol)
@@ -205,7 +224,9 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
   model.shutter_time_s = context.shutter_time_s;
   const bool aerosol = model.aerosol();
   const TcpLimits jerk_limits = with_jerk_limits(limits, settings_.jerk_ramp_s);
-  if (const JointMap* joints = limits.joint_map(); joints != nullptr && joints->turns_tool)
+  // a job that turns the tool on a machine whose joints turn it: timed on the joints
+  if (const JointMap* joints = limits.joint_map();
+      joints != nullptr && joints->turns_tool && turns_tool(toolpath))
     return plan_on_joints(toolpath, jerk_limits, settings_, model);
 
   PathMotionOptions options;
