@@ -159,7 +159,8 @@ TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s) {
       if (!(axis.j_max_mm_s3 > 0.0)) axis.j_max_mm_s3 = axis.a_max_mm_s2 / jerk_ramp_s;
     return m;
   };
-  if (limits.uniform()) return TcpLimits(fill(limits.requested()));
+  if (limits.uniform())
+    return TcpLimits(fill(limits.requested()), nullptr, limits.shared_joint_map());
   return TcpLimits(
       fill(limits.requested()),
       [limits, fill](const Vec3& lo, const Vec3& hi) { return fill(limits.over(lo, hi)); },

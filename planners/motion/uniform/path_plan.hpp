@@ -121,7 +121,7 @@ struct PlannedPath {
 };
 
 // The limits a planner needs with a jerk limit on every axis: the user's where given, else
-// a_max / jerk_ramp_s (the acceleration ramps up in jerk_ramp_s).
+// a_max / jerk_ramp_s (the acceleration ramps up in jerk_ramp_s); the machine's joint map kept.
 TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s);
 
 // Plans a chain from t_begin with the corners as given (one per point; ends ignored). `limits`
