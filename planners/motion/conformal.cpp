@@ -642,8 +642,6 @@ void set_cruise_speed(PathGrid& grid, double speed_mm_s) {
     if (point.speed_mm_s > 0.0) point.speed_mm_s = speed_mm_s;
 }
 
-}  // namespace
-
 // Lowers the grid's speed bounds ahead of every slow-down of the law (its samples) so that the
 // speed falls by at most 1 / lag_s per mm: dv/dt = v dv/ds >= -v / lag_s, the deceleration a
 // flow lagging by lag_s can follow when its command leads the speed ((v + lag_s dv/dt) stays
@@ -673,6 +671,8 @@ bool cap_decelerations(PathGrid& grid, const PathSamples& samples, double lag_s,
   }
   return lowered;
 }
+
+}  // namespace
 
 // ---------------------------------------------------------------------------------------
 

@@ -148,24 +148,26 @@ Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits
                           const UniformSettings& settings, const DepositModel& model) {
   const bool aerosol = model.aerosol();
   const double tau_s = aerosol ? 0.0 : model.settings.tau_s;
-  const auto plan_with = [&](ConformalControl control, ConformalPlanReport& report) {
+  // (a report only where it is read: with one, conformal also computes each path's constant
+  // speed bound)
+  const auto plan_with = [&](ConformalControl control, ConformalPlanReport* report) {
     ConformalSettings conformal;
     conformal.zone_mm = 2.0 * settings.tolerance_mm;
     conformal.period_s = settings.period_s;
     conformal.control = control;
     conformal.flow_lag_s = tau_s;  // decelerations the led flow can follow
-    Trajectory timed = ConformalPlanner(conformal).plan(toolpath, jerk_limits, &report);
+    Trajectory timed = ConformalPlanner(conformal).plan(toolpath, jerk_limits, report);
     std::vector<TrajectoryPiece> pieces = timed.pieces();
     if (!aerosol)
       for (TrajectoryPiece& piece : pieces)
         if (piece.depositing) piece.flow_lead_s = tau_s;  // pressure advance
     return std::make_pair(std::move(pieces), timed.warnings());
   };
-  ConformalPlanReport constant_report, follow_report;
+  ConformalPlanReport constant_report;
   auto [constant, warnings] =
-      plan_with(aerosol ? ConformalControl::speed : ConformalControl::both, constant_report);
+      plan_with(aerosol ? ConformalControl::speed : ConformalControl::both, &constant_report);
   std::vector<TrajectoryPiece> follow;
-  if (!aerosol) follow = plan_with(ConformalControl::flow, follow_report).first;
+  if (!aerosol) follow = plan_with(ConformalControl::flow, nullptr).first;
   // both plans share their transitions (rest to rest between the same poses): per path, the
   // chosen piece; then every piece placed after the one before
   const bool comparable = follow.size() == constant.size();
