@@ -467,8 +467,10 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
             6.0 * (samples.position_mm[k + 1][axis] - samples.position_mm[k][axis]) / (h * h);
         const double v0 = samples.velocity_mm_s[k][axis], v1 = samples.velocity_mm_s[k + 1][axis];
         const double a0 = c - (4.0 * v0 + 2.0 * v1) / h, a1 = -c + (2.0 * v0 + 4.0 * v1) / h;
+        // (relative 1e-9: the law's cruise at a speed limit is exact but for rounding, and
+        // lowered shares could not lower it)
         if (std::max(std::abs(a0), std::abs(a1)) > a_max * (1 + 1e-9) ||
-            std::max(std::abs(v0), std::abs(v1)) > v_max * (1 + 1e-12))
+            std::max(std::abs(v0), std::abs(v1)) > v_max * (1 + 1e-9))
           bad[k] = 1;
       }
     }

@@ -86,6 +86,31 @@ TEST(ConformalJerk, RandomToolpathsStayWithinTheJerkLimit) {
               worst);
 }
 
+// A straight line faster than the x axis allows, on a fine grid (ds 0.01 mm): the law
+// cruises at x's v_max, which its samples meet but for rounding. The check of the samples
+// once took that rounding (1e-12 of v_max) for an excess that lowered shares cannot repair,
+// and failed with an internal error after 12 rounds (the bonnet's transitions did).
+TEST(ConformalJerk, CruiseAtAnAxisSpeedLimitOnAFineGrid) {
+  PrintPath path;
+  path.speed_mm_s = 400.0;
+  for (int i = 0; i <= 60; ++i) path.points.emplace_back(2.5 * i, 1.9 * i + 0.3, 1.0 + 0.01 * i);
+  const MachineLimits limits = MachineLimits::uniform(200.0, 2000.0, 200000.0);
+  const Toolpath toolpath = one_path(path);
+  ConformalSettings settings;
+  settings.control = ConformalControl::none;
+  settings.ds_mm = 0.01;
+  const Trajectory plan = ConformalPlanner(settings).plan(toolpath, limits);
+  testing_support::expect_contract(plan, toolpath, limits);
+  testing_support::expect_finite_difference_limits(plan, limits, 0.01);
+  // the line cruises at x's limit: some sample's x speed within 1e-6 of 200 mm/s
+  double peak_x = 0.0;
+  for (const TrajectoryPiece& piece : plan.pieces())
+    if (piece.depositing)
+      for (const Vec3& v : std::get<SampledMotion>(piece.motion).velocity_mm_s)
+        peak_x = std::max(peak_x, std::abs(v.x()));
+  EXPECT_NEAR(peak_x, 200.0, 1e-6);
+}
+
 // A path whose tool axis turns over a fillet, planned through a joint map with a slow tilt
 // joint (the tool axis' angle from +z in the xz-plane, as an arm's wrist): under a TCP j_max
 // the joint still binds (the TOPP-RA ceiling carries its limits), the TCP's finite-difference
