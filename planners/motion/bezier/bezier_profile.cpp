@@ -378,6 +378,18 @@ std::optional<JerkGridProfile> plan_jerk_grid_profile(double distance_mm, double
     }
     break;
   }
+  // a line too short for the lowest candidate (cap / 256): halve it until a peak fits, then
+  // bisect towards the half above (the S-curves' distance falls with the peak, to 0)
+  double high = candidates.back();
+  for (int halving = 0; halving < 64 && !(v_peak > 0.0); ++halving, high *= 0.5) {
+    const double low = 0.5 * high;
+    if (!fits(low)) continue;
+    v_peak = low;
+    for (int iteration = 0; iteration < 40; ++iteration) {
+      const double mid = 0.5 * (v_peak + high);
+      (fits(mid) ? v_peak : high) = mid;
+    }
+  }
   if (!(v_peak > 0.0)) return std::nullopt;
 
   // a profile at this peak: S-curve up, whole cruise steps, S-curve down (exact end: through x)

@@ -203,6 +203,30 @@ TEST(BezierJerkProfile, OpenEndStopsLessThanOneCruiseStepBeforeTheJoint) {
   }
 }
 
+// lines far shorter than the S-curves to the cap / 256 need (1e-4 mm from rest to rest at a
+// cap of 40 mm/s): the peak is searched below the scan, the end is exact and within the limits
+// (these lines once had no profile: an internal error on a slicer's 0.1 um segment)
+TEST(BezierJerkProfile, TinyLineFromRestToRestFindsALowPeak) {
+  for (const double distance : {1e-3, 1e-4, 1e-6, 1e-9}) {
+    JerkCase c;
+    c.v_cap = 40.0;
+    c.a = 300.0;
+    c.j = 3000.0;
+    c.period = 0.001;
+    c.distance = distance;
+    c.v_in = c.v_out = 0.0;
+    const auto profile =
+        plan_jerk_grid_profile(c.distance, 0.0, 0.0, c.v_cap, c.a, c.j, c.period, true);
+    ASSERT_TRUE(profile) << distance;
+    EXPECT_NEAR(profile->distance_mm(c.period), distance, 1e-9 * (1 + distance)) << distance;
+    EXPECT_NEAR(expect_jerk_profile_within_limits(*profile, c, 0), 0.0, 1e-9 * c.v_cap);
+    // about as fast as the continuous move: rest to rest over d under j alone (four jerk
+    // phases) takes (32 d / j)^(1/3); the grid rounds each phase up to whole steps
+    EXPECT_LE(profile->total_steps() * c.period, std::cbrt(32.0 * distance / c.j) + 6 * c.period)
+        << distance;
+  }
+}
+
 // a long line from rest to rest cruises at exactly the cap; its time is the continuous
 // double-S's (d / v + v / a + a / j) within a few steps
 TEST(BezierJerkProfile, LongLineCruisesAtFullSpeed) {
