@@ -1291,10 +1291,16 @@ void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
     const int line = origin.point_lines.at(origin.name_segments ? k + 1 : 0);
     // consecutive points must differ
     if (length_mm <= kJoinTolerance_mm) {
-      problems_.add_problem(Problem{origin.file, line, origin.key,
-                                    segment + " has zero length: both points are " +
-                                        format_point(path.points[k]) +
-                                        " (consecutive points must differ)"});
+      // (points closer than the tolerance but not equal are named both, with the distance)
+      const std::string where = length_mm == 0.0
+                                    ? "both points are " + format_point(path.points[k])
+                                    : "the points " + format_point(path.points[k]) + " and " +
+                                          format_point(path.points[k + 1]) + " are " +
+                                          format_number(length_mm) + " mm apart, within the " +
+                                          format_number(kJoinTolerance_mm) + " mm join tolerance";
+      problems_.add_problem(
+          Problem{origin.file, line, origin.key,
+                  segment + " has zero length: " + where + " (consecutive points must differ)"});
       continue;
     }
     if (path.speed_mm_s <= 0.0) continue;
