@@ -87,6 +87,25 @@ struct LineWords {
 };
 
 // Marlin's text commands (M117 message, M23 file name, ...): the rest of the line is text
+// whether text (up to a comment) holds a G word: G, spaces, a digit, after a space or the start
+bool has_g_word(const char* p, const char* end) {
+  for (const char* c = p; c < end && *c != ';' && *c != '(' && *c != '"'; ++c) {
+    if (upper(*c) != 'G' || (c > p && !is_space(c[-1]))) continue;
+    const char* d = c + 1;
+    while (d < end && is_space(*d)) ++d;
+    if (d < end && is_digit(*d)) return true;
+  }
+  return false;
+}
+
+// whether the code number at p (after its letter, spaces allowed) is `number`, whole
+bool code_number_is(const char* p, const char* end, int number) {
+  while (p < end && is_space(*p)) ++p;
+  int value = 0;
+  const auto [stop, error] = std::from_chars(p, end, value);
+  return error == std::errc() && stop > p && value == number && (stop == end || *stop != '.');
+}
+
 bool is_text_command(int number) {
   switch (number) {
     case 0:
@@ -225,12 +244,25 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     while (digits < end && is_space(*digits)) ++digits;
     int number = 0;
     const auto [stop, error] = std::from_chars(digits, end, number);
-    if (error == std::errc() && stop > digits && (stop == end || *stop != '.') &&
-        is_text_command(number) &&
-        !(open_code_ && open_code_->letter == 'M' && open_code_->tenths == number * 10) &&
-        !(close_code_ && close_code_->letter == 'M' && close_code_->tenths == number * 10))
+    // the code in tenths (M862.3: 8623), -1 when it is not a number
+    int tenths = -1;
+    if (error == std::errc() && stop > digits) {
+      tenths = number * 10;
+      if (stop + 1 < end && *stop == '.' && is_digit(stop[1])) tenths += stop[1] - '0';
+    }
+    const bool shutter_code =
+        (open_code_ && open_code_->letter == 'M' && open_code_->tenths == tenths) ||
+        (close_code_ && close_code_->letter == 'M' && close_code_->tenths == tenths);
+    if (tenths >= 0 && !shutter_code && tenths % 10 == 0 && is_text_command(number)) return;
+    // any other M code but M82, M83 and the shutter's: the firmware's settings, whose
+    // parameters need not be numbers (M862.3 P "MK3S", M115 U3.13.2); no geometry, unless the
+    // line also holds a G code (checked below, as a whole line)
+    if (tenths >= 0 && !shutter_code && tenths != 820 && tenths != 830 && !has_g_word(q, end))
       return;
   }
+  // G29 (bed levelling, probing) takes flags without numbers (Prusa's G29 A, G29 G): no
+  // geometry here (the next move names its point)
+  if (q < end && upper(*q) == 'G' && code_number_is(q + 1, end, 29)) return;
   if (!split_words(p, end, line_number)) return;
   execute(line_number);
 }
@@ -283,6 +315,17 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
     const char* word_end = p;
     while (word_end < end && !is_space(*word_end) && *word_end != ';' && *word_end != '(')
       ++word_end;
+    // G28's axes may be named without a number (Marlin's G28 X Y, Prusa's G28 W): flags
+    if (digits == 0 && p == number_start &&
+        (p == end || is_space(*p) || *p == ';' || is_letter(*p)) && letter != 'G' &&
+        letter != 'M' && !words_.has(letter) &&
+        std::any_of(words_.codes.begin(), words_.codes.begin() + words_.n_codes,
+                    [](const Code& code) { return code.letter == 'G' && code.tenths == 280; })) {
+      words_.present |= 1u << (letter - 'A');
+      words_.value[letter - 'A'] = 0.0;
+      words_.text[letter - 'A'] = word_start;
+      continue;
+    }
     const bool clean = digits > 0 && (p == end || !(is_digit(*p) || *p == '.'));
     if (!clean ||
         (p < end && !is_space(*p) && !is_letter(*p) && *p != ';' && *p != '(' && *p != '*')) {
@@ -332,7 +375,7 @@ void GcodeParser::execute(int line_number) {
   }
   // G/M codes: check, then modes before motion
   int motion = -1;
-  bool uses_axes = false;  // G92, G28, G10, G4: the axis words belong to the command
+  bool uses_axes = false;  // G92, G28, G10, G4, M codes: the axis words belong to the command
   bool dwell = false, set_position = false, home = false;
   for (int i = 0; i < words_.n_codes; ++i) {
     const Code code = words_.codes[i];
@@ -348,6 +391,9 @@ void GcodeParser::execute(int line_number) {
     }
     if (code.letter == 'M') {
       if (code.tenths == 820 || code.tenths == 830) extruder_relative_ = code.tenths == 830;
+      // an M code's axis words are its parameters (M201 X1000: the x acceleration, M92, M203,
+      // M205, M906, ...), never a modal move
+      uses_axes = true;
       continue;
     }
     switch (code.tenths) {

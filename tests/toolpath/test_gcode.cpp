@@ -97,6 +97,36 @@ TEST(Gcode, SubMicronMoveIsNoSegment) {
     EXPECT_GT((path.points[k + 1] - path.points[k]).norm(), kJoinTolerance_mm);
 }
 
+// M codes take axis letters as parameters (a slicer's start code: M201 accelerations, M203
+// feeds, M205 jerk, M92 steps per mm): never a move, before the first move (which used to be
+// refused as axis words without a motion command) or after one (a modal G1 to X1000)
+TEST(Gcode, McodeAxisWordsAreParametersNotMoves) {
+  const GcodeImport imported = parse(
+      "M201 X1000 Y1000 Z200 E5000\nM203 X200 Y200 Z12 E120\nM205 X8.00 Y8.00 Z0.40 E4.50\n"
+      "G1 X1 E1 F600\nM92 X80 Y80\nG1 Y1 E2\nM906 X800 Y800\nX2 E3\n");
+  ASSERT_EQ(imported.toolpath.paths.size(), 1u);
+  // the modal G1 still holds for a bare axis line after the M codes
+  expect_points(imported.toolpath.paths[0],
+                {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(2, 1, 0)});
+}
+
+// a PrusaSlicer start block: firmware checks whose parameters are text (M862.3 P "MK3S",
+// M115 U3.13.2), homing with axes named by letter alone (G28 W, G28 X Y: to 0 on those axes),
+// Prusa's G29 flags and G80 mesh levelling; none of it moves the print, and a bad G word on
+// an M line is still found
+TEST(Gcode, SlicerStartBlockWithTextParameters) {
+  const GcodeImport imported = parse(
+      "M862.3 P \"MK3S\" ; printer model check\nM862.1 P0.4\nM115 U3.13.2\n"
+      "M204 P1250 R1250 T1250\nG28 W ; home all without mesh bed level\nG80\nG29 A\nG29 G\n"
+      "G1 X5 Y5 F600\nG28 X Y\nG1 X1 E1\nM555 X50 Y50 W100 H100\n");
+  ASSERT_EQ(imported.toolpath.paths.size(), 1u);
+  // homed x and y from (5, 5): the print move starts at the origin
+  expect_points(imported.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(1, 0, 0)});
+  const auto problems = problems_of("M104 S200 G1 X1e308\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_NE(problems[0].message.find("out of range"), std::string::npos);
+}
+
 TEST(Gcode, InchesAndSetPosition) {
   // G20: 1 inch = 25.4 mm; F60 in/min = 25.4 mm/s
   const GcodeImport inches = parse("G20\nG1 X1 Y0 E0.1 F60\n");
