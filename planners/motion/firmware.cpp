@@ -87,12 +87,14 @@ bool s_curve_fits(double va, double vb, double length, double accel, double jerk
 // the highest speed in [low, high] whose ramp to or from `low` fits in `length`
 double s_curve_reach(double low, double high, double length, double accel, double jerk) {
   if (s_curve_fits(low, high, length, accel, jerk)) return high;
+  // bisection on the higher speed; the ramp always starts from `low` itself
+  double reached = low;
   for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (low + high);
-    if (mid <= low || mid >= high) break;
-    (s_curve_fits(low, mid, length, accel, jerk) ? low : high) = mid;
+    const double mid = 0.5 * (reached + high);
+    if (mid <= reached || mid >= high) break;
+    (s_curve_fits(low, mid, length, accel, jerk) ? reached : high) = mid;
   }
-  return low;
+  return reached;
 }
 
 // The passes with Bezier ramps: every junction speed within its cap (rest at both ends) and

@@ -324,6 +324,35 @@ TEST(FirmwareSCurve, RandomToolpathsStayWithinTheJerkLimit) {
   testing_support::expect_finite_difference_limits(plan, limits, 0.01);
 }
 
+// A slicer's perimeter: a 10 mm circle of 0.25 mm chords at 30 mm/s under j_max 30000, where
+// the ramps, not the junctions, bound the speeds. The look-ahead's bisection for the highest
+// speed a ramp reaches once moved the ramp's lower end with it, so the passes lowered speeds
+// that fitted and never settled (an internal error after 10000 sweeps on every such perimeter).
+TEST(FirmwareSCurve, ShortChordPerimeterSettles) {
+  std::vector<Vec3> points;
+  const int chords = 251;  // 2 pi 10 / 0.25
+  for (int i = 0; i <= chords; ++i) {
+    const double angle = 2.0 * kPi * i / chords;
+    points.emplace_back(10.0 * std::cos(angle), 10.0 * std::sin(angle), 0.0);
+  }
+  const Toolpath circle = polyline(points, 30.0);
+  const MachineLimits limits = MachineLimits::uniform(200, 1500, 30000);
+  for (const char* mode : {"marlin", "klipper"}) {
+    SCOPED_TRACE(mode);
+    const Trajectory plan = plan_with({"firmware", {}, 0, {{"mode", mode}}}, circle, limits);
+    testing_support::expect_contract(plan, circle, limits);
+    testing_support::expect_finite_difference_limits(plan, limits, 0.01);
+    // the speed builds up over many chords (the passes settled on speeds above what stopping
+    // at every junction allows), below the print speed, and never faster than without j_max
+    const double mean_speed = 2.0 * kPi * 10.0 / plan.duration_s();
+    EXPECT_GT(mean_speed, 5.0);
+    EXPECT_LT(mean_speed, 30.0);
+    const Trajectory free =
+        plan_with({"firmware", {}, 0, {{"mode", mode}}}, circle, MachineLimits::uniform(200, 1500));
+    EXPECT_GE(plan.duration_s(), free.duration_s() - 1e-9);
+  }
+}
+
 TEST(Firmware, ParametersOfTheOtherFirmwareAreRefused) {
   EXPECT_EQ(check_planner_spec({"firmware", {{"junction_deviation_mm", {0.02}}}, 0}), "");
   EXPECT_NE(check_planner_spec({"firmware", {}, 0, {{"mode", "grbl"}}}).find("marlin | klipper"),
