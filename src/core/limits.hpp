@@ -44,6 +44,10 @@ struct JointLimit {
   bool revolute = false;  // a hinge (rad) rather than a slide (mm)
 };
 
+// How far a prismatic joint may pass its range's end by rounding alone: a path that ends on the
+// travel's end (a purge line to x = 100 on a +-100 mm bed) is sampled a few ulp beyond it.
+constexpr double kTravelRounding_mm = 1e-9;
+
 using JointVector = std::vector<double>;  // mm for prismatic joints, rad for revolute ones
 
 // The machine's joints along a path, for planners that parametrise a path in time under the

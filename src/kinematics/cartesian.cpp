@@ -51,11 +51,13 @@ class Cartesian : public Machine {
     }
     for (int i = 0; i < 3; ++i) {
       const JointLimit& limit = limits_[i];
-      if (joints[i] < limit.min || joints[i] > limit.max) {
+      if (joints[i] < limit.min - kTravelRounding_mm ||
+          joints[i] > limit.max + kTravelRounding_mm) {
         if (why)
           *why = "the cartesian machine's " + limit.name + " axis at " + format_mm(joints[i]) +
                  " mm is outside its travel [" + format_mm(limit.min) + ", " +
-                 format_mm(limit.max) + "] mm";
+                 format_mm(limit.max) + "] mm, by " +
+                 format_mm(std::max(limit.min - joints[i], joints[i] - limit.max)) + " mm";
         return false;
       }
     }

@@ -242,10 +242,14 @@ bool LinearDelta::inverse(const Pose& pose, JointVector& joints, std::string* wh
                   " mm outside the reachable region)");
     }
     const double joint_mm = joint_for_platform_mm(geometry_, arm, platform_mm);
-    if (joint_mm < geometry_.carriage_min_mm || joint_mm > geometry_.carriage_max_mm) {
+    if (joint_mm < geometry_.carriage_min_mm - kTravelRounding_mm ||
+        joint_mm > geometry_.carriage_max_mm + kTravelRounding_mm) {
       return fail(arm_name + " would be at " + format_mm(joint_mm) + " mm, outside its travel [" +
                   format_mm(geometry_.carriage_min_mm) + ", " +
-                  format_mm(geometry_.carriage_max_mm) + "] mm");
+                  format_mm(geometry_.carriage_max_mm) + "] mm, by " +
+                  format_mm(std::max(geometry_.carriage_min_mm - joint_mm,
+                                     joint_mm - geometry_.carriage_max_mm)) +
+                  " mm");
     }
     joints[arm] = joint_mm;
   }

@@ -60,12 +60,14 @@ class XyStage : public Machine {
     static const char* kTcpAxis[2] = {"x", "y"};
     for (int i = 0; i < 2; ++i) {
       const JointLimit& limit = limits_[i];
-      if (joints[i] < limit.min || joints[i] > limit.max) {
+      if (joints[i] < limit.min - kTravelRounding_mm ||
+          joints[i] > limit.max + kTravelRounding_mm) {
         if (why)
           *why = "joint " + limit.name + " at " + format_mm(joints[i]) +
                  " mm is outside its travel [" + format_mm(limit.min) + ", " +
-                 format_mm(limit.max) + "] mm (TCP " + kTcpAxis[i] + " = " + format_mm(tcp_mm[i]) +
-                 " mm)";
+                 format_mm(limit.max) + "] mm, by " +
+                 format_mm(std::max(limit.min - joints[i], joints[i] - limit.max)) + " mm (TCP " +
+                 kTcpAxis[i] + " = " + format_mm(tcp_mm[i]) + " mm)";
         return false;
       }
     }

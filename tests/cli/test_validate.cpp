@@ -34,7 +34,7 @@ toolpath:
       "on x, above limits v_max 4 (lower the speed or raise the limit)\n" +
       "error: " + path +
       ":8: toolpath.polylines[0]: point 3 (70, 4, 0) mm is not reachable by xy_stage: joint x "
-      "at -70 mm is outside its travel [-50, 50] mm (TCP x = 70 mm)\n";
+      "at -70 mm is outside its travel [-50, 50] mm, by 20 mm (TCP x = 70 mm)\n";
   EXPECT_EQ(r.output, expected);
 }
 

@@ -48,10 +48,13 @@ TEST(Cartesian, RejectsPointsOutsideTheTravelNamingTheAxis) {
   JointVector joints;
   std::string why;
   EXPECT_FALSE(machine->inverse(Pose(Vec3(0, 0, 150.5)), joints, &why));
-  EXPECT_EQ(why, "the cartesian machine's z axis at 150.5 mm is outside its travel [-10, 150] mm");
+  EXPECT_EQ(
+      why,
+      "the cartesian machine's z axis at 150.5 mm is outside its travel [-10, 150] mm, by 0.5 mm");
   EXPECT_FALSE(machine->inverse(Pose(Vec3(-100.25, 0, 0)), joints, &why));
   EXPECT_EQ(why,
-            "the cartesian machine's x axis at -100.2 mm is outside its travel [-100, 100] mm");
+            "the cartesian machine's x axis at -100.2 mm is outside its travel [-100, 100] mm, by "
+            "0.25 mm");
 }
 
 TEST(Cartesian, TcpLimitsAreTheTighterOfTheRequestedAndTheJoints) {
