@@ -307,6 +307,10 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
   // the shares' factors per grid point (lowered by repairs) and the TCP limits per axis over
   // the whole path (for the finite-difference check)
   std::vector<double> scale(n, 1.0);
+  // and the ceiling's factors (lowered where a sample's speed passed an axis' v_max: between
+  // grid points the S-curves can rise a little above a ceiling that binds on speed, which
+  // lowered shares do not change)
+  std::vector<double> ceiling_scale(n, 1.0);
   Vec3 j_min = Vec3::Zero();
   for (const MachineLimits& limits : interval_limits)
     for (int k = 0; k < 3; ++k) {
@@ -319,7 +323,8 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
     std::vector<double> x_lim(n);
     for (size_t i = 0; i < n; ++i) {
       const double topp_scale = options.tcp_accel_scale.empty() ? 1.0 : options.tcp_accel_scale[i];
-      x_lim[i] = std::min(out.law.x[i], curvature_x_bound(terms[i], grid, options.accel_scale,
+      x_lim[i] = ceiling_scale[i] *
+                 std::min(out.law.x[i], curvature_x_bound(terms[i], grid, options.accel_scale,
                                                           topp_scale * scale[i]));
     }
     const std::vector<double> share_scale = [&] {
@@ -451,6 +456,7 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
     // the samples' cubic interpolation against the TCP limits: acceleration at both ends of
     // every period, speed at every sample, jerk by 1 ms finite differences
     std::vector<char> bad(periods, 0);
+    std::vector<double> speed_excess(periods, 1.0);  // |v| / v_max where above 1
     size_t hint = 0;
     const double h = period_s;
     for (size_t k = 0; k < periods; ++k) {
@@ -467,11 +473,11 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
             6.0 * (samples.position_mm[k + 1][axis] - samples.position_mm[k][axis]) / (h * h);
         const double v0 = samples.velocity_mm_s[k][axis], v1 = samples.velocity_mm_s[k + 1][axis];
         const double a0 = c - (4.0 * v0 + 2.0 * v1) / h, a1 = -c + (2.0 * v0 + 4.0 * v1) / h;
-        // (relative 1e-9: the law's cruise at a speed limit is exact but for rounding, and
-        // lowered shares could not lower it)
-        if (std::max(std::abs(a0), std::abs(a1)) > a_max * (1 + 1e-9) ||
-            std::max(std::abs(v0), std::abs(v1)) > v_max * (1 + 1e-9))
+        // (relative 1e-9: the law's cruise at a speed limit meets it but for rounding)
+        const double speed_ratio = std::max(std::abs(v0), std::abs(v1)) / v_max;
+        if (std::max(std::abs(a0), std::abs(a1)) > a_max * (1 + 1e-9) || speed_ratio > 1 + 1e-9)
           bad[k] = 1;
+        if (speed_ratio > 1 + 1e-9) speed_excess[k] = std::max(speed_excess[k], speed_ratio);
       }
     }
     std::vector<double> jerk_ratio;
@@ -494,7 +500,13 @@ TimedPath jerk_limited_time_path(const PathGrid& grid,
       const double s_hi = samples.s_mm[std::min(periods, k + 4)];
       const size_t first = interval_holding(grid, s_lo, 0);
       const size_t last = interval_holding(grid, s_hi, first) + 1;
-      for (size_t i = first; i <= last; ++i) lowered[i] = 1;
+      for (size_t i = first; i <= last; ++i) {
+        lowered[i] = 1;
+        // x = sdot^2: the speed's excess squared, and a little more
+        if (speed_excess[k] > 1.0)
+          ceiling_scale[i] =
+              std::min(ceiling_scale[i], (1.0 - 1e-6) / (speed_excess[k] * speed_excess[k]));
+      }
     }
     for (size_t i = 0; i < n; ++i)
       if (lowered[i]) scale[i] *= kJerkRepairScale;

@@ -25,7 +25,9 @@
 // period like TOPP-RA's (a late start from rest), and the samples' cubic interpolation checked
 // against the TCP limits: its acceleration at both ends of every period, and its jerk as the
 // 1 ms finite differences see it (sampled_jerk.hpp); where one is exceeded the shares are
-// lowered by kJerkRepairScale around it and the law planned again (at most kJerkRepairRounds).
+// lowered by kJerkRepairScale around it (and the ceiling by the speed's excess squared where a
+// speed was: between grid points an S-curve can rise a little above a ceiling bound by v_max)
+// and the law planned again (at most kJerkRepairRounds).
 // Joint jerk is not planned: the machines that take a joint j_max (xy_stage, cartesian) have
 // their joints along the TCP axes, whose j_max it becomes; linear_delta and arm6 refuse one.
 #pragma once

@@ -111,6 +111,35 @@ TEST(ConformalJerk, CruiseAtAnAxisSpeedLimitOnAFineGrid) {
   EXPECT_NEAR(peak_x, 200.0, 1e-6);
 }
 
+// Limits that fall along the path (as a delta's TCP limits do towards its rim: v_max from
+// 120 mm/s at x = 0 to 60 at x = 120) under a print speed above them all: the law cruises on a
+// ceiling bound by the speed, and its S-curves between grid points rose up to 1.5e-5 above it.
+// Lowered shares do not lower a speed, so the repairs now lower the ceiling there too (the
+// delta failed with an internal error after 12 rounds on a slicer's file).
+TEST(ConformalJerk, FallingSpeedLimitHoldsBetweenGridPoints) {
+  PrintPath path;
+  path.speed_mm_s = 400.0;
+  for (int i = 0; i <= 48; ++i) path.points.emplace_back(2.5 * i, 0.3 * i, 0.0);
+  const MachineLimits base = MachineLimits::uniform(120.0, 1500.0, 30000.0);
+  const auto falling = [](const Vec3& lo, const Vec3& hi) {
+    const double x = std::max(std::abs(lo.x()), std::abs(hi.x()));
+    return MachineLimits::uniform(120.0 - 0.5 * x, 1500.0, 30000.0);
+  };
+  const TcpLimits limits(base, falling);
+  const Toolpath toolpath = one_path(path);
+  const Trajectory plan = planner_with(ConformalControl::none).plan(toolpath, limits);
+  // every sample within the falling v_max at its own x (1e-9 of rounding)
+  for (const TrajectoryPiece& piece : plan.pieces()) {
+    const SampledMotion& motion = std::get<SampledMotion>(piece.motion);
+    for (size_t k = 0; k < motion.position_mm.size(); ++k) {
+      const double x = motion.position_mm[k].x();
+      const double v_max = 120.0 - 0.5 * std::abs(x);
+      EXPECT_LE(std::abs(motion.velocity_mm_s[k].x()), v_max * (1 + 1e-6)) << "x = " << x;
+    }
+  }
+  testing_support::expect_contract(plan, toolpath, base);
+}
+
 // A path whose tool axis turns over a fillet, planned through a joint map with a slow tilt
 // joint (the tool axis' angle from +z in the xz-plane, as an arm's wrist): under a TCP j_max
 // the joint still binds (the TOPP-RA ceiling carries its limits), the TCP's finite-difference
