@@ -231,6 +231,8 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     }
     return;
   }
+  // grbl's system commands ($H homing, $X unlock, $$ settings): not G-code
+  if (*p == '$') return;
   // Klipper's extended commands (a name, not a letter and a number): not motion
   if (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_')) return;
   // the first code after an optional line number: Marlin's text commands end here

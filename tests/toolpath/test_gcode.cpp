@@ -112,11 +112,11 @@ TEST(Gcode, McodeAxisWordsAreParametersNotMoves) {
 
 // a PrusaSlicer start block: firmware checks whose parameters are text (M862.3 P "MK3S",
 // M115 U3.13.2), homing with axes named by letter alone (G28 W, G28 X Y: to 0 on those axes),
-// Prusa's G29 flags and G80 mesh levelling; none of it moves the print, and a bad G word on
-// an M line is still found
+// Prusa's G29 flags and G80 mesh levelling, grbl's $H and $X; none of it moves the print, and
+// a bad G word on an M line is still found
 TEST(Gcode, SlicerStartBlockWithTextParameters) {
   const GcodeImport imported = parse(
-      "M862.3 P \"MK3S\" ; printer model check\nM862.1 P0.4\nM115 U3.13.2\n"
+      "$H\n$X\nM862.3 P \"MK3S\" ; printer model check\nM862.1 P0.4\nM115 U3.13.2\n"
       "M204 P1250 R1250 T1250\nG28 W ; home all without mesh bed level\nG80\nG29 A\nG29 G\n"
       "G1 X5 Y5 F600\nG28 X Y\nG1 X1 E1\nM555 X50 Y50 W100 H100\n");
   ASSERT_EQ(imported.toolpath.paths.size(), 1u);
