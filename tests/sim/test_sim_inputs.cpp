@@ -156,6 +156,7 @@ TEST(SimInputs, TrajectoryOutsideTheTravelNamesTimeAndJoint) {
     EXPECT_NE(text.find("trajectory"), std::string::npos) << text;
     EXPECT_NE(text.find("joint x"), std::string::npos) << text;
     EXPECT_NE(text.find("at t = "), std::string::npos) << text;
+    EXPECT_NE(text.find(" s (printing path 0): "), std::string::npos) << text;
     // the first sample beyond the travel: TCP x passes 50 mm during the print at 3 mm/s
     const double print_start_x = print.trajectory.at(print.print_begin_s).position_mm.x();
     const double expected_t = print.print_begin_s + (50.0 - print_start_x) / 3.0;
