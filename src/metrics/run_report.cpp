@@ -86,7 +86,8 @@ std::vector<std::string> actuator_limit_warnings(const ActuatorStats& stats) {
       if (q.limit > 0.0 && q.peak > q.limit)
         warnings.push_back("joint " + stats.joint_names[j] + ": peak " + q.what + " " +
                            number(q.peak) + " " + q.unit + " above its limit " + number(q.limit) +
-                           " " + q.unit + " in the simulation");
+                           " " + q.unit + " (+" + number(100.0 * (q.peak / q.limit - 1.0)) +
+                           " %) in the simulation");
   }
   return warnings;
 }

@@ -33,12 +33,19 @@ TEST(ActuatorWarnings, OneLinePerQuantityBeyondItsLimit) {
   stats.peak_force[0] = 50.5;
   const std::vector<std::string> warnings = actuator_limit_warnings(stats);
   ASSERT_EQ(warnings.size(), 3u);
-  EXPECT_EQ(warnings[0], "joint y: peak speed 733 mm/s above its limit 200 mm/s in the simulation");
+  // the excess in per cent too: where the peak rounds to the limit (15.003 against 15) the
+  // figures alone read "15 above 15"
+  EXPECT_EQ(warnings[0],
+            "joint y: peak speed 733 mm/s above its limit 200 mm/s (+266.5 %) in the simulation");
   EXPECT_EQ(warnings[1],
-            "joint y: peak actuator force 50.5 N above its limit 50 N in the simulation");
+            "joint y: peak actuator force 50.5 N above its limit 50 N (+1 %) in the simulation");
   EXPECT_EQ(warnings[2],
-            "joint j5: peak acceleration 1.44e+04 deg/s^2 above its limit 1280 deg/s^2 in the "
-            "simulation");
+            "joint j5: peak acceleration 1.44e+04 deg/s^2 above its limit 1280 deg/s^2 (+1025 %) "
+            "in the simulation");
+  stats = two_joints();
+  stats.peak_vel[0] = 200.03;
+  EXPECT_EQ(actuator_limit_warnings(stats).at(0),
+            "joint y: peak speed 200 mm/s above its limit 200 mm/s (+0.015 %) in the simulation");
 }
 
 }  // namespace
