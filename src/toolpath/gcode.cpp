@@ -86,7 +86,6 @@ struct LineWords {
   double get(char letter) const { return value[letter - 'A']; }
 };
 
-// Marlin's text commands (M117 message, M23 file name, ...): the rest of the line is text
 // whether text (up to a comment) holds a G word: G, spaces, a digit, after a space or the start
 bool has_g_word(const char* p, const char* end) {
   for (const char* c = p; c < end && *c != ';' && *c != '(' && *c != '"'; ++c) {
@@ -106,6 +105,7 @@ bool code_number_is(const char* p, const char* end, int number) {
   return error == std::errc() && stop > p && value == number && (stop == end || *stop != '.');
 }
 
+// Marlin's text commands (M117 message, M23 file name, ...): the rest of the line is text
 bool is_text_command(int number) {
   switch (number) {
     case 0:
