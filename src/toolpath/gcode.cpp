@@ -31,6 +31,9 @@ constexpr std::size_t kMaxListedProblems = 20;
 constexpr double kMinMove_mm = kJoinTolerance_mm;
 // the largest magnitude a number may have (beyond: a typo or garbage)
 constexpr double kMaxMagnitude = 1e9;
+// the largest G or M code number (Marlin's and RepRapFirmware's run to a few thousand); its
+// tenths must fit an int
+constexpr int kMaxCodeNumber = 99999;
 // z levels closer than this are one layer (mm)
 constexpr double kLayerTolerance_mm = 1e-6;
 // an arc's end may miss its centre's radius by this much (absolute mm, relative)
@@ -248,7 +251,7 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     const auto [stop, error] = std::from_chars(digits, end, number);
     // the code in tenths (M862.3: 8623), -1 when it is not a number
     int tenths = -1;
-    if (error == std::errc() && stop > digits) {
+    if (error == std::errc() && stop > digits && number <= kMaxCodeNumber) {
       tenths = number * 10;
       if (stop + 1 < end && *stop == '.' && is_digit(stop[1])) tenths += stop[1] - '0';
     }
@@ -347,6 +350,11 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
     }
     if (letter == 'G' || letter == 'M') {
       const double tenths = value * 10.0;
+      if (value > kMaxCodeNumber) {
+        problem(line_number, "code number out of range in '" + printable(word_start, p) +
+                                 "' (at most " + std::to_string(kMaxCodeNumber) + ")");
+        return false;
+      }
       if (value < 0.0 || std::abs(tenths - std::round(tenths)) > 1e-6 ||
           words_.n_codes == static_cast<int>(words_.codes.size())) {
         problem(line_number, "malformed code '" + printable(word_start, p) + "'");

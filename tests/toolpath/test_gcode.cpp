@@ -127,6 +127,17 @@ TEST(Gcode, SlicerStartBlockWithTextParameters) {
   EXPECT_NE(problems[0].message.find("out of range"), std::string::npos);
 }
 
+// code numbers beyond any firmware's (the fuzzer's M999999999 overflowed the code in tenths)
+// are refused, naming the word; the largest accepted code is still read as an unknown M code
+TEST(Gcode, HugeCodeNumbersAreRefused) {
+  const auto problems = problems_of("M999999999\nG1 X1 E1\nM5 X1 G19999999\nM99999 X1\n");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 1);
+  EXPECT_EQ(problems[0].message, "code number out of range in 'M999999999' (at most 99999)");
+  EXPECT_EQ(problems[1].line, 3);
+  EXPECT_EQ(problems[1].message, "code number out of range in 'G19999999' (at most 99999)");
+}
+
 TEST(Gcode, InchesAndSetPosition) {
   // G20: 1 inch = 25.4 mm; F60 in/min = 25.4 mm/s
   const GcodeImport inches = parse("G20\nG1 X1 Y0 E0.1 F60\n");
