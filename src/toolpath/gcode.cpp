@@ -133,7 +133,9 @@ std::optional<Code> code_of(const std::string& text) {
   if (text.size() < 2 || (upper(text[0]) != 'G' && upper(text[0]) != 'M')) return std::nullopt;
   double number = 0.0;
   const auto [end, error] = std::from_chars(text.data() + 1, text.data() + text.size(), number);
-  if (error != std::errc() || end != text.data() + text.size() || number < 0.0) return std::nullopt;
+  if (error != std::errc() || end != text.data() + text.size() || !(number >= 0.0) ||
+      number > kMaxCodeNumber)
+    return std::nullopt;
   return Code{upper(text[0]), static_cast<int>(std::lround(number * 10.0))};
 }
 

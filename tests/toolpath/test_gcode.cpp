@@ -136,6 +136,20 @@ TEST(Gcode, HugeCodeNumbersAreRefused) {
   EXPECT_EQ(problems[0].message, "code number out of range in 'M999999999' (at most 99999)");
   EXPECT_EQ(problems[1].line, 3);
   EXPECT_EQ(problems[1].message, "code number out of range in 'G19999999' (at most 99999)");
+  // a shutter code beyond that, or not a number, is refused before any line is read
+  for (const std::string code : {"M1e12", "Mnan", "M-3", "M99999.1"}) {
+    GcodeOptions options;
+    options.open_code = code;
+    try {
+      parse_gcode_program("G1 X1\n", "test.gcode", options);
+      ADD_FAILURE() << "expected an InputError for open code " << code;
+    } catch (const InputError& e) {
+      ASSERT_EQ(e.problems().size(), 1u);
+      EXPECT_EQ(e.problems()[0].key, "toolpath.gcode.open");
+      EXPECT_EQ(e.problems()[0].message,
+                "'" + code + "' is not a G or M code (e.g. M3, M5, M106, M107)");
+    }
+  }
 }
 
 TEST(Gcode, InchesAndSetPosition) {
