@@ -251,9 +251,9 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     while (digits < end && is_space(*digits)) ++digits;
     int number = 0;
     const auto [stop, error] = std::from_chars(digits, end, number);
-    // the code in tenths (M862.3: 8623), -1 when it is not a number
+    // the code in tenths (M862.3: 8623); -1 when it is no code number (split_words refuses it)
     int tenths = -1;
-    if (error == std::errc() && stop > digits && number <= kMaxCodeNumber) {
+    if (error == std::errc() && stop > digits && number >= 0 && number <= kMaxCodeNumber) {
       tenths = number * 10;
       if (stop + 1 < end && *stop == '.' && is_digit(stop[1])) tenths += stop[1] - '0';
     }

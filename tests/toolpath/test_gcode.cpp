@@ -130,12 +130,15 @@ TEST(Gcode, SlicerStartBlockWithTextParameters) {
 // code numbers beyond any firmware's (the fuzzer's M999999999 overflowed the code in tenths)
 // are refused, naming the word; the largest accepted code is still read as an unknown M code
 TEST(Gcode, HugeCodeNumbersAreRefused) {
-  const auto problems = problems_of("M999999999\nG1 X1 E1\nM5 X1 G19999999\nM99999 X1\n");
-  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  const auto problems =
+      problems_of("M999999999\nG1 X1 E1\nM5 X1 G19999999\nM99999 X1\nM-999999999\n");
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
   EXPECT_EQ(problems[0].line, 1);
   EXPECT_EQ(problems[0].message, "code number out of range in 'M999999999' (at most 99999)");
   EXPECT_EQ(problems[1].line, 3);
   EXPECT_EQ(problems[1].message, "code number out of range in 'G19999999' (at most 99999)");
+  EXPECT_EQ(problems[2].line, 5);
+  EXPECT_EQ(problems[2].message, "malformed code 'M-999999999'");
   // a shutter code beyond that, or not a number, is refused before any line is read
   for (const std::string code : {"M1e12", "Mnan", "M-3", "M99999.1"}) {
     GcodeOptions options;
