@@ -160,8 +160,22 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   // the progress line names the run (a compare's order and planner: its label)
   ProgressLine progress(scenario.name + "/" + spec.run_label() + ": simulating",
                         ProgressLine::style_for_stderr(settings.progress));
-  run.record =
-      run.simulation->run(trajectory, on_step, [&](double fraction) { progress.update(fraction); });
+  // a plan that leaves the machine's reach or travel is the planner's doing: said at its entry
+  // in the scenario, by name (a compare runs several)
+  try {
+    run.record = run.simulation->run(trajectory, on_step,
+                                     [&](double fraction) { progress.update(fraction); });
+  } catch (const InputError& e) {
+    std::vector<Problem> problems = e.problems();
+    for (Problem& problem : problems) {
+      if (!problem.file.empty() || problem.key != "trajectory") continue;
+      problem.file = scenario.file;
+      problem.line = spec.line > 0 ? spec.line : scenario.line_of("planners");
+      problem.key = "planners";
+      problem.message = "the " + spec.run_label() + " plan " + problem.message;
+    }
+    throw InputError(scenario.located(std::move(problems)));
+  }
   depositing.finish();
   progress.finish();
   run.simulation->set_feedforward_hook({});  // it refers to this function's locals

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "core/error.hpp"
 #include "pipeline/pipeline_test_util.hpp"
 #include "pipeline/quiet_settings.hpp"
 #include "pipeline/run.hpp"
@@ -113,6 +114,41 @@ TEST_F(CartesianPipeline, ScoresEachLayerAndTracksThePath) {
   }
   ASSERT_TRUE(report.path_error.has_value());
   EXPECT_LT(report.path_error->max_mm, report.planned_path_error.max_mm + 0.005);
+}
+
+// a plan that leaves the travel (lspb_mtt's flying transition from an intro line ending at the
+// bed's edge, x = 100, overshoots it by about 0.013 mm) is refused at the planner's entry in
+// the scenario, by name: file, line and key, not a bare "trajectory"
+TEST(CartesianPlanOutsideTravel, IsNamedAtThePlannersEntry) {
+  const std::string dir = fresh_directory("cartesian_plan_outside_travel");
+  const std::string scenario = write_text(dir, "edge.yaml", R"(name: edge
+machine: cartesian
+limits: {v_max: 200, a_max: 1250}
+process: {type: extrusion, bead_width_mm: 0.45, layer_height_mm: 0.2}
+toolpath:
+  speed: 16.6667
+  polylines:
+    - [[60, -3, 0.2], [100, -3, 0.2]]
+    - [[20, 20, 0.2], [40, 20, 0.2]]
+planners: [lspb_mtt]
+)");
+  const PreparedJob job = prepare_job(load_scenario(scenario));
+  try {
+    simulate_job(job, job.scenario.planners.front(), quiet());
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 1u);
+    const Problem& problem = e.problems()[0];
+    EXPECT_EQ(problem.file, scenario);
+    EXPECT_EQ(problem.line, 10);
+    EXPECT_EQ(problem.key, "planners");
+    const std::string& message = problem.message;
+    EXPECT_EQ(message.rfind("the lspb_mtt plan at t = ", 0), 0u) << message;
+    EXPECT_NE(message.find(" s (in a transition the planner added): the cartesian machine's x "
+                           "axis at 100 mm is outside its travel [-100, 100] mm, by 0.01"),
+              std::string::npos)
+        << message;
+  }
 }
 
 }  // namespace
