@@ -215,12 +215,16 @@ std::string output_directory(const Scenario& scenario, const std::string& reques
   return requested.empty() ? (fs::path("results") / scenario.name).string() : requested;
 }
 
+int planner_entry_line(const Scenario& scenario, const PlannerSpec& spec) {
+  return spec.line > 0 ? spec.line : scenario.line_of("planners");
+}
+
 Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec) {
   // a jerk limit in force (the user's, or the joints' mapped) must be honoured
   Vec3 lo, hi;
   job.toolpath.bounds(lo, hi);
   const std::string ignored = check_planner_limits(spec, job.limits.over(lo, hi));
-  const int line = spec.line > 0 ? spec.line : job.scenario.line_of("planners");
+  const int line = planner_entry_line(job.scenario, spec);
   if (!ignored.empty()) throw InputError(job.scenario.file, line, "planners", ignored);
   // exact arcs to a planner that consumes them; chords within the tolerance to the others
   const PlannerInfo* info = find_planner(spec.name);

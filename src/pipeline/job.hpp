@@ -79,6 +79,9 @@ struct PlannedRun {
   MetricsReport report;   // planned metrics only
 };
 PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec);
+// the scenario line of a planner's entry (its own list item, else the `planners` key): where
+// a problem of its plan is reported
+int planner_entry_line(const Scenario& scenario, const PlannerSpec& spec);
 // the planner's trajectory alone (plan_job's first step): InputError for a jerk limit the
 // planner ignores, a toolpath it cannot plan, or a plan too long to sample at all
 Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec);

@@ -170,7 +170,7 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
     for (Problem& problem : problems) {
       if (!problem.file.empty() || problem.key != "trajectory") continue;
       problem.file = scenario.file;
-      problem.line = spec.line > 0 ? spec.line : scenario.line_of("planners");
+      problem.line = planner_entry_line(scenario, spec);
       problem.key = "planners";
       problem.message = "the " + spec.run_label() + " plan " + problem.message;
     }
