@@ -22,6 +22,8 @@ double s_curve_duration(double dv, double a_max, double j_max) {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// velocity brackets resolve to this share of v_max at the finest (AxisProblem::resolution)
+constexpr double kVelocityResolution = 1e-24;
 
 // a double's place in the order of all doubles (-0 and +0 alike), and back: adjacent doubles
 // have adjacent keys
@@ -38,13 +40,15 @@ double from_order_key(int64_t key) {
 }
 
 // The point where a predicate that holds left of it and fails right of it flips, to full
-// double precision (the two adjacent doubles it flips between); returns the side where it
-// holds (so a profile built from it never needs a negative cruise). Bisects the doubles
-// themselves, in their order: at most 64 probes however small the flip point (halving the
-// value takes over a thousand to reach a flip near 0).
+// double precision (the two adjacent doubles it flips between), or to within `resolution`
+// (absolute), whichever is coarser; returns the side where it holds (so a profile built from it
+// never needs a negative cruise). Bisects the doubles themselves, in their order: at most 64
+// probes however small the flip point (halving the value takes over a thousand to reach a flip
+// near 0). The resolution ends a bracket around 0, whose probes would otherwise go down
+// through every binade to the subnormals (each probe there costs a hundred times a normal one).
 template <class Predicate>
-double bisect(double lo, double hi, Predicate holds) {
-  if (!(lo < hi)) return lo;
+double bisect(double lo, double hi, double resolution, Predicate holds) {
+  if (!(lo < hi) || hi - lo <= resolution) return lo;
   int64_t lo_key = order_key(lo), hi_key = order_key(hi);
   // the doubles strictly between hi and lo, plus one (unsigned: no overflow for any bracket)
   const auto gap = [&] { return static_cast<uint64_t>(hi_key) - static_cast<uint64_t>(lo_key); };
@@ -53,20 +57,20 @@ double bisect(double lo, double hi, Predicate holds) {
     if (!holds(from_order_key(lo_key + 1))) return lo;
     if (holds(from_order_key(hi_key - 1))) return from_order_key(hi_key - 1);
   }
-  while (gap() > 1) {
+  while (gap() > 1 && from_order_key(hi_key) - from_order_key(lo_key) > resolution) {
     const int64_t mid_key = lo_key + static_cast<int64_t>(gap() / 2);
     (holds(from_order_key(mid_key)) ? lo_key : hi_key) = mid_key;
   }
   return from_order_key(lo_key);
 }
 
-// The same point as bisect(lo, hi, holds) with holds(x) = residual(x) <= 0 (or < 0 when
+// The same point as bisect(lo, hi, resolution, holds) with holds(x) = residual(x) <= 0 (or < 0 when
 // strict), found in far fewer probes: Illinois steps on the residual (a midpoint where it is
 // not finite or two steps have not halved the bracket) narrow the bracket, each probe decided
 // by the predicate, so it always holds at lo and fails at hi; bisect finishes to adjacent
 // doubles. For a predicate that flips once, the result is bisect's to the last bit.
 template <class Residual>
-double bisect_residual(double lo, double hi, Residual residual, bool strict) {
+double bisect_residual(double lo, double hi, double resolution, Residual residual, bool strict) {
   const auto holds = [strict](double r) { return strict ? r < 0.0 : r <= 0.0; };
   double r_lo = residual(lo), r_hi = residual(hi);
   if (holds(r_lo) && !holds(r_hi)) {
@@ -74,7 +78,7 @@ double bisect_residual(double lo, double hi, Residual residual, bool strict) {
     double width_before = 2.0 * (hi - lo);
     for (int i = 0; i < 16; ++i) {
       const double width = hi - lo;
-      if (!(width > 1e-13 * std::max(std::abs(lo), std::abs(hi)))) break;
+      if (!(width > 1e-13 * std::max(std::abs(lo), std::abs(hi))) || width <= resolution) break;
       double x = 0.5 * (lo + hi);
       if (std::isfinite(r_lo) && std::isfinite(r_hi)) {
         // the interpolated probe, a little away from the ends
@@ -97,7 +101,7 @@ double bisect_residual(double lo, double hi, Residual residual, bool strict) {
       }
     }
   }
-  return bisect(lo, hi, [&](double x) { return holds(residual(x)); });
+  return bisect(lo, hi, resolution, [&](double x) { return holds(residual(x)); });
 }
 
 // A peak (or trough) velocity v_p of the family, held as the two velocity changes into and
@@ -114,6 +118,9 @@ struct AxisProblem {
   double v_max = 0.0, a_max = 0.0, j_max = 0.0;
 
   double knee() const { return a_max * a_max / j_max; }
+  // the velocity brackets' resolution: a velocity this far below v_max changes no profile
+  // measurably (bisect: it ends the brackets around 0)
+  double resolution() const { return kVelocityResolution * v_max; }
   double tau(double dv) const { return s_curve_duration(dv, a_max, j_max); }
   // d tau / d|dv|
   double tau_slope(double dv) const {
@@ -166,7 +173,7 @@ Peak highest_peak(const AxisProblem& pr, double T) {
   if (pr.time(pr.above(0.0)) >= T) return pr.above(0.0);
   const double x_top = pr.v_max - std::max(pr.v0, pr.v1);
   return pr.above(bisect_residual(
-      0.0, x_top, [&](double x) { return pr.time(pr.above(x)) - T; }, false));
+      0.0, x_top, pr.resolution(), [&](double x) { return pr.time(pr.above(x)) - T; }, false));
 }
 Peak lowest_peak(const AxisProblem& pr, double T) {
   return negated(highest_peak(pr.mirrored(), T));
@@ -182,21 +189,23 @@ std::pair<double, double> falls_short(const AxisProblem& pr, double d) {
   auto F = [&](double x) { return pr.travel(pr.above(x)); };
   auto g = [&](double x) { return pr.time(pr.above(x)); };
   // lowest point of F: where its slope crosses zero on v_p in [m, 0], else at m
-  const double x_low =
-      m < 0.0 ? bisect_residual(
-                    0.0, -m, [&](double x) { return pr.travel_slope(pr.above(x)); }, true)
-              : 0.0;
+  const double x_low = m < 0.0 ? bisect_residual(
+                                     0.0, -m, pr.resolution(),
+                                     [&](double x) { return pr.travel_slope(pr.above(x)); }, true)
+                               : 0.0;
   if (F(x_low) >= d) return {kInf, -kInf};
   // falling side: from the first duration, or from where F comes down to d
-  const double lo = F(0.0) < d ? g(0.0)
-                               : g(bisect_residual(
-                                     0.0, x_low, [&](double x) { return d - F(x); }, false));
+  const double lo =
+      F(0.0) < d ? g(0.0)
+                 : g(bisect_residual(
+                       0.0, x_low, pr.resolution(), [&](double x) { return d - F(x); }, false));
   // rising side: where F climbs back to d, or on the cruise at v_max
   const Peak top = pr.at(pr.v_max);
   const double F_top = pr.travel(top);
-  const double hi = F_top >= d ? g(bisect_residual(
-                                     x_low, x_top, [&](double x) { return F(x) - d; }, true))
-                               : pr.time(top) + (d - F_top) / pr.v_max;
+  const double hi =
+      F_top >= d ? g(bisect_residual(
+                       x_low, x_top, pr.resolution(), [&](double x) { return F(x) - d; }, true))
+                 : pr.time(top) + (d - F_top) / pr.v_max;
   return {lo, hi};
 }
 
@@ -343,7 +352,8 @@ AxisProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, doubl
   const double gap = std::abs(b.v1 - b.v0);
   if (gap > 0.0 && pr.time(pr.up_from_low(0.5 * gap)) > T) {
     const double x = bisect_residual(
-        0.0, 0.5 * gap, [&](double y) { return pr.time(pr.up_from_low(y)) - T; }, false);
+        0.0, 0.5 * gap, pr.resolution(), [&](double y) { return pr.time(pr.up_from_low(y)) - T; },
+        false);
     const Peak c1 = pr.up_from_low(x), c2 = pr.down_from_high(x);
     const double d1 = pr.displacement(c1, T), d2 = pr.displacement(c2, T);
     // d in the gap: blend the two members bounding it (both fill T exactly)
@@ -359,7 +369,8 @@ AxisProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, doubl
   const double x_lo = lo.dv0, x_hi = hi.dv0;
   auto member = [&](double dv0) { return Peak{dv0, dv0 + (b.v0 - b.v1)}; };
   const double x = bisect_residual(
-      x_lo, x_hi, [&](double y) { return pr.displacement(member(y), T) - d; }, true);
+      x_lo, x_hi, pr.resolution(), [&](double y) { return pr.displacement(member(y), T) - d; },
+      true);
   return double_s(b, x == x_lo ? lo : member(x), T, pr);
 }
 
