@@ -20,7 +20,7 @@
 // as far as the slowest candidate's speed change and the flow lag's settling after it, the
 // largest blend and the largest trim its loops try, plus 6 sigma) is planned as the planner
 // will plan it (entering and leaving at print speed), its deposit predicted step by step (at
-// most 4 ms and a quarter sigma of travel; the footprint cut at 4 sigma) from the extruder's
+// most 10 ms and a quarter sigma of travel; the footprint cut at 4 sigma) from the extruder's
 // settled state, plus pre- and post-rolls at print speed so the window's ends deposit as a
 // continuing line would (the rolls' deposit is the same for every candidate: predicted once),
 // and compared with the even deposit the process engineer asks for: on every cell within half a
