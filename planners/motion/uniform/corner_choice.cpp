@@ -217,12 +217,19 @@ struct CornerWindow {
   struct TargetCell {
     int ix = 0, iy = 0;
     double missing_mm = 0.0, line_area_mm2 = 0.0;
+    double missing_shared_mm = 0.0;  // less the shared ends' deposit too
   };
   struct CentreSample {
     double x_mm = 0.0, y_mm = 0.0, peak_mm = 0.0, missing_mm = 0.0;
+    double missing_shared_mm = 0.0;
   };
   std::vector<TargetCell> cells;
   std::vector<CentreSample> centre;
+  // the window's shared ends: its first shared_in_mm (from a) and last shared_out_mm (to b),
+  // beyond where any candidate is expected to change anything. Their deposit, at print speed, is
+  // predicted once with the rolls (missing_shared_mm); a candidate found steady on them has
+  // only the rest of its window predicted, any other the whole window
+  double shared_in_mm = 0.0, shared_out_mm = 0.0;
   // the process each candidate's window deposit is predicted with, restarted for each
   Process* scratch = nullptr;
 };
@@ -260,6 +267,17 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
       max_blend_half_length(geometry, (c - a).norm(), (b - c).norm(), kInf);
   w.v_in = window.edge_speed_mm_s[0], w.v_out = window.edge_speed_mm_s[1];
   w.lag_s = options.lag_s;
+  // the shared ends: the window less what the candidates change (its reach without the
+  // kWindowSigmas margin) and the shutter's lead before a change. Aerosol only: an extruder's
+  // flow still settles at the exit, and its command is held over each step, so a window
+  // stepped from another start moves its prediction by a per cent or two (enough to flip a
+  // near tie: thompson_fig7_delta's 117 deg slowed blend took another size)
+  if (model.aerosol()) {
+    const double change_mm = reach - kWindowSigmas * model.settings.footprint_sigma_mm();
+    const double lead_mm = model.shutter_time_s * std::max(w.v_in, w.v_out);
+    w.shared_in_mm = std::max(0.0, (c - a).norm() - change_mm - lead_mm);
+    w.shared_out_mm = std::max(0.0, (b - c).norm() - change_mm - lead_mm);
+  }
   return w;
 }
 
@@ -347,6 +365,64 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     const double peak = areas[edge] * peak_per_area;
     w.centre.push_back({p.x(), p.y(), peak, peak - rolls.thickness_mm_at(p.x(), p.y())});
   }
+
+  // the shared ends, deposited with the rolls (after them in time), and the targets less both
+  std::vector<double> rolls_only(w.cells.size());
+  for (size_t k = 0; k < w.cells.size(); ++k)
+    rolls_only[k] = rolls.cell_thickness_mm(w.cells[k].ix, w.cells[k].iy);
+  std::vector<double> rolls_only_centre(w.centre.size());
+  for (size_t k = 0; k < w.centre.size(); ++k)
+    rolls_only_centre[k] = rolls.thickness_mm_at(w.centre[k].x_mm, w.centre[k].y_mm);
+  const double after_rolls_s = roll_mm / w.v_out;
+  if (w.shared_in_mm > 0.0) steady(a, a + w.shared_in_mm * w.d_in, w.v_in, after_rolls_s);
+  if (w.shared_out_mm > 0.0)
+    steady(b - w.shared_out_mm * w.d_out, b, w.v_out,
+           after_rolls_s + w.shared_in_mm / w.v_in + 1.0);
+  const ThicknessField& with_ends = rolls_process.field();
+  for (size_t k = 0; k < w.cells.size(); ++k) {
+    CornerWindow::TargetCell& cell = w.cells[k];
+    cell.missing_shared_mm =
+        cell.missing_mm + rolls_only[k] - with_ends.cell_thickness_mm(cell.ix, cell.iy);
+  }
+  for (size_t k = 0; k < w.centre.size(); ++k) {
+    CornerWindow::CentreSample& sample = w.centre[k];
+    sample.missing_shared_mm = sample.missing_mm + rolls_only_centre[k] -
+                               with_ends.thickness_mm_at(sample.x_mm, sample.y_mm);
+  }
+}
+
+// Whether a window's plan prints its shared ends as the rolls' prediction of them does: on the
+// incoming line at print speed from a, and (when there is a shared exit) on the outgoing one at
+// print speed up to b, the material fully on, sampled every step_s and at their ends.
+bool steady_on_shared_ends(const CornerWindow& w, const Trajectory& motion,
+                           const std::vector<std::pair<double, double>>& closed,
+                           const DepositModel& model, double step_s) {
+  const double duration = motion.duration_s();
+  TrajectoryCursor cursor(motion);
+  // the plan at time t against the steady line through `from` along d at speed v, there at t0
+  const auto steady_at = [&](double t, const Vec3& from, const Vec3& d, double v, double t0) {
+    const TrajectorySample sample = cursor.at(t);
+    constexpr double kTolerance = 1e-9;
+    return sample.depositing && std::abs(sample.flow_fraction - 1.0) <= kTolerance &&
+           open_fraction(closed, t, model.shutter_time_s) == 1.0 &&
+           (sample.position_mm - (from + (t - t0) * v * d)).norm() <= kTolerance * (1.0 + v) &&
+           (sample.velocity_mm_s - v * d).norm() <= kTolerance * v;
+  };
+  const auto steady_over = [&](double t_first, double t_last, const Vec3& from, const Vec3& d,
+                               double v, double t0) {
+    const int samples = std::max(1, static_cast<int>(std::ceil((t_last - t_first) / step_s)));
+    for (int k = 0; k <= samples; ++k) {
+      const double t = k == samples ? t_last : t_first + k * (t_last - t_first) / samples;
+      if (!steady_at(t, from, d, v, t0)) return false;
+    }
+    return true;
+  };
+  if (w.shared_in_mm > 0.0 && !steady_over(0.0, w.shared_in_mm / w.v_in, w.a, w.d_in, w.v_in, 0.0))
+    return false;
+  if (w.shared_out_mm > 0.0 &&
+      !steady_over(duration - w.shared_out_mm / w.v_out, duration, w.b, w.d_out, w.v_out, duration))
+    return false;
+  return true;
 }
 
 // The predicted error and extra time of one corner plan in its window (see the header). A plan
@@ -377,19 +453,26 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   }
 
   // the deposit of the window's plan, the extruder settled at print speed as the pre-roll
-  // leaves it (the rolls' deposit, shared by every candidate, is taken off the targets)
+  // leaves it (the rolls' deposit, shared by every candidate, is taken off the targets); on
+  // [t_begin, t_end], the window less its shared ends when the plan is steady on them
   Process* process = w.scratch;
   process->restart();
   process->start_steady(steady_step(v_in));
   const double step_s = prediction_step_s(sigma, std::max(v_in, v_out));
   const auto closed = closed_spans(motion);
-  const int steps = std::max(1, static_cast<int>(std::ceil(duration / step_s)));
-  const double dt = duration / steps;
+  const double shared_in_s = w.shared_in_mm / v_in;
+  const double shared_out_s = w.shared_out_mm / v_out;
+  const bool shared = shared_in_s + shared_out_s < duration &&
+                      steady_on_shared_ends(w, motion, closed, model, step_s);
+  const double t_begin = shared ? shared_in_s : 0.0;
+  const double t_end = shared ? duration - shared_out_s : duration;
+  const int steps = std::max(1, static_cast<int>(std::ceil((t_end - t_begin) / step_s)));
+  const double dt = (t_end - t_begin) / steps;
   TrajectoryCursor cursor(motion);
-  TrajectorySample before = cursor.at(0.0);
+  TrajectorySample before = cursor.at(t_begin);
   bool shut_before = false, before_stale = false;
   for (int k = 0; k < steps; ++k) {
-    const double t0 = k * dt, t1 = k + 1 == steps ? duration : (k + 1) * dt;
+    const double t0 = t_begin + k * dt, t1 = k + 1 == steps ? t_end : t_begin + (k + 1) * dt;
     const double open0 = open_fraction(closed, t0, model.shutter_time_s);
     const double open1 = open_fraction(closed, t1, model.shutter_time_s);
     // an aerosol's shut shutter lets nothing through: after the first such step (which ends
@@ -424,9 +507,12 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   CellReader cells(field);
   double error_mm = 0.0;
   for (const CornerWindow::TargetCell& cell : w.cells)
-    error_mm += std::abs(cells.at(cell.ix, cell.iy) - cell.missing_mm) * h * h / cell.line_area_mm2;
+    error_mm +=
+        std::abs(cells.at(cell.ix, cell.iy) - (shared ? cell.missing_shared_mm : cell.missing_mm)) *
+        h * h / cell.line_area_mm2;
   for (const CornerWindow::CentreSample& sample : w.centre)
-    error_mm += std::abs(field.thickness_mm_at(sample.x_mm, sample.y_mm) - sample.missing_mm) /
+    error_mm += std::abs(field.thickness_mm_at(sample.x_mm, sample.y_mm) -
+                         (shared ? sample.missing_shared_mm : sample.missing_mm)) /
                 sample.peak_mm * h;
 
   candidate.error_mm = error_mm;
