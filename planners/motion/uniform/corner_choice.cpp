@@ -437,6 +437,10 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   plans[1] = plan;
   PathMotionOptions window_options = options;
   window_options.enter_at_speed = window_options.leave_at_speed = true;
+  // its blend sampled twice a prediction step at the finest (the samples are interpolated by
+  // their velocities; the chosen plan is sampled at options.period_s)
+  window_options.period_s =
+      std::max(options.period_s, 0.5 * prediction_step_s(sigma, std::max(w.v_in, w.v_out)));
   PlannedPath planned = plan_chain(w.chain, w.geometry, plans, limits, window_options, 0.0);
   const Trajectory motion("uniform", std::move(planned.pieces));
   const double duration = motion.duration_s();
