@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace depotwin {
 
@@ -28,12 +29,26 @@ void hermite_state(const std::vector<Vec3>& positions, const std::vector<Vec3>& 
 
 double sampled_jerk_ratio(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
                           double period_s, const Vec3& j_max_mm_s3, std::vector<double>* per_period,
-                          double fd_period_s) {
+                          double fd_period_s, double position_rounding_mm) {
   const size_t n = positions.size();
   const size_t periods = n > 0 ? n - 1 : 0;
   if (per_period) per_period->assign(periods, 0.0);
   if (n < 2) return 0.0;
   const double duration = periods * period_s, H = fd_period_s;
+  // what rounding alone makes of the differences: kRoundingUlps of the largest coordinate on
+  // each position in a third difference (1 + 3 + 3 + 1 of them, over H^3), and on each of the
+  // two positions an interpolated velocity divides by the sample period (6 / h each) in a
+  // second difference (1 + 2 + 1, over H^2). At j_max 0.01 mm/s^3, 8 mm from the origin, that
+  // read 0.1 % over the limit on a straight S-curve
+  constexpr double kRoundingUlps = 16.0;
+  double largest_coordinate = 0.0;
+  for (const Vec3& q : positions)
+    largest_coordinate = std::max(largest_coordinate, q.cwiseAbs().maxCoeff());
+  const double position_rounding =
+      kRoundingUlps * std::numeric_limits<double>::epsilon() * (1.0 + largest_coordinate) +
+      position_rounding_mm;
+  const double rounding_from_positions = 8.0 * position_rounding / (H * H * H);
+  const double rounding_from_velocities = 4.0 * 12.0 * position_rounding / (period_s * H * H);
   double worst = 0.0;
   std::vector<Vec3> p, v;
   for (int offset = 0; offset < kJerkCheckOffsets; ++offset) {
@@ -48,11 +63,13 @@ double sampled_jerk_ratio(const std::vector<Vec3>& positions, const std::vector<
       double ratio = 0.0;
       for (int axis = 0; axis < 3; ++axis) {
         if (!(j_max_mm_s3[axis] > 0.0)) continue;
-        double jerk = std::abs(v[m + 2][axis] - 2 * v[m + 1][axis] + v[m][axis]) / (H * H);
+        double jerk = std::abs(v[m + 2][axis] - 2 * v[m + 1][axis] + v[m][axis]) / (H * H) -
+                      rounding_from_velocities;
         if (m + 3 < count)
           jerk = std::max(jerk, std::abs(p[m + 3][axis] - 3 * p[m + 2][axis] + 3 * p[m + 1][axis] -
                                          p[m][axis]) /
-                                    (H * H * H));
+                                        (H * H * H) -
+                                    rounding_from_positions);
         ratio = std::max(ratio, jerk / j_max_mm_s3[axis]);
       }
       worst = std::max(worst, ratio);

@@ -17,12 +17,16 @@ namespace depotwin {
 // Hermite interpolation of (positions, velocities) at `period_s`: third differences of the
 // positions over 3 fd periods and second differences of the velocities over 2, sampled from
 // kJerkCheckOffsets start offsets spread over one fd period, windows inside the motion only
-// (it is at rest, or continues smoothly, beyond its ends). per_period (optional, one per sample
-// period): the largest ratio of the windows that touch that period.
+// (it is at rest, or continues smoothly, beyond its ends), less what rounding alone makes of
+// the differences: a few ulps of the largest coordinate on every position, plus
+// position_rounding_mm (a move the caller made to samples, e.g. onto a line's exact end).
+// per_period (optional, one per sample period): the largest ratio of the windows that touch
+// that period.
 constexpr int kJerkCheckOffsets = 8;
 double sampled_jerk_ratio(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
                           double period_s, const Vec3& j_max_mm_s3,
-                          std::vector<double>* per_period = nullptr, double fd_period_s = 0.001);
+                          std::vector<double>* per_period = nullptr, double fd_period_s = 0.001,
+                          double position_rounding_mm = 0.0);
 
 // position and velocity of the cubic Hermite interpolation at time t (clamped to the samples)
 void hermite_state(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,

@@ -555,6 +555,9 @@ class PathSampler {
     print_end = g_.lead ? lead_out_begin_ : positions_.size() - 1;
     print_begin = g_.lead ? lead_in_end_ : 0;
   }
+  // the largest distance a line's last sample was moved to put it exactly on the line's end
+  // (the closed-form profile's own rounding)
+  double largest_end_snap_mm() const { return largest_end_snap_mm_; }
 
  private:
   // pieces: 2k = line k, 2k + 1 = node k + 1
@@ -618,6 +621,8 @@ class PathSampler {
     const int total_steps = jerk_ ? jerk_profile_.total_steps() : profile_.total_steps();
     if (end.exact && step_ == total_steps) {
       // the profile ends exactly at the line's end, on this sample
+      largest_end_snap_mm_ =
+          std::max(largest_end_snap_mm_, (positions_.back() - line.to_mm).cwiseAbs().maxCoeff());
       positions_.back() = line.to_mm;
       velocities_.back() = end.speed_mm_s * line.dir;
       if (g_.lead && k == 0) lead_in_end_ = positions_.size() - 1;
@@ -727,6 +732,7 @@ class PathSampler {
   // blend state
   double blend_u_ = 0.0;
   size_t lead_in_end_ = 0, lead_out_begin_ = 0;
+  double largest_end_snap_mm_ = 0.0;
 };
 
 // How far the interpolated samples go beyond the limits, per blend: cubic Hermite between
@@ -737,12 +743,24 @@ class PathSampler {
 // carry exact quadratics).
 bool check_sampled_limits(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
                           const std::vector<int>& nodes, const PathGeometry& g, double period_s,
-                          const MachineLimits& limits, std::vector<double>& slow_down) {
-  // rounding (a ramp at exactly a_max, the last sample put exactly on the path's end)
+                          const MachineLimits& limits, double end_snap_mm,
+                          std::vector<double>& slow_down) {
+  // rounding (a ramp at exactly a_max): a share of the limit; and the acceleration that a
+  // position's rounding makes over one period, 6 dp / h^2, for a few ulps of the largest
+  // coordinate and the largest move of a line's last sample onto its end (at a_max 0.1 mm/s^2
+  // a 9e-12 mm move alone read 0.03 % over the limit; at 0.01, the ulps 1e-6 of it)
   constexpr double kTolerance = 1e-6;
+  constexpr double kRoundingUlps = 16.0;
   bool owned = true;
   slow_down.assign(g.nodes.size(), 1.0);
   const double h = period_s;
+  double largest_coordinate = 0.0;
+  for (const Vec3& p : positions)
+    largest_coordinate = std::max(largest_coordinate, p.cwiseAbs().maxCoeff());
+  const double position_rounding =
+      kRoundingUlps * std::numeric_limits<double>::epsilon() * (1.0 + largest_coordinate) +
+      end_snap_mm;
+  const double a_rounding = 6.0 * position_rounding / (h * h);
   const bool jerk_limited = !g.lines.empty() && g.lines.front().jerk_mm_s3 > 0.0;
   // the blend interval k belongs to (either end on it, or the joint between two lines)
   const auto owner = [&](size_t k) {
@@ -763,7 +781,8 @@ bool check_sampled_limits(const std::vector<Vec3>& positions, const std::vector<
         const double s = a0 / (a0 - a1);
         v_peak = std::max(v_peak, std::abs(v0 + h * (a0 * s + 0.5 * (a1 - a0) * s * s)));
       }
-      const double a_ratio = std::max(std::abs(a0), std::abs(a1)) / limits.axes[axis].a_max_mm_s2;
+      const double a_ratio = std::max(0.0, std::max(std::abs(a0), std::abs(a1)) - a_rounding) /
+                             limits.axes[axis].a_max_mm_s2;
       const double v_ratio = v_peak / limits.axes[axis].v_max_mm_s;
       if (a_ratio > 1.0 + kTolerance) factor = std::min(factor, std::sqrt(1.0 / a_ratio));
       if (v_ratio > 1.0 + kTolerance) factor = std::min(factor, 1.0 / v_ratio);
@@ -783,7 +802,8 @@ bool check_sampled_limits(const std::vector<Vec3>& positions, const std::vector<
   const Vec3 j_max(limits.axes[0].j_max_mm_s3, limits.axes[1].j_max_mm_s3,
                    limits.axes[2].j_max_mm_s3);
   std::vector<double> ratio;
-  if (sampled_jerk_ratio(positions, velocities, h, j_max, &ratio) <= 1.0 + kJerkTolerance)
+  if (sampled_jerk_ratio(positions, velocities, h, j_max, &ratio, 0.001, end_snap_mm) <=
+      1.0 + kJerkTolerance)
     return owned;
   for (size_t k = 0; k < ratio.size(); ++k) {
     if (ratio[k] <= 1.0 + kJerkTolerance) continue;
@@ -967,8 +987,9 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
       owners.clear();
       PathSampler sampler(geometry, settings_.period_s, positions, velocities, owners);
       sampler.run(print_begin, print_end);
-      const bool owned = check_sampled_limits(positions, velocities, owners, geometry,
-                                              settings_.period_s, limits, slow_down);
+      const bool owned =
+          check_sampled_limits(positions, velocities, owners, geometry, settings_.period_s, limits,
+                               sampler.largest_end_snap_mm(), slow_down);
       const bool within =
           std::all_of(slow_down.begin(), slow_down.end(), [](double f) { return f >= 1.0; });
       if (owned && within) break;

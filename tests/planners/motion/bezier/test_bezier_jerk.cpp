@@ -123,5 +123,51 @@ TEST(BezierJerk, RandomToolpathsStayWithinTheJerkLimit) {
   std::printf("bezier: largest finite-difference jerk / j_max on random toolpaths: %.4f\n", worst);
 }
 
+// A very slow machine (acceleration and jerk limits far below any real one) plans too: the
+// planner's own check of its samples once read rounding as a limit exceeded (at a_max 0.1
+// mm/s^2 the 9e-12 mm that puts a line's last sample exactly on its end, at 0.01 every ramp; at
+// j_max 0.01 and 1e-4 mm/s^3 the S-curves) and stopped with an internal error. Within the
+// limits, up to what 1e-11 mm of position rounding per 1 ms sample reads as by finite
+// differences (6e-5 mm/s^2, 0.08 mm/s^3: nothing on a real machine, but many times such a
+// j_max). Thompson & Yoon's Fig. 7 connected segments.
+// the length travelled with material on, sampled every 1 ms
+double printed_length(const Trajectory& plan) {
+  double length = 0.0;
+  TrajectorySample before = plan.at(0.0);
+  for (double t = 0.001; t <= plan.duration_s(); t += 0.001) {
+    const TrajectorySample after = plan.at(t);
+    if (before.depositing && after.depositing)
+      length += (after.position_mm - before.position_mm).norm();
+    before = after;
+  }
+  return length;
+}
+
+TEST(BezierJerk, VerySlowMachinesPlanWithinTheirLimits) {
+  const Toolpath toolpath =
+      single_path({Vec3(0, 0, 0), Vec3(5, 0, 0), Vec3(8, 6, 0), Vec3(2, 4, 0)}, 3.0);
+  constexpr double kRoundingMm = 1e-11, h = 0.001;
+  for (const MachineLimits& limits :
+       {MachineLimits::uniform(4.0, 0.1), MachineLimits::uniform(4.0, 0.01),
+        MachineLimits::uniform(4.0, 30.0, 1e-2), MachineLimits::uniform(4.0, 30.0, 1e-4),
+        MachineLimits::uniform(4.0, 0.01, 1e-3)}) {
+    const double a_max = limits.axes[0].a_max_mm_s2, j_max = limits.axes[0].j_max_mm_s3;
+    SCOPED_TRACE(testing::Message() << "a_max " << a_max << ", j_max " << j_max);
+    Trajectory plan("bezier", {});
+    ASSERT_NO_THROW(plan = planner_with(0.5).plan(toolpath, limits));
+    // at rest at both ends, the whole path printed
+    const TrajectorySample first = plan.at(0.0), last = plan.at(plan.duration_s());
+    EXPECT_LT((first.position_mm - toolpath.start_mm).norm(), 1e-9);
+    EXPECT_LT((last.position_mm - toolpath.end_mm).norm(), 1e-9);
+    EXPECT_LT(first.velocity_mm_s.norm() + last.velocity_mm_s.norm(), 1e-9);
+    EXPECT_NEAR(printed_length(plan), toolpath.paths[0].length_mm(), 0.5);
+    const auto peaks = testing_support::finite_difference_peaks(plan, limits, h);
+    EXPECT_LE(peaks.max_speed_ratio(), 1 + 1e-6);
+    EXPECT_LE(peaks.max_accel_ratio() * a_max, a_max * (1 + 1e-6) + 6.0 * kRoundingMm / (h * h));
+    if (j_max > 0.0)
+      EXPECT_LE(peaks.max_jerk_ratio() * j_max, j_max * 1.01 + 8.0 * kRoundingMm / (h * h * h));
+  }
+}
+
 }  // namespace
 }  // namespace depotwin
