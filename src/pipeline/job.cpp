@@ -16,6 +16,7 @@
 #include "report/output_dir.hpp"
 #include "report/summary_table.hpp"
 #include "report/trajectory_csv.hpp"
+#include "sim/joint_reference.hpp"
 #include "sim/part_model.hpp"
 
 namespace depotwin {
@@ -217,6 +218,28 @@ std::string output_directory(const Scenario& scenario, const std::string& reques
 
 int planner_entry_line(const Scenario& scenario, const PlannerSpec& spec) {
   return spec.line > 0 ? spec.line : scenario.line_of("planners");
+}
+
+void locate_plan_problems(const Scenario& scenario, const PlannerSpec& spec,
+                          std::vector<Problem>& problems) {
+  for (Problem& problem : problems) {
+    if (!problem.file.empty() || problem.key != "trajectory") continue;
+    problem.file = scenario.file;
+    problem.line = planner_entry_line(scenario, spec);
+    problem.key = "planners";
+    problem.message = "the " + spec.run_label() + " plan " + problem.message;
+  }
+}
+
+void check_plan_poses(const PreparedJob& job, const PlannerSpec& spec,
+                      const Trajectory& trajectory) {
+  try {
+    check_trajectory_poses(*job.machine, trajectory, job.scenario.sim.timestep_s);
+  } catch (const InputError& e) {
+    std::vector<Problem> problems = e.problems();
+    locate_plan_problems(job.scenario, spec, problems);
+    throw InputError(job.scenario.located(std::move(problems)));
+  }
 }
 
 Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec) {

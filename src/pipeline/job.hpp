@@ -82,6 +82,15 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec);
 // the scenario line of a planner's entry (its own list item, else the `planners` key): where
 // a problem of its plan is reported
 int planner_entry_line(const Scenario& scenario, const PlannerSpec& spec);
+// The plan's poses, as the simulation will solve them (check_trajectory_poses at the
+// scenario's sim.timestep_s): a pose out of reach or a joint outside its travel is an
+// InputError at the planner's entry, key `planners`: "the <run label> plan at t = ...: ..."
+void check_plan_poses(const PreparedJob& job, const PlannerSpec& spec,
+                      const Trajectory& trajectory);
+// problems of a plan found as it is solved (key "trajectory", no file) moved to the planner's
+// entry as check_plan_poses words them; the others as they are
+void locate_plan_problems(const Scenario& scenario, const PlannerSpec& spec,
+                          std::vector<Problem>& problems);
 // the planner's trajectory alone (plan_job's first step): InputError for a jerk limit the
 // planner ignores, a toolpath it cannot plan, or a plan too long to sample at all
 Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec);

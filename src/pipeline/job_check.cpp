@@ -351,8 +351,14 @@ std::vector<RunEstimate> check_runs(const PreparedJob& job,
   for (const PlannerSpec& spec : planners) {
     // planned, measured and dropped: the plan itself is small, a verb plans it again
     try {
-      const double duration_s = plan_trajectory(job, spec).duration_s();
-      runs.push_back(estimate_planned(job, spec.run_label(), duration_s, simulate));
+      const Trajectory plan = plan_trajectory(job, spec);
+      const RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
+      // a run simulates it: its every pose solved now, as the simulation will (a planner's
+      // move may leave the travel or the reach between the toolpath's points); a run too long
+      // for sim.max_steps is refused for that instead (size_problems), before any such work
+      if (simulate && run.steps <= static_cast<double>(job.scenario.sim.max_steps))
+        check_plan_poses(job, spec, plan);
+      runs.push_back(run);
     } catch (const InputError& e) {
       const std::vector<Problem> found = job.scenario.located(e.problems());
       problems.insert(problems.end(), found.begin(), found.end());

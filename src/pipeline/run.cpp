@@ -167,13 +167,7 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
                                      [&](double fraction) { progress.update(fraction); });
   } catch (const InputError& e) {
     std::vector<Problem> problems = e.problems();
-    for (Problem& problem : problems) {
-      if (!problem.file.empty() || problem.key != "trajectory") continue;
-      problem.file = scenario.file;
-      problem.line = planner_entry_line(scenario, spec);
-      problem.key = "planners";
-      problem.message = "the " + spec.run_label() + " plan " + problem.message;
-    }
+    locate_plan_problems(scenario, spec, problems);
     throw InputError(scenario.located(std::move(problems)));
   }
   depositing.finish();

@@ -65,6 +65,23 @@ void joints_at(const Machine& machine, const TrajectorySample& sample, const Joi
 
 }  // namespace
 
+void check_trajectory_poses(const Machine& machine, const Trajectory& trajectory,
+                            double timestep_s) {
+  if (!(timestep_s > 0.0)) throw InternalError("check_trajectory_poses: timestep_s must be > 0");
+  const double duration_s = trajectory.duration_s();
+  // the steps up to the first past the end (after it the final pose only repeats)
+  const long steps = static_cast<long>(std::ceil(duration_s / timestep_s - 1e-9)) + 1;
+  JointVector joints, next_joints;
+  TrajectoryCursor plan(trajectory);
+  for (long k = 0; k <= steps; ++k) {
+    if (k % 1024 == 0) throw_if_interrupted();
+    const TrajectorySample sample =
+        planned_sample(plan, static_cast<double>(k) * timestep_s, duration_s);
+    joints_at(machine, sample, k == 0 ? nullptr : &joints, next_joints);
+    joints.swap(next_joints);
+  }
+}
+
 JointReferences plan_joint_references(const BoundModel& bound, const Trajectory& trajectory,
                                       long steps, RecordedRun& run) {
   const Machine& machine = *bound.machine;

@@ -33,4 +33,12 @@ struct JointReferences {
 JointReferences plan_joint_references(const BoundModel& bound, const Trajectory& trajectory,
                                       long steps, RecordedRun& run);
 
+// The same check of the whole trajectory without a model: every step's pose (a step of
+// timestep_s, the final pose after the end) through the machine's inverse kinematics, each
+// solution seeded by the previous one as the simulation seeds it, and every joint within its
+// travel; InputError("trajectory") naming the time, word for word what the simulation would
+// say. What validate, run and compare check of each plan before anything is simulated.
+void check_trajectory_poses(const Machine& machine, const Trajectory& trajectory,
+                            double timestep_s);
+
 }  // namespace depotwin

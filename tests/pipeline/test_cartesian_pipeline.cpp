@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "pipeline/job_check.hpp"
 #include "pipeline/pipeline_test_util.hpp"
 #include "pipeline/quiet_settings.hpp"
 #include "pipeline/run.hpp"
@@ -132,11 +133,7 @@ toolpath:
     - [[20, 20, 0.2], [40, 20, 0.2]]
 planners: [lspb_mtt]
 )");
-  const PreparedJob job = prepare_job(load_scenario(scenario));
-  try {
-    simulate_job(job, job.scenario.planners.front(), quiet());
-    FAIL() << "expected an InputError";
-  } catch (const InputError& e) {
+  const auto expect_named = [&](const InputError& e) {
     ASSERT_EQ(e.problems().size(), 1u);
     const Problem& problem = e.problems()[0];
     EXPECT_EQ(problem.file, scenario);
@@ -148,7 +145,26 @@ planners: [lspb_mtt]
                            "axis at 100 mm is outside its travel [-100, 100] mm, by 0.01"),
               std::string::npos)
         << message;
+  };
+  // as the simulation solves the plan's poses
+  const Scenario loaded = load_scenario(scenario);
+  const PreparedJob job = prepare_job(loaded);
+  try {
+    simulate_job(job, job.scenario.planners.front(), quiet());
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    expect_named(e);
   }
+  // and the same, word for word, by the checks validate, run and compare make before any
+  // simulation (validate used to pass the file)
+  try {
+    prepare_checked_job(loaded, loaded.planners, JobBudget{}, true, false);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    expect_named(e);
+  }
+  // a plan alone (`depotwin plan`) is not simulated: not refused
+  EXPECT_NO_THROW(prepare_checked_job(loaded, loaded.planners, JobBudget{}, false, false));
 }
 
 }  // namespace
