@@ -6,6 +6,14 @@
 
 namespace depotwin {
 
+double sample_position_rounding_mm(const std::vector<Vec3>& positions, double extra_mm) {
+  double largest_coordinate = 0.0;
+  for (const Vec3& p : positions)
+    largest_coordinate = std::max(largest_coordinate, p.cwiseAbs().maxCoeff());
+  return kSampleRoundingUlps * std::numeric_limits<double>::epsilon() * (1.0 + largest_coordinate) +
+         extra_mm;
+}
+
 void hermite_state(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
                    double period_s, double t, Vec3& position, Vec3& velocity) {
   const size_t n = positions.size();
@@ -35,18 +43,12 @@ double sampled_jerk_ratio(const std::vector<Vec3>& positions, const std::vector<
   if (per_period) per_period->assign(periods, 0.0);
   if (n < 2) return 0.0;
   const double duration = periods * period_s, H = fd_period_s;
-  // what rounding alone makes of the differences: kRoundingUlps of the largest coordinate on
-  // each position in a third difference (1 + 3 + 3 + 1 of them, over H^3), and on each of the
-  // two positions an interpolated velocity divides by the sample period (6 / h each) in a
-  // second difference (1 + 2 + 1, over H^2). At j_max 0.01 mm/s^3, 8 mm from the origin, that
-  // read 0.1 % over the limit on a straight S-curve
-  constexpr double kRoundingUlps = 16.0;
-  double largest_coordinate = 0.0;
-  for (const Vec3& q : positions)
-    largest_coordinate = std::max(largest_coordinate, q.cwiseAbs().maxCoeff());
-  const double position_rounding =
-      kRoundingUlps * std::numeric_limits<double>::epsilon() * (1.0 + largest_coordinate) +
-      position_rounding_mm;
+  // what rounding alone makes of the differences: the positions' rounding on each position in
+  // a third difference (1 + 3 + 3 + 1 of them, over H^3), and on each of the two positions an
+  // interpolated velocity divides by the sample period (6 / h each) in a second difference
+  // (1 + 2 + 1, over H^2). At j_max 0.01 mm/s^3, 8 mm from the origin, that read 0.1 % over the
+  // limit on a straight S-curve
+  const double position_rounding = sample_position_rounding_mm(positions, position_rounding_mm);
   const double rounding_from_positions = 8.0 * position_rounding / (H * H * H);
   const double rounding_from_velocities = 4.0 * 12.0 * position_rounding / (period_s * H * H);
   double worst = 0.0;

@@ -28,6 +28,11 @@ double sampled_jerk_ratio(const std::vector<Vec3>& positions, const std::vector<
                           std::vector<double>* per_period = nullptr, double fd_period_s = 0.001,
                           double position_rounding_mm = 0.0);
 
+// How far rounding may have moved any of these positions: kSampleRoundingUlps of the largest
+// coordinate, plus extra_mm (a move the caller made, e.g. a sample put onto a line's exact end)
+constexpr double kSampleRoundingUlps = 16.0;
+double sample_position_rounding_mm(const std::vector<Vec3>& positions, double extra_mm = 0.0);
+
 // position and velocity of the cubic Hermite interpolation at time t (clamped to the samples)
 void hermite_state(const std::vector<Vec3>& positions, const std::vector<Vec3>& velocities,
                    double period_s, double t, Vec3& position, Vec3& velocity);

@@ -750,17 +750,10 @@ bool check_sampled_limits(const std::vector<Vec3>& positions, const std::vector<
   // coordinate and the largest move of a line's last sample onto its end (at a_max 0.1 mm/s^2
   // a 9e-12 mm move alone read 0.03 % over the limit; at 0.01, the ulps 1e-6 of it)
   constexpr double kTolerance = 1e-6;
-  constexpr double kRoundingUlps = 16.0;
   bool owned = true;
   slow_down.assign(g.nodes.size(), 1.0);
   const double h = period_s;
-  double largest_coordinate = 0.0;
-  for (const Vec3& p : positions)
-    largest_coordinate = std::max(largest_coordinate, p.cwiseAbs().maxCoeff());
-  const double position_rounding =
-      kRoundingUlps * std::numeric_limits<double>::epsilon() * (1.0 + largest_coordinate) +
-      end_snap_mm;
-  const double a_rounding = 6.0 * position_rounding / (h * h);
+  const double a_rounding = 6.0 * sample_position_rounding_mm(positions, end_snap_mm) / (h * h);
   const bool jerk_limited = !g.lines.empty() && g.lines.front().jerk_mm_s3 > 0.0;
   // the blend interval k belongs to (either end on it, or the joint between two lines)
   const auto owner = [&](size_t k) {
