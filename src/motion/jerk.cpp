@@ -45,7 +45,7 @@ double from_order_key(int64_t key) {
 // never needs a negative cruise). Bisects the doubles themselves, in their order: at most 64
 // probes however small the flip point (halving the value takes over a thousand to reach a flip
 // near 0). The resolution ends a bracket around 0, whose probes would otherwise go down
-// through every binade to the subnormals (each probe there costs a hundred times a normal one).
+// through every binade to the subnormals (whose arithmetic is many times slower).
 template <class Predicate>
 double bisect(double lo, double hi, double resolution, Predicate holds) {
   if (!(lo < hi) || hi - lo <= resolution) return lo;
