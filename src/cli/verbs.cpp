@@ -62,13 +62,14 @@ int plan_verb(const RunOptions& options) {
 }
 
 int validate_verb(const std::string& path, const std::string& max_memory) {
-  // every check `run` makes before it simulates, made the same way (pipeline/job_check.hpp);
-  // no lower bound of the print order (a report shows it, validate does not)
+  // every check `run` makes before it simulates, made the same way (pipeline/job_check.hpp),
+  // and the plans' poses, which `run` checks as it simulates; no lower bound of the print order
+  // (a report shows it, validate does not)
   const JobBudget budget = job_budget(max_memory);
   const Scenario scenario = check_scenario(path, budget);
   std::vector<RunEstimate> runs;
   const PreparedJob job =
-      prepare_checked_job(scenario, scenario.planners, budget, true, false, &runs);
+      prepare_checked_job(scenario, scenario.planners, budget, true, false, &runs, true);
   // what `run` would take: the longest run, and the memory of all of them
   const auto longest = std::max_element(
       runs.begin(), runs.end(),

@@ -346,17 +346,17 @@ Scenario check_scenario(const std::string& path, const JobBudget& budget, std::s
 
 std::vector<RunEstimate> check_runs(const PreparedJob& job,
                                     const std::vector<PlannerSpec>& planners, bool simulate,
-                                    std::vector<Problem>& problems) {
+                                    std::vector<Problem>& problems, bool solve_poses) {
   std::vector<RunEstimate> runs;
   for (const PlannerSpec& spec : planners) {
     // planned, measured and dropped: the plan itself is small, a verb plans it again
     try {
       const Trajectory plan = plan_trajectory(job, spec);
       const RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
-      // a run simulates it: its every pose solved now, as the simulation will (a planner's
-      // move may leave the travel or the reach between the toolpath's points); a run too long
-      // for sim.max_steps is refused for that instead (size_problems), before any such work
-      if (simulate && run.steps <= static_cast<double>(job.scenario.sim.max_steps))
+      // validate: its every pose solved now, as the simulation will (a planner's move may
+      // leave the travel or the reach between the toolpath's points); a run too long for
+      // sim.max_steps is refused for that instead (size_problems), before any such work
+      if (solve_poses && simulate && run.steps <= static_cast<double>(job.scenario.sim.max_steps))
         check_plan_poses(job, spec, plan);
       runs.push_back(run);
     } catch (const InputError& e) {
@@ -369,7 +369,7 @@ std::vector<RunEstimate> check_runs(const PreparedJob& job,
 
 PreparedJob prepare_checked_job(const Scenario& scenario, const std::vector<PlannerSpec>& planners,
                                 const JobBudget& budget, bool simulate, bool with_lower_bound,
-                                std::vector<RunEstimate>* estimates) {
+                                std::vector<RunEstimate>* estimates, bool solve_poses) {
   PrepareOptions options;
   options.lower_bound = with_lower_bound;
   PreparedJob job = [&] {
@@ -380,7 +380,7 @@ PreparedJob prepare_checked_job(const Scenario& scenario, const std::vector<Plan
     }
   }();
   std::vector<Problem> problems;
-  const std::vector<RunEstimate> runs = check_runs(job, planners, simulate, problems);
+  const std::vector<RunEstimate> runs = check_runs(job, planners, simulate, problems, solve_poses);
   if (problems.empty()) {
     const std::vector<Problem> size = size_problems(scenario, runs, budget);
     problems.insert(problems.end(), size.begin(), size.end());

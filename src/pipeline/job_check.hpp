@@ -66,16 +66,21 @@ Scenario check_scenario(const std::string& path, const JobBudget& budget, std::s
                         bool simulate = true);
 
 // Stage 2 (above): each planner's plan on the prepared job, measured; problems (a plan the
-// planner refuses, a run too large) appended to `problems`, the estimates returned
+// planner refuses, a run too large) appended to `problems`, the estimates returned. With
+// solve_poses (validate), each run's plan is also solved pose by pose as the simulation will
+// solve it (check_plan_poses: a plan leaving the travel or the reach); run and compare leave
+// that to the simulation itself, which says the same word for word (on an arm the inverse
+// kinematics of every step is most of a run's cost, and would be paid twice)
 std::vector<RunEstimate> check_runs(const PreparedJob& job,
                                     const std::vector<PlannerSpec>& planners, bool simulate,
-                                    std::vector<Problem>& problems);
+                                    std::vector<Problem>& problems, bool solve_poses = false);
 
 // What a verb does before its work: stage 2 on the job prepared for it (the lower bound of
 // the print order computed only when `with_lower_bound`: a report shows it, validate does
 // not), every problem thrown together. The estimates of the runs go to `estimates`.
 PreparedJob prepare_checked_job(const Scenario& scenario, const std::vector<PlannerSpec>& planners,
                                 const JobBudget& budget, bool simulate, bool with_lower_bound,
-                                std::vector<RunEstimate>* estimates = nullptr);
+                                std::vector<RunEstimate>* estimates = nullptr,
+                                bool solve_poses = false);
 
 }  // namespace depotwin

@@ -229,6 +229,12 @@ std::vector<Row> rows() {
                        probe_with("limits:", "limits: {v_max: 4, a_max: 1e-3}"),
                        "{s}:3: limits\\.a_max: run lspb_mtt would take 2\\.95e\\+07 physics "
                        "steps, more than sim\\.max_steps = 1e\\+07"));
+  // a plan leaving the travel between the toolpath's points (lspb_mtt's transitions fly past
+  // the stage's edge at this acceleration): validate solves the plan's poses as run does
+  r.push_back(scenario("PlanLeavesTheTravel",
+                       probe_with("limits:", "limits: {v_max: 4, a_max: 0.05}"),
+                       "{s}:11: planners: the lspb_mtt plan at t = [0-9.]+ s \\(in a transition "
+                       "the planner added\\): joint x at 50 mm is outside its travel"));
   r.push_back(scenario("SlowPrintTooManySteps", probe_with("  speed:", "  speed: 1e-5"),
                        "{s}:6: toolpath\\.speed: the job would take .* physics steps, more than "
                        "sim\\.max_steps"));

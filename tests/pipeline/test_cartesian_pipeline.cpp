@@ -155,15 +155,17 @@ planners: [lspb_mtt]
   } catch (const InputError& e) {
     expect_named(e);
   }
-  // and the same, word for word, by the checks validate, run and compare make before any
-  // simulation (validate used to pass the file)
+  // and the same, word for word, by validate's checks, which solve the plans' poses (validate
+  // used to pass the file)
   try {
-    prepare_checked_job(loaded, loaded.planners, JobBudget{}, true, false);
+    prepare_checked_job(loaded, loaded.planners, JobBudget{}, true, false, nullptr, true);
     FAIL() << "expected an InputError";
   } catch (const InputError& e) {
     expect_named(e);
   }
-  // a plan alone (`depotwin plan`) is not simulated: not refused
+  // run's checks leave the poses to the simulation (above); a plan alone (`depotwin plan`) is
+  // not simulated: neither refuses it before
+  EXPECT_NO_THROW(prepare_checked_job(loaded, loaded.planners, JobBudget{}, true, false));
   EXPECT_NO_THROW(prepare_checked_job(loaded, loaded.planners, JobBudget{}, false, false));
 }
 
