@@ -37,7 +37,8 @@ JointReferences plan_joint_references(const BoundModel& bound, const Trajectory&
 // timestep_s, the final pose after the end) through the machine's inverse kinematics, each
 // solution seeded by the previous one as the simulation seeds it, and every joint within its
 // travel; InputError("trajectory") naming the time, word for word what the simulation would
-// say. What validate, run and compare check of each plan before anything is simulated.
+// say. What validate checks of each plan before anything is simulated (run and compare leave
+// it to plan_joint_references).
 void check_trajectory_poses(const Machine& machine, const Trajectory& trajectory,
                             double timestep_s);
 
