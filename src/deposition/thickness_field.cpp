@@ -29,20 +29,8 @@ double ThicknessField::cell_thickness_mm(int ix, int iy) const {
 }
 
 double ThicknessField::thickness_mm_at(double x_mm, double y_mm) const {
-  // the four cell centres around the point and the point's fractional position
-  const double fx = x_mm / cell_mm_;
-  const double fy = y_mm / cell_mm_;
-  const double ix0_real = std::floor(fx);
-  const double iy0_real = std::floor(fy);
-  const int ix0 = static_cast<int>(ix0_real);
-  const int iy0 = static_cast<int>(iy0_real);
-  const double wx = fx - ix0_real;
-  const double wy = fy - iy0_real;
-  const double v00 = cell_thickness_mm(ix0, iy0);
-  const double v10 = cell_thickness_mm(ix0 + 1, iy0);
-  const double v01 = cell_thickness_mm(ix0, iy0 + 1);
-  const double v11 = cell_thickness_mm(ix0 + 1, iy0 + 1);
-  return (1.0 - wy) * ((1.0 - wx) * v00 + wx * v10) + wy * ((1.0 - wx) * v01 + wx * v11);
+  return bilinear_between_cells(x_mm, y_mm, cell_mm_,
+                                [this](int ix, int iy) { return cell_thickness_mm(ix, iy); });
 }
 
 double ThicknessField::total_volume_mm3() const {

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <functional>
 
@@ -26,6 +27,26 @@ struct FieldBounds {
   double x_hi_mm = 0.0;
   double y_hi_mm = 0.0;
 };
+
+// Bilinear interpolation between cell centres (lattice of ThicknessField) of the values
+// cell(ix, iy): thickness_mm_at's rule, for readers that look their cells up their own way.
+template <class CellFn>
+double bilinear_between_cells(double x_mm, double y_mm, double cell_mm, CellFn&& cell) {
+  // the four cell centres around the point and the point's fractional position
+  const double fx = x_mm / cell_mm;
+  const double fy = y_mm / cell_mm;
+  const double ix0_real = std::floor(fx);
+  const double iy0_real = std::floor(fy);
+  const int ix0 = static_cast<int>(ix0_real);
+  const int iy0 = static_cast<int>(iy0_real);
+  const double wx = fx - ix0_real;
+  const double wy = fy - iy0_real;
+  const double v00 = cell(ix0, iy0);
+  const double v10 = cell(ix0 + 1, iy0);
+  const double v01 = cell(ix0, iy0 + 1);
+  const double v11 = cell(ix0 + 1, iy0 + 1);
+  return (1.0 - wy) * ((1.0 - wx) * v00 + wx * v10) + wy * ((1.0 - wx) * v01 + wx * v11);
+}
 
 class ThicknessField {
  public:

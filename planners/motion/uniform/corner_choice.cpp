@@ -175,7 +175,8 @@ DepositionStep steady_step(double speed_mm_s) {
 }
 
 // Reads a field's cells in runs (rows of cells): the tile of the last read is kept, so most
-// reads skip the tile lookup. The values of ThicknessField::cell_thickness_mm.
+// reads skip the tile lookup. The values of ThicknessField::cell_thickness_mm and
+// thickness_mm_at.
 class CellReader {
  public:
   explicit CellReader(const ThicknessField& field) : field_(field) {}
@@ -186,6 +187,11 @@ class CellReader {
       tile_ = field_.tiles().find(tx, ty);
     }
     return tile_ ? tile_[ThicknessField::Tiles::local_index(ix, iy)] : 0.0;
+  }
+  // the field's thickness_mm_at (x, y)
+  double interpolated(double x_mm, double y_mm) {
+    return bilinear_between_cells(x_mm, y_mm, field_.cell_mm(),
+                                  [this](int ix, int iy) { return at(ix, iy); });
   }
 
  private:
@@ -317,7 +323,8 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   };
   steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
   steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
-  const ThicknessField& rolls = rolls_process.field();
+  // (read through one reader until the shared ends are deposited, which may add tiles)
+  CellReader rolls(rolls_process.field());
 
   // the even deposit over the window's target cells: the steady line's cross section at the
   // cell's distance from the nearest centreline point
@@ -351,7 +358,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
         cell.ix = ix, cell.iy = iy;
         cell.missing_mm =
             areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma)) -
-            rolls.cell_thickness_mm(ix, iy);
+            rolls.at(ix, iy);
         cell.line_area_mm2 = areas[edge];
         w.cells.push_back(cell);
       }
@@ -363,31 +370,30 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     const int edge = arc < leg[0] ? 0 : 1;
     const Vec3 p = edge == 0 ? Vec3(a + arc * w.d_in) : Vec3(c + (arc - leg[0]) * w.d_out);
     const double peak = areas[edge] * peak_per_area;
-    w.centre.push_back({p.x(), p.y(), peak, peak - rolls.thickness_mm_at(p.x(), p.y())});
+    w.centre.push_back({p.x(), p.y(), peak, peak - rolls.interpolated(p.x(), p.y())});
   }
 
   // the shared ends, deposited with the rolls (after them in time), and the targets less both
   std::vector<double> rolls_only(w.cells.size());
   for (size_t k = 0; k < w.cells.size(); ++k)
-    rolls_only[k] = rolls.cell_thickness_mm(w.cells[k].ix, w.cells[k].iy);
+    rolls_only[k] = rolls.at(w.cells[k].ix, w.cells[k].iy);
   std::vector<double> rolls_only_centre(w.centre.size());
   for (size_t k = 0; k < w.centre.size(); ++k)
-    rolls_only_centre[k] = rolls.thickness_mm_at(w.centre[k].x_mm, w.centre[k].y_mm);
+    rolls_only_centre[k] = rolls.interpolated(w.centre[k].x_mm, w.centre[k].y_mm);
   const double after_rolls_s = roll_mm / w.v_out;
   if (w.shared_in_mm > 0.0) steady(a, a + w.shared_in_mm * w.d_in, w.v_in, after_rolls_s);
   if (w.shared_out_mm > 0.0)
     steady(b - w.shared_out_mm * w.d_out, b, w.v_out,
            after_rolls_s + w.shared_in_mm / w.v_in + 1.0);
-  const ThicknessField& with_ends = rolls_process.field();
+  CellReader with_ends(rolls_process.field());
   for (size_t k = 0; k < w.cells.size(); ++k) {
     CornerWindow::TargetCell& cell = w.cells[k];
-    cell.missing_shared_mm =
-        cell.missing_mm + rolls_only[k] - with_ends.cell_thickness_mm(cell.ix, cell.iy);
+    cell.missing_shared_mm = cell.missing_mm + rolls_only[k] - with_ends.at(cell.ix, cell.iy);
   }
   for (size_t k = 0; k < w.centre.size(); ++k) {
     CornerWindow::CentreSample& sample = w.centre[k];
-    sample.missing_shared_mm = sample.missing_mm + rolls_only_centre[k] -
-                               with_ends.thickness_mm_at(sample.x_mm, sample.y_mm);
+    sample.missing_shared_mm =
+        sample.missing_mm + rolls_only_centre[k] - with_ends.interpolated(sample.x_mm, sample.y_mm);
   }
 }
 
@@ -515,7 +521,7 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
         std::abs(cells.at(cell.ix, cell.iy) - (shared ? cell.missing_shared_mm : cell.missing_mm)) *
         h * h / cell.line_area_mm2;
   for (const CornerWindow::CentreSample& sample : w.centre)
-    error_mm += std::abs(field.thickness_mm_at(sample.x_mm, sample.y_mm) -
+    error_mm += std::abs(cells.interpolated(sample.x_mm, sample.y_mm) -
                          (shared ? sample.missing_shared_mm : sample.missing_mm)) /
                 sample.peak_mm * h;
 
