@@ -132,6 +132,9 @@ class Process {
   void flush() { flush_pending(); }
   // exact after every advance, batched or not
   const MaterialAccount& account() const { return account_; }
+  // put the two steps a failed batch comes down to in one call (StepBatch::pair_short_steps):
+  // for predictions, a little less exact on curves for half the calls there
+  void pair_short_steps(bool on) { batch_.pair_short_steps(on); }
   // how the steps were batched so far
   const StepBatch::Stats& batch_stats() const { return batch_.stats(); }
   const DepositionSettings& settings() const { return settings_; }

@@ -31,6 +31,28 @@ void StepBatch::deposit_single(GaussianFootprint& footprint, ThicknessField& fie
                           [&rate](double u) { return rate.at(u); });
 }
 
+bool StepBatch::deposit_pair(GaussianFootprint& footprint, ThicknessField& field, int begin) {
+  // 2-point Gauss-Legendre nodes on [0, 1] (weights equal)
+  constexpr double kPairNodes[2] = {0.5 - 0.28867513459481288225, 0.5 + 0.28867513459481288225};
+  const double longest_mm = kPairChordSigmas * sigma_mm_;
+  FootprintNode nodes[4];
+  for (int j = 0; j < 2; ++j) {
+    const BatchStep& step = pending_[begin + j].step;
+    const double dx = step.x1_mm - step.x0_mm, dy = step.y1_mm - step.y0_mm;
+    if (dx * dx + dy * dy > longest_mm * longest_mm) return false;
+    // the step's volume split by its rate at the two nodes (uniform when it has no shape)
+    double rates[2] = {step.rate.at(kPairNodes[0]), step.rate.at(kPairNodes[1])};
+    if (!(rates[0] + rates[1] > 0.0)) rates[0] = rates[1] = 1.0;
+    const double volume_per_rate = step.volume_mm3 / (rates[0] + rates[1]);
+    for (int k = 0; k < 2; ++k)
+      nodes[2 * j + k] = FootprintNode{step.x0_mm + kPairNodes[k] * dx,
+                                       step.y0_mm + kPairNodes[k] * dy, rates[k] * volume_per_rate};
+  }
+  footprint.deposit_nodes(field, nodes, 4);
+  stats_.paired_steps += 2;
+  return true;
+}
+
 void StepBatch::add(GaussianFootprint& footprint, ThicknessField& field, const BatchStep& step) {
   // nothing lands: the run of steps with material ends here
   if (!(step.volume_mm3 > 0.0)) {
@@ -169,6 +191,7 @@ void StepBatch::deposit_range(GaussianFootprint& footprint, ThicknessField& fiel
   }
   if (worst_kink > 0) {
     ++stats_.splits;
+    if (pair_short_steps_ && end - begin == 2 && deposit_pair(footprint, field, begin)) return;
     deposit_range(footprint, field, begin, worst_kink);
     deposit_range(footprint, field, worst_kink, end);
     return;
@@ -221,6 +244,7 @@ void StepBatch::deposit_range(GaussianFootprint& footprint, ThicknessField& fiel
     return;
   }
   ++stats_.splits;
+  if (pair_short_steps_ && end - begin == 2 && deposit_pair(footprint, field, begin)) return;
   const int middle = begin + (end - begin) / 2;
   deposit_range(footprint, field, begin, middle);
   deposit_range(footprint, field, middle, end);

@@ -300,6 +300,9 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   if (!scratch.rolls) {
     scratch.rolls = make_process(prediction_settings(settings), w.cell_mm);
     scratch.window = make_process(prediction_settings(settings), w.cell_mm);
+    // (curves: a halved batch's last two steps in one footprint call, step_batch.hpp)
+    scratch.rolls->pair_short_steps(true);
+    scratch.window->pair_short_steps(true);
   }
   Process& rolls_process = *scratch.rolls;
   w.scratch = scratch.window.get();
