@@ -19,6 +19,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // it; at 4 ms the comparison scenarios' line_cv and times were the same to every digit shown)
 constexpr double kStepS = 0.01;
 constexpr double kStepSigmas = 0.25;
+// a slowed aerosol blend's prediction takes up to this many steps at once (see evaluate_corner)
+constexpr int kMaxMergedSteps = 4;
 constexpr double kWindowSigmas = 6.0;  // window beyond what the candidates change
 constexpr double kRollSigmas = 6.0;    // pre- and post-rolls (the footprint ends at 5 sigma)
 // an extruder's flow settles within this many lags (exp(-6) = 0.25 %): the rolls and the window
@@ -484,8 +486,29 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   TrajectoryCursor cursor(motion);
   TrajectorySample before = cursor.at(t_begin);
   bool shut_before = false, before_stale = false;
-  for (int k = 0; k < steps; ++k) {
-    const double t0 = t_begin + k * dt, t1 = k + 1 == steps ? t_end : t_begin + (k + 1) * dt;
+  // an aerosol plan with the shutter open throughout (a blend) takes as many grid steps at once,
+  // up to kMaxMergedSteps, as keep its chord within kStepSigmas: a slowed corner's chords are
+  // then as long as the print speed's (the stream is constant, the chord integrated exactly)
+  const bool merge_slow_steps = model.aerosol() && closed.empty();
+  const double longest_chord_mm = kStepSigmas * sigma;
+  for (int k = 0; k < steps;) {
+    const double t0 = t_begin + k * dt;
+    int taken = 1;
+    TrajectorySample after;
+    if (merge_slow_steps) {
+      // (clamped as a double: at rest the ratio is infinite)
+      const double fit = longest_chord_mm / (before.velocity_mm_s.norm() * dt);
+      taken = static_cast<int>(std::clamp(fit, 1.0, static_cast<double>(kMaxMergedSteps)));
+      taken = std::min(taken, steps - k);
+      after = cursor.at(k + taken == steps ? t_end : t_begin + (k + taken) * dt);
+      // (an accelerating plan may have run further: one grid step then)
+      if (taken > 1 && (after.position_mm - before.position_mm).norm() > longest_chord_mm) {
+        taken = 1;
+        after = cursor.at(k + 1 == steps ? t_end : t_begin + (k + 1) * dt);
+      }
+    }
+    k += taken;
+    const double t1 = k == steps ? t_end : t_begin + k * dt;
     const double open0 = open_fraction(closed, t0, model.shutter_time_s);
     const double open1 = open_fraction(closed, t1, model.shutter_time_s);
     // an aerosol's shut shutter lets nothing through: after the first such step (which ends
@@ -499,7 +522,7 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
     }
     if (before_stale) before = cursor.at(t0);
     before_stale = false;
-    const TrajectorySample after = cursor.at(t1);
+    if (!merge_slow_steps) after = cursor.at(t1);
     DepositionStep step;
     step.t0_s = t0;
     step.t1_s = t1;
