@@ -26,10 +26,11 @@
 //
 // Paired steps (pair_short_steps, for predictions that trade a little accuracy for speed): where
 // a halved batch comes down to two steps, each no longer than kPairChordSigmas, that still
-// fail, both are deposited in one 4-node call, 2 Gauss-Legendre nodes along each chord (its
-// own volume and rate shape), instead of one deposit_chord each (3 nodes, one call each): an
-// error of at most 6.9e-4 (L/sigma)^4 <= 5.6e-6 of the step's peak (gaussian_footprint.hpp)
-// for half the calls, most of the work on curves (a blend's chords keep the moments apart).
+// fail (their moments, or a rate kink between them), both are deposited in one 4-node call, 2
+// Gauss-Legendre nodes along each chord (its own volume and rate shape), instead of one
+// deposit_chord each (3 nodes, one call each): an error of at most 6.9e-4 (L/sigma)^4 <= 5.6e-6 of
+// the step's peak (gaussian_footprint.hpp) for half the calls, most of the work on curves (a
+// blend's chords keep the moments apart).
 //
 // A batch also ends at a gap in time or position between steps, after kMaxSteps steps,
 // and on flush(). Batch boundaries depend only on the steps (and on when flush() is
