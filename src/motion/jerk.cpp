@@ -22,8 +22,10 @@ double s_curve_duration(double dv, double a_max, double j_max) {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// velocity brackets resolve to this share of v_max at the finest (AxisProblem::resolution)
+// velocity brackets resolve to this share of v_max at the coarsest (AxisProblem::resolution),
+// and finer where a tiny S-curve would move the position by more than kDistanceResolution_mm
 constexpr double kVelocityResolution = 1e-24;
+constexpr double kDistanceResolution_mm = 1e-12;
 
 // a double's place in the order of all doubles (-0 and +0 alike), and back: adjacent doubles
 // have adjacent keys
@@ -118,9 +120,15 @@ struct AxisProblem {
   double v_max = 0.0, a_max = 0.0, j_max = 0.0;
 
   double knee() const { return a_max * a_max / j_max; }
-  // the velocity brackets' resolution: a velocity this far below v_max changes no profile
-  // measurably (bisect: it ends the brackets around 0)
-  double resolution() const { return kVelocityResolution * v_max; }
+  // the velocity brackets' resolution (bisect: it ends the brackets around 0 before the
+  // subnormals). A velocity change this small changes no profile measurably: 1e-24 of v_max,
+  // and at most dx with 4 sqrt(dx / j) v_max <= kDistanceResolution_mm, since both S-curves'
+  // time 4 sqrt(x / j) at a tiny x moves by up to 4 sqrt(dx / j) (a 1e-7 mm move at 770 mm/s
+  // turns on x ~ 1e-19, which 1e-24 of v_max = 8e-21 alone left 4 % short in time)
+  double resolution() const {
+    const double time_s = kDistanceResolution_mm / (4.0 * v_max);
+    return std::min(kVelocityResolution * v_max, j_max * time_s * time_s);
+  }
   double tau(double dv) const { return s_curve_duration(dv, a_max, j_max); }
   // d tau / d|dv|
   double tau_slope(double dv) const {

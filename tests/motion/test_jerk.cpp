@@ -137,6 +137,19 @@ TEST(Jerk, AMoveOfARoundingErrorTakesItsOwnTime) {
   expect_valid(move.axes[0], b, expected_s, kV, kA, kJ);
 }
 
+TEST(Jerk, ATinyMoveAtSpeedIsTimedByItsLength) {
+  // 1e-7 mm cruising at 770 mm/s (fuzz_move's regression-tiny-move-at-speed): T = d / v to
+  // 1e-9, the peak a mere ~1e-19 mm/s above v0. The velocity brackets must resolve that
+  // (1e-24 of v_max = 8e-21 alone left T 4 % short, and the move "not feasible")
+  const AxisBoundary b{0, 1e-7, 770, 770};
+  const double v_max = 7770, a_max = 1, j_max = 77, expected_s = 1e-7 / 770;
+  EXPECT_NEAR(jerk_min_time_move(b, v_max, a_max, j_max).duration_s(), expected_s,
+              1e-9 * expected_s);
+  const SynchronizedMove move = synchronized_move({AxisMove{b, v_max, a_max, j_max}});
+  EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
+  expect_valid(move.axes[0], b, move.duration_s, v_max, a_max, j_max);
+}
+
 TEST(Jerk, ALongMoveHasNoFeasibleSliverOfOneRoundingError) {
   // Mtt.ALongMoveHasNoFeasibleSliverOfOneRoundingError with a jerk limit: the move must still
   // pass the ramp to rest (at least 77777 s plus the jerk ramps) and come back, exactly
