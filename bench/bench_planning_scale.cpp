@@ -186,8 +186,8 @@ void register_planner(const char* planner_name, int largest_segments) {
 int main(int argc, char** argv) {
   for (const char* name : {"lspb_mtt", "stop_and_go", "bezier", "firmware"})
     register_planner(name, 100000);
-  // uniform predicts the deposit at each corner (about 0.3 ms per segment here): 10^4 at most,
-  // its 10^5 (100 baseline plans per iteration) would take the bench's quarter hour
+  // uniform predicts the deposit at each corner (about 0.2 ms per segment here): 10^4 at most,
+  // its 10^5 (three plans, 300 baseline plans, three warm ones) would add minutes
   register_planner("uniform", 10000);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
