@@ -491,8 +491,10 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   // then as long as the print speed's (the stream is constant, the chord integrated exactly)
   const bool merge_slow_steps = model.aerosol() && closed.empty();
   const double longest_chord_mm = kStepSigmas * sigma;
+  // the time of grid point k (the last one exactly t_end)
+  const auto grid_time = [&](int k) { return k == steps ? t_end : t_begin + k * dt; };
   for (int k = 0; k < steps;) {
-    const double t0 = t_begin + k * dt;
+    const double t0 = grid_time(k);
     int taken = 1;
     TrajectorySample after;
     if (merge_slow_steps) {
@@ -500,15 +502,15 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
       const double fit = longest_chord_mm / (before.velocity_mm_s.norm() * dt);
       taken = static_cast<int>(std::clamp(fit, 1.0, static_cast<double>(kMaxMergedSteps)));
       taken = std::min(taken, steps - k);
-      after = cursor.at(k + taken == steps ? t_end : t_begin + (k + taken) * dt);
+      after = cursor.at(grid_time(k + taken));
       // (an accelerating plan may have run further: one grid step then)
       if (taken > 1 && (after.position_mm - before.position_mm).norm() > longest_chord_mm) {
         taken = 1;
-        after = cursor.at(k + 1 == steps ? t_end : t_begin + (k + 1) * dt);
+        after = cursor.at(grid_time(k + 1));
       }
     }
     k += taken;
-    const double t1 = k == steps ? t_end : t_begin + k * dt;
+    const double t1 = grid_time(k);
     const double open0 = open_fraction(closed, t0, model.shutter_time_s);
     const double open1 = open_fraction(closed, t1, model.shutter_time_s);
     // an aerosol's shut shutter lets nothing through: after the first such step (which ends
