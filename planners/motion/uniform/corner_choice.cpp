@@ -63,12 +63,13 @@ double overlap_mm(const CornerGeometry& g, const DepositModel& model) {
   return alpha < 0.5 * kPi ? 2.0 * sigma / std::max(std::sin(alpha), 1e-3) : 0.0;
 }
 
-// the largest trim a loop candidate tries on an edge of this length
-double largest_trim_mm(const CornerGeometry& g, double edge_mm, const DepositModel& model) {
-  const double fraction =
-      std::max(*std::max_element(std::begin(kTrimFractions), std::end(kTrimFractions)),
-               *std::max_element(std::begin(kTrimInFractions), std::end(kTrimInFractions)));
-  return std::min(fraction * overlap_mm(g, model), kMaxTrimShare * edge_mm);
+// the largest trim a loop candidate tries on an edge of this length, at these fractions of the
+// overlap (kTrimInFractions before the corner, kTrimFractions after it)
+template <size_t count>
+double largest_trim_mm(const CornerGeometry& g, double edge_mm, const DepositModel& model,
+                       const double (&fractions)[count]) {
+  return std::min(*std::max_element(fractions, fractions + count) * overlap_mm(g, model),
+                  kMaxTrimShare * edge_mm);
 }
 
 // how far on each side of the corner the window reaches: the slowest candidate's speed
@@ -87,7 +88,8 @@ double window_reach_mm(const PrintChain& chain, size_t corner, const CornerGeome
     // (and the extruder's flow settling after it, as the post-roll allows for)
     reach = std::max(reach, speed_change_distance(line.v_max_mm_s, 0.0, line) +
                                 kLagSettlingLags * options.lag_s * line.v_max_mm_s);
-    reach = std::max(reach, largest_trim_mm(g, (b - a).norm(), model));
+    reach = std::max(reach, std::max(largest_trim_mm(g, (b - a).norm(), model, kTrimFractions),
+                                     largest_trim_mm(g, (b - a).norm(), model, kTrimInFractions)));
   }
   return reach + g.max_half_length_mm * g.tangent_per_length + kWindowSigmas * sigma;
 }
@@ -225,19 +227,22 @@ struct CornerWindow {
   struct TargetCell {
     int ix = 0, iy = 0;
     double missing_mm = 0.0, line_area_mm2 = 0.0;
-    double missing_shared_mm = 0.0;  // less the shared ends' deposit too
+    double missing_shared_mm[2] = {};  // less the shared ends' deposit too (per SharedEnds)
   };
   struct CentreSample {
     double x_mm = 0.0, y_mm = 0.0, peak_mm = 0.0, missing_mm = 0.0;
-    double missing_shared_mm = 0.0;
+    double missing_shared_mm[2] = {};
   };
   std::vector<TargetCell> cells;
   std::vector<CentreSample> centre;
   // the window's shared ends: its first shared_in_mm (from a) and last shared_out_mm (to b),
-  // beyond where any candidate is expected to change anything. Their deposit, at print speed, is
-  // predicted once with the rolls (missing_shared_mm); a candidate found steady on them has
+  // beyond where the candidates of a kind are expected to change anything: every candidate
+  // (kBlendEnds: blends, slowed corners and stops), or the loops alone (kLoopEnds: the line at
+  // print speed up to the trims, so longer ends). Their deposit, at print speed, is predicted
+  // once with the rolls (missing_shared_mm); a candidate found steady on its kind's ends has
   // only the rest of its window predicted, any other the whole window
-  double shared_in_mm = 0.0, shared_out_mm = 0.0;
+  enum SharedEnds { kBlendEnds = 0, kLoopEnds = 1 };
+  double shared_in_mm[2] = {}, shared_out_mm[2] = {};
   // the process each candidate's window deposit is predicted with, restarted for each
   Process* scratch = nullptr;
 };
@@ -283,8 +288,18 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   if (model.aerosol()) {
     const double change_mm = reach - kWindowSigmas * model.settings.footprint_sigma_mm();
     const double lead_mm = model.shutter_time_s * std::max(w.v_in, w.v_out);
-    w.shared_in_mm = std::max(0.0, (c - a).norm() - change_mm - lead_mm);
-    w.shared_out_mm = std::max(0.0, (b - c).norm() - change_mm - lead_mm);
+    w.shared_in_mm[CornerWindow::kBlendEnds] = std::max(0.0, (c - a).norm() - change_mm - lead_mm);
+    w.shared_out_mm[CornerWindow::kBlendEnds] = std::max(0.0, (b - c).norm() - change_mm - lead_mm);
+    // a loop changes the lines only from its trims on (and the shutter's lead before them):
+    // ends at least as long, as the largest trims are within change_mm (less a hundredth of
+    // sigma, so the shutter's ramp starts clear of them, not on them to rounding)
+    const double margin_mm = 0.01 * model.settings.footprint_sigma_mm();
+    const double loop_in_mm = largest_trim_mm(geometry, edge_in, model, kTrimInFractions);
+    const double loop_out_mm = largest_trim_mm(geometry, edge_out, model, kTrimFractions);
+    w.shared_in_mm[CornerWindow::kLoopEnds] =
+        std::max(0.0, (c - a).norm() - loop_in_mm - lead_mm - margin_mm);
+    w.shared_out_mm[CornerWindow::kLoopEnds] =
+        std::max(0.0, (b - c).norm() - loop_out_mm - lead_mm - margin_mm);
   }
   return w;
 }
@@ -378,34 +393,45 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     w.centre.push_back({p.x(), p.y(), peak, peak - rolls.interpolated(p.x(), p.y())});
   }
 
-  // the shared ends, deposited with the rolls (after them in time), and the targets less both
+  // the shared ends, deposited with the rolls (after them in time), and the targets less both:
+  // the blends' ends, then what the loops' longer ends add to them
   std::vector<double> rolls_only(w.cells.size());
   for (size_t k = 0; k < w.cells.size(); ++k)
     rolls_only[k] = rolls.at(w.cells[k].ix, w.cells[k].iy);
   std::vector<double> rolls_only_centre(w.centre.size());
   for (size_t k = 0; k < w.centre.size(); ++k)
     rolls_only_centre[k] = rolls.interpolated(w.centre[k].x_mm, w.centre[k].y_mm);
-  const double after_rolls_s = roll_mm / w.v_out;
-  if (w.shared_in_mm > 0.0) steady(a, a + w.shared_in_mm * w.d_in, w.v_in, after_rolls_s);
-  if (w.shared_out_mm > 0.0)
-    steady(b - w.shared_out_mm * w.d_out, b, w.v_out,
-           after_rolls_s + w.shared_in_mm / w.v_in + 1.0);
-  CellReader with_ends(rolls_process.field());
-  for (size_t k = 0; k < w.cells.size(); ++k) {
-    CornerWindow::TargetCell& cell = w.cells[k];
-    cell.missing_shared_mm = cell.missing_mm + rolls_only[k] - with_ends.at(cell.ix, cell.iy);
-  }
-  for (size_t k = 0; k < w.centre.size(); ++k) {
-    CornerWindow::CentreSample& sample = w.centre[k];
-    sample.missing_shared_mm =
-        sample.missing_mm + rolls_only_centre[k] - with_ends.interpolated(sample.x_mm, sample.y_mm);
+  double t_s = roll_mm / w.v_out;  // (aerosol: the times only order the steps)
+  double deposited_in_mm = 0.0, deposited_out_mm = 0.0;
+  for (const int kind : {CornerWindow::kBlendEnds, CornerWindow::kLoopEnds}) {
+    if (w.shared_in_mm[kind] > deposited_in_mm) {
+      steady(a + deposited_in_mm * w.d_in, a + w.shared_in_mm[kind] * w.d_in, w.v_in, t_s);
+      t_s += (w.shared_in_mm[kind] - deposited_in_mm) / w.v_in + 1.0;
+      deposited_in_mm = w.shared_in_mm[kind];
+    }
+    if (w.shared_out_mm[kind] > deposited_out_mm) {
+      steady(b - w.shared_out_mm[kind] * w.d_out, b - deposited_out_mm * w.d_out, w.v_out, t_s);
+      t_s += (w.shared_out_mm[kind] - deposited_out_mm) / w.v_out + 1.0;
+      deposited_out_mm = w.shared_out_mm[kind];
+    }
+    CellReader with_ends(rolls_process.field());
+    for (size_t k = 0; k < w.cells.size(); ++k) {
+      CornerWindow::TargetCell& cell = w.cells[k];
+      cell.missing_shared_mm[kind] =
+          cell.missing_mm + rolls_only[k] - with_ends.at(cell.ix, cell.iy);
+    }
+    for (size_t k = 0; k < w.centre.size(); ++k) {
+      CornerWindow::CentreSample& sample = w.centre[k];
+      sample.missing_shared_mm[kind] = sample.missing_mm + rolls_only_centre[k] -
+                                       with_ends.interpolated(sample.x_mm, sample.y_mm);
+    }
   }
 }
 
 // Whether a window's plan prints its shared ends as the rolls' prediction of them does: on the
 // incoming line at print speed from a, and (when there is a shared exit) on the outgoing one at
 // print speed up to b, the material fully on, sampled every step_s and at their ends.
-bool steady_on_shared_ends(const CornerWindow& w, const Trajectory& motion,
+bool steady_on_shared_ends(const CornerWindow& w, int kind, const Trajectory& motion,
                            const std::vector<std::pair<double, double>>& closed,
                            const DepositModel& model, double step_s) {
   const double duration = motion.duration_s();
@@ -428,10 +454,10 @@ bool steady_on_shared_ends(const CornerWindow& w, const Trajectory& motion,
     }
     return true;
   };
-  if (w.shared_in_mm > 0.0 && !steady_over(0.0, w.shared_in_mm / w.v_in, w.a, w.d_in, w.v_in, 0.0))
-    return false;
-  if (w.shared_out_mm > 0.0 &&
-      !steady_over(duration - w.shared_out_mm / w.v_out, duration, w.b, w.d_out, w.v_out, duration))
+  const double in_mm = w.shared_in_mm[kind], out_mm = w.shared_out_mm[kind];
+  if (in_mm > 0.0 && !steady_over(0.0, in_mm / w.v_in, w.a, w.d_in, w.v_in, 0.0)) return false;
+  if (out_mm > 0.0 &&
+      !steady_over(duration - out_mm / w.v_out, duration, w.b, w.d_out, w.v_out, duration))
     return false;
   return true;
 }
@@ -475,10 +501,12 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   process->start_steady(steady_step(v_in));
   const double step_s = prediction_step_s(sigma, std::max(v_in, v_out));
   const auto closed = closed_spans(motion);
-  const double shared_in_s = w.shared_in_mm / v_in;
-  const double shared_out_s = w.shared_out_mm / v_out;
+  const int kind =
+      plan.treatment == CornerTreatment::loop ? CornerWindow::kLoopEnds : CornerWindow::kBlendEnds;
+  const double shared_in_s = w.shared_in_mm[kind] / v_in;
+  const double shared_out_s = w.shared_out_mm[kind] / v_out;
   const bool shared = shared_in_s + shared_out_s < duration &&
-                      steady_on_shared_ends(w, motion, closed, model, step_s);
+                      steady_on_shared_ends(w, kind, motion, closed, model, step_s);
   const double t_begin = shared ? shared_in_s : 0.0;
   const double t_end = shared ? duration - shared_out_s : duration;
   const int steps = std::max(1, static_cast<int>(std::ceil((t_end - t_begin) / step_s)));
@@ -545,12 +573,12 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   CellReader cells(field);
   double error_mm = 0.0;
   for (const CornerWindow::TargetCell& cell : w.cells)
-    error_mm +=
-        std::abs(cells.at(cell.ix, cell.iy) - (shared ? cell.missing_shared_mm : cell.missing_mm)) *
-        h * h / cell.line_area_mm2;
+    error_mm += std::abs(cells.at(cell.ix, cell.iy) -
+                         (shared ? cell.missing_shared_mm[kind] : cell.missing_mm)) *
+                h * h / cell.line_area_mm2;
   for (const CornerWindow::CentreSample& sample : w.centre)
     error_mm += std::abs(cells.interpolated(sample.x_mm, sample.y_mm) -
-                         (shared ? sample.missing_shared_mm : sample.missing_mm)) /
+                         (shared ? sample.missing_shared_mm[kind] : sample.missing_mm)) /
                 sample.peak_mm * h;
 
   candidate.error_mm = error_mm;
