@@ -120,13 +120,24 @@ BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
   const Vec3 e2 = (d_out - d_out.dot(d_in) * d_in).normalized();
   BlendShape shape;
   double curvature_norm = 0.0, third_norm = 0.0;
-  for (int half = 0; half < 2; ++half) {
-    for (int k = 0; k <= kShapeSamples; ++k) {
-      const double u = static_cast<double>(k) / kShapeSamples;
-      const double psi = half == 0 ? phi * u * u : theta - phi * u * u;
-      const double kappa = 2.0 * phi * u, rate = half == 0 ? 2.0 * phi : -2.0 * phi;
-      const Vec3 t = std::cos(psi) * d_in + std::sin(psi) * e2;
-      const Vec3 normal = -std::sin(psi) * d_in + std::cos(psi) * e2;
+  // cos and sin of phi u^2 at u = k / N by the chirp recurrence: the angle grows by
+  // phi (2k + 1) / N^2 from sample k to k + 1, a rotation whose own angle grows by 2 phi / N^2
+  // (no sincos per sample; rounding drifts by ~N^2 eps = 7e-12, far within kShapeSlack). The
+  // second half's theta - phi u^2 follows by the difference formulas
+  const double angle_step = phi / (static_cast<double>(kShapeSamples) * kShapeSamples);
+  double cos_psi = 1.0, sin_psi = 0.0;
+  double cos_turn = std::cos(angle_step), sin_turn = std::sin(angle_step);
+  const double cos_growth = std::cos(2.0 * angle_step), sin_growth = std::sin(2.0 * angle_step);
+  const double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+  for (int k = 0; k <= kShapeSamples; ++k) {
+    const double u = static_cast<double>(k) / kShapeSamples;
+    const double kappa = 2.0 * phi * u;
+    for (int half = 0; half < 2; ++half) {
+      const double c = half == 0 ? cos_psi : cos_theta * cos_psi + sin_theta * sin_psi;
+      const double s = half == 0 ? sin_psi : sin_theta * cos_psi - cos_theta * sin_psi;
+      const double rate = half == 0 ? 2.0 * phi : -2.0 * phi;
+      const Vec3 t = c * d_in + s * e2;
+      const Vec3 normal = -s * d_in + c * e2;
       const Vec3 d2 = kappa * normal, d3 = rate * normal - kappa * kappa * t;
       shape.tangent = shape.tangent.cwiseMax(t.cwiseAbs());
       shape.curvature = shape.curvature.cwiseMax(d2.cwiseAbs());
@@ -134,6 +145,13 @@ BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
       curvature_norm = std::max(curvature_norm, d2.norm());
       third_norm = std::max(third_norm, d3.norm());
     }
+    // (psi, turn) -> (psi + turn, turn + growth)
+    const double next_cos = cos_psi * cos_turn - sin_psi * sin_turn;
+    sin_psi = sin_psi * cos_turn + cos_psi * sin_turn;
+    cos_psi = next_cos;
+    const double next_cos_turn = cos_turn * cos_growth - sin_turn * sin_growth;
+    sin_turn = sin_turn * cos_growth + cos_turn * sin_growth;
+    cos_turn = next_cos_turn;
   }
   // what the samples may miss between them
   shape.tangent.array() += kShapeSlack;
