@@ -72,6 +72,22 @@ double largest_trim_mm(const CornerGeometry& g, double edge_mm, const DepositMod
                   kMaxTrimShare * edge_mm);
 }
 
+// the longer of the two edges' speed changes from print speed to rest, and the extruder's flow
+// settling after it (as the post-roll allows for)
+double speed_change_reach_mm(const PrintChain& chain, size_t corner, const TcpLimits& limits,
+                             const PathMotionOptions& options) {
+  double reach = 0.0;
+  for (const size_t e : {corner - 1, corner}) {
+    const Vec3& a = chain.points[e];
+    const Vec3& b = chain.points[e + 1];
+    const LineLimits line = line_limits((b - a).normalized(), limits.along(a, b),
+                                        chain.edge_speed_mm_s[e], options.lag_s);
+    reach = std::max(reach, speed_change_distance(line.v_max_mm_s, 0.0, line) +
+                                kLagSettlingLags * options.lag_s * line.v_max_mm_s);
+  }
+  return reach;
+}
+
 // how far on each side of the corner the window reaches: the slowest candidate's speed
 // change (to rest) and the flow lag's settling after it, the largest blend or trim, and
 // kWindowSigmas
@@ -79,17 +95,11 @@ double window_reach_mm(const PrintChain& chain, size_t corner, const CornerGeome
                        const TcpLimits& limits, const PathMotionOptions& options,
                        const DepositModel& model) {
   const double sigma = model.settings.footprint_sigma_mm();
-  double reach = 0.0;
+  double reach = speed_change_reach_mm(chain, corner, limits, options);
   for (const size_t e : {corner - 1, corner}) {
-    const Vec3& a = chain.points[e];
-    const Vec3& b = chain.points[e + 1];
-    const LineLimits line = line_limits((b - a).normalized(), limits.along(a, b),
-                                        chain.edge_speed_mm_s[e], options.lag_s);
-    // (and the extruder's flow settling after it, as the post-roll allows for)
-    reach = std::max(reach, speed_change_distance(line.v_max_mm_s, 0.0, line) +
-                                kLagSettlingLags * options.lag_s * line.v_max_mm_s);
-    reach = std::max(reach, std::max(largest_trim_mm(g, (b - a).norm(), model, kTrimFractions),
-                                     largest_trim_mm(g, (b - a).norm(), model, kTrimInFractions)));
+    const double edge_mm = (chain.points[e + 1] - chain.points[e]).norm();
+    reach = std::max(reach, std::max(largest_trim_mm(g, edge_mm, model, kTrimFractions),
+                                     largest_trim_mm(g, edge_mm, model, kTrimInFractions)));
   }
   return reach + g.max_half_length_mm * g.tangent_per_length + kWindowSigmas * sigma;
 }
@@ -280,26 +290,27 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
       max_blend_half_length(geometry, (c - a).norm(), (b - c).norm(), kInf);
   w.v_in = window.edge_speed_mm_s[0], w.v_out = window.edge_speed_mm_s[1];
   w.lag_s = options.lag_s;
-  // the shared ends: the window less what the candidates change (its reach without the
-  // kWindowSigmas margin) and the shutter's lead before a change. Aerosol only: an extruder's
-  // flow still settles at the exit, and its command is held over each step, so a window
-  // stepped from another start moves its prediction by a per cent or two (enough to flip a
-  // near tie: thompson_fig7_delta's 117 deg slowed blend took another size)
-  if (model.aerosol()) {
-    const double change_mm = reach - kWindowSigmas * model.settings.footprint_sigma_mm();
-    const double lead_mm = model.shutter_time_s * std::max(w.v_in, w.v_out);
-    w.shared_in_mm[CornerWindow::kBlendEnds] = std::max(0.0, (c - a).norm() - change_mm - lead_mm);
-    w.shared_out_mm[CornerWindow::kBlendEnds] = std::max(0.0, (b - c).norm() - change_mm - lead_mm);
-    // a loop changes the lines only from its trims on (and the shutter's lead before them):
-    // ends at least as long, as the largest trims are within change_mm (less a hundredth of
-    // sigma, so the shutter's ramp starts clear of them, not on them to rounding)
-    const double margin_mm = 0.01 * model.settings.footprint_sigma_mm();
+  // the shared ends: the window less what a kind's candidates change and the shutter's lead
+  // before a change (less a hundredth of sigma, so a ramp starts clear of them, not on them to
+  // rounding). Blends and slowed corners change the lines from their speed change on (to rest
+  // at the most) and the largest blend; loops from their largest trims on. Aerosol only: an
+  // extruder's flow still settles at the exit, and its command is held over each step, so a
+  // window stepped from another start moves its prediction by a per cent or two (enough to
+  // flip a near tie: thompson_fig7_delta's 117 deg slowed blend took another size)
+  if (model.aerosol() && model.share_window_ends) {
+    const double lead_mm = model.shutter_time_s * std::max(w.v_in, w.v_out) +
+                           0.01 * model.settings.footprint_sigma_mm();
+    const double blend_change_mm = speed_change_reach_mm(chain, corner, limits, options) +
+                                   geometry.max_half_length_mm * geometry.tangent_per_length;
+    w.shared_in_mm[CornerWindow::kBlendEnds] =
+        std::max(0.0, (c - a).norm() - blend_change_mm - lead_mm);
+    w.shared_out_mm[CornerWindow::kBlendEnds] =
+        std::max(0.0, (b - c).norm() - blend_change_mm - lead_mm);
     const double loop_in_mm = largest_trim_mm(geometry, edge_in, model, kTrimInFractions);
     const double loop_out_mm = largest_trim_mm(geometry, edge_out, model, kTrimFractions);
-    w.shared_in_mm[CornerWindow::kLoopEnds] =
-        std::max(0.0, (c - a).norm() - loop_in_mm - lead_mm - margin_mm);
+    w.shared_in_mm[CornerWindow::kLoopEnds] = std::max(0.0, (c - a).norm() - loop_in_mm - lead_mm);
     w.shared_out_mm[CornerWindow::kLoopEnds] =
-        std::max(0.0, (b - c).norm() - loop_out_mm - lead_mm - margin_mm);
+        std::max(0.0, (b - c).norm() - loop_out_mm - lead_mm);
   }
   return w;
 }
@@ -393,64 +404,125 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     w.centre.push_back({p.x(), p.y(), peak, peak - rolls.interpolated(p.x(), p.y())});
   }
 
-  // the shared ends, deposited with the rolls (after them in time), and the targets less both:
-  // the blends' ends, then what the loops' longer ends add to them
-  std::vector<double> rolls_only(w.cells.size());
-  for (size_t k = 0; k < w.cells.size(); ++k)
-    rolls_only[k] = rolls.at(w.cells[k].ix, w.cells[k].iy);
-  std::vector<double> rolls_only_centre(w.centre.size());
-  for (size_t k = 0; k < w.centre.size(); ++k)
-    rolls_only_centre[k] = rolls.interpolated(w.centre[k].x_mm, w.centre[k].y_mm);
+  // the shared ends, deposited with the rolls (after them in time): on each side the kinds'
+  // ends in order of length, each piece from where the last ended, the targets read after
+  // each. A kind's ends add to the targets what its pieces did (the deposit is linear)
+  struct Reading {
+    std::vector<double> cells, centre;
+  };
+  const auto read = [&w, &rolls_process](Reading& reading) {
+    CellReader reader(rolls_process.field());
+    reading.cells.resize(w.cells.size());
+    for (size_t k = 0; k < w.cells.size(); ++k)
+      reading.cells[k] = reader.at(w.cells[k].ix, w.cells[k].iy);
+    reading.centre.resize(w.centre.size());
+    for (size_t k = 0; k < w.centre.size(); ++k)
+      reading.centre[k] = reader.interpolated(w.centre[k].x_mm, w.centre[k].y_mm);
+  };
+  constexpr int kKinds = 2;
   double t_s = roll_mm / w.v_out;  // (aerosol: the times only order the steps)
-  double deposited_in_mm = 0.0, deposited_out_mm = 0.0;
-  for (const int kind : {CornerWindow::kBlendEnds, CornerWindow::kLoopEnds}) {
-    if (w.shared_in_mm[kind] > deposited_in_mm) {
-      steady(a + deposited_in_mm * w.d_in, a + w.shared_in_mm[kind] * w.d_in, w.v_in, t_s);
-      t_s += (w.shared_in_mm[kind] - deposited_in_mm) / w.v_in + 1.0;
-      deposited_in_mm = w.shared_in_mm[kind];
+  // side 0: from a along d_in; side 1: back from b along -d_out
+  Reading side_start[2], after_kind[2][kKinds];
+  for (int side = 0; side < 2; ++side) {
+    const double* shared_mm = side == 0 ? w.shared_in_mm : w.shared_out_mm;
+    const Vec3 from = side == 0 ? a : b;
+    const Vec3 along = side == 0 ? w.d_in : Vec3(-w.d_out);
+    const double speed = side == 0 ? w.v_in : w.v_out;
+    read(side_start[side]);
+    int order[kKinds] = {CornerWindow::kBlendEnds, CornerWindow::kLoopEnds};
+    if (shared_mm[order[1]] < shared_mm[order[0]]) std::swap(order[0], order[1]);
+    double deposited_mm = 0.0;
+    for (const int kind : order) {
+      if (shared_mm[kind] > deposited_mm) {
+        // (the outgoing side printed towards b, as the window does)
+        const Vec3 p0 = from + deposited_mm * along, p1 = from + shared_mm[kind] * along;
+        if (side == 0)
+          steady(p0, p1, speed, t_s);
+        else
+          steady(p1, p0, speed, t_s);
+        t_s += (shared_mm[kind] - deposited_mm) / speed + 1.0;
+        deposited_mm = shared_mm[kind];
+      }
+      read(after_kind[side][kind]);
     }
-    if (w.shared_out_mm[kind] > deposited_out_mm) {
-      steady(b - w.shared_out_mm[kind] * w.d_out, b - deposited_out_mm * w.d_out, w.v_out, t_s);
-      t_s += (w.shared_out_mm[kind] - deposited_out_mm) / w.v_out + 1.0;
-      deposited_out_mm = w.shared_out_mm[kind];
-    }
-    CellReader with_ends(rolls_process.field());
-    for (size_t k = 0; k < w.cells.size(); ++k) {
-      CornerWindow::TargetCell& cell = w.cells[k];
-      cell.missing_shared_mm[kind] =
-          cell.missing_mm + rolls_only[k] - with_ends.at(cell.ix, cell.iy);
-    }
-    for (size_t k = 0; k < w.centre.size(); ++k) {
-      CornerWindow::CentreSample& sample = w.centre[k];
-      sample.missing_shared_mm[kind] = sample.missing_mm + rolls_only_centre[k] -
-                                       with_ends.interpolated(sample.x_mm, sample.y_mm);
-    }
+  }
+  for (int kind = 0; kind < kKinds; ++kind) {
+    // what the kind's two ends added: (after its in-end less before it) + (the same out)
+    const auto added = [&](const auto& of, size_t k) {
+      return (of(after_kind[0][kind])[k] - of(side_start[0])[k]) +
+             (of(after_kind[1][kind])[k] - of(side_start[1])[k]);
+    };
+    const auto cells = [](const Reading& r) -> const std::vector<double>& { return r.cells; };
+    const auto centre = [](const Reading& r) -> const std::vector<double>& { return r.centre; };
+    for (size_t k = 0; k < w.cells.size(); ++k)
+      w.cells[k].missing_shared_mm[kind] = w.cells[k].missing_mm - added(cells, k);
+    for (size_t k = 0; k < w.centre.size(); ++k)
+      w.centre[k].missing_shared_mm[kind] = w.centre[k].missing_mm - added(centre, k);
   }
 }
 
 // Whether a window's plan prints its shared ends as the rolls' prediction of them does: on the
 // incoming line at print speed from a, and (when there is a shared exit) on the outgoing one at
-// print speed up to b, the material fully on, sampled every step_s and at their ends.
+// print speed up to b, the material fully on throughout. A phase-timed piece (a line's profile)
+// is checked exactly: where no phase overlapping the span accelerates or jerks, the motion is
+// linear, and its two ends decide; any other piece is sampled every step_s and at its ends.
 bool steady_on_shared_ends(const CornerWindow& w, int kind, const Trajectory& motion,
                            const std::vector<std::pair<double, double>>& closed,
                            const DepositModel& model, double step_s) {
+  constexpr double kTolerance = 1e-9;
   const double duration = motion.duration_s();
   TrajectoryCursor cursor(motion);
-  // the plan at time t against the steady line through `from` along d at speed v, there at t0
-  const auto steady_at = [&](double t, const Vec3& from, const Vec3& d, double v, double t0) {
-    const TrajectorySample sample = cursor.at(t);
-    constexpr double kTolerance = 1e-9;
-    return sample.depositing && std::abs(sample.flow_fraction - 1.0) <= kTolerance &&
-           open_fraction(closed, t, model.shutter_time_s) == 1.0 &&
-           (sample.position_mm - (from + (t - t0) * v * d)).norm() <= kTolerance * (1.0 + v) &&
-           (sample.velocity_mm_s - v * d).norm() <= kTolerance * v;
+  // the plan's position and velocity at time t against the steady line through `from` along d
+  // at speed v, there at t0
+  const auto on_line = [&](double t, const Vec3& position, const Vec3& velocity, const Vec3& from,
+                           const Vec3& d, double v, double t0) {
+    return (position - (from + (t - t0) * v * d)).norm() <= kTolerance * (1.0 + v) &&
+           (velocity - v * d).norm() <= kTolerance * v;
   };
   const auto steady_over = [&](double t_first, double t_last, const Vec3& from, const Vec3& d,
                                double v, double t0) {
-    const int samples = std::max(1, static_cast<int>(std::ceil((t_last - t_first) / step_s)));
-    for (int k = 0; k <= samples; ++k) {
-      const double t = k == samples ? t_last : t_first + k * (t_last - t_first) / samples;
-      if (!steady_at(t, from, d, v, t0)) return false;
+    // the shutter fully open: no closed span overlaps [t, t + its time] for t in the span
+    for (const auto& [close, open] : closed)
+      if (open > close && close < t_last + model.shutter_time_s && open > t_first) return false;
+    for (int index = 0; index < static_cast<int>(motion.pieces().size()); ++index) {
+      const TrajectoryPiece& piece = motion.pieces()[index];
+      if (piece.t_begin_s > t_last || piece.t_end_s < t_first) continue;
+      const double t_a = std::max(t_first, piece.t_begin_s), t_b = std::min(t_last, piece.t_end_s);
+      const auto* phases = std::get_if<PhaseMotion>(&piece.motion);
+      if (phases == nullptr) {
+        const int samples = std::max(1, static_cast<int>(std::ceil((t_b - t_a) / step_s)));
+        for (int k = 0; k <= samples; ++k) {
+          const double t = k == samples ? t_b : t_a + k * (t_b - t_a) / samples;
+          const TrajectorySample sample = cursor.at(t);
+          if (!sample.depositing || std::abs(sample.flow_fraction - 1.0) > kTolerance ||
+              !on_line(t, sample.position_mm, sample.velocity_mm_s, from, d, v, t0))
+            return false;
+        }
+        continue;
+      }
+      // (the flow at constant velocity: the piece's fraction, or the speed over the desired one
+      // when it follows the speed)
+      if (!piece.depositing) return false;
+      const double flow =
+          piece.flow_lead_s >= 0.0
+              ? (piece.desired_speed_mm_s > 0.0 ? v / piece.desired_speed_mm_s : 0.0)
+              : piece.flow_fraction;
+      if (std::abs(flow - 1.0) > kTolerance) return false;
+      const double tau_a = t_a - piece.t_begin_s, tau_b = t_b - piece.t_begin_s;
+      Vec3 position_a, velocity_a, position_b, velocity_b;
+      for (int axis = 0; axis < 3; ++axis) {
+        const AxisProfile& profile = phases->axes[axis];
+        for (const Phase& phase : profile.phases())
+          if (phase.t_begin_s < tau_b && phase.t_begin_s + phase.duration_s > tau_a &&
+              (phase.a0 != 0.0 || phase.jerk != 0.0))
+            return false;
+        const AxisState state_a = profile.at(tau_a), state_b = profile.at(tau_b);
+        position_a[axis] = state_a.q, velocity_a[axis] = state_a.v;
+        position_b[axis] = state_b.q, velocity_b[axis] = state_b.v;
+      }
+      if (!on_line(t_a, position_a, velocity_a, from, d, v, t0) ||
+          !on_line(t_b, position_b, velocity_b, from, d, v, t0))
+        return false;
     }
     return true;
   };

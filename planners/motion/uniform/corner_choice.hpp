@@ -50,6 +50,10 @@ namespace depotwin {
 struct DepositModel {
   DepositionSettings settings;
   double shutter_time_s = 0.02;
+  // aerosol: a candidate steady on its window's ends takes their deposit from the rolls' (see
+  // corner_choice.cpp, CornerWindow); off, every candidate's whole window is predicted (the
+  // tests compare the two)
+  bool share_window_ends = true;
   bool aerosol() const { return settings.type == ProcessType::aerosol; }
 };
 

@@ -11,6 +11,7 @@
 #include "metrics/motion_metrics.hpp"
 #include "motion/sync.hpp"
 #include "planners/motion/transition.hpp"
+#include "planners/motion/uniform/corner_choice.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
 
 namespace depotwin {
@@ -180,6 +181,50 @@ TEST(UniformPlanner, CornerChoiceDoesNotDependOnWhereTheCornerLies) {
       // (rounding may flip a batch split of the deposit: up to a few 1e-6; predicted on the
       // bed's own grid, as before, these corners differed by 7-14 %)
       EXPECT_NEAR(figure(b, "predicted_error_mm"), error, 1e-4 * error);
+    }
+  }
+}
+
+// An aerosol corner's candidates steady on their window's ends take those ends' deposit from the
+// steady line predicted once per corner (the slowed blends beyond their speed change, the
+// loops beyond their trims) and predict only the rest. Against every candidate's whole window
+// predicted: the same candidates and choice, each predicted error within 2 % (the two step
+// grids meet the shutter's ramps differently: up to 0.7 % for the loops here, 3e-5 for the
+// slowed blends).
+TEST(UniformPlanner, SharedWindowEndsPredictAsTheWholeWindow) {
+  for (const double interior_deg : {110.0, 60.0, 25.0}) {
+    SCOPED_TRACE(std::to_string(interior_deg));
+    const double turn = deg_to_rad(180.0 - interior_deg);
+    PrintChain chain;
+    chain.points = {Vec3(-8, 0, 0), Vec3(0, 0, 0), Vec3(8 * std::cos(turn), 8 * std::sin(turn), 0)};
+    chain.orientations.assign(3, ToolOrientation{});
+    chain.edge_speed_mm_s = {3.0, 3.0};
+    chain.edge_path = {0, 0};
+    chain.edge_source = {0, 0};
+    chain.point_path = {0, 0, 0};
+    chain.point_index = {0, 1, 2};
+    const std::vector<CornerGeometry> geometry = corner_geometry(chain.points, 0.05);
+    PathMotionOptions options;
+    options.enter_at_speed = options.leave_at_speed = true;
+    DepositModel shared, whole;
+    whole.share_window_ends = false;
+    PredictionScratch shared_scratch, whole_scratch;
+    const CornerDecision a =
+        choose_corner(chain, 1, geometry, kLimits, options, shared, 0.2, shared_scratch);
+    const CornerDecision b =
+        choose_corner(chain, 1, geometry, kLimits, options, whole, 0.2, whole_scratch);
+    ASSERT_EQ(a.candidates.size(), b.candidates.size());
+    ASSERT_GE(a.candidates.size(), 3u);  // slowed blends and loops
+    EXPECT_EQ(a.chosen.name, b.chosen.name);
+    EXPECT_EQ(a.chosen.plan.trim_in_mm, b.chosen.plan.trim_in_mm);
+    EXPECT_EQ(a.chosen.plan.trim_out_mm, b.chosen.plan.trim_out_mm);
+    EXPECT_EQ(a.chosen.plan.half_length_mm, b.chosen.plan.half_length_mm);
+    for (size_t k = 0; k < a.candidates.size(); ++k) {
+      EXPECT_EQ(a.candidates[k].name, b.candidates[k].name);
+      EXPECT_EQ(a.candidates[k].extra_time_s, b.candidates[k].extra_time_s);
+      EXPECT_GT(b.candidates[k].error_mm, 0.0);
+      EXPECT_NEAR(a.candidates[k].error_mm, b.candidates[k].error_mm,
+                  0.02 * b.candidates[k].error_mm);
     }
   }
 }
