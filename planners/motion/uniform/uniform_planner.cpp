@@ -75,18 +75,33 @@ PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerG
   d.figures.push_back({"deviation_mm", deviation, "mm"});
   d.figures.push_back({"trim_in_mm", c.plan.trim_in_mm, "mm"});
   d.figures.push_back({"trim_out_mm", c.plan.trim_out_mm, "mm"});
-  // the best of each other kind, for comparison
-  int pruned = 0;
+  // the best of each other kind, for comparison (of a kind whose every prediction was
+  // abandoned, the least cost it was known to exceed)
+  int pruned = 0, abandoned = 0;
   for (const char* kind : {"blend", "slow", "loop", "stop"}) {
     double best = std::numeric_limits<double>::infinity();
-    for (const CornerCandidate& other : decision.candidates)
-      if (other.name == kind && !other.pruned) best = std::min(best, other.cost);
-    if (std::isfinite(best)) d.figures.push_back({std::string(kind) + "_cost_mm", best, "mm"});
+    double above = std::numeric_limits<double>::infinity();
+    for (const CornerCandidate& other : decision.candidates) {
+      if (other.name != kind || other.pruned) continue;
+      if (other.abandoned)
+        above = std::min(above, other.cost);
+      else
+        best = std::min(best, other.cost);
+    }
+    if (std::isfinite(best))
+      d.figures.push_back({std::string(kind) + "_cost_mm", best, "mm"});
+    else if (std::isfinite(above))
+      d.figures.push_back({std::string(kind) + "_cost_above_mm", above, "mm"});
   }
-  // candidates whose extra time alone cost more than the chosen one's total
-  for (const CornerCandidate& other : decision.candidates) pruned += other.pruned ? 1 : 0;
+  // candidates whose extra time alone cost more than the best before them, and whose deposit
+  // partway did
+  for (const CornerCandidate& other : decision.candidates) {
+    pruned += other.pruned ? 1 : 0;
+    abandoned += other.abandoned ? 1 : 0;
+  }
   d.figures.push_back({"candidates", static_cast<double>(decision.candidates.size()), "count"});
   d.figures.push_back({"pruned_by_time", static_cast<double>(pruned), "count"});
+  d.figures.push_back({"abandoned", static_cast<double>(abandoned), "count"});
   return d;
 }
 

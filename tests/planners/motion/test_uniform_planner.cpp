@@ -208,13 +208,15 @@ TEST(UniformPlanner, SharedWindowEndsPredictAsTheWholeWindow) {
     options.enter_at_speed = options.leave_at_speed = true;
     DepositModel shared, whole;
     whole.share_window_ends = false;
+    // (every candidate predicted to its end)
+    shared.abandon_costly_predictions = whole.abandon_costly_predictions = false;
     PredictionScratch shared_scratch, whole_scratch;
     const CornerDecision a =
         choose_corner(chain, 1, geometry, kLimits, options, shared, 0.2, shared_scratch);
     const CornerDecision b =
         choose_corner(chain, 1, geometry, kLimits, options, whole, 0.2, whole_scratch);
     ASSERT_EQ(a.candidates.size(), b.candidates.size());
-    ASSERT_GE(a.candidates.size(), 3u);  // slowed blends and loops
+    ASSERT_GE(a.candidates.size(), 2u);  // loops and slowed blends
     EXPECT_EQ(a.chosen.name, b.chosen.name);
     EXPECT_EQ(a.chosen.plan.trim_in_mm, b.chosen.plan.trim_in_mm);
     EXPECT_EQ(a.chosen.plan.trim_out_mm, b.chosen.plan.trim_out_mm);
@@ -227,6 +229,65 @@ TEST(UniformPlanner, SharedWindowEndsPredictAsTheWholeWindow) {
                   0.02 * b.candidates[k].error_mm);
     }
   }
+}
+
+// An aerosol's slowed corner is abandoned once its deposit so far exceeds the targets by more
+// than the best candidate's cost: the deposit only grows, so that excess is a lower bound of
+// its error.
+// Against the same corners with every slowed corner predicted to its end: each abandoned
+// candidate's bound is at most its full error and above the chosen one's cost, and the choice
+// and every other candidate are the same.
+TEST(UniformPlanner, AbandonedSlowedCornersCouldNotHaveWon) {
+  int abandoned = 0;
+  for (const ProcessType type : {ProcessType::aerosol, ProcessType::extrusion}) {
+    for (const double interior_deg : {110.0, 60.0, 25.0, 8.0}) {
+      SCOPED_TRACE(std::string(process_type_name(type)) + " " + std::to_string(interior_deg));
+      const double turn = deg_to_rad(180.0 - interior_deg);
+      PrintChain chain;
+      chain.points = {Vec3(-8, 0, 0), Vec3(0, 0, 0),
+                      Vec3(8 * std::cos(turn), 8 * std::sin(turn), 0)};
+      chain.orientations.assign(3, ToolOrientation{});
+      chain.edge_speed_mm_s = {3.0, 3.0};
+      chain.edge_path = {0, 0};
+      chain.edge_source = {0, 0};
+      chain.point_path = {0, 0, 0};
+      chain.point_index = {0, 1, 2};
+      const std::vector<CornerGeometry> geometry = corner_geometry(chain.points, 0.05);
+      const bool aerosol = type == ProcessType::aerosol;
+      PathMotionOptions options;
+      options.enter_at_speed = options.leave_at_speed = aerosol;
+      options.lag_s = aerosol ? 0.0 : 0.05;
+      options.flow_follows_speed = options.loops_at_rest = !aerosol;
+      DepositModel quick, full;
+      quick.settings = full.settings = *context_for(type).process;
+      full.abandon_costly_predictions = false;
+      PredictionScratch quick_scratch, full_scratch;
+      const CornerDecision a =
+          choose_corner(chain, 1, geometry, kLimits, options, quick, 0.2, quick_scratch);
+      const CornerDecision b =
+          choose_corner(chain, 1, geometry, kLimits, options, full, 0.2, full_scratch);
+      ASSERT_EQ(a.candidates.size(), b.candidates.size());
+      EXPECT_EQ(a.chosen.name, b.chosen.name);
+      EXPECT_EQ(a.chosen.cost, b.chosen.cost);
+      EXPECT_FALSE(a.chosen.abandoned);
+      for (size_t k = 0; k < a.candidates.size(); ++k) {
+        const CornerCandidate &quick_one = a.candidates[k], &full_one = b.candidates[k];
+        EXPECT_EQ(quick_one.name, full_one.name);
+        EXPECT_FALSE(full_one.abandoned);
+        if (!quick_one.abandoned) {
+          EXPECT_EQ(quick_one.cost, full_one.cost);
+          continue;
+        }
+        ++abandoned;
+        EXPECT_EQ(type, ProcessType::aerosol);  // (an extruder's slowed corners run in full)
+        EXPECT_EQ(quick_one.name, "slow");
+        EXPECT_GT(quick_one.error_mm, 0.0);
+        EXPECT_LE(quick_one.error_mm, full_one.error_mm);
+        EXPECT_GT(quick_one.cost, a.chosen.cost);
+      }
+    }
+  }
+  EXPECT_GT(abandoned, 0);  // (the bound did fire)
 }
 
 // An extruder cannot close a shutter, but it can stop: at a sharp joint its loop ends the line
