@@ -28,24 +28,36 @@ struct FieldBounds {
   double y_hi_mm = 0.0;
 };
 
-// Bilinear interpolation between cell centres (lattice of ThicknessField) of the values
-// cell(ix, iy): thickness_mm_at's rule, for readers that look their cells up their own way.
-template <class CellFn>
-double bilinear_between_cells(double x_mm, double y_mm, double cell_mm, CellFn&& cell) {
-  // the four cell centres around the point and the point's fractional position
+// Where a point lies on the lattice of cell centres (ThicknessField): the cell below and left
+// of it and its fractional position from there, the weights of bilinear interpolation.
+struct BilinearPoint {
+  int ix0 = 0, iy0 = 0;
+  double wx = 0.0, wy = 0.0;
+};
+inline BilinearPoint bilinear_point(double x_mm, double y_mm, double cell_mm) {
   const double fx = x_mm / cell_mm;
   const double fy = y_mm / cell_mm;
   const double ix0_real = std::floor(fx);
   const double iy0_real = std::floor(fy);
-  const int ix0 = static_cast<int>(ix0_real);
-  const int iy0 = static_cast<int>(iy0_real);
-  const double wx = fx - ix0_real;
-  const double wy = fy - iy0_real;
-  const double v00 = cell(ix0, iy0);
-  const double v10 = cell(ix0 + 1, iy0);
-  const double v01 = cell(ix0, iy0 + 1);
-  const double v11 = cell(ix0 + 1, iy0 + 1);
-  return (1.0 - wy) * ((1.0 - wx) * v00 + wx * v10) + wy * ((1.0 - wx) * v01 + wx * v11);
+  return BilinearPoint{static_cast<int>(ix0_real), static_cast<int>(iy0_real), fx - ix0_real,
+                       fy - iy0_real};
+}
+
+// Bilinear interpolation between cell centres of the values cell(ix, iy) at a point
+// (bilinear_point once, for a point read many times): thickness_mm_at's rule, for readers that
+// look their cells up their own way.
+template <class CellFn>
+double bilinear_between_cells(const BilinearPoint& p, CellFn&& cell) {
+  const double v00 = cell(p.ix0, p.iy0);
+  const double v10 = cell(p.ix0 + 1, p.iy0);
+  const double v01 = cell(p.ix0, p.iy0 + 1);
+  const double v11 = cell(p.ix0 + 1, p.iy0 + 1);
+  return (1.0 - p.wy) * ((1.0 - p.wx) * v00 + p.wx * v10) +
+         p.wy * ((1.0 - p.wx) * v01 + p.wx * v11);
+}
+template <class CellFn>
+double bilinear_between_cells(double x_mm, double y_mm, double cell_mm, CellFn&& cell) {
+  return bilinear_between_cells(bilinear_point(x_mm, y_mm, cell_mm), cell);
 }
 
 class ThicknessField {

@@ -202,10 +202,9 @@ class CellReader {
     }
     return tile_ ? tile_[ThicknessField::Tiles::local_index(ix, iy)] : 0.0;
   }
-  // the field's thickness_mm_at (x, y)
-  double interpolated(double x_mm, double y_mm) {
-    return bilinear_between_cells(x_mm, y_mm, field_.cell_mm(),
-                                  [this](int ix, int iy) { return at(ix, iy); });
+  // the field's thickness_mm_at where the point lies (bilinear_point on the same cells)
+  double interpolated(const BilinearPoint& point) {
+    return bilinear_between_cells(point, [this](int ix, int iy) { return at(ix, iy); });
   }
 
  private:
@@ -240,7 +239,8 @@ struct CornerWindow {
     double missing_shared_mm[2] = {};  // less the shared ends' deposit too (per SharedEnds)
   };
   struct CentreSample {
-    double x_mm = 0.0, y_mm = 0.0, peak_mm = 0.0, missing_mm = 0.0;
+    BilinearPoint point;  // (on the field's cell lattice)
+    double peak_mm = 0.0, missing_mm = 0.0;
     double missing_shared_mm[2] = {};
   };
   std::vector<TargetCell> cells;
@@ -401,7 +401,8 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     const int edge = arc < leg[0] ? 0 : 1;
     const Vec3 p = edge == 0 ? Vec3(a + arc * w.d_in) : Vec3(c + (arc - leg[0]) * w.d_out);
     const double peak = areas[edge] * peak_per_area;
-    w.centre.push_back({p.x(), p.y(), peak, peak - rolls.interpolated(p.x(), p.y())});
+    const BilinearPoint point = bilinear_point(p.x(), p.y(), h);
+    w.centre.push_back({point, peak, peak - rolls.interpolated(point)});
   }
 
   // the shared ends, deposited with the rolls (after them in time): on each side the kinds'
@@ -417,7 +418,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
       reading.cells[k] = reader.at(w.cells[k].ix, w.cells[k].iy);
     reading.centre.resize(w.centre.size());
     for (size_t k = 0; k < w.centre.size(); ++k)
-      reading.centre[k] = reader.interpolated(w.centre[k].x_mm, w.centre[k].y_mm);
+      reading.centre[k] = reader.interpolated(w.centre[k].point);
   };
   constexpr int kKinds = 2;
   double t_s = roll_mm / w.v_out;  // (aerosol: the times only order the steps)
@@ -614,7 +615,7 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
                        shared ? cell.missing_shared_mm[kind] : cell.missing_mm) *
                   h * h / cell.line_area_mm2;
     for (const CornerWindow::CentreSample& sample : w.centre)
-      error_mm += part(cells.interpolated(sample.x_mm, sample.y_mm),
+      error_mm += part(cells.interpolated(sample.point),
                        shared ? sample.missing_shared_mm[kind] : sample.missing_mm) /
                   sample.peak_mm * h;
     return error_mm;
