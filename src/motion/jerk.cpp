@@ -236,6 +236,12 @@ bool null_move(const AxisBoundary& b) {
   return std::abs(b.q1 - b.q0) <= 1e-12 && std::abs(b.v1 - b.v0) <= 1e-12;
 }
 
+// an axis the move leaves where it is, at rest at both ends (the z of a move in the plane): it
+// may take any time, and stays at rest throughout
+bool at_rest_in_place(const AxisBoundary& b) {
+  return b.q0 == b.q1 && b.v0 == 0.0 && b.v1 == 0.0;
+}
+
 double tolerance(const AxisBoundary& b, double T, const AxisProblem& pr) {
   return 1e-9 * (1.0 + std::abs(b.q1 - b.q0) + pr.v_max * T);
 }
@@ -303,6 +309,7 @@ AxisProfile blend(const AxisProfile& first, const AxisProfile& second, double w,
 FeasibleDurations jerk_feasible_durations(const AxisBoundary& b, double v_max, double a_max,
                                           double j_max) {
   const AxisProblem pr = checked_problem(b, v_max, a_max, j_max);
+  if (at_rest_in_place(b)) return FeasibleDurations{{{0.0, kInf}}};
   const double d = b.q1 - b.q0;
   const double t_velocity = pr.tau(b.v1 - b.v0);
   // durations where the farthest profile falls short, and (mirrored: q, v -> -q, -v) where
@@ -345,6 +352,11 @@ AxisProfile jerk_fixed_time_move(const AxisBoundary& b, double duration_s, doubl
   if (T <= 0.0) {
     if (null_move(b)) return AxisProfile(b.q0, b.v0);
     throw InternalError("jerk-limited move: zero duration for a non-null move");
+  }
+  if (at_rest_in_place(b)) {
+    AxisProfile rest(b.q0, 0.0);
+    rest.append(T, 0.0);
+    return rest;
   }
   if (!reachable(b, T, pr))
     throw InternalError("jerk-limited move: duration " + std::to_string(T) + " s is not feasible");

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -148,6 +149,31 @@ TEST(Jerk, ATinyMoveAtSpeedIsTimedByItsLength) {
   const SynchronizedMove move = synchronized_move({AxisMove{b, v_max, a_max, j_max}});
   EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
   expect_valid(move.axes[0], b, move.duration_s, v_max, a_max, j_max);
+}
+
+TEST(Jerk, AnAxisAtRestInPlaceStaysAtRestForAnyDuration) {
+  // the z of a move in the plane: any duration is feasible, and the axis holds still for
+  // exactly that long (the general solution had femtosecond phases at both ends, ~1e-25 mm/s)
+  const AxisBoundary b{1.5, 1.5, 0, 0};
+  const FeasibleDurations feasible = jerk_feasible_durations(b, 100, 3000, 60000);
+  ASSERT_EQ(feasible.intervals.size(), 1u);
+  EXPECT_EQ(feasible.t_min(), 0.0);
+  EXPECT_EQ(feasible.intervals.front().second, std::numeric_limits<double>::infinity());
+  for (const double T : {0.0, 1e-9, 0.37, 1e4}) {
+    const AxisProfile profile = jerk_fixed_time_move(b, T, 100, 3000, 60000);
+    EXPECT_EQ(profile.duration_s(), T);
+    for (const double t : {0.0, 0.5 * T, T}) {
+      const AxisState state = profile.at(t);
+      EXPECT_EQ(state.q, 1.5);
+      EXPECT_EQ(state.v, 0.0);
+      EXPECT_EQ(state.a, 0.0);
+    }
+  }
+  // synchronised with a moving axis, it takes the moving one's time
+  const SynchronizedMove move = synchronized_move(
+      {AxisMove{AxisBoundary{0, 2, 0, 0}, 100, 3000, 60000}, AxisMove{b, 100, 3000, 60000}});
+  EXPECT_EQ(move.axes[1].duration_s(), move.duration_s);
+  EXPECT_EQ(move.axes[1].at(0.5 * move.duration_s).q, 1.5);
 }
 
 TEST(Jerk, ALongMoveHasNoFeasibleSliverOfOneRoundingError) {
