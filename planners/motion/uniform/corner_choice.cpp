@@ -213,6 +213,23 @@ class CellReader {
   const double* tile_ = nullptr;
 };
 
+// Reads the cells of one tile of a field (a window whose targets all lie in it): no tile lookup
+// per read. The values of CellReader.
+class TileReader {
+ public:
+  TileReader(const ThicknessField& field, int tile_x, int tile_y)
+      : tile_(field.tiles().find(tile_x, tile_y)) {}
+  double at(int ix, int iy) const {
+    return tile_ ? tile_[ThicknessField::Tiles::local_index(ix, iy)] : 0.0;
+  }
+  double interpolated(const BilinearPoint& point) const {
+    return bilinear_between_cells(point, [this](int ix, int iy) { return at(ix, iy); });
+  }
+
+ private:
+  const double* tile_;
+};
+
 // What every candidate at one corner shares: the window of the path around it (planned alone,
 // entering and leaving at print speed), and the even deposit it is compared with.
 struct CornerWindow {
@@ -245,6 +262,17 @@ struct CornerWindow {
   };
   std::vector<TargetCell> cells;
   std::vector<CentreSample> centre;
+  // whether every target cell and every cell a centreline sample reads lies in one tile (most
+  // windows: the corner is mid-tile), and which
+  bool one_tile = false;
+  int tile_x = 0, tile_y = 0;
+  // calls read(reader) with a reader of the field's cells: a TileReader where one tile holds
+  // them all, else a CellReader
+  template <class ReadFn>
+  auto with_reader(const ThicknessField& field, ReadFn&& read) const {
+    if (one_tile) return read(TileReader(field, tile_x, tile_y));
+    return read(CellReader(field));
+  }
   // the window's shared ends: its first shared_in_mm (from a) and last shared_out_mm (to b),
   // beyond where the candidates of a kind are expected to change anything: every candidate
   // (kBlendEnds: blends, slowed corners and stops), or the loops alone (kLoopEnds: the line at
@@ -405,6 +433,22 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     w.centre.push_back({point, peak, peak - rolls.interpolated(point)});
   }
 
+  // the one tile all reads fall in, if one does
+  {
+    using Tiles = ThicknessField::Tiles;
+    bool first = true, one = true;
+    const auto in_tile = [&](int ix, int iy) {
+      if (first) w.tile_x = Tiles::tile_of(ix), w.tile_y = Tiles::tile_of(iy), first = false;
+      one = one && Tiles::tile_of(ix) == w.tile_x && Tiles::tile_of(iy) == w.tile_y;
+    };
+    for (const CornerWindow::TargetCell& cell : w.cells) in_tile(cell.ix, cell.iy);
+    for (const CornerWindow::CentreSample& sample : w.centre) {
+      in_tile(sample.point.ix0, sample.point.iy0);
+      in_tile(sample.point.ix0 + 1, sample.point.iy0 + 1);
+    }
+    w.one_tile = one && !first;
+  }
+
   // the shared ends, deposited with the rolls (after them in time): on each side the kinds'
   // ends in order of length, each piece from where the last ended, the targets read after
   // each. A kind's ends add to the targets what its pieces did (the deposit is linear)
@@ -412,13 +456,14 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     std::vector<double> cells, centre;
   };
   const auto read = [&w, &rolls_process](Reading& reading) {
-    CellReader reader(rolls_process.field());
-    reading.cells.resize(w.cells.size());
-    for (size_t k = 0; k < w.cells.size(); ++k)
-      reading.cells[k] = reader.at(w.cells[k].ix, w.cells[k].iy);
-    reading.centre.resize(w.centre.size());
-    for (size_t k = 0; k < w.centre.size(); ++k)
-      reading.centre[k] = reader.interpolated(w.centre[k].point);
+    w.with_reader(rolls_process.field(), [&](auto&& reader) {
+      reading.cells.resize(w.cells.size());
+      for (size_t k = 0; k < w.cells.size(); ++k)
+        reading.cells[k] = reader.at(w.cells[k].ix, w.cells[k].iy);
+      reading.centre.resize(w.centre.size());
+      for (size_t k = 0; k < w.centre.size(); ++k)
+        reading.centre[k] = reader.interpolated(w.centre[k].point);
+    });
   };
   constexpr int kKinds = 2;
   double t_s = roll_mm / w.v_out;  // (aerosol: the times only order the steps)
@@ -605,20 +650,21 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   const ThicknessField& field = process->field();
   const double h = field.cell_mm();
   const auto error_so_far = [&](bool excess_only) {
-    CellReader cells(field);
-    const auto part = [excess_only](double deposit, double target) {
-      return excess_only ? std::max(0.0, deposit - target) : std::abs(deposit - target);
-    };
-    double error_mm = 0.0;
-    for (const CornerWindow::TargetCell& cell : w.cells)
-      error_mm += part(cells.at(cell.ix, cell.iy),
-                       shared ? cell.missing_shared_mm[kind] : cell.missing_mm) *
-                  h * h / cell.line_area_mm2;
-    for (const CornerWindow::CentreSample& sample : w.centre)
-      error_mm += part(cells.interpolated(sample.point),
-                       shared ? sample.missing_shared_mm[kind] : sample.missing_mm) /
-                  sample.peak_mm * h;
-    return error_mm;
+    return w.with_reader(field, [&](auto&& cells) {
+      const auto part = [excess_only](double deposit, double target) {
+        return excess_only ? std::max(0.0, deposit - target) : std::abs(deposit - target);
+      };
+      double error_mm = 0.0;
+      for (const CornerWindow::TargetCell& cell : w.cells)
+        error_mm += part(cells.at(cell.ix, cell.iy),
+                         shared ? cell.missing_shared_mm[kind] : cell.missing_mm) *
+                    h * h / cell.line_area_mm2;
+      for (const CornerWindow::CentreSample& sample : w.centre)
+        error_mm += part(cells.interpolated(sample.point),
+                         shared ? sample.missing_shared_mm[kind] : sample.missing_mm) /
+                    sample.peak_mm * h;
+      return error_mm;
+    });
   };
   const double time_cost_mm = time_weight_mm_s * candidate.extra_time_s;
   // the abandon checks: at three quarters of the steps and at seven eighths (a slowed corner's
