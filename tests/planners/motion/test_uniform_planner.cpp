@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "deposition/deposition_metrics.hpp"
 #include "metrics/motion_metrics.hpp"
@@ -185,6 +186,32 @@ TEST(UniformPlanner, CornerChoiceDoesNotDependOnWhereTheCornerLies) {
   }
 }
 
+// the chain of two 8 mm edges meeting at the joint (interior) angle, printed at 3 mm/s, as
+// choose_corner takes it
+PrintChain joint_chain(double interior_deg) {
+  const double turn = deg_to_rad(180.0 - interior_deg);
+  PrintChain chain;
+  chain.points = {Vec3(-8, 0, 0), Vec3(0, 0, 0), Vec3(8 * std::cos(turn), 8 * std::sin(turn), 0)};
+  chain.orientations.assign(3, ToolOrientation{});
+  chain.edge_speed_mm_s = {3.0, 3.0};
+  chain.edge_path = {0, 0};
+  chain.edge_source = {0, 0};
+  chain.point_path = {0, 0, 0};
+  chain.point_index = {0, 1, 2};
+  return chain;
+}
+
+// its corner decided under two deposit models (tolerance 0.05 mm, time_weight 0.2 mm/s)
+std::pair<CornerDecision, CornerDecision> decide_under(const PrintChain& chain,
+                                                       const PathMotionOptions& options,
+                                                       const DepositModel& first,
+                                                       const DepositModel& second) {
+  const std::vector<CornerGeometry> geometry = corner_geometry(chain.points, 0.05);
+  PredictionScratch first_scratch, second_scratch;
+  return {choose_corner(chain, 1, geometry, kLimits, options, first, 0.2, first_scratch),
+          choose_corner(chain, 1, geometry, kLimits, options, second, 0.2, second_scratch)};
+}
+
 // An aerosol corner's candidates steady on their window's ends take those ends' deposit from the
 // steady line predicted once per corner (the slowed blends beyond their speed change, the
 // loops beyond their trims) and predict only the rest. Against every candidate's whole window
@@ -194,27 +221,13 @@ TEST(UniformPlanner, CornerChoiceDoesNotDependOnWhereTheCornerLies) {
 TEST(UniformPlanner, SharedWindowEndsPredictAsTheWholeWindow) {
   for (const double interior_deg : {110.0, 60.0, 25.0}) {
     SCOPED_TRACE(std::to_string(interior_deg));
-    const double turn = deg_to_rad(180.0 - interior_deg);
-    PrintChain chain;
-    chain.points = {Vec3(-8, 0, 0), Vec3(0, 0, 0), Vec3(8 * std::cos(turn), 8 * std::sin(turn), 0)};
-    chain.orientations.assign(3, ToolOrientation{});
-    chain.edge_speed_mm_s = {3.0, 3.0};
-    chain.edge_path = {0, 0};
-    chain.edge_source = {0, 0};
-    chain.point_path = {0, 0, 0};
-    chain.point_index = {0, 1, 2};
-    const std::vector<CornerGeometry> geometry = corner_geometry(chain.points, 0.05);
     PathMotionOptions options;
     options.enter_at_speed = options.leave_at_speed = true;
     DepositModel shared, whole;
     whole.share_window_ends = false;
     // (every candidate predicted to its end)
     shared.abandon_costly_predictions = whole.abandon_costly_predictions = false;
-    PredictionScratch shared_scratch, whole_scratch;
-    const CornerDecision a =
-        choose_corner(chain, 1, geometry, kLimits, options, shared, 0.2, shared_scratch);
-    const CornerDecision b =
-        choose_corner(chain, 1, geometry, kLimits, options, whole, 0.2, whole_scratch);
+    const auto [a, b] = decide_under(joint_chain(interior_deg), options, shared, whole);
     ASSERT_EQ(a.candidates.size(), b.candidates.size());
     ASSERT_GE(a.candidates.size(), 2u);  // loops and slowed blends
     EXPECT_EQ(a.chosen.name, b.chosen.name);
@@ -242,17 +255,6 @@ TEST(UniformPlanner, AbandonedSlowedCornersCouldNotHaveWon) {
   for (const ProcessType type : {ProcessType::aerosol, ProcessType::extrusion}) {
     for (const double interior_deg : {110.0, 60.0, 25.0, 8.0}) {
       SCOPED_TRACE(std::string(process_type_name(type)) + " " + std::to_string(interior_deg));
-      const double turn = deg_to_rad(180.0 - interior_deg);
-      PrintChain chain;
-      chain.points = {Vec3(-8, 0, 0), Vec3(0, 0, 0),
-                      Vec3(8 * std::cos(turn), 8 * std::sin(turn), 0)};
-      chain.orientations.assign(3, ToolOrientation{});
-      chain.edge_speed_mm_s = {3.0, 3.0};
-      chain.edge_path = {0, 0};
-      chain.edge_source = {0, 0};
-      chain.point_path = {0, 0, 0};
-      chain.point_index = {0, 1, 2};
-      const std::vector<CornerGeometry> geometry = corner_geometry(chain.points, 0.05);
       const bool aerosol = type == ProcessType::aerosol;
       PathMotionOptions options;
       options.enter_at_speed = options.leave_at_speed = aerosol;
@@ -261,11 +263,7 @@ TEST(UniformPlanner, AbandonedSlowedCornersCouldNotHaveWon) {
       DepositModel quick, full;
       quick.settings = full.settings = *context_for(type).process;
       full.abandon_costly_predictions = false;
-      PredictionScratch quick_scratch, full_scratch;
-      const CornerDecision a =
-          choose_corner(chain, 1, geometry, kLimits, options, quick, 0.2, quick_scratch);
-      const CornerDecision b =
-          choose_corner(chain, 1, geometry, kLimits, options, full, 0.2, full_scratch);
+      const auto [a, b] = decide_under(joint_chain(interior_deg), options, quick, full);
       ASSERT_EQ(a.candidates.size(), b.candidates.size());
       EXPECT_EQ(a.chosen.name, b.chosen.name);
       EXPECT_EQ(a.chosen.cost, b.chosen.cost);
