@@ -164,8 +164,9 @@ TEST(BezierJerk, VerySlowMachinesPlanWithinTheirLimits) {
     const auto peaks = testing_support::finite_difference_peaks(plan, limits, h);
     EXPECT_LE(peaks.max_speed_ratio(), 1 + 1e-6);
     EXPECT_LE(peaks.max_accel_ratio() * a_max, a_max * (1 + 1e-6) + 6.0 * kRoundingMm / (h * h));
-    if (j_max > 0.0)
+    if (j_max > 0.0) {
       EXPECT_LE(peaks.max_jerk_ratio() * j_max, j_max * 1.01 + 8.0 * kRoundingMm / (h * h * h));
+    }
   }
 }
 
