@@ -753,25 +753,27 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
     return candidate;
   };
 
-  // the blends: the least that keeps the print speed, else the largest within the tolerance
-  bool full_speed_blend = false;
+  // the least blend that keeps the print speed, when it fits the tolerance
+  CornerPlan full_speed;
+  bool full_speed_fits = false;
   if (g.max_half_length_mm > 0.0) {
     const MachineLimits box = corner_blend_limits(g, g.max_half_length_mm, limits);
     const double needed = blend_half_length_for_speed(g.shape, speed, box);
     if (needed <= g.max_half_length_mm) {
-      // the only candidate: the print speed kept within the tolerance, nothing to weigh it
-      // against (its deposit is not predicted; its time is)
-      CornerPlan plan;
-      plan.treatment = CornerTreatment::blend;
-      plan.half_length_mm = std::max(needed, 1e-9 * g.max_half_length_mm);
-      CornerCandidate candidate =
-          evaluate_corner(window, plan, limits, options, model, time_weight_mm_s, -kInf);
-      candidate.name = "blend";
-      candidates.push_back(candidate);
-      full_speed_blend = true;
+      full_speed.treatment = CornerTreatment::blend;
+      full_speed.half_length_mm = std::max(needed, 1e-9 * g.max_half_length_mm);
+      full_speed_fits = true;
     }
   }
-  if (!full_speed_blend) {
+  if (full_speed_fits && overlap_mm(g, model) <= 0.0) {
+    // at 90 deg or more the lines do not overlap: the only candidate, the print speed kept
+    // within the tolerance, nothing to weigh it against (its deposit is not predicted; its
+    // time is)
+    CornerCandidate candidate =
+        evaluate_corner(window, full_speed, limits, options, model, time_weight_mm_s, -kInf);
+    candidate.name = "blend";
+    candidates.push_back(candidate);
+  } else {
     add_targets(window, model, scratch);
     // loops, printing resuming past the overlap of the two lines at a sharp corner (aerosol:
     // at print speed, the shutter closed; extrusion: the line ends at rest, the nozzle travels
@@ -819,7 +821,12 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
         previous = slow.cost;
       }
     };
-    if (model.aerosol()) {
+    if (full_speed_fits) {
+      // a sharper joint taken at print speed: its lines still overlap next to the corner, so
+      // the blend is weighed against the loops, which trim the overlap
+      add("blend", full_speed, false);
+      add_loops();
+    } else if (model.aerosol()) {
       // the stream cannot follow the speed: a slowed corner thickens the line as 1 / v, and
       // beats a loop seldom (on bench_uniform's 462 such corners, never where its largest blend
       // did not). The loops first, so the slowed corners can stop as soon as they cannot win

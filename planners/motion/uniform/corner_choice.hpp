@@ -15,19 +15,20 @@
 //           trim: the line ends at rest, the nozzle travels with the flow off and the next line
 //           starts from rest (the flow follows the speed at both);
 //   stop    extrusion only: the path comes to rest at the corner (the flow follows the speed).
-// A corner the least blend takes at print speed has that one candidate: its deposit is not
-// predicted. Otherwise, for each candidate, a window of the path around the corner (the two edges,
-// as far as the slowest candidate's speed change and the flow lag's settling after it, the
-// largest blend and the largest trim its loops try, plus 6 sigma) is planned as the planner
-// will plan it (entering and leaving at print speed), its deposit predicted step by step (at
-// most 10 ms and a quarter sigma of travel; the footprint cut at 4 sigma) from the extruder's
-// settled state, plus pre- and post-rolls at print speed so the window's ends deposit as a
-// continuing line would (the rolls' deposit is the same for every candidate: predicted once),
-// and compared with the even deposit the process engineer asks for: on every cell within half a
-// line width of the window's centreline (1 sigma clear of its ends), the steady line's cross
-// section at the cell's distance from the nearest centreline point (the union of the lines:
-// where two lines meet at a sharp corner the target is not their doubled sum). The predicted
-// thickness error is
+// A corner of 90 deg or more that the least blend takes at print speed has that one candidate:
+// its deposit is not predicted. At a sharper one the two lines overlap next to the corner even
+// at print speed: that blend is predicted and weighed against the loops. Otherwise, for each
+// candidate, a window of the path around the corner (the two edges, as far as the slowest
+// candidate's speed change and the flow lag's settling after it, the largest blend and the largest
+// trim its loops try, plus 6 sigma) is planned as the planner will plan it (entering and leaving at
+// print speed), its deposit predicted step by step (at most 10 ms and a quarter sigma of travel;
+// the footprint cut at 4 sigma) from the extruder's settled state, plus pre- and post-rolls at
+// print speed so the window's ends deposit as a continuing line would (the rolls' deposit is the
+// same for every candidate: predicted once), and compared with the even deposit the process
+// engineer asks for: on every cell within half a line width of the window's centreline (1 sigma
+// clear of its ends), the steady line's cross section at the cell's distance from the nearest
+// centreline point (the union of the lines: where two lines meet at a sharp corner the target is
+// not their doubled sum). The predicted thickness error is
 //   E = sum |T - T*| cell^2 / A_line   (mm: the length of line whose material is misplaced;
 //                                        A_line the steady line's cross-section area)
 // and the cost E + time_weight * (window time - window length / print speed): time_weight is

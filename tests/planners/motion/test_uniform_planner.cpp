@@ -139,6 +139,26 @@ TEST(UniformPlanner, ShallowJointIsBlendedAtFullSpeed) {
   }
 }
 
+// On a quicker machine (a_max 300 mm/s^2) a blend within the tolerance keeps the print speed at
+// 28 degrees too, but there the two lines still overlap next to the corner: that blend's deposit
+// is predicted and weighed against the loops, which trim the overlap (aerosol: a loop wins,
+// cheaper by its predicted error than the blend by more than its time). At 100 degrees the
+// lines do not overlap and the blend stays the only candidate.
+TEST(UniformPlanner, SharpJointAtPrintSpeedIsWeighedAgainstLoops) {
+  const MachineLimits quick = MachineLimits::uniform(20.0, 300.0, 30000.0);
+  const UniformPlanner planner{UniformSettings{}};
+  const PlanDecision sharp =
+      only_corner(planner.plan_in_context(joint(28.0), quick, context_for(ProcessType::aerosol)));
+  EXPECT_EQ(sharp.choice, "loop");
+  EXPECT_GT(figure(sharp, "candidates"), 2.0);
+  EXPECT_GT(figure(sharp, "blend_cost_mm"), figure(sharp, "cost_mm"));
+  const PlanDecision open =
+      only_corner(planner.plan_in_context(joint(100.0), quick, context_for(ProcessType::aerosol)));
+  EXPECT_EQ(open.choice, "blend");
+  EXPECT_EQ(figure(open, "candidates"), 1.0);
+  EXPECT_NEAR(figure(open, "speed_mm_s"), 3.0, 1e-9);
+}
+
 // At a 10 degree joint no blend within the tolerance can keep the speed; aerosol does not slow
 // down there (its thickness would follow 1/v): it closes the shutter and loops, and every
 // deposited sample is at the print speed.
