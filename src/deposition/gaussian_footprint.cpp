@@ -20,6 +20,17 @@ constexpr double kMaxSubChordSigmas = 0.3;
 // continuous in the node position, with the hard cut's mass to first order
 constexpr double kTaperSigmas = 0.5;
 
+// floor and ceil of x as int, |x| < 2^31 (std::floor and std::ceil exactly, without their
+// library code where the target has no rounding instruction)
+int floor_int(double x) {
+  const int i = static_cast<int>(x);
+  return x < i ? i - 1 : i;
+}
+int ceil_int(double x) {
+  const int i = static_cast<int>(x);
+  return x > i ? i + 1 : i;
+}
+
 // count Gaussian recurrences side by side: g_k[i] = value_k, value_k *= ratio_k,
 // ratio_k *= step_factor, sum_k += value_k (independent chains, so the multiplies overlap)
 template <int count>
@@ -98,11 +109,11 @@ void GaussianFootprint::fill_factors(const double* centres_mm, const double* sca
   for (int k = 0; k < count; ++k) {
     double* gk = g + static_cast<size_t>(k) * capacity_;
     const double centre = centres_mm[k];
-    const int first = std::max(0, static_cast<int>(std::ceil((centre - reach_mm_) / h)) - i0);
-    const int last = std::min(n - 1, static_cast<int>(std::floor((centre + reach_mm_) / h)) - i0);
+    const int first = std::max(0, ceil_int((centre - reach_mm_) / h) - i0);
+    const int last = std::min(n - 1, floor_int((centre + reach_mm_) / h) - i0);
     // cells where the taper has begun, on either side of the centre
-    const int inner_first = static_cast<int>(std::floor((centre - taper_start_mm_) / h)) - i0;
-    const int inner_last = static_cast<int>(std::ceil((centre + taper_start_mm_) / h)) - i0;
+    const int inner_first = floor_int((centre - taper_start_mm_) / h) - i0;
+    const int inner_last = ceil_int((centre + taper_start_mm_) / h) - i0;
     double removed = 0.0;
     auto cut = [&](int i) {
       removed += gk[i];
@@ -120,8 +131,9 @@ void GaussianFootprint::fill_factors(const double* centres_mm, const double* sca
     for (int i = std::max(last + 1, 0); i < n; ++i) cut(i);
     for (int i = first; i <= std::min(last, inner_first); ++i) fade(i);
     for (int i = std::max(first, std::max(inner_last, inner_first + 1)); i <= last; ++i) fade(i);
+    // (the cells beyond reach are 0 already)
     const double factor = scales[k] / (sum[k] - removed);
-    for (int i = 0; i < n; ++i) gk[i] *= factor;
+    for (int i = first; i <= last; ++i) gk[i] *= factor;
   }
 }
 
@@ -135,16 +147,32 @@ void GaussianFootprint::deposit_nodes(ThicknessField& field, const FootprintNode
     y_min = std::min(y_min, nodes[k].y_mm);
     y_max = std::max(y_max, nodes[k].y_mm);
   }
-  const int ix_lo = static_cast<int>(std::ceil((x_min - reach_mm_) / cell_mm_));
-  const int ix_hi = static_cast<int>(std::floor((x_max + reach_mm_) / cell_mm_));
-  const int iy_lo = static_cast<int>(std::ceil((y_min - reach_mm_) / cell_mm_));
-  const int iy_hi = static_cast<int>(std::floor((y_max + reach_mm_) / cell_mm_));
+  const int ix_lo = ceil_int((x_min - reach_mm_) / cell_mm_);
+  const int ix_hi = floor_int((x_max + reach_mm_) / cell_mm_);
+  const int iy_lo = ceil_int((y_min - reach_mm_) / cell_mm_);
+  const int iy_hi = floor_int((y_max + reach_mm_) / cell_mm_);
   const int nx = ix_hi - ix_lo + 1;
   const int ny = iy_hi - iy_lo + 1;
   if (nx > capacity_ || ny > capacity_ || count < 1 || count > kMaxNodes)
     throw InternalError("GaussianFootprint: box of " + std::to_string(nx) + " x " +
                         std::to_string(ny) + " cells exceeds capacity " +
                         std::to_string(capacity_));
+
+  // the rows to write: the box's, within the field's write region if it has one (nothing to
+  // write there: nothing to compute)
+  const ThicknessField::WriteRegion* region = field.write_region();
+  int row_first = iy_lo, row_last = iy_hi;
+  if (region != nullptr) {
+    row_first = std::max(row_first, region->iy_lo);
+    row_last = std::min(row_last, region->iy_hi());
+    const auto row_overlaps = [&](int iy) {
+      const std::pair<int, int>& span = region->spans[iy - region->iy_lo];
+      return std::max(span.first, ix_lo) <= std::min(span.second, ix_hi);
+    };
+    while (row_first <= row_last && !row_overlaps(row_first)) ++row_first;
+    while (row_last >= row_first && !row_overlaps(row_last)) --row_last;
+    if (row_first > row_last) return;
+  }
 
   // per-node column factors, and row factors scaled to thickness (volume / cell area)
   const double inv_area = 1.0 / (cell_mm_ * cell_mm_);
@@ -169,18 +197,27 @@ void GaussianFootprint::deposit_nodes(ThicknessField& field, const FootprintNode
   const double* gy2 = gy1 + capacity_;
   const double* gy3 = gy2 + capacity_;
 
-  // rank-count update of every tile the box overlaps: cell += sum_k gy_k[row] gx_k[col]
-  ThicknessField::Tiles& tiles = field.tiles_for_writing(ix_lo, ix_hi, iy_lo, iy_hi);
-  for (int ty = Tiles::tile_of(iy_lo); ty <= Tiles::tile_of(iy_hi); ++ty) {
-    const int row_lo = std::max(iy_lo, ty * kTile);
-    const int row_hi = std::min(iy_hi, ty * kTile + kTile - 1);
+  // rank-count update of every tile the box overlaps: cell += sum_k gy_k[row] gx_k[col] (in a
+  // write region, each row's cells within its span)
+  ThicknessField::Tiles& tiles = field.tiles_for_writing(ix_lo, ix_hi, row_first, row_last);
+  for (int ty = Tiles::tile_of(row_first); ty <= Tiles::tile_of(row_last); ++ty) {
+    const int row_lo = std::max(row_first, ty * kTile);
+    const int row_hi = std::min(row_last, ty * kTile + kTile - 1);
     for (int tx = Tiles::tile_of(ix_lo); tx <= Tiles::tile_of(ix_hi); ++tx) {
-      const int col_lo = std::max(ix_lo, tx * kTile);
-      const int col_hi = std::min(ix_hi, tx * kTile + kTile - 1);
-      const int cols = col_hi - col_lo + 1;
-      const int c0 = col_lo - ix_lo;
-      double* tile = tiles.get_or_create(tx, ty);
+      const int tile_col_lo = std::max(ix_lo, tx * kTile);
+      const int tile_col_hi = std::min(ix_hi, tx * kTile + kTile - 1);
+      double* tile = nullptr;
       for (int iy = row_lo; iy <= row_hi; ++iy) {
+        int col_lo = tile_col_lo, col_hi = tile_col_hi;
+        if (region != nullptr) {
+          const std::pair<int, int>& span = region->spans[iy - region->iy_lo];
+          col_lo = std::max(col_lo, span.first);
+          col_hi = std::min(col_hi, span.second);
+          if (col_lo > col_hi) continue;
+        }
+        if (tile == nullptr) tile = tiles.get_or_create(tx, ty);
+        const int cols = col_hi - col_lo + 1;
+        const int c0 = col_lo - ix_lo;
         const int r = iy - iy_lo;
         double* __restrict dst = tile + Tiles::local_of(iy) * kTile + Tiles::local_of(col_lo);
         const double a0 = gy0[r];

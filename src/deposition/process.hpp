@@ -135,6 +135,9 @@ class Process {
   // put the two steps a failed batch comes down to in one call (StepBatch::pair_short_steps):
   // for predictions, a little less exact on curves for half the calls there
   void pair_short_steps(bool on) { batch_.pair_short_steps(on); }
+  // deposit only the region's cells from now on (ThicknessField::limit_writes: a prediction read
+  // at a few cells); kept by restart()
+  void limit_writes(ThicknessField::WriteRegion region) { field_.limit_writes(std::move(region)); }
   // how the steps were batched so far
   const StepBatch::Stats& batch_stats() const { return batch_.stats(); }
   const DepositionSettings& settings() const { return settings_; }

@@ -13,6 +13,8 @@
 #include <cmath>
 #include <cstddef>
 #include <functional>
+#include <utility>
+#include <vector>
 
 #include "core/heightmap.hpp"
 #include "deposition/sparse_tiles.hpp"
@@ -109,6 +111,27 @@ class ThicknessField {
   // cells written since the last zero() are cleared (their bounding box)
   void zero();
 
+  // The cells a deposit will be read at, when that is not all of them (a prediction compared
+  // with its targets): in row iy, cells [first, last] of its span, rows [iy_lo, iy_lo + rows).
+  // The deposition kernel (GaussianFootprint) then skips every other cell, so those hold only
+  // part of the deposit (total_volume_mm3 and the metrics no longer add up); the cells within
+  // are exactly as without the region.
+  struct WriteRegion {
+    int iy_lo = 0;
+    std::vector<std::pair<int, int>> spans;  // per row from iy_lo: first > last for none
+    int iy_hi() const { return iy_lo + static_cast<int>(spans.size()) - 1; }
+  };
+  void limit_writes(WriteRegion region) {
+    region_ = std::move(region);
+    limited_ = true;
+  }
+  void write_everywhere() {
+    limited_ = false;
+    region_.spans.clear();
+  }
+  // the region writes are limited to; nullptr when every cell is written
+  const WriteRegion* write_region() const { return limited_ ? &region_ : nullptr; }
+
   // raw tile access for the metrics; writing through it (non-const) makes the next zero()
   // clear every tile
   Tiles& tiles() {
@@ -140,6 +163,8 @@ class ThicknessField {
   double cell_mm_;
   Tiles tiles_;
   CellBox written_;
+  bool limited_ = false;
+  WriteRegion region_;
 };
 
 }  // namespace depotwin

@@ -259,6 +259,53 @@ TEST(Footprint, ContinuousInNodePositionAtTheTruncationRadius) {
   EXPECT_NEAR(inside.total_volume_mm3(), 1e-3, 1e-15);
 }
 
+// a field limited to a region (ThicknessField::limit_writes): its cells hold exactly what an
+// unlimited field's do, every other cell nothing; a deposit wholly outside touches no tile
+TEST(Footprint, WriteRegionKeepsItsCellsExactAndSkipsTheRest) {
+  GaussianFootprint footprint(kSigma, kCell, 5.0, 2.0);
+  ThicknessField everywhere(kCell), limited(kCell);
+  // a band of rows 3..10, each from a column that moves with the row (a slanted strip)
+  ThicknessField::WriteRegion region;
+  region.iy_lo = 3;
+  for (int iy = 3; iy <= 10; ++iy) region.spans.push_back({iy - 8, iy + 2});
+  region.spans[4] = {1, 0};  // row 7: no cell
+  limited.limit_writes(region);
+  // 1-, 3- and 4-node groups across the band and beside it
+  const FootprintNode nodes[4] = {
+      {0.05, 0.12, 1e-3}, {0.07, 0.15, 2e-3}, {0.09, 0.19, 1e-3}, {0.11, 0.21, 5e-4}};
+  for (const int count : {1, 3, 4}) {
+    footprint.deposit_nodes(everywhere, nodes, count);
+    footprint.deposit_nodes(limited, nodes, count);
+  }
+  int inside = 0;
+  for (int iy = -30; iy <= 40; ++iy)
+    for (int ix = -40; ix <= 40; ++ix) {
+      const bool in_region = iy >= 3 && iy <= 10 && ix >= region.spans[iy - 3].first &&
+                             ix <= region.spans[iy - 3].second;
+      if (in_region) {
+        ++inside;
+        ASSERT_EQ(limited.cell_thickness_mm(ix, iy), everywhere.cell_thickness_mm(ix, iy))
+            << ix << ", " << iy;
+        EXPECT_GT(limited.cell_thickness_mm(ix, iy), 0.0) << ix << ", " << iy;
+      } else {
+        ASSERT_EQ(limited.cell_thickness_mm(ix, iy), 0.0) << ix << ", " << iy;
+      }
+    }
+  EXPECT_EQ(inside, 7 * 11);
+  // (so it holds only part of the material)
+  EXPECT_GT(limited.total_volume_mm3(), 0.0);
+  EXPECT_LT(limited.total_volume_mm3(), 0.9 * everywhere.total_volume_mm3());
+  // nodes 2 mm away: their box misses the band, no tile is made
+  const size_t tiles = limited.allocated_tiles();
+  const FootprintNode far_node{2.0, 2.0, 1e-3};
+  footprint.deposit_nodes(limited, &far_node, 1);
+  EXPECT_EQ(limited.allocated_tiles(), tiles);
+  // writing everywhere again: the far node lands whole
+  limited.write_everywhere();
+  footprint.deposit_nodes(limited, &far_node, 1);
+  EXPECT_GT(limited.allocated_tiles(), tiles);
+}
+
 TEST(Batching, BadBatchLengthIsInputError) {
   EXPECT_THROW(make_process(aerosol_settings(-1.0)), InputError);
   EXPECT_THROW(make_process(aerosol_settings(3.0)), InputError);
