@@ -380,13 +380,9 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
       rolls_process.advance(step);
     }
   };
-  steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
-  steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
-  // (read through one reader until the shared ends are deposited, which may add tiles)
-  CellReader rolls(rolls_process.field());
 
   // the even deposit over the window's target cells: the steady line's cross section at the
-  // cell's distance from the nearest centreline point
+  // cell's distance from the nearest centreline point (the rolls' deposit taken off below)
   const double h = w.cell_mm;
   const double r = 0.5 * settings.resolved_line_width_mm();
   const double total_arc = (c - a).norm() + (b - c).norm();
@@ -416,8 +412,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
         CornerWindow::TargetCell cell;
         cell.ix = ix, cell.iy = iy;
         cell.missing_mm =
-            areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma)) -
-            rolls.at(ix, iy);
+            areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma));
         cell.line_area_mm2 = areas[edge];
         w.cells.push_back(cell);
       }
@@ -429,9 +424,39 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     const int edge = arc < leg[0] ? 0 : 1;
     const Vec3 p = edge == 0 ? Vec3(a + arc * w.d_in) : Vec3(c + (arc - leg[0]) * w.d_out);
     const double peak = areas[edge] * peak_per_area;
-    const BilinearPoint point = bilinear_point(p.x(), p.y(), h);
-    w.centre.push_back({point, peak, peak - rolls.interpolated(point)});
+    w.centre.push_back({bilinear_point(p.x(), p.y(), h), peak, peak});
   }
+
+  // every deposit of this corner is read at those cells alone: the scratch fields write no
+  // other (in each row, from its first such cell to its last)
+  {
+    // the cells read: each target, and the four around each centreline sample
+    std::vector<std::pair<int, int>> read_cells;
+    for (const CornerWindow::TargetCell& cell : w.cells) read_cells.emplace_back(cell.ix, cell.iy);
+    for (const CornerWindow::CentreSample& sample : w.centre)
+      for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx)
+          read_cells.emplace_back(sample.point.ix0 + dx, sample.point.iy0 + dy);
+    ThicknessField::WriteRegion region;
+    if (!read_cells.empty()) {
+      const auto [low, high] =
+          std::minmax_element(read_cells.begin(), read_cells.end(),
+                              [](const auto& p, const auto& q) { return p.second < q.second; });
+      region.iy_lo = low->second;
+      region.spans.assign(static_cast<size_t>(high->second - low->second + 1),
+                          {std::numeric_limits<int>::max(), std::numeric_limits<int>::min()});
+      for (const auto& [ix, iy] : read_cells) {
+        std::pair<int, int>& span = region.spans[static_cast<size_t>(iy - region.iy_lo)];
+        span.first = std::min(span.first, ix), span.second = std::max(span.second, ix);
+      }
+    }
+    rolls_process.limit_writes(region);
+    w.scratch->limit_writes(std::move(region));
+  }
+
+  // the rolls' deposit, taken off the targets
+  steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
+  steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
 
   // the one tile all reads fall in, if one does
   {
@@ -449,13 +474,15 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     w.one_tile = one && !first;
   }
 
-  // the shared ends, deposited with the rolls (after them in time): on each side the kinds'
-  // ends in order of length, each piece from where the last ended, the targets read after
-  // each. A kind's ends add to the targets what its pieces did (the deposit is linear)
+  // the targets' readings of the rolls' field: the rolls alone, then as the shared ends are
+  // deposited with them (after them in time)
   struct Reading {
     std::vector<double> cells, centre;
   };
-  const auto read = [&w, &rolls_process](Reading& reading) {
+  std::vector<Reading> readings;
+  readings.reserve(5);
+  const auto read = [&w, &rolls_process, &readings]() {
+    Reading& reading = readings.emplace_back();
     w.with_reader(rolls_process.field(), [&](auto&& reader) {
       reading.cells.resize(w.cells.size());
       for (size_t k = 0; k < w.cells.size(); ++k)
@@ -464,17 +491,29 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
       for (size_t k = 0; k < w.centre.size(); ++k)
         reading.centre[k] = reader.interpolated(w.centre[k].point);
     });
+    return static_cast<int>(readings.size()) - 1;
   };
+  // what the window's own deposit should add: the target less the rolls'
+  const int rolls_only = read();
+  for (size_t k = 0; k < w.cells.size(); ++k)
+    w.cells[k].missing_mm -= readings[rolls_only].cells[k];
+  for (size_t k = 0; k < w.centre.size(); ++k)
+    w.centre[k].missing_mm -= readings[rolls_only].centre[k];
+
+  // the shared ends: on each side the kinds' ends in order of length, each piece from where the
+  // last ended, the targets read after each (a kind whose end adds nothing shares the last
+  // reading). A kind's ends add to the targets what its pieces did (the deposit is linear)
   constexpr int kKinds = 2;
   double t_s = roll_mm / w.v_out;  // (aerosol: the times only order the steps)
   // side 0: from a along d_in; side 1: back from b along -d_out
-  Reading side_start[2], after_kind[2][kKinds];
+  int side_start[2] = {rolls_only, rolls_only}, after_kind[2][kKinds] = {};
+  int last = rolls_only;
   for (int side = 0; side < 2; ++side) {
     const double* shared_mm = side == 0 ? w.shared_in_mm : w.shared_out_mm;
     const Vec3 from = side == 0 ? a : b;
     const Vec3 along = side == 0 ? w.d_in : Vec3(-w.d_out);
     const double speed = side == 0 ? w.v_in : w.v_out;
-    read(side_start[side]);
+    side_start[side] = last;
     int order[kKinds] = {CornerWindow::kBlendEnds, CornerWindow::kLoopEnds};
     if (shared_mm[order[1]] < shared_mm[order[0]]) std::swap(order[0], order[1]);
     double deposited_mm = 0.0;
@@ -488,22 +527,23 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
           steady(p1, p0, speed, t_s);
         t_s += (shared_mm[kind] - deposited_mm) / speed + 1.0;
         deposited_mm = shared_mm[kind];
+        last = read();
       }
-      read(after_kind[side][kind]);
+      after_kind[side][kind] = last;
     }
   }
   for (int kind = 0; kind < kKinds; ++kind) {
     // what the kind's two ends added: (after its in-end less before it) + (the same out)
-    const auto added = [&](const auto& of, size_t k) {
-      return (of(after_kind[0][kind])[k] - of(side_start[0])[k]) +
-             (of(after_kind[1][kind])[k] - of(side_start[1])[k]);
-    };
-    const auto cells = [](const Reading& r) -> const std::vector<double>& { return r.cells; };
-    const auto centre = [](const Reading& r) -> const std::vector<double>& { return r.centre; };
+    const Reading &in_before = readings[side_start[0]], &in_after = readings[after_kind[0][kind]];
+    const Reading &out_before = readings[side_start[1]], &out_after = readings[after_kind[1][kind]];
     for (size_t k = 0; k < w.cells.size(); ++k)
-      w.cells[k].missing_shared_mm[kind] = w.cells[k].missing_mm - added(cells, k);
+      w.cells[k].missing_shared_mm[kind] =
+          w.cells[k].missing_mm -
+          ((in_after.cells[k] - in_before.cells[k]) + (out_after.cells[k] - out_before.cells[k]));
     for (size_t k = 0; k < w.centre.size(); ++k)
-      w.centre[k].missing_shared_mm[kind] = w.centre[k].missing_mm - added(centre, k);
+      w.centre[k].missing_shared_mm[kind] =
+          w.centre[k].missing_mm - ((in_after.centre[k] - in_before.centre[k]) +
+                                    (out_after.centre[k] - out_before.centre[k]));
   }
 }
 
