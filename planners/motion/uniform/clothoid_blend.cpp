@@ -119,7 +119,6 @@ BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
   const double theta = turn_angle(d_in, d_out), phi = 0.5 * theta;
   const Vec3 e2 = (d_out - d_out.dot(d_in) * d_in).normalized();
   BlendShape shape;
-  double curvature_norm = 0.0, third_norm = 0.0;
   // cos and sin of phi u^2 at u = k / N by the chirp recurrence: the angle grows by
   // phi (2k + 1) / N^2 from sample k to k + 1, a rotation whose own angle grows by 2 phi / N^2
   // (no sincos per sample; rounding drifts by ~N^2 eps = 7e-12, far within kShapeSlack). The
@@ -142,8 +141,6 @@ BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
       shape.tangent = shape.tangent.cwiseMax(t.cwiseAbs());
       shape.curvature = shape.curvature.cwiseMax(d2.cwiseAbs());
       shape.third = shape.third.cwiseMax(d3.cwiseAbs());
-      curvature_norm = std::max(curvature_norm, d2.norm());
-      third_norm = std::max(third_norm, d3.norm());
     }
     // (psi, turn) -> (psi + turn, turn + growth)
     const double next_cos = cos_psi * cos_turn - sin_psi * sin_turn;
@@ -153,7 +150,10 @@ BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
     sin_turn = sin_turn * cos_growth + cos_turn * sin_growth;
     cos_turn = next_cos_turn;
   }
-  // what the samples may miss between them
+  // what the samples may miss between them, against the largest norms (t and the normal are
+  // orthonormal: |d2| = kappa and |d3| = sqrt(4 phi^2 + kappa^4), largest at u = 1)
+  const double curvature_norm = 2.0 * phi;
+  const double third_norm = std::sqrt(4.0 * phi * phi + std::pow(2.0 * phi, 4));
   shape.tangent.array() += kShapeSlack;
   shape.curvature.array() += kShapeSlack * curvature_norm;
   shape.third.array() += kShapeSlack * third_norm;
