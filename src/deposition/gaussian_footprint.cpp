@@ -106,14 +106,17 @@ void GaussianFootprint::fill_factors(const double* centres_mm, const double* sca
   // moves: only the few cells at the ends change, and the sum with them; then the
   // discrete normalisation: its cells receive exactly its volume (times its scale)
   const double inv_taper = 1.0 / (kTaperSigmas * sigma_mm_);
+  const double inv_h = 1.0 / h;
   for (int k = 0; k < count; ++k) {
     double* gk = g + static_cast<size_t>(k) * capacity_;
     const double centre = centres_mm[k];
-    const int first = std::max(0, ceil_int((centre - reach_mm_) / h) - i0);
-    const int last = std::min(n - 1, floor_int((centre + reach_mm_) / h) - i0);
+    // (by 1 / h: a rounding that moves an index by one moves a cell the taper gives nothing,
+    // or leaves whole, from one loop to the other)
+    const int first = std::max(0, ceil_int((centre - reach_mm_) * inv_h) - i0);
+    const int last = std::min(n - 1, floor_int((centre + reach_mm_) * inv_h) - i0);
     // cells where the taper has begun, on either side of the centre
-    const int inner_first = floor_int((centre - taper_start_mm_) / h) - i0;
-    const int inner_last = ceil_int((centre + taper_start_mm_) / h) - i0;
+    const int inner_first = floor_int((centre - taper_start_mm_) * inv_h) - i0;
+    const int inner_last = ceil_int((centre + taper_start_mm_) * inv_h) - i0;
     double removed = 0.0;
     auto cut = [&](int i) {
       removed += gk[i];

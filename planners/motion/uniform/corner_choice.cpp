@@ -122,10 +122,11 @@ double open_fraction(const std::vector<std::pair<double, double>>& closed, doubl
   return std::clamp(1.0 - blocked / time_s, 0.0, 1.0);
 }
 
-// nearest point of the polyline a - c - b to p: distance and arc length from a
+// nearest point of the polyline a - c - b to p: squared distance and arc length from a (the
+// squares compared: no root per edge)
 void nearest_on_window(const Vec3& a, const Vec3& c, const Vec3& b, const Eigen::Vector2d& p,
-                       double& distance, double& arc, int& edge) {
-  distance = kInf;
+                       double& distance_squared, double& arc, int& edge) {
+  distance_squared = kInf;
   double start = 0.0;
   const Vec3 ends[3] = {a, c, b};
   for (int e = 0; e < 2; ++e) {
@@ -133,9 +134,9 @@ void nearest_on_window(const Vec3& a, const Vec3& c, const Vec3& b, const Eigen:
     const Eigen::Vector2d d = p1 - p0;
     const double length = d.norm();
     const double f = length > 0.0 ? std::clamp((p - p0).dot(d) / (length * length), 0.0, 1.0) : 0.0;
-    const double dist = (p0 + f * d - p).norm();
-    if (dist < distance) {
-      distance = dist;
+    const double squared = (p0 + f * d - p).squaredNorm();
+    if (squared < distance_squared) {
+      distance_squared = squared;
       arc = start + f * length;
       edge = e;
     }
@@ -250,14 +251,19 @@ struct CornerWindow {
   // the target cells (within half a line width of the centreline, clear of the window's ends)
   // and the centreline's samples, in the order their errors are summed; each holds what the
   // window's own deposit should add to the rolls' (the target less the rolls' deposit there)
+  // Each error is weighted into a length of line: a cell's thickness error times its area over
+  // the line's cross section (the length that volume would print), a centreline sample's error
+  // over the line's peak times a cell of arc length.
   struct TargetCell {
     int ix = 0, iy = 0;
-    double missing_mm = 0.0, line_area_mm2 = 0.0;
+    double missing_mm = 0.0;
+    double weight = 0.0;               // cell area / line cross section
     double missing_shared_mm[2] = {};  // less the shared ends' deposit too (per SharedEnds)
   };
   struct CentreSample {
     BilinearPoint point;  // (on the field's cell lattice)
-    double peak_mm = 0.0, missing_mm = 0.0;
+    double missing_mm = 0.0;
+    double weight = 0.0;  // cell / line peak
     double missing_shared_mm[2] = {};
   };
   std::vector<TargetCell> cells;
@@ -403,17 +409,20 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     for (int e = 0; e < 2; ++e) {
       const int first = e == 1 ? std::max(spans[1].first, spans[0].second + 1) : spans[0].first;
       for (int ix = first; ix <= spans[e].second; ++ix) {
-        double distance = 0.0, arc = 0.0;
+        double distance_squared = 0.0, arc = 0.0;
         int edge = 0;
-        nearest_on_window(a, c, b, Eigen::Vector2d(ix * h, iy * h), distance, arc, edge);
-        if (distance > r || arc < kEndClearSigmas * sigma ||
+        nearest_on_window(a, c, b, Eigen::Vector2d(ix * h, iy * h), distance_squared, arc, edge);
+        if (distance_squared > r * r * (1.0 + 1e-9) || arc < kEndClearSigmas * sigma ||
             arc > total_arc - kEndClearSigmas * sigma)
           continue;
+        // (the root only near the line, and the band's edge decided on it)
+        const double distance = std::sqrt(distance_squared);
+        if (distance > r) continue;
         CornerWindow::TargetCell cell;
         cell.ix = ix, cell.iy = iy;
         cell.missing_mm =
             areas[edge] * peak_per_area * std::exp(-0.5 * distance * distance / (sigma * sigma));
-        cell.line_area_mm2 = areas[edge];
+        cell.weight = h * h / areas[edge];
         w.cells.push_back(cell);
       }
     }
@@ -424,7 +433,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
     const int edge = arc < leg[0] ? 0 : 1;
     const Vec3 p = edge == 0 ? Vec3(a + arc * w.d_in) : Vec3(c + (arc - leg[0]) * w.d_out);
     const double peak = areas[edge] * peak_per_area;
-    w.centre.push_back({bilinear_point(p.x(), p.y(), h), peak, peak});
+    w.centre.push_back({bilinear_point(p.x(), p.y(), h), peak, h / peak});
   }
 
   // every deposit of this corner is read at those cells alone: the scratch fields write no
@@ -698,11 +707,11 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
       for (const CornerWindow::TargetCell& cell : w.cells)
         error_mm += part(cells.at(cell.ix, cell.iy),
                          shared ? cell.missing_shared_mm[kind] : cell.missing_mm) *
-                    h * h / cell.line_area_mm2;
+                    cell.weight;
       for (const CornerWindow::CentreSample& sample : w.centre)
         error_mm += part(cells.interpolated(sample.point),
-                         shared ? sample.missing_shared_mm[kind] : sample.missing_mm) /
-                    sample.peak_mm * h;
+                         shared ? sample.missing_shared_mm[kind] : sample.missing_mm) *
+                    sample.weight;
       return error_mm;
     });
   };
