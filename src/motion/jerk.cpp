@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "core/error.hpp"
 
@@ -173,6 +174,39 @@ Peak negated(const Peak& p) {
   return Peak{-p.dv0, -p.dv1};
 }
 
+// g(above(x)) = T in closed form (NaN where none is found): each S-curve's time is
+// 2 sqrt(dv / j) up to the knee and dv / a + a / j beyond, so on each side of the knees the
+// equation is linear in x or quadratic in a root of it (u = sqrt(x + c), c the velocity change
+// at x = 0); the root whose pieces agree with the knees is the one
+double peak_time_root(const AxisProblem& pr, double T) {
+  const Peak base = pr.above(0.0);
+  const double c0 = base.dv0, c1 = base.dv1;
+  const double a = pr.a_max, j = pr.j_max, knee = pr.knee(), root_j = std::sqrt(j);
+  // (the pieces' conditions with a little slack: the bracket is checked on g itself)
+  const auto below = [&](double dv) { return dv <= knee * (1.0 + 1e-9); };
+  const auto above = [&](double dv) { return dv >= knee * (1.0 - 1e-9); };
+  // both S-curves trapezoidal: (x + c0) / a + (x + c1) / a + 2 a / j = T
+  const double linear = 0.5 * (a * (T - 2.0 * a / j) - c0 - c1);
+  if (above(linear + c0) && above(linear + c1)) return linear;
+  // both triangular: u + w = T sqrt(j) / 2 with u^2 - w^2 = c0 - c1
+  const double sum = 0.5 * T * root_j;
+  const double u = 0.5 * (sum + (c0 - c1) / sum);
+  const double both_roots = u * u - c0;
+  if (u >= 0.0 && sum - u >= 0.0 && below(both_roots + c0) && below(both_roots + c1))
+    return both_roots;
+  // one triangular (its change c_s), the other trapezoidal (c_l): u^2 / a + 2 u / sqrt(j) +
+  // (c_l - c_s) / a + a / j - T = 0
+  for (const auto& [c_s, c_l] : {std::pair{c0, c1}, std::pair{c1, c0}}) {
+    const double constant = (c_l - c_s) / a + a / j - T;
+    const double discriminant = 1.0 / j - constant / a;
+    if (!(discriminant >= 0.0)) continue;
+    const double root = a * (std::sqrt(discriminant) - 1.0 / root_j);
+    const double x = root * root - c_s;
+    if (root >= 0.0 && below(x + c_s) && above(x + c_l)) return x;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
 // the highest admissible peak for T >= tau(|v1 - v0|): g <= T, v_p <= v_max (g rises on
 // v_p >= max(v0, v1))
 Peak highest_peak(const AxisProblem& pr, double T) {
@@ -180,8 +214,17 @@ Peak highest_peak(const AxisProblem& pr, double T) {
   if (pr.time(top) <= T) return top;
   if (pr.time(pr.above(0.0)) >= T) return pr.above(0.0);
   const double x_top = pr.v_max - std::max(pr.v0, pr.v1);
-  return pr.above(bisect_residual(
-      0.0, x_top, pr.resolution(), [&](double x) { return pr.time(pr.above(x)) - T; }, false));
+  const auto residual = [&](double x) { return pr.time(pr.above(x)) - T; };
+  // the closed form's root brackets the flip point within a few doubles, each end checked on g
+  // (the flip point, and so the bisection's result, is the same whatever the bracket where the
+  // resolution is finer than the doubles there: bisect_residual's to the last bit)
+  const double guess = peak_time_root(pr, T);
+  const double margin = 8.0 * std::numeric_limits<double>::epsilon() * std::abs(guess);
+  if (guess - margin > 0.0 && guess + margin < x_top && pr.resolution() < 0.01 * margin &&
+      residual(guess - margin) <= 0.0 && residual(guess + margin) > 0.0)
+    return pr.above(bisect(guess - margin, guess + margin, pr.resolution(),
+                           [&](double x) { return residual(x) <= 0.0; }));
+  return pr.above(bisect_residual(0.0, x_top, pr.resolution(), residual, false));
 }
 Peak lowest_peak(const AxisProblem& pr, double T) {
   return negated(highest_peak(pr.mirrored(), T));
