@@ -21,19 +21,33 @@ constexpr double kShapeSlack = 1e-4;
 }  // namespace
 
 void clothoid_integrals(double phi, double u, double& x, double& y) {
-  // X = u sum_{k even} (-1)^{k/2} a^k / (k! (2k + 1)), Y = u sum_{k odd} ..., a = phi u^2
+  // X = u sum_{k even} (-1)^{k/2} a^k / (k! (2k + 1)), Y = u sum_{k odd} ..., a = phi u^2: the
+  // terms four at a time (signs +X, +Y, -X, -Y), by the reciprocals of k and 2k + 1 (no
+  // division: the series is a chain of multiplies)
+  constexpr int kTerms = 40;
+  struct Reciprocals {
+    double of_k[kTerms + 1] = {};
+    double of_odd[kTerms + 1] = {};
+    constexpr Reciprocals() {
+      for (int k = 1; k <= kTerms; ++k) of_k[k] = 1.0 / k;
+      for (int k = 0; k <= kTerms; ++k) of_odd[k] = 1.0 / (2 * k + 1);
+    }
+  };
+  static constexpr Reciprocals kReciprocal;
   const double a = phi * u * u;
   double term = 1.0;  // a^k / k!
-  x = 0.0;
+  x = 1.0;            // (k = 0)
   y = 0.0;
-  for (int k = 0; k < 40; ++k) {
-    if (k > 0) term *= a / k;
-    const double value = term / (2 * k + 1);
-    if (k % 2 == 0)
-      x += (k % 4 == 0 ? value : -value);
-    else
-      y += (k % 4 == 1 ? value : -value);
-    if (k > 4 && std::abs(term) < 1e-18) break;
+  for (int k = 1; k + 3 <= kTerms; k += 4) {
+    term *= a * kReciprocal.of_k[k];
+    y += term * kReciprocal.of_odd[k];
+    term *= a * kReciprocal.of_k[k + 1];
+    x -= term * kReciprocal.of_odd[k + 1];
+    term *= a * kReciprocal.of_k[k + 2];
+    y -= term * kReciprocal.of_odd[k + 2];
+    term *= a * kReciprocal.of_k[k + 3];
+    x += term * kReciprocal.of_odd[k + 3];
+    if (std::abs(term) < 1e-18) break;
   }
   x *= u;
   y *= u;
