@@ -122,11 +122,12 @@ void GaussianFootprint::fill_factors(const double* centres_mm, const double* sca
       removed += gk[i];
       gk[i] = 0.0;
     };
+    // (without branches: clamped, s = 0 keeps the cell exactly (weight 1) and s = 1 takes all
+    // of it (weight 0))
     auto fade = [&](int i) {
-      const double s = (std::abs((i0 + i) * h - centre) - taper_start_mm_) * inv_taper;
-      if (s <= 0.0) return;
-      const double kept =
-          s >= 1.0 ? 0.0 : gk[i] * (1.0 - s * s * s * (10.0 + s * (-15.0 + 6.0 * s)));
+      const double s =
+          std::clamp((std::abs((i0 + i) * h - centre) - taper_start_mm_) * inv_taper, 0.0, 1.0);
+      const double kept = gk[i] * (1.0 - s * s * s * (10.0 + s * (-15.0 + 6.0 * s)));
       removed += gk[i] - kept;
       gk[i] = kept;
     };

@@ -398,6 +398,9 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   const Vec3 hi = a.cwiseMax(b).cwiseMax(c) + Vec3::Constant(r + h);
   const int ix_lo = static_cast<int>(std::floor(lo.x() / h));
   const int ix_hi = static_cast<int>(std::ceil(hi.x() / h));
+  // (room for the band's cells: its length by its width, and the ends' caps)
+  w.cells.reserve(static_cast<size_t>((total_arc / h + 2.0 * r / h + 2.0) * (2.0 * r / h + 2.0)));
+  w.centre.reserve(static_cast<size_t>(total_arc / h) + 1);
   for (int iy = static_cast<int>(std::floor(lo.y() / h));
        iy <= static_cast<int>(std::ceil(hi.y() / h)); ++iy) {
     // only the row's cells near either edge (in the same order as a scan of the whole row):
@@ -441,6 +444,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   {
     // the cells read: each target, and the four around each centreline sample
     std::vector<std::pair<int, int>> read_cells;
+    read_cells.reserve(w.cells.size() + 4 * w.centre.size());
     for (const CornerWindow::TargetCell& cell : w.cells) read_cells.emplace_back(cell.ix, cell.iy);
     for (const CornerWindow::CentreSample& sample : w.centre)
       for (int dy = 0; dy < 2; ++dy)
