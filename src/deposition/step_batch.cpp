@@ -153,31 +153,10 @@ void StepBatch::deposit_range(GaussianFootprint& footprint, ThicknessField& fiel
     ++stats_.single_steps;
     return;
   }
-  const double origin_x = pending_[begin].step.x0_mm;
-  const double origin_y = pending_[begin].step.y0_mm;
-
-  // the steps' exact volume, first moment and second moment about the range's start
-  // (uniform motion along each chord: q = a + u d, with E[u], E[u^2] under its rate)
-  double volume = 0.0, m1x = 0.0, m1y = 0.0, mxx = 0.0, mxy = 0.0, myy = 0.0;
-  for (int k = begin; k < end; ++k) {
-    const Pending& p = pending_[k];
-    const double v = p.step.volume_mm3;
-    const double ax = p.step.x0_mm - origin_x, ay = p.step.y0_mm - origin_y;
-    const double dx = p.step.x1_mm - p.step.x0_mm, dy = p.step.y1_mm - p.step.y0_mm;
-    volume += v;
-    m1x += v * (ax + dx * p.mean_u);
-    m1y += v * (ay + dy * p.mean_u);
-    mxx += v * (ax * ax + 2.0 * ax * dx * p.mean_u + dx * dx * p.mean_u2);
-    mxy += v * (ax * ay + (ax * dy + dx * ay) * p.mean_u + dx * dy * p.mean_u2);
-    myy += v * (ay * ay + 2.0 * ay * dy * p.mean_u + dy * dy * p.mean_u2);
-  }
-  // centroid, and the second moments about it
-  const double cx = m1x / volume, cy = m1y / volume;
-  const double cxx = mxx - volume * cx * cx;
-  const double cxy = mxy - volume * cx * cy;
-  const double cyy = myy - volume * cy * cy;
-
-  // a rate kink: split there, so each side is smooth for the quadrature
+  // a rate kink: split there, so each side is smooth for the quadrature (the range's volume
+  // first: the kinks are sized by its mean flow)
+  double volume = 0.0;
+  for (int k = begin; k < end; ++k) volume += pending_[k].step.volume_mm3;
   const double t_lo = pending_[begin].t_begin_s;
   const double t_hi = pending_[end - 1].t_begin_s + pending_[end - 1].duration_s;
   int worst_kink = -1;
@@ -196,6 +175,28 @@ void StepBatch::deposit_range(GaussianFootprint& footprint, ThicknessField& fiel
     deposit_range(footprint, field, worst_kink, end);
     return;
   }
+
+  // the steps' exact first and second moments about the range's start (uniform motion along
+  // each chord: q = a + u d, with E[u], E[u^2] under its rate)
+  const double origin_x = pending_[begin].step.x0_mm;
+  const double origin_y = pending_[begin].step.y0_mm;
+  double m1x = 0.0, m1y = 0.0, mxx = 0.0, mxy = 0.0, myy = 0.0;
+  for (int k = begin; k < end; ++k) {
+    const Pending& p = pending_[k];
+    const double v = p.step.volume_mm3;
+    const double ax = p.step.x0_mm - origin_x, ay = p.step.y0_mm - origin_y;
+    const double dx = p.step.x1_mm - p.step.x0_mm, dy = p.step.y1_mm - p.step.y0_mm;
+    m1x += v * (ax + dx * p.mean_u);
+    m1y += v * (ay + dy * p.mean_u);
+    mxx += v * (ax * ax + 2.0 * ax * dx * p.mean_u + dx * dx * p.mean_u2);
+    mxy += v * (ax * ay + (ax * dy + dx * ay) * p.mean_u + dx * dy * p.mean_u2);
+    myy += v * (ay * ay + 2.0 * ay * dy * p.mean_u + dy * dy * p.mean_u2);
+  }
+  // centroid, and the second moments about it
+  const double cx = m1x / volume, cy = m1y / volume;
+  const double cxx = mxx - volume * cx * cx;
+  const double cxy = mxy - volume * cx * cy;
+  const double cyy = myy - volume * cy * cy;
 
   // 4 Gauss-Legendre nodes in time over the range, on the steps' chords, weighted by the
   // volume rate there (each step: V rate(u) / (int rate du * duration))
