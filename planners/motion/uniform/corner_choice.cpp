@@ -122,48 +122,80 @@ double open_fraction(const std::vector<std::pair<double, double>>& closed, doubl
   return std::clamp(1.0 - blocked / time_s, 0.0, 1.0);
 }
 
-// nearest point of the polyline a - c - b to p: squared distance and arc length from a (the
-// squares compared: no root per edge)
-void nearest_on_window(const Vec3& a, const Vec3& c, const Vec3& b, const Eigen::Vector2d& p,
-                       double& distance_squared, double& arc, int& edge) {
-  distance_squared = kInf;
-  double start = 0.0;
-  const Vec3 ends[3] = {a, c, b};
-  for (int e = 0; e < 2; ++e) {
-    const Eigen::Vector2d p0 = ends[e].head<2>(), p1 = ends[e + 1].head<2>();
-    const Eigen::Vector2d d = p1 - p0;
-    const double length = d.norm();
-    const double f = length > 0.0 ? std::clamp((p - p0).dot(d) / (length * length), 0.0, 1.0) : 0.0;
-    const double squared = (p0 + f * d - p).squaredNorm();
-    if (squared < distance_squared) {
-      distance_squared = squared;
-      arc = start + f * length;
-      edge = e;
+// The polyline a - c - b in the plane, its two edges' starts, directions and lengths (the
+// same arithmetic as taking them per point, once).
+struct WindowPolyline {
+  Eigen::Vector2d start[2], direction[2];
+  double length[2] = {}, length_squared[2] = {};
+  WindowPolyline(const Vec3& a, const Vec3& c, const Vec3& b) {
+    const Vec3 ends[3] = {a, c, b};
+    for (int e = 0; e < 2; ++e) {
+      start[e] = ends[e].head<2>();
+      direction[e] = ends[e + 1].head<2>() - start[e];
+      length[e] = direction[e].norm();
+      length_squared[e] = length[e] * length[e];
     }
-    start += length;
   }
-}
+  // the nearest point to p: squared distance and arc length from a (the squares compared: no
+  // root per edge)
+  void nearest(const Eigen::Vector2d& p, double& distance_squared, double& arc, int& edge) const {
+    distance_squared = kInf;
+    double arc_start = 0.0;
+    for (int e = 0; e < 2; ++e) {
+      const Eigen::Vector2d& p0 = start[e];
+      const Eigen::Vector2d& d = direction[e];
+      const double f =
+          length[e] > 0.0 ? std::clamp((p - p0).dot(d) / length_squared[e], 0.0, 1.0) : 0.0;
+      const double squared = (p0 + f * d - p).squaredNorm();
+      if (squared < distance_squared) {
+        distance_squared = squared;
+        arc = arc_start + f * length[e];
+        edge = e;
+      }
+      arc_start += length[e];
+    }
+  }
+};
 
 // the cells [first, last] of row y (within [ix_lo, ix_hi]) that may lie within r of the segment
-// p0-p1: the x range of the segment's points within r of the row, widened by r and a cell (an
-// empty range, first > last, when none is)
+// p0-p1: its r-neighbourhood (a stadium: the band p0-p1 +- r along its normal and a disc at each
+// end, convex) meets the row in one interval, widened by a cell (an empty range, first > last,
+// when it misses the row)
 std::pair<int, int> row_cells_near(const Vec3& p0, const Vec3& p1, double y, double r, double h,
                                    int ix_lo, int ix_hi) {
-  const double dy = p1.y() - p0.y();
-  double t0 = 0.0, t1 = 1.0;
-  if (dy != 0.0) {
-    t0 = (y - r - p0.y()) / dy;
-    t1 = (y + r - p0.y()) / dy;
-    if (t0 > t1) std::swap(t0, t1);
-    t0 = std::max(t0, 0.0);
-    t1 = std::min(t1, 1.0);
-  } else if (std::abs(y - p0.y()) > r) {
-    t0 = 1.0, t1 = 0.0;
+  double lo = kInf, hi = -kInf;
+  const auto include = [&](double x) { lo = std::min(lo, x), hi = std::max(hi, x); };
+  // the end discs
+  for (const Vec3* end : {&p0, &p1}) {
+    const double dy = y - end->y();
+    if (std::abs(dy) <= r) {
+      const double half = std::sqrt(r * r - dy * dy);
+      include(end->x() - half);
+      include(end->x() + half);
+    }
   }
-  if (!(t0 <= t1)) return {ix_hi + 1, ix_hi};
-  const double x0 = p0.x() + t0 * (p1.x() - p0.x()), x1 = p0.x() + t1 * (p1.x() - p0.x());
-  const int first = static_cast<int>(std::floor((std::min(x0, x1) - r) / h)) - 1;
-  const int last = static_cast<int>(std::ceil((std::max(x0, x1) + r) / h)) + 1;
+  // the band: the rectangle p0 +- r n, p1 +- r n, each side crossing the row
+  const Eigen::Vector2d d = (p1 - p0).head<2>();
+  const double length = d.norm();
+  if (length > 0.0) {
+    const Eigen::Vector2d n = Eigen::Vector2d(-d.y(), d.x()) * (r / length);
+    const Eigen::Vector2d a = p0.head<2>(), b = p1.head<2>();
+    const Eigen::Vector2d corners[4] = {a + n, b + n, b - n, a - n};
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d& from = corners[k];
+      const Eigen::Vector2d& to = corners[(k + 1) % 4];
+      if ((y < from.y() && y < to.y()) || (y > from.y() && y > to.y())) continue;
+      if (from.y() == to.y()) {
+        include(from.x());
+        include(to.x());
+      } else {
+        include(from.x() + (y - from.y()) / (to.y() - from.y()) * (to.x() - from.x()));
+      }
+    }
+  }
+  if (!(lo <= hi)) return {ix_hi + 1, ix_hi};
+  const int first = static_cast<int>(std::floor(lo / h)) - 1;
+  const int last = static_cast<int>(std::ceil(hi / h)) + 1;
   return {std::max(first, ix_lo), std::min(last, ix_hi)};
 }
 
@@ -398,6 +430,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   const Vec3 hi = a.cwiseMax(b).cwiseMax(c) + Vec3::Constant(r + h);
   const int ix_lo = static_cast<int>(std::floor(lo.x() / h));
   const int ix_hi = static_cast<int>(std::ceil(hi.x() / h));
+  const WindowPolyline polyline(a, c, b);
   // (room for the band's cells: its length by its width, and the ends' caps)
   w.cells.reserve(static_cast<size_t>((total_arc / h + 2.0 * r / h + 2.0) * (2.0 * r / h + 2.0)));
   w.centre.reserve(static_cast<size_t>(total_arc / h) + 1);
@@ -414,7 +447,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
       for (int ix = first; ix <= spans[e].second; ++ix) {
         double distance_squared = 0.0, arc = 0.0;
         int edge = 0;
-        nearest_on_window(a, c, b, Eigen::Vector2d(ix * h, iy * h), distance_squared, arc, edge);
+        polyline.nearest(Eigen::Vector2d(ix * h, iy * h), distance_squared, arc, edge);
         if (distance_squared > r * r * (1.0 + 1e-9) || arc < kEndClearSigmas * sigma ||
             arc > total_arc - kEndClearSigmas * sigma)
           continue;
