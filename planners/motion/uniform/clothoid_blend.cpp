@@ -126,13 +126,14 @@ double ClothoidBlend::curvature(double s) const {
   return d2.norm();
 }
 
-BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
-  // the derivatives depend on the tangent angle and the curvature only (no positions needed):
-  // at half-length 1, psi = phi u^2 and kappa = 2 phi u on the first half (u from the start),
-  // psi = 2 phi - phi u^2 and kappa = 2 phi u on the second (u from the end), kappa' = +-2 phi
-  const double theta = turn_angle(d_in, d_out), phi = 0.5 * theta;
-  const Vec3 e2 = (d_out - d_out.dot(d_in) * d_in).normalized();
-  BlendShape shape;
+namespace {
+
+// the per-axis maxima of |t|, |p''| and |p'''| over the unit blend's samples (see unit_shape), on
+// vectors of the axes that move (Vec3, or the plane's Vector2d: a planar corner's z is 0 at every
+// sample, so its maxima stay 0)
+template <class Vector>
+void unit_shape_maxima(const Vector& d_in, const Vector& e2, double phi, double theta,
+                       Vector& tangent, Vector& curvature, Vector& third) {
   // cos and sin of phi u^2 at u = k / N by the chirp recurrence: the angle grows by
   // phi (2k + 1) / N^2 from sample k to k + 1, a rotation whose own angle grows by 2 phi / N^2
   // (no sincos per sample; rounding drifts by ~N^2 eps = 7e-12, far within kShapeSlack). The
@@ -142,6 +143,7 @@ BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
   double cos_turn = std::cos(angle_step), sin_turn = std::sin(angle_step);
   const double cos_growth = std::cos(2.0 * angle_step), sin_growth = std::sin(2.0 * angle_step);
   const double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+  tangent.setZero(), curvature.setZero(), third.setZero();
   for (int k = 0; k <= kShapeSamples; ++k) {
     const double u = static_cast<double>(k) / kShapeSamples;
     const double kappa = 2.0 * phi * u;
@@ -149,12 +151,12 @@ BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
       const double c = half == 0 ? cos_psi : cos_theta * cos_psi + sin_theta * sin_psi;
       const double s = half == 0 ? sin_psi : sin_theta * cos_psi - cos_theta * sin_psi;
       const double rate = half == 0 ? 2.0 * phi : -2.0 * phi;
-      const Vec3 t = c * d_in + s * e2;
-      const Vec3 normal = -s * d_in + c * e2;
-      const Vec3 d2 = kappa * normal, d3 = rate * normal - kappa * kappa * t;
-      shape.tangent = shape.tangent.cwiseMax(t.cwiseAbs());
-      shape.curvature = shape.curvature.cwiseMax(d2.cwiseAbs());
-      shape.third = shape.third.cwiseMax(d3.cwiseAbs());
+      const Vector t = c * d_in + s * e2;
+      const Vector normal = -s * d_in + c * e2;
+      const Vector d2 = kappa * normal, d3 = rate * normal - kappa * kappa * t;
+      tangent = tangent.cwiseMax(t.cwiseAbs());
+      curvature = curvature.cwiseMax(d2.cwiseAbs());
+      third = third.cwiseMax(d3.cwiseAbs());
     }
     // (psi, turn) -> (psi + turn, turn + growth)
     const double next_cos = cos_psi * cos_turn - sin_psi * sin_turn;
@@ -163,6 +165,27 @@ BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
     const double next_cos_turn = cos_turn * cos_growth - sin_turn * sin_growth;
     sin_turn = sin_turn * cos_growth + cos_turn * sin_growth;
     cos_turn = next_cos_turn;
+  }
+}
+
+}  // namespace
+
+BlendShape ClothoidBlend::unit_shape(const Vec3& d_in, const Vec3& d_out) {
+  // the derivatives depend on the tangent angle and the curvature only (no positions needed):
+  // at half-length 1, psi = phi u^2 and kappa = 2 phi u on the first half (u from the start),
+  // psi = 2 phi - phi u^2 and kappa = 2 phi u on the second (u from the end), kappa' = +-2 phi
+  const double theta = turn_angle(d_in, d_out), phi = 0.5 * theta;
+  const Vec3 e2 = (d_out - d_out.dot(d_in) * d_in).normalized();
+  BlendShape shape;
+  if (d_in.z() == 0.0 && e2.z() == 0.0) {
+    Eigen::Vector2d tangent, curvature, third;
+    unit_shape_maxima<Eigen::Vector2d>(d_in.head<2>(), e2.head<2>(), phi, theta, tangent, curvature,
+                                       third);
+    shape.tangent.head<2>() = tangent;
+    shape.curvature.head<2>() = curvature;
+    shape.third.head<2>() = third;
+  } else {
+    unit_shape_maxima<Vec3>(d_in, e2, phi, theta, shape.tangent, shape.curvature, shape.third);
   }
   // what the samples may miss between them, against the largest norms (t and the normal are
   // orthonormal: |d2| = kappa and |d3| = sqrt(4 phi^2 + kappa^4), largest at u = 1)
