@@ -158,9 +158,7 @@ void advise_huge_pages(void* data, std::size_t bytes) {
 class GcodeParser {
  public:
   GcodeParser(std::string file_label, const GcodeOptions& options)
-      : options_(options),
-        open_code_(code_of(options.open_code)),
-        close_code_(code_of(options.close_code)) {
+      : open_code_(code_of(options.open_code)), close_code_(code_of(options.close_code)) {
     program_.file_label = std::move(file_label);
   }
 
@@ -183,7 +181,6 @@ class GcodeParser {
   void home();
   void extrude(double delta);
 
-  const GcodeOptions& options_;
   std::optional<Code> open_code_;
   std::optional<Code> close_code_;
   std::vector<Problem> problems_;

@@ -734,7 +734,6 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   // (excess_only), only where the deposit already exceeds its target: the rest of the window
   // adds material and never takes any away, so that much error remains (a lower bound)
   const ThicknessField& field = process->field();
-  const double h = field.cell_mm();
   const auto error_so_far = [&](bool excess_only) {
     return w.with_reader(field, [&](auto&& cells) {
       const auto part = [excess_only](double deposit, double target) {
