@@ -473,7 +473,8 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   }
 
   // every deposit of this corner is read at those cells alone: the scratch fields write no
-  // other (in each row, from its first such cell to its last)
+  // other (in each row, from its first such cell to its last); and the one tile they all fall
+  // in, if one does (their bounding box's corners do)
   {
     // the cells read: each target, and the four around each centreline sample
     std::vector<std::pair<int, int>> read_cells;
@@ -491,10 +492,15 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
       region.iy_lo = low->second;
       region.spans.assign(static_cast<size_t>(high->second - low->second + 1),
                           {std::numeric_limits<int>::max(), std::numeric_limits<int>::min()});
+      int ix_first = std::numeric_limits<int>::max(), ix_last = std::numeric_limits<int>::min();
       for (const auto& [ix, iy] : read_cells) {
         std::pair<int, int>& span = region.spans[static_cast<size_t>(iy - region.iy_lo)];
         span.first = std::min(span.first, ix), span.second = std::max(span.second, ix);
+        ix_first = std::min(ix_first, ix), ix_last = std::max(ix_last, ix);
       }
+      using Tiles = ThicknessField::Tiles;
+      w.tile_x = Tiles::tile_of(ix_first), w.tile_y = Tiles::tile_of(low->second);
+      w.one_tile = Tiles::tile_of(ix_last) == w.tile_x && Tiles::tile_of(high->second) == w.tile_y;
     }
     rolls_process.limit_writes(region);
     w.scratch->limit_writes(std::move(region));
@@ -503,22 +509,6 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   // the rolls' deposit, taken off the targets
   steady(a - roll_mm * w.d_in, a, w.v_in, -roll_mm / w.v_in);
   steady(b, b + roll_mm * w.d_out, w.v_out, 0.0);
-
-  // the one tile all reads fall in, if one does
-  {
-    using Tiles = ThicknessField::Tiles;
-    bool first = true, one = true;
-    const auto in_tile = [&](int ix, int iy) {
-      if (first) w.tile_x = Tiles::tile_of(ix), w.tile_y = Tiles::tile_of(iy), first = false;
-      one = one && Tiles::tile_of(ix) == w.tile_x && Tiles::tile_of(iy) == w.tile_y;
-    };
-    for (const CornerWindow::TargetCell& cell : w.cells) in_tile(cell.ix, cell.iy);
-    for (const CornerWindow::CentreSample& sample : w.centre) {
-      in_tile(sample.point.ix0, sample.point.iy0);
-      in_tile(sample.point.ix0 + 1, sample.point.iy0 + 1);
-    }
-    w.one_tile = one && !first;
-  }
 
   // the targets' readings of the rolls' field: the rolls alone, then as the shared ends are
   // deposited with them (after them in time)
