@@ -271,10 +271,20 @@ Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec) {
   return trajectory;
 }
 
+const Trajectory* PreparedJob::checked_plan(const PlannerSpec& spec) const {
+  // the spec's line and label name the run; its name, parameters and choices make the plan
+  for (const CheckedPlan& checked : checked_plans)
+    if (checked.spec.name == spec.name && checked.spec.params == spec.params &&
+        checked.spec.choices == spec.choices)
+      return checked.trajectory.get();
+  return nullptr;
+}
+
 PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   PlannedRun run;
   run.spec = spec;
-  run.trajectory = plan_trajectory(job, spec);
+  const Trajectory* checked = job.checked_plan(spec);
+  run.trajectory = checked ? *checked : plan_trajectory(job, spec);
   run.planned = sample_trajectory(run.trajectory, kSamplePeriod_s);
 
   MetricsReport& r = run.report;

@@ -45,10 +45,22 @@ struct PreparedJob {
   Toolpath exact_toolpath;
   Toolpath reference_toolpath;
 
+  // the plans made while the job was checked (check_runs), one per planner spec: plan_job
+  // takes a spec's plan from here instead of planning again. Planning is deterministic, so
+  // it is the same plan; for `uniform`, whose plan predicts every corner's deposit, it halves
+  // a verb's planning time
+  struct CheckedPlan {
+    PlannerSpec spec;
+    std::shared_ptr<const Trajectory> trajectory;
+  };
+  std::vector<CheckedPlan> checked_plans;
+
   // what the metrics measure against: the file's arcs (finely chorded) when it has any
   const Toolpath& intended_toolpath() const {
     return reference_toolpath.paths.empty() ? toolpath : reference_toolpath;
   }
+  // the plan check_runs made for `spec` (same planner, parameters and choices), or null
+  const Trajectory* checked_plan(const PlannerSpec& spec) const;
 };
 
 // the sagitta of the chords the metrics measure G-code arcs by (mm)
@@ -78,6 +90,7 @@ struct PlannedRun {
   MotionSamples planned;  // the plan every 1 ms
   MetricsReport report;   // planned metrics only
 };
+// the plan: the one check_runs made for this spec when there is one, else planned now
 PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec);
 // the scenario line of a planner's entry (its own list item, else the `planners` key): where
 // a problem of its plan is reported

@@ -344,14 +344,18 @@ Scenario check_scenario(const std::string& path, const JobBudget& budget, std::s
   return std::move(reading.scenario);
 }
 
-std::vector<RunEstimate> check_runs(const PreparedJob& job,
-                                    const std::vector<PlannerSpec>& planners, bool simulate,
-                                    std::vector<Problem>& problems, bool solve_poses) {
+std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerSpec>& planners,
+                                    bool simulate, std::vector<Problem>& problems,
+                                    bool solve_poses) {
   std::vector<RunEstimate> runs;
   for (const PlannerSpec& spec : planners) {
-    // planned, measured and dropped: the plan itself is small, a verb plans it again
+    // planned and measured; the plan itself is small (pieces, not samples), so the job keeps
+    // it for the verb (PreparedJob::checked_plans) rather than plan it again
     try {
-      const Trajectory plan = plan_trajectory(job, spec);
+      if (!job.checked_plan(spec))
+        job.checked_plans.push_back(
+            {spec, std::make_shared<const Trajectory>(plan_trajectory(job, spec))});
+      const Trajectory& plan = *job.checked_plan(spec);
       const RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
       // validate: its every pose solved now, as the simulation will (a planner's move may
       // leave the travel or the reach between the toolpath's points); a run too long for

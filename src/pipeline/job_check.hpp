@@ -7,9 +7,10 @@
 //    actuator the machine needs, the settings the deposition and the simulation check again,
 //    and the job's size from a lower bound on its duration (print time and the first and last
 //    ramps), against sim.max_steps and the memory budget, before anything is planned.
-// 2. check_runs: on the prepared job (print order, the arm's posture), every run planned (and
-//    dropped again: the plans are small, their samples are not), its exact duration giving the
-//    physics steps, the 1 ms samples and the memory of all the runs a verb keeps together.
+// 2. check_runs: on the prepared job (print order, the arm's posture), every run planned (the
+//    plans, which are small, kept in the job for the verb; their samples are not made here),
+//    its exact duration giving the physics steps, the 1 ms samples and the memory of all the
+//    runs a verb keeps together.
 //
 // Nothing here allocates in proportion to a job's duration or its deposition grid.
 #pragma once
@@ -70,10 +71,11 @@ Scenario check_scenario(const std::string& path, const JobBudget& budget, std::s
 // solve_poses (validate), each run's plan is also solved pose by pose as the simulation will
 // solve it (check_plan_poses: a plan leaving the travel or the reach); run and compare leave
 // that to the simulation itself, which says the same word for word (on an arm the inverse
-// kinematics of every step is most of a run's cost, and would be paid twice)
-std::vector<RunEstimate> check_runs(const PreparedJob& job,
-                                    const std::vector<PlannerSpec>& planners, bool simulate,
-                                    std::vector<Problem>& problems, bool solve_poses = false);
+// kinematics of every step is most of a run's cost, and would be paid twice). Each plan is
+// kept in job.checked_plans, where plan_job takes it.
+std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerSpec>& planners,
+                                    bool simulate, std::vector<Problem>& problems,
+                                    bool solve_poses = false);
 
 // What a verb does before its work: stage 2 on the job prepared for it (the lower bound of
 // the print order computed only when `with_lower_bound`: a report shows it, validate does
