@@ -75,6 +75,44 @@ sim: {timestep_s: 0.0005, settle_s: 1}
   }
 }
 
+// the plans made while the job is checked are kept, one per planner, and plan_job takes them:
+// the same plan as planning again (uniform, which predicts the deposit, and a paper planner),
+// a spec differing only in its label shares its plan, other parameters do not
+TEST(JobEstimate, CheckedPlansAreKeptAndEqualAFreshPlan) {
+  const std::string dir = fresh_directory("job_checked_plans");
+  const Scenario scenario =
+      load_scenario(write_text(dir, "vee.yaml", R"(limits: {v_max: 20, a_max: 200}
+toolpath:
+  speed: 5
+  polylines:
+    - [[0, 0], [6, 0], [1, 3]]
+)"));
+  const PlannerSpec uniform{"uniform", {}, 0};
+  PlannerSpec relabelled = uniform;
+  relabelled.label = "uniform_again";
+  const PlannerSpec lspb{"lspb_mtt", {}, 0};
+  const PreparedJob job =
+      prepare_checked_job(scenario, {uniform, relabelled, lspb}, JobBudget{}, true, false);
+  ASSERT_EQ(job.checked_plans.size(), 2u);
+  EXPECT_EQ(job.checked_plan(relabelled), job.checked_plan(uniform));
+  PlannerSpec other = uniform;
+  other.params["tolerance_mm"] = {0.02};
+  EXPECT_EQ(job.checked_plan(other), nullptr);
+  for (const PlannerSpec& spec : {uniform, lspb}) {
+    const Trajectory fresh = plan_trajectory(job, spec);
+    const PlannedRun run = plan_job(job, spec);
+    ASSERT_EQ(run.trajectory.duration_s(), fresh.duration_s()) << spec.name;
+    ASSERT_EQ(run.trajectory.decisions().size(), fresh.decisions().size()) << spec.name;
+    // sample by sample, to the bit
+    for (double t = 0.0; t < fresh.duration_s(); t += 0.01) {
+      const TrajectorySample a = run.trajectory.at(t);
+      const TrajectorySample b = fresh.at(t);
+      ASSERT_EQ(a.position_mm, b.position_mm) << spec.name << " t = " << t;
+      ASSERT_EQ(a.velocity_mm_s, b.velocity_mm_s) << spec.name << " t = " << t;
+    }
+  }
+}
+
 // the lower bound refuses a job far beyond the steps allowed before any planning, at the key
 // that drives it; raising sim.max_steps lets it through that check
 TEST(JobEstimate, TheStepLimitIsTheScenariosToRaise) {
