@@ -28,6 +28,20 @@ std::string message_number(double value) {
   return text;
 }
 
+void append_number(std::string& out, double value, int significant_digits) {
+  char text[32];  // "-1.2345678901234567e-308": 24 characters at 17 digits
+  const std::to_chars_result end = std::to_chars(text, text + sizeof text, value,
+                                                 std::chars_format::general, significant_digits);
+  out.append(text, end.ptr);
+}
+
+void append_fixed(std::string& out, double value, int decimals) {
+  char text[340];  // the largest double in "%.17f": 309 digits before the point
+  const std::to_chars_result end =
+      std::to_chars(text, text + sizeof text, value, std::chars_format::fixed, decimals);
+  out.append(text, end.ptr);
+}
+
 namespace {
 
 // the length of the well-formed UTF-8 sequence of a printable code point (>= U+00A0) at

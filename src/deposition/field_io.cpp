@@ -4,12 +4,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <sstream>
 #include <vector>
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "core/interrupt.hpp"
+#include "core/number_text.hpp"
 #include "core/png.hpp"
 
 namespace depotwin {
@@ -71,37 +71,38 @@ double write_heightmap_png16(const HeightMap& map, const std::string& path, doub
 
 void write_heightmap_csv(const HeightMap& map, const std::string& path, double um_per_level) {
   check_map(map);
-  std::ostringstream out;
-  out << "# depotwin thickness map: thickness in um; first column y_mm (the row's y), the "
-         "header's other cells x_mm (each column's x), both at the cell centres\n"
-      << "# origin_x_mm=" << format_number(map.origin_x_mm)
-      << " origin_y_mm=" << format_number(map.origin_y_mm)
-      << " cell_mm=" << format_number(map.cell_mm) << " nx=" << map.nx << " ny=" << map.ny << "\n"
-      << "# um_per_level=" << format_number(um_per_level)
-      << " (scale of the 16-bit PNG: thickness_um = gray * um_per_level)\n"
-      << "# origin = centre of the bottom-left cell; first data row = top row (y = origin_y_mm "
-         "+ (ny - 1) * cell_mm); columns along +x\n"
-      << "# pandas: pd.read_csv(path, comment='#', index_col='y_mm')\n";
-  // the header: y_mm, then every column's x (mm)
-  char value[32];
-  out << "y_mm";
+  std::string out =
+      "# depotwin thickness map: thickness in um; first column y_mm (the row's y), the "
+      "header's other cells x_mm (each column's x), both at the cell centres\n"
+      "# origin_x_mm=" +
+      format_number(map.origin_x_mm) + " origin_y_mm=" + format_number(map.origin_y_mm) +
+      " cell_mm=" + format_number(map.cell_mm) + " nx=" + std::to_string(map.nx) +
+      " ny=" + std::to_string(map.ny) + "\n# um_per_level=" + format_number(um_per_level) +
+      " (scale of the 16-bit PNG: thickness_um = gray * um_per_level)\n"
+      "# origin = centre of the bottom-left cell; first data row = top row (y = origin_y_mm "
+      "+ (ny - 1) * cell_mm); columns along +x\n"
+      "# pandas: pd.read_csv(path, comment='#', index_col='y_mm')\n";
+  // a cell is at most "-1.234567e-308," (15 characters); typical ones half that
+  out.reserve(out.size() + static_cast<size_t>(map.nx + 1) * (map.ny + 1) * 8);
+  // the header: y_mm, then every column's x (mm), as %.9g
+  out += "y_mm";
   for (int ix = 0; ix < map.nx; ++ix) {
-    std::snprintf(value, sizeof(value), "%.9g", map.origin_x_mm + ix * map.cell_mm);
-    out << ',' << value;
+    out += ',';
+    append_number(out, map.origin_x_mm + ix * map.cell_mm, 9);
   }
-  out << '\n';
+  out += '\n';
+  // each row: its y (%.9g), then the thickness of its cells (%.7g), top row first
   for (int row = 0; row < map.ny; ++row) {
     throw_if_interrupted();  // a signal asked to stop (core/interrupt.hpp)
     const int iy = map.ny - 1 - row;
-    std::snprintf(value, sizeof(value), "%.9g", map.origin_y_mm + iy * map.cell_mm);
-    out << value;
+    append_number(out, map.origin_y_mm + iy * map.cell_mm, 9);
     for (int ix = 0; ix < map.nx; ++ix) {
-      std::snprintf(value, sizeof(value), "%.7g", static_cast<double>(map.at(ix, iy)));
-      out << ',' << value;
+      out += ',';
+      append_number(out, static_cast<double>(map.at(ix, iy)), 7);
     }
-    out << '\n';
+    out += '\n';
   }
-  write_file_atomically(path, out.str());
+  write_file_atomically(path, out);
 }
 
 }  // namespace depotwin

@@ -1,7 +1,6 @@
 #include "plots/plot_data.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -11,18 +10,17 @@
 #include <set>
 #include <utility>
 
+#include "core/number_text.hpp"
+
 namespace depotwin::plots {
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// a number in %.9g form, independent of the C locale
+// a number in %.9g form, independent of the C locale (core/number_text.hpp)
 void append_number(std::string& out, double value) {
-  char buffer[32];
-  const auto result =
-      std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general, 9);
-  out.append(buffer, result.ptr);
+  depotwin::append_number(out, value, 9);
 }
 
 }  // namespace

@@ -1,0 +1,86 @@
+// Numbers written to data files (core/number_text.hpp): append_number and append_fixed give
+// the text printf's "%.<n>g" and "%.<n>f" give, character for character, on the values a
+// trajectory or a thickness map holds and on the edge cases of both formats.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/number_text.hpp"
+
+namespace depotwin {
+namespace {
+
+std::string printf_text(const char* format, int precision, double value) {
+  char text[400];
+  std::snprintf(text, sizeof text, format, precision, value);
+  return text;
+}
+
+std::vector<double> edge_values() {
+  const double inf = std::numeric_limits<double>::infinity();
+  return {0.0,
+          -0.0,
+          1.0,
+          -1.0,
+          0.5,
+          2.5,
+          1e-5,
+          1e-4,
+          9.9999999e-5,
+          123456789.0,
+          1234567890.0,
+          999999999.5,
+          0.1 + 0.2,
+          1e300,
+          -1e-300,
+          4.9e-324,
+          std::numeric_limits<double>::max(),
+          1e9,
+          1e-9,
+          3.0000005,
+          0.0000015,
+          2.675,
+          inf,
+          -inf,
+          std::nan("")};
+}
+
+TEST(NumberText, AppendNumberIsPrintfsG) {
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-12, 12);
+  std::vector<double> values = edge_values();
+  for (int i = 0; i < 20000; ++i)
+    values.push_back(mantissa(random) * std::pow(10.0, exponent(random)));
+  for (const int digits : {1, 6, 7, 9, 17}) {
+    for (const double value : values) {
+      std::string text = "x";
+      append_number(text, value, digits);
+      ASSERT_EQ(text, "x" + printf_text("%.*g", digits, value)) << digits << " digits";
+    }
+  }
+}
+
+TEST(NumberText, AppendFixedIsPrintfsF) {
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> seconds(0.0, 1e5);
+  std::vector<double> values = edge_values();
+  // the 1 ms sample times of a long job, whose last digits round both ways
+  for (int k = 0; k < 20000; ++k) values.push_back(k * 0.001);
+  for (int i = 0; i < 20000; ++i) values.push_back(seconds(random));
+  for (const int decimals : {0, 3, 6, 17}) {
+    for (const double value : values) {
+      std::string text;
+      append_fixed(text, value, decimals);
+      ASSERT_EQ(text, printf_text("%.*f", decimals, value)) << decimals << " decimals";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace depotwin
