@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "core/interrupt.hpp"
+#include "metrics/polyline_distance.hpp"
 
 namespace depotwin {
 
@@ -166,12 +168,8 @@ double total_time_s(const std::vector<TimeSpan>& spans) {
 
 double distance_to_polyline(const Vec3& point, const std::vector<Vec3>& polyline) {
   double best = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i + 1 < polyline.size(); ++i) {
-    const Vec3 a = polyline[i], ab = polyline[i + 1] - a;
-    const double len2 = ab.squaredNorm();
-    const double u = len2 > 0.0 ? std::clamp((point - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (a + u * ab - point).norm());
-  }
+  for (size_t i = 0; i + 1 < polyline.size(); ++i)
+    best = std::min(best, point_segment_distance(point, polyline[i], polyline[i + 1]));
   if (polyline.size() == 1) best = (polyline[0] - point).norm();
   return best;
 }
@@ -179,13 +177,17 @@ double distance_to_polyline(const Vec3& point, const std::vector<Vec3>& polyline
 PathErrorStats path_error(const MotionSamples& samples, const Toolpath& toolpath) {
   PathErrorStats stats;
   double sum_sq = 0.0, total_time = 0.0;
+  // each path's segments binned once, when its first sample comes (polyline_distance.hpp)
+  std::vector<std::unique_ptr<PolylineDistance>> distance(toolpath.paths.size());
   for (size_t k = 0; k < samples.size(); ++k) {
     // a long path's distances take seconds: a signal that asked to stop ends them
     if (k % 1024 == 0) throw_if_interrupted();
     const int path = samples.path_index[k];
     if (!samples.depositing[k] || path < 0 || path >= static_cast<int>(toolpath.paths.size()))
       continue;
-    const double e = distance_to_polyline(samples.position_mm[k], toolpath.paths[path].points);
+    if (!distance[path])
+      distance[path] = std::make_unique<PolylineDistance>(toolpath.paths[path].points);
+    const double e = (*distance[path])(samples.position_mm[k]);
     const double w = time_weight(samples, k);
     stats.max_mm = std::max(stats.max_mm, e);
     sum_sq += e * e * w;
