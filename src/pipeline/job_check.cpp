@@ -193,6 +193,17 @@ std::string duration_text(const Scenario& scenario, const RunEstimate& run) {
   return text;
 }
 
+// for a G-code file of several layers among those a run prints: the key that prints fewer
+std::string fewer_layers_hint(const Scenario& scenario) {
+  if (!scenario.gcode) return "";
+  const GcodeToolpath& gcode = *scenario.gcode;
+  const int last =
+      gcode.last_layer >= 0 ? gcode.last_layer : static_cast<int>(gcode.layer_z_mm.size()) - 1;
+  if (last - gcode.first_layer < 1) return "";
+  return ", print fewer of its " + std::to_string(last - gcode.first_layer + 1) +
+         " layers (toolpath.gcode.layers: [from, to])";
+}
+
 }  // namespace
 
 double parse_memory_size(const std::string& text, const std::string& option) {
@@ -281,8 +292,8 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
         (run.label.empty() ? std::string("the job") : "run " + run.label) + " would take " +
             count_text(run.steps) + " physics steps, more than sim.max_steps = " +
             count_text(max_steps) + ": " + duration_text(scenario, run) + ", at sim.timestep_s " +
-            number(scenario.sim.timestep_s) +
-            " s (check the print speeds, the limits and sim, or raise sim.max_steps)"));
+            number(scenario.sim.timestep_s) + " s (check the print speeds, the limits and sim" +
+            fewer_layers_hint(scenario) + ", or raise sim.max_steps)"));
     if (run.label.empty()) break;  // before planning every run is the same estimate
   }
   // every run a verb keeps together, against the memory budget
@@ -306,7 +317,8 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
             (run.label.empty() ? "each run " : "run " + run.label + " ") + "keeps " + parts + " (" +
             duration_text(scenario, run) +
             "); check the print speeds, the limits, sim.timestep_s and sim.cell_mm, run fewer "
-            "planners, or raise --max-memory"));
+            "planners" +
+            fewer_layers_hint(scenario) + ", or raise --max-memory"));
   }
   return problems;
 }

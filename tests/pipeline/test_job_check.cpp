@@ -141,6 +141,41 @@ planners: [lspb_mtt]
       check_scenario(write_text(dir, "raised.yaml", slow + "sim: {max_steps: 2e7}\n"), budget));
 }
 
+// a G-code job too large for the memory allowed names the key that prints fewer of its
+// layers (three here; one selected: no such hint, it prints one layer)
+TEST(JobEstimate, ALargeGcodeJobIsToldToPrintFewerLayers) {
+  const std::string dir = fresh_directory("job_layers");
+  std::string gcode = "G21\nG90\nM83\n";
+  for (int layer = 0; layer < 3; ++layer)
+    gcode += "G0 X0 Y0 Z" + std::to_string(0.2 * (layer + 1)) +
+             "\nG1 X20 Y0 E1 F600\nG1 X20 Y20 E1\nG1 X0 Y20 E1\nG1 X0 Y0 E1\n";
+  write_text(dir, "square.gcode", gcode);
+  const std::string head = "machine: cartesian\nprocess: {type: extrusion}\ntoolpath:\n";
+  JobBudget budget;
+  budget.max_memory_bytes = 1e6;
+  try {
+    check_scenario(write_text(dir, "all.yaml", head + "  gcode: square.gcode\n"), budget);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& error) {
+    ASSERT_EQ(error.problems().size(), 1u) << error.what();
+    EXPECT_NE(error.problems()[0].message.find(
+                  "print fewer of its 3 layers (toolpath.gcode.layers: [from, to])"),
+              std::string::npos)
+        << error.what();
+  }
+  try {
+    check_scenario(
+        write_text(dir, "one.yaml", head + "  gcode: {file: square.gcode, layers: [1, 1]}\n"),
+        budget);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& error) {
+    ASSERT_EQ(error.problems().size(), 1u) << error.what();
+    EXPECT_EQ(error.problems()[0].message.find("fewer of its"), std::string::npos) << error.what();
+    EXPECT_NE(error.problems()[0].message.find("more than --max-memory"), std::string::npos)
+        << error.what();
+  }
+}
+
 // a long segments list read apart (scenario/lifted_list.hpp) gives the scenario and the
 // problems yaml-cpp gives: the same list with a comment in it goes through yaml-cpp
 TEST(LiftedSegments, GiveTheSameScenarioAndProblemsAsYamlCpp) {
