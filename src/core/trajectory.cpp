@@ -174,7 +174,8 @@ double evaluate_flow_fraction(const TrajectoryPiece& piece, double tau, const Ve
   const double speed = velocity_mm_s.norm();
   const double speed_rate = speed > 0.0 ? velocity_mm_s.dot(acceleration_mm_s2) / speed : 0.0;
   if (!(piece.desired_speed_mm_s > 0.0)) return 0.0;
-  return std::max(0.0, (speed + piece.flow_lead_s * speed_rate) / piece.desired_speed_mm_s);
+  const double fraction = (speed + piece.flow_lead_s * speed_rate) / piece.desired_speed_mm_s;
+  return piece.flow_may_retract ? fraction : std::max(0.0, fraction);
 }
 
 namespace {

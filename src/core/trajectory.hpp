@@ -65,8 +65,12 @@ struct TrajectoryPiece {
   double flow_fraction = 1.0;
   // >= 0: the commanded flow follows the planned speed instead, led by this time (pressure
   // advance over an extruder's flow lag tau: fraction (|v| + lead d|v|/dt) / desired speed,
-  // never below 0), so the lagged flow is |v| / desired speed of the nominal; -1: as above
+  // never below 0 unless flow_may_retract), so the lagged flow is |v| / desired speed of the
+  // nominal; -1: as above
   double flow_lead_s = -1.0;
+  // with flow_lead_s: the led fraction goes below 0 where a deceleration calls for it (an
+  // extruder that may retract, process.retract), instead of stopping at 0
+  bool flow_may_retract = false;
   std::variant<PhaseMotion, SampledMotion> motion;
   ToolAxisMotion tool_axis;  // the orientation channel
 };

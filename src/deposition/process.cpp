@@ -183,7 +183,8 @@ double ExtrusionProcess::command_mm3_s(const DepositionStep& step) const {
                                    ? settings_.flow_mm3_s
                                    : std::max(0.0, step.desired_speed_mm_s) *
                                          settings_.bead_width_mm * settings_.layer_height_mm;
-  return std::max(0.0, step.flow_command) * nominal_mm3_s;
+  // a command below 0 retracts only where the extruder may (settings.retract)
+  return (settings_.retract ? step.flow_command : std::max(0.0, step.flow_command)) * nominal_mm3_s;
 }
 
 void ExtrusionProcess::restart() {
@@ -194,7 +195,7 @@ void ExtrusionProcess::restart() {
 
 void ExtrusionProcess::start_steady(const DepositionStep& step) {
   check_step(step);
-  flow_mm3_s_ = command_mm3_s(step);
+  flow_mm3_s_ = std::max(0.0, command_mm3_s(step));
   peak_command_mm3_s_ = std::max(peak_command_mm3_s_, flow_mm3_s_);
 }
 
@@ -220,19 +221,42 @@ void ExtrusionProcess::advance(const DepositionStep& step) {
       flow1_mm3_s = 0.0;
     }
   }
+  // a retracting command (settings.retract) draws the flow down faster; it stops at 0, at
+  // u = ln((Q0 - Qc) / -Qc) / (dt / tau) of the step, having put down Qc u dt + Q0 tau
+  double flowing_share = 1.0;  // the share of the step the nozzle flows in
+  if (command_mm3_s < 0.0) {
+    if (flow0_mm3_s <= 0.0 || tau_s <= 0.0) {
+      flowing_share = 0.0;
+      volume_mm3 = 0.0;
+    } else if (flow1_mm3_s < 0.0) {
+      flowing_share = std::log((flow0_mm3_s - command_mm3_s) / -command_mm3_s) / decay_per_step;
+      volume_mm3 = command_mm3_s * flowing_share * dt_s + flow0_mm3_s * tau_s;
+    }
+    flow1_mm3_s = std::max(0.0, flow1_mm3_s);
+  }
   flow_mm3_s_ = flow1_mm3_s;
   volume_mm3 = std::max(0.0, volume_mm3);
 
   // everything that leaves the nozzle lands
   account_.emitted_mm3 += volume_mm3;
   account_.landed_mm3 += volume_mm3;
+  if (flowing_share <= 0.0) return;
 
-  // rate within the step: Qc + (Q0 - Qc) exp(-u dt / tau)
+  // rate within the step: Qc + (Q0 - Qc) exp(-u dt / tau), over the part of the chord the
+  // nozzle flows along (all of it unless a retraction stopped the flow)
   StepRate rate;
   rate.constant = command_mm3_s;
   rate.decaying = tau_s > 0.0 ? flow0_mm3_s - command_mm3_s : 0.0;
   rate.decay = decay_per_step;
-  deposit_step(step, volume_mm3, rate);
+  if (flowing_share >= 1.0) {
+    deposit_step(step, volume_mm3, rate);
+    return;
+  }
+  DepositionStep flowing = step;
+  flowing.t1_s = step.t0_s + flowing_share * dt_s;
+  flowing.p1_mm = step.p0_mm + flowing_share * (step.p1_mm - step.p0_mm);
+  rate.decay = decay_per_step * flowing_share;
+  deposit_step(flowing, volume_mm3, rate);
 }
 
 std::unique_ptr<Process> make_process(const DepositionSettings& settings, double cell_mm) {

@@ -9,7 +9,9 @@
 //  extrusion commanded flow Qc = flow_command * Q_nominal, Q_nominal = desired speed x
 //            bead width x layer height (or flow_mm3_s when given); the nozzle flow lags
 //            it, dQ/dt = (Qc - Q) / tau (pressure build-up), so a path starts thin and
-//            ooze keeps flowing after the command stops. Nothing is captured.
+//            ooze keeps flowing after the command stops. A command below 0 (settings.retract:
+//            the filament pulled back) draws Q down faster, and Q stops at 0. Nothing is
+//            captured.
 //            Bead profile: isotropic Gaussian with sigma = w / 4. Why: the same kernel and
 //            line-width convention as aerosol (+-w/2 = +-2 sigma holds 95.4% of a steady
 //            line), so metrics mean the same for both; round blobs where the nozzle
@@ -53,6 +55,9 @@ struct DepositionSettings {
   double bead_width_mm = 0.4;      // extrusion
   double layer_height_mm = 0.2;    // extrusion
   double tau_s = 0.05;             // extrusion flow lag time constant (0 = no lag)
+  // extrusion: a flow command below 0 is kept (the extruder retracts: the nozzle flow falls
+  // faster, and stops at 0), not raised to 0
+  bool retract = false;
   double truncation_sigmas = 5.0;  // footprint fades out at this many sigma (+-0.25; renormalised)
   // consecutive steps are deposited as one quadrature until their path would exceed this
   // many sigma (step_batch.hpp); 0 = every step on its own

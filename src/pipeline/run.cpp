@@ -45,6 +45,7 @@ DepositionSettings deposition_settings(const Scenario& scenario) {
   s.bead_width_mm = p.bead_width_mm;
   s.layer_height_mm = p.layer_height_mm;
   s.tau_s = p.tau_s;
+  s.retract = p.retract;
   return s;
 }
 

@@ -491,6 +491,12 @@ void Loader::read_process(const Field& field) {
   read("bead_width_mm", process.bead_width_mm);
   read("layer_height_mm", process.layer_height_mm);
   read("tau_s", process.tau_s);
+  if (const Field* f = view.find("retract")) {
+    if (type_known && process.type != "extrusion")
+      problems_.add(f->line, f->key, "applies to extrusion, not to process type " + process.type);
+    else
+      process.retract = read_bool(*f, problems_).value_or(process.retract);
+  }
 }
 
 void Loader::read_toolpath(const Field* field) {

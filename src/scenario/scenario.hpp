@@ -35,6 +35,9 @@ struct ProcessSpec {
   double bead_width_mm = 0.4;
   double layer_height_mm = 0.2;
   double tau_s = 0.05;
+  // extrusion: the flow command may go below 0 (the extruder pulls the filament back), as
+  // Klipper's pressure advance does in decelerations; the nozzle flow stops at 0
+  bool retract = false;
 };
 
 // `sim:` — simulation and deposition-grid settings.

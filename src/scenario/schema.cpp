@@ -230,7 +230,17 @@ std::vector<SchemaSection> make_schema() {
         number("layer_height_mm", "mm", ValueRange::closed(0.001, 100.0), process.layer_height_mm,
                "bead height", "extrusion"),
         number("tau_s", "s", positive_up_to(100.0), process.tau_s,
-               "time constant of the flow's first-order lag behind its command", "extrusion")}});
+               "time constant of the flow's first-order lag behind its command", "extrusion"),
+        [&] {
+          SchemaKey key = word("retract", {"false", "true"}, process.retract ? "true" : "false",
+                               "the extruder may pull the filament back: a flow command below "
+                               "0, as pressure advance commands in a deceleration (the nozzle "
+                               "flow stops at 0); uniform then decelerates at a_max instead of "
+                               "at most |v| / tau_s");
+          key.type = "true | false";
+          key.applies_to = "extrusion";
+          return key;
+        }()}});
 
   // toolpath and its kinds
   schema.push_back(

@@ -138,6 +138,54 @@ TEST(Extrusion, ZeroTauFollowsTheCommandInstantly) {
   EXPECT_NEAR(cross_section_mm2(process.field(), 0.5) / (kBeadWidth * kLayerHeight), 1.0, 1e-4);
 }
 
+// process.retract: a command below 0 draws the lagged flow down faster and stops it at 0.
+// From Q0 = nominal, a command of -nominal held for 0.1 s (2 tau) crosses 0 at t* = tau ln 2
+// and lays Qc t* + Q0 tau = Q0 tau (1 - ln 2); after that nothing flows, and the chord is
+// deposited only up to where the flow stopped. Without retract the same command is 0: the
+// flow decays as exp(-t / tau) and lays Q0 tau (1 - exp(-2)).
+TEST(Extrusion, RetractingCommandStopsTheFlowAtZero) {
+  for (const bool retract : {true, false}) {
+    SCOPED_TRACE(retract ? "retract" : "no retract");
+    DepositionSettings settings = extrusion_settings();
+    settings.retract = retract;
+    ExtrusionProcess process(settings, 0.0);
+    const double nominal = kSpeed * kBeadWidth * kLayerHeight;
+    DepositionStep step;
+    step.flow_command = 1.0;
+    step.desired_speed_mm_s = kSpeed;
+    process.start_steady(step);
+    ASSERT_DOUBLE_EQ(process.nozzle_flow_mm3_s(), nominal);
+    // one 0.1 s step along x from 0 to 2 mm, commanding -1
+    step.t0_s = 0.0;
+    step.t1_s = 2.0 * kTau;
+    step.p0_mm = Vec3(0, 0, 0);
+    step.p1_mm = Vec3(2, 0, 0);
+    step.flow_command = -1.0;
+    process.advance(step);
+    const double expected =
+        retract ? nominal * kTau * (1.0 - std::log(2.0)) : nominal * kTau * -std::expm1(-2.0);
+    EXPECT_NEAR(process.account().emitted_mm3, expected, 1e-12 * expected);
+    EXPECT_NEAR(process.field().total_volume_mm3(), expected, 1e-9 * expected);
+    if (retract) {
+      EXPECT_EQ(process.nozzle_flow_mm3_s(), 0.0);
+      // the flow stopped at u = ln 2 / 2 of the 2 mm chord, x = ln 2 mm: beyond the footprint's
+      // reach past it (5 sigma = 0.5 mm) the field is empty, before it the bead lies
+      const ThicknessField& field = process.field();
+      const auto column = [&](double x_mm) { return cross_section_mm2(field, x_mm); };
+      EXPECT_EQ(column(std::log(2.0) + 0.55), 0.0);
+      EXPECT_GT(column(0.3), 0.0);
+      // a later retracting step lays nothing and the flow stays at 0
+      step.t0_s = step.t1_s;
+      step.t1_s += 0.01;
+      process.advance(step);
+      EXPECT_NEAR(process.account().emitted_mm3, expected, 1e-12 * expected);
+      EXPECT_EQ(process.nozzle_flow_mm3_s(), 0.0);
+    } else {
+      EXPECT_NEAR(process.nozzle_flow_mm3_s(), nominal * std::exp(-2.0), 1e-12 * nominal);
+    }
+  }
+}
+
 // start_steady: the lagged flow starts settled at the step's command, so a line printed from
 // there lands exactly command x time (no thin start), and nothing lands before it
 TEST(Extrusion, StartSteadySettlesTheLagWithoutDepositing) {

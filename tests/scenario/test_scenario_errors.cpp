@@ -405,13 +405,23 @@ process:
   type: aerosol
   sigma_mm: 0
   tau_s: 0.05
+  retract: true
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 )");
-  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
   expect_problem(problems, scenario_path(), "process.sigma_mm", 3,
                  "must be in [0.001, 100], got 0");
   expect_problem(problems, scenario_path(), "process.tau_s", 4,
                  "applies to extrusion, not to process type aerosol");
+  expect_problem(problems, scenario_path(), "process.retract", 5,
+                 "applies to extrusion, not to process type aerosol");
+  // on extrusion, a word that is not true or false
+  const auto word = problems_of(R"(
+process: {type: extrusion, retract: sometimes}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(word.size(), 1u) << dump(word);
+  expect_problem(word, scenario_path(), "process.retract", 1, "expected true or false, got");
 }
 
 // the cell of the deposition grid against the footprint it samples, and the servo loop's

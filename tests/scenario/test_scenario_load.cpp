@@ -132,6 +132,7 @@ process:
   bead_width_mm: 0.45
   layer_height_mm: 0.25
   tau_s: 0.08
+  retract: true
 toolpath:
   speed: 20
   start: [0, 0, 5]
@@ -170,6 +171,7 @@ outputs: {render: false, image_width: 320, image_height: 2048}
   EXPECT_EQ(s.process.bead_width_mm, 0.45);
   EXPECT_EQ(s.process.layer_height_mm, 0.25);
   EXPECT_EQ(s.process.tau_s, 0.08);
+  EXPECT_TRUE(s.process.retract);
   // toolpath: 3-D start/end, bare and map polylines, per-path speed
   expect_point(s.toolpath.start_mm, 0, 0, 5);
   expect_point(s.toolpath.end_mm, 100, 100, 5.5);
@@ -188,9 +190,9 @@ outputs: {render: false, image_width: 320, image_height: 2048}
   // planners keep the file's order and lines
   ASSERT_EQ(s.planners.size(), 2u);
   EXPECT_EQ(s.planners[0].name, "stop_and_go");
-  EXPECT_EQ(s.planners[0].line, 25);
+  EXPECT_EQ(s.planners[0].line, 26);
   EXPECT_EQ(s.planners[1].name, "lspb_mtt");
-  EXPECT_EQ(s.planners[1].line, 26);
+  EXPECT_EQ(s.planners[1].line, 27);
   // sim and outputs
   EXPECT_EQ(s.sim.timestep_s, 0.0005);
   EXPECT_EQ(s.sim.cell_mm, 0.05);

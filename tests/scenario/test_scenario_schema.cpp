@@ -143,6 +143,8 @@ TEST_F(SchemaFiles, AFileWithoutTheKeysGetsTheTablesDefaults) {
   expect_default("process", "layer_height_mm", s.process.layer_height_mm);
   expect_default("process", "tau_s", s.process.tau_s);
   EXPECT_EQ(schema_section("process").key("type").default_text, s.process.type);
+  EXPECT_EQ(schema_section("process").key("retract").default_text,
+            s.process.retract ? "true" : "false");
   expect_default("sim", "timestep_s", s.sim.timestep_s);
   expect_default("sim", "control_period_s", s.sim.control_period_s);
   expect_default("sim", "cell_mm", s.sim.cell_mm);

@@ -81,7 +81,7 @@ double speed_change_reach_mm(const PrintChain& chain, size_t corner, const TcpLi
     const Vec3& a = chain.points[e];
     const Vec3& b = chain.points[e + 1];
     const LineLimits line = line_limits((b - a).normalized(), limits.along(a, b),
-                                        chain.edge_speed_mm_s[e], options.lag_s);
+                                        chain.edge_speed_mm_s[e], options.deceleration_lag_s());
     reach = std::max(reach, speed_change_distance(line.v_max_mm_s, 0.0, line) +
                                 kLagSettlingLags * options.lag_s * line.v_max_mm_s);
   }

@@ -246,7 +246,7 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     if (trim0 + trim1 >= edge_length) line.to = line.from;
     const MachineLimits box =
         line.length > 0.0 ? limits.along(line.from, line.to) : limits.along(p0, p1);
-    line.limits = line_limits(line.u, box, speed, options.lag_s);
+    line.limits = line_limits(line.u, box, speed, options.deceleration_lag_s());
   }
   for (size_t i = 1; i + 1 < n; ++i)
     if (corners[i].treatment == CornerTreatment::blend)
@@ -313,6 +313,7 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     piece.depositing = true;
     piece.desired_speed_mm_s = chain.edge_speed_mm_s[edge];
     piece.flow_lead_s = lead;
+    piece.flow_may_retract = options.flow_follows_speed && options.flow_may_retract;
     return piece;
   };
   for (size_t k = 0; k < edges; ++k) {

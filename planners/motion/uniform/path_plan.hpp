@@ -84,7 +84,13 @@ struct PathMotionOptions {
   bool leave_at_speed = false;      // ends at print speed
   double lag_s = 0.0;               // extruder flow lag: the deceleration rule and the flow lead
   bool flow_follows_speed = false;  // pieces carry flow_lead_s = lag_s
-  double period_s = 0.001;          // longest sample period of a blend
+  // the led flow may go below 0 (process.retract: the extruder pulls the filament back), so
+  // decelerations are bounded by a_max alone, not by |v| / lag_s
+  bool flow_may_retract = false;
+  // the lag the deceleration rule keeps to (LineLimits::lag_s): lag_s, or 0 when the flow may
+  // retract
+  double deceleration_lag_s() const { return flow_may_retract ? 0.0 : lag_s; }
+  double period_s = 0.001;  // longest sample period of a blend
   // loops leave and re-enter their lines at rest (extrusion: the line ends at rest, the nozzle
   // travels with the flow off, the next line starts from rest); else at the lines' speeds
   bool loops_at_rest = false;

@@ -170,12 +170,16 @@ Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits
     conformal.zone_mm = 2.0 * settings.tolerance_mm;
     conformal.period_s = settings.period_s;
     conformal.control = control;
-    conformal.flow_lag_s = tau_s;  // decelerations the led flow can follow
+    // decelerations the led flow can follow (any, when the extruder may retract)
+    conformal.flow_lag_s = model.settings.retract ? 0.0 : tau_s;
     Trajectory timed = ConformalPlanner(conformal).plan(toolpath, jerk_limits, report);
     std::vector<TrajectoryPiece> pieces = timed.pieces();
     if (!aerosol)
       for (TrajectoryPiece& piece : pieces)
-        if (piece.depositing) piece.flow_lead_s = tau_s;  // pressure advance
+        if (piece.depositing) {
+          piece.flow_lead_s = tau_s;  // pressure advance
+          piece.flow_may_retract = model.settings.retract;
+        }
     return std::make_pair(std::move(pieces), timed.warnings());
   };
   ConformalPlanReport constant_report;
@@ -250,6 +254,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
   options.enter_at_speed = options.leave_at_speed = aerosol;
   options.lag_s = aerosol ? 0.0 : model.settings.tau_s;
   options.flow_follows_speed = !aerosol;
+  options.flow_may_retract = !aerosol && model.settings.retract;
   options.loops_at_rest = !aerosol;
   options.period_s = settings_.period_s;
 
