@@ -50,11 +50,11 @@ struct DepositionSettings {
   // aerosol: stream flow; 0 = derived so a 3 mm/s line peaks at 2 um (see aerosol_flow_mm3_s)
   // extrusion: 0 = desired speed x bead width x layer height per step; > 0 = fixed nominal flow
   double flow_mm3_s = 0.0;
-  double sigma_mm = 0.1;           // aerosol footprint standard deviation
-  double line_width_mm = 0.0;      // 0 = 4 sigma (aerosol) or bead width (extrusion)
-  double bead_width_mm = 0.4;      // extrusion
-  double layer_height_mm = 0.2;    // extrusion
-  double tau_s = 0.05;             // extrusion flow lag time constant (0 = no lag)
+  double sigma_mm = 0.1;         // aerosol footprint standard deviation
+  double line_width_mm = 0.0;    // 0 = 4 sigma (aerosol) or bead width (extrusion)
+  double bead_width_mm = 0.4;    // extrusion
+  double layer_height_mm = 0.2;  // extrusion
+  double tau_s = 0.05;           // extrusion flow lag time constant (0 = no lag)
   // extrusion: a flow command below 0 is kept (the extruder retracts: the nozzle flow falls
   // faster, and stops at 0), not raised to 0
   bool retract = false;
