@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "core/interrupt.hpp"
+#include "metrics/polyline_distance.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/job_check.hpp"
 #include "report/output_dir.hpp"
@@ -82,15 +83,6 @@ PieceSamples sample_piece(const TrajectoryPiece& piece, double period_s,
   return samples;
 }
 
-// distance from p to the segment a-b
-double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double length2 = ab.squaredNorm();
-  if (length2 <= 0.0) return (p - a).norm();
-  const double u = std::clamp((p - a).dot(ab) / length2, 0.0, 1.0);
-  return (p - (a + u * ab)).norm();
-}
-
 // Douglas-Peucker over samples [first, last]: the kept indices (first and last included), so
 // every sample between two kept ones lies within tolerance of their chord
 std::vector<size_t> simplify(const std::vector<Vec3>& points, size_t first, size_t last,
@@ -104,7 +96,7 @@ std::vector<size_t> simplify(const std::vector<Vec3>& points, size_t first, size
     double farthest_mm = -1.0;
     size_t farthest = a;
     for (size_t i = a + 1; i < b; ++i) {
-      const double d = distance_to_segment(points[i], points[a], points[b]);
+      const double d = point_segment_distance(points[i], points[a], points[b]);
       if (d > farthest_mm) farthest_mm = d, farthest = i;
     }
     if (farthest_mm > tolerance_mm) {

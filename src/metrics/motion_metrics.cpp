@@ -174,9 +174,8 @@ double distance_to_polyline(const Vec3& point, const std::vector<Vec3>& polyline
   return best;
 }
 
-PathErrorStats path_error(const MotionSamples& samples, const Toolpath& toolpath) {
-  PathErrorStats stats;
-  double sum_sq = 0.0, total_time = 0.0;
+std::vector<double> path_distances(const MotionSamples& samples, const Toolpath& toolpath) {
+  std::vector<double> distances(samples.size(), std::numeric_limits<double>::quiet_NaN());
   // each path's segments binned once, when its first sample comes (polyline_distance.hpp)
   std::vector<std::unique_ptr<PolylineDistance>> distance(toolpath.paths.size());
   for (size_t k = 0; k < samples.size(); ++k) {
@@ -187,7 +186,18 @@ PathErrorStats path_error(const MotionSamples& samples, const Toolpath& toolpath
       continue;
     if (!distance[path])
       distance[path] = std::make_unique<PolylineDistance>(toolpath.paths[path].points);
-    const double e = (*distance[path])(samples.position_mm[k]);
+    distances[k] = (*distance[path])(samples.position_mm[k]);
+  }
+  return distances;
+}
+
+PathErrorStats path_error(const MotionSamples& samples, const Toolpath& toolpath) {
+  PathErrorStats stats;
+  double sum_sq = 0.0, total_time = 0.0;
+  const std::vector<double> distances = path_distances(samples, toolpath);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const double e = distances[k];
+    if (std::isnan(e)) continue;  // nothing deposited, or no path
     const double w = time_weight(samples, k);
     stats.max_mm = std::max(stats.max_mm, e);
     sum_sq += e * e * w;

@@ -74,6 +74,10 @@ struct PathErrorStats {
   double rms_mm = 0.0;  // time-weighted
 };
 PathErrorStats path_error(const MotionSamples& samples, const Toolpath& toolpath);
+// per sample, that distance (mm): NaN where the sample deposits nothing or names no path of
+// `toolpath` (a distance itself is never NaN: infinity at worst); each path's segments are
+// binned once (polyline_distance.hpp)
+std::vector<double> path_distances(const MotionSamples& samples, const Toolpath& toolpath);
 
 // distance from a point to a polyline
 double distance_to_polyline(const Vec3& point, const std::vector<Vec3>& polyline);

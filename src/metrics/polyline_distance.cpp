@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "metrics/motion_metrics.hpp"
+
 namespace depotwin {
 
 namespace {
@@ -98,11 +100,7 @@ void PolylineDistance::for_each_cell_of_segment(std::size_t k, Visit&& visit) co
 }
 
 double PolylineDistance::scan_all(const Vec3& point) const {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k + 1 < points_.size(); ++k)
-    best = std::min(best, point_segment_distance(point, points_[k], points_[k + 1]));
-  if (points_.size() == 1) best = (points_[0] - point).norm();
-  return best;
+  return distance_to_polyline(point, points_);
 }
 
 double PolylineDistance::operator()(const Vec3& point) const {

@@ -38,7 +38,7 @@ class PolylineDistance {
   double operator()(const Vec3& point) const;
 
  private:
-  // every segment: distance_to_polyline's own loop
+  // every segment: distance_to_polyline
   double scan_all(const Vec3& point) const;
   // the grid's cells (column i, row j) the segment from point k to k + 1 may pass through
   template <typename Visit>

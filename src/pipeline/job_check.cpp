@@ -193,14 +193,12 @@ std::string duration_text(const Scenario& scenario, const RunEstimate& run) {
   return text;
 }
 
-// for a G-code file of several layers among those a run prints: the key that prints fewer
+// for a G-code file printing several layers (those `layers:` selected, numbered from 0 in
+// the toolpath): the key that prints fewer
 std::string fewer_layers_hint(const Scenario& scenario) {
-  if (!scenario.gcode) return "";
-  const GcodeToolpath& gcode = *scenario.gcode;
-  const int last =
-      gcode.last_layer >= 0 ? gcode.last_layer : static_cast<int>(gcode.layer_z_mm.size()) - 1;
-  if (last - gcode.first_layer < 1) return "";
-  return ", print fewer of its " + std::to_string(last - gcode.first_layer + 1) +
+  const int layers = scenario.toolpath.layer_count();
+  if (!scenario.gcode || layers < 2) return "";
+  return ", print fewer of its " + std::to_string(layers) +
          " layers (toolpath.gcode.layers: [from, to])";
 }
 

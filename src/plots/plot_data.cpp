@@ -7,12 +7,10 @@
 #include <cstring>
 #include <limits>
 #include <map>
-#include <memory>
 #include <set>
 #include <utility>
 
 #include "core/number_text.hpp"
-#include "metrics/polyline_distance.hpp"
 
 namespace depotwin::plots {
 
@@ -410,17 +408,9 @@ std::vector<double> speed_error_with_gaps(const MotionSamples& samples) {
 
 std::vector<double> relative_position_error(const MotionSamples& samples, const Toolpath& toolpath,
                                             double feature_mm) {
-  std::vector<double> error(samples.size(), kNaN);
-  const int path_count = static_cast<int>(toolpath.paths.size());
-  // each path's segments binned once (metrics/polyline_distance.hpp: path_error's distances)
-  std::vector<std::unique_ptr<PolylineDistance>> distance(toolpath.paths.size());
-  for (size_t k = 0; k < samples.size(); ++k) {
-    const int path = samples.path_index[k];
-    if (!samples.depositing[k] || path < 0 || path >= path_count) continue;
-    if (!distance[path])
-      distance[path] = std::make_unique<PolylineDistance>(toolpath.paths[path].points);
-    error[k] = (*distance[path])(samples.position_mm[k]) / feature_mm;
-  }
+  // path_error's distances (NaN stays NaN)
+  std::vector<double> error = path_distances(samples, toolpath);
+  for (double& e : error) e /= feature_mm;
   return error;
 }
 
