@@ -93,6 +93,11 @@ class TcpLimits {
   const MachineLimits& requested() const { return requested_; }
   // true when the limits are the same everywhere
   bool uniform() const { return !over_box_; }
+  // true when the limits over every box are the same: uniform, or refined per box by a machine
+  // whose refinement ignores the box (a Cartesian machine, an XY stage: each TCP axis one joint)
+  bool same_everywhere() const { return !over_box_ || box_independent_; }
+  // declares that over_box gives the same limits for every box (the machine knows)
+  void set_box_independent(bool independent) { box_independent_ = independent; }
   // the machine's joints along a path; null when the limits come without a machine
   const JointMap* joint_map() const { return joint_map_.get(); }
   // the same, to share with limits derived from these
@@ -102,6 +107,7 @@ class TcpLimits {
   MachineLimits requested_;
   BoxLimits over_box_;
   std::shared_ptr<const JointMap> joint_map_;
+  bool box_independent_ = false;
 };
 
 }  // namespace depotwin

@@ -58,6 +58,9 @@ class Machine {
   // looser than `requested`).
   virtual MachineLimits cartesian_limits(const MachineLimits& requested, const Vec3& lo,
                                          const Vec3& hi) const = 0;
+  // true when cartesian_limits ignores its box (each TCP axis driven by one joint): the TCP
+  // limits are then the same everywhere (TcpLimits::same_everywhere)
+  virtual bool limits_ignore_position() const { return false; }
   // the user's TCP limits, refined per move by cartesian_limits, with the machine's joint map
   // (joint positions along a path by inverse_near; the machine must outlive it)
   TcpLimits tcp_limits(const MachineLimits& requested) const;

@@ -71,12 +71,14 @@ TcpLimits Machine::tcp_limits(const MachineLimits& requested) const {
     }
     return true;
   };
-  return TcpLimits(
+  TcpLimits limits(
       requested,
       [this, requested](const Vec3& lo, const Vec3& hi) {
         return cartesian_limits(requested, lo, hi);
       },
       std::move(joint_map));
+  limits.set_box_independent(limits_ignore_position());
+  return limits;
 }
 
 std::string vertical_axis_problem(const std::string& machine, const Pose& pose) {

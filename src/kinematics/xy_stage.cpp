@@ -107,6 +107,8 @@ class XyStage : public Machine {
     return limits;
   }
 
+  bool limits_ignore_position() const override { return true; }
+
   std::string set_joint_limits(const AxisLimits& joint) override {
     for (JointLimit& limit : limits_) {
       limit.v_max = joint.v_max_mm_s;

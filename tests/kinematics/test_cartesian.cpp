@@ -2,6 +2,8 @@
 // travel (Klipper's `cartesian`), each TCP axis limited by its own joint.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "kinematics/cartesian.hpp"
 #include "kinematics/machine.hpp"
 
@@ -66,6 +68,38 @@ TEST(Cartesian, TcpLimitsAreTheTighterOfTheRequestedAndTheJoints) {
   EXPECT_DOUBLE_EQ(limits.axes[1].v_max_mm_s, 300.0);
   EXPECT_DOUBLE_EQ(limits.axes[2].v_max_mm_s, 15.0);
   EXPECT_DOUBLE_EQ(limits.axes[2].a_max_mm_s2, 300.0);
+}
+
+// A machine that declares its TCP limits free of the position (each TCP axis one joint: the
+// gantry and the XY stage) gives the same limits over every box, and its TcpLimits say so
+// (uniform's corner decisions are then reused across layers); the delta's and the arm's
+// depend on where the box is, and theirs do not.
+TEST(Machines, LimitsDeclaredFreeOfThePositionAreTheSameOverEveryBox) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> coordinate(-150.0, 150.0), size(0.0, 40.0);
+  const MachineLimits requested = MachineLimits::uniform(80.0, 900.0, 20000.0);
+  for (const std::string& name : machine_names()) {
+    SCOPED_TRACE(name);
+    const auto machine = make_machine(name);
+    const TcpLimits limits = machine->tcp_limits(requested);
+    EXPECT_EQ(limits.same_everywhere(), machine->limits_ignore_position());
+    if (!machine->limits_ignore_position()) continue;
+    const MachineLimits first = limits.over(Vec3::Zero(), Vec3::Zero());
+    bool all_same = true;
+    for (int k = 0; k < 50; ++k) {
+      const Vec3 lo(coordinate(rng), coordinate(rng), 0.5 * coordinate(rng));
+      const MachineLimits box = limits.over(lo, lo + Vec3(size(rng), size(rng), size(rng)));
+      for (int axis = 0; axis < 3; ++axis)
+        all_same = all_same && box.axes[axis].v_max_mm_s == first.axes[axis].v_max_mm_s &&
+                   box.axes[axis].a_max_mm_s2 == first.axes[axis].a_max_mm_s2 &&
+                   box.axes[axis].j_max_mm_s3 == first.axes[axis].j_max_mm_s3;
+    }
+    EXPECT_TRUE(all_same);
+  }
+  for (const char* free_of_position : {"cartesian", "xy_stage"})
+    EXPECT_TRUE(make_machine(free_of_position)->limits_ignore_position()) << free_of_position;
+  for (const char* position_bound : {"linear_delta", "arm6"})
+    EXPECT_FALSE(make_machine(position_bound)->limits_ignore_position()) << position_bound;
 }
 
 }  // namespace
