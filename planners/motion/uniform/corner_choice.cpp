@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <utility>
@@ -927,6 +928,59 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
       decision.chosen = candidate;
   decision.candidates = std::move(candidates);
   return decision;
+}
+
+std::vector<uint64_t> CornerDecisionCache::corner_key(const PrintChain& chain, size_t corner,
+                                                      const std::vector<CornerGeometry>& geometry) {
+  std::vector<uint64_t> key;
+  key.reserve(40);
+  const auto add = [&key](double value) {
+    uint64_t bits = 0;
+    std::memcpy(&bits, &value, sizeof bits);
+    key.push_back(bits);
+  };
+  const auto add_vector = [&add](const Vec3& v) {
+    for (int axis = 0; axis < 3; ++axis) add(v[axis]);
+  };
+  // the three points: (x, y), and the heights unless the corner is planar (then a marker)
+  const Vec3& a = chain.points[corner - 1];
+  const Vec3& c = chain.points[corner];
+  const Vec3& b = chain.points[corner + 1];
+  const CornerGeometry& g = geometry[corner];
+  for (const Vec3* p : {&a, &c, &b, &g.point}) {
+    add(p->x());
+    add(p->y());
+  }
+  const bool planar = a.z() == c.z() && b.z() == c.z() && g.point.z() == c.z();
+  key.push_back(planar ? 1 : 0);
+  if (!planar)
+    for (const Vec3* p : {&a, &c, &b, &g.point}) add(p->z());
+  // the edges' speeds and the corner's geometry
+  add(chain.edge_speed_mm_s[corner - 1]);
+  add(chain.edge_speed_mm_s[corner]);
+  add_vector(g.d_in);
+  add_vector(g.d_out);
+  add(g.turn_rad);
+  add(g.interior_deg);
+  add(g.tangent_per_length);
+  add(g.deviation_per_length);
+  add_vector(g.shape.tangent);
+  add_vector(g.shape.curvature);
+  add_vector(g.shape.third);
+  add(g.max_half_length_mm);
+  return key;
+}
+
+size_t CornerDecisionCache::KeyHash::operator()(const std::vector<uint64_t>& key) const {
+  // each word mixed by splitmix64's finaliser into the running hash
+  uint64_t hash = key.size();
+  for (const uint64_t word : key) {
+    uint64_t z = word + 0x9e3779b97f4a7c15ull + hash;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    hash = z ^ (z >> 31);
+  }
+  return static_cast<size_t>(hash);
 }
 
 }  // namespace depotwin

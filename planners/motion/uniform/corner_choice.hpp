@@ -43,9 +43,11 @@
 // the slowed blends' whole series, the stop, then the loops.
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "core/limits.hpp"
@@ -101,5 +103,54 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              const std::vector<CornerGeometry>& geometry, const TcpLimits& limits,
                              const PathMotionOptions& options, const DepositModel& model,
                              double time_weight_mm_s, PredictionScratch& scratch);
+
+// The decisions of one planning's corners, kept so that a corner equal to one already decided
+// takes its decision instead of predicting it again (a slicer's layers repeat their perimeters
+// and infill: the same corners at another height). Equal means equal to the bit in everything
+// choose_corner reads of the corner: its point and its two neighbours, its two edges' print
+// speeds and its geometry (the planning's limits, options, deposit model and time weight are
+// the same for every corner). The height is left out of the key where the corner is planar
+// (its three points at one z): the window is then planned and predicted in the corner's own
+// frame, every z the same, with limits that hold everywhere; its decision does not depend on
+// that z (tests/planners/motion/test_uniform_planner.cpp checks it to the bit). Only when the
+// limits are the same everywhere (a Cartesian machine): where they depend on the position (a
+// delta), nothing is kept.
+class CornerDecisionCache {
+ public:
+  CornerDecisionCache(const TcpLimits& limits, bool enabled)
+      : enabled_(enabled && limits.same_everywhere()) {}
+  // the decision of interior point `corner` of the chain: an equal corner's, or decide()'s
+  // (stored for the next equal one)
+  template <class Decide>
+  CornerDecision decision(const PrintChain& chain, size_t corner,
+                          const std::vector<CornerGeometry>& geometry, Decide&& decide) {
+    if (!enabled_) return decide();
+    std::vector<uint64_t> key = corner_key(chain, corner, geometry);
+    if (const auto found = decisions_.find(key); found != decisions_.end()) {
+      ++reused_;
+      return found->second;
+    }
+    CornerDecision decided = decide();
+    // (bounded: when full, the kept decisions start over from this one; a slicer's layers
+    // repeat the layer before)
+    if (decisions_.size() >= kMaxKept) decisions_.clear();
+    decisions_.emplace(std::move(key), decided);
+    return decided;
+  }
+  // how many decisions were taken from an equal corner's
+  size_t reused() const { return reused_; }
+  // at most this many decisions are kept (about 1.2 kB each)
+  static constexpr size_t kMaxKept = size_t{1} << 15;
+
+ private:
+  struct KeyHash {
+    size_t operator()(const std::vector<uint64_t>& key) const;
+  };
+  static std::vector<uint64_t> corner_key(const PrintChain& chain, size_t corner,
+                                          const std::vector<CornerGeometry>& geometry);
+  bool enabled_;
+  size_t reused_ = 0;
+  std::unordered_map<std::vector<uint64_t>, CornerDecision, KeyHash> decisions_;
+};
 
 }  // namespace depotwin

@@ -161,10 +161,12 @@ TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s) {
   };
   if (limits.uniform())
     return TcpLimits(fill(limits.requested()), nullptr, limits.shared_joint_map());
-  return TcpLimits(
+  TcpLimits filled(
       fill(limits.requested()),
       [limits, fill](const Vec3& lo, const Vec3& hi) { return fill(limits.over(lo, hi)); },
       limits.shared_joint_map());
+  filled.set_box_independent(limits.same_everywhere());
+  return filled;
 }
 
 std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm) {

@@ -276,6 +276,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     t = pieces.back().t_end_s;
   };
   PredictionScratch scratch;  // the corner predictions' processes, reused
+  CornerDecisionCache decided(jerk_limits, settings_.reuse_corner_decisions);
   for (const PrintChain& chain : print_chains(chorded)) {
     // each corner's treatment, by the predicted deposit
     const std::vector<CornerGeometry> geometry =
@@ -286,8 +287,10 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
       if (geometry[i].turn_rad <= 0.0 ||
           (geometry[i].max_half_length_mm <= 0.0 && geometry[i].turn_rad < 0.5 * kPi))
         continue;  // straight on
-      chain_decisions.emplace_back(i, choose_corner(chain, i, geometry, jerk_limits, options, model,
-                                                    settings_.time_weight_mm_s, scratch));
+      chain_decisions.emplace_back(i, decided.decision(chain, i, geometry, [&]() {
+        return choose_corner(chain, i, geometry, jerk_limits, options, model,
+                             settings_.time_weight_mm_s, scratch);
+      }));
       corners[i] = chain_decisions.back().second.chosen.plan;
     }
     // planned from 0, then placed after the transition that brings the nozzle to its start;

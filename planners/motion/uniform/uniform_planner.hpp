@@ -44,6 +44,10 @@ struct UniformSettings {
   double time_weight_mm_s = 0.2;
   double jerk_ramp_s = 0.01;  // without j_max: the acceleration ramps up in this time
   double period_s = 0.001;    // longest sample period of a blend
+  // a corner equal to one already decided in the same planning takes its decision
+  // (CornerDecisionCache; not a scenario parameter: off, every corner is predicted, as the
+  // tests compare)
+  bool reuse_corner_decisions = true;
 };
 
 class UniformPlanner : public Planner {

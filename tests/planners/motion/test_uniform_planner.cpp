@@ -503,5 +503,179 @@ TEST(UniformPlanner, MaterialBalanceAndDeterminism) {
   }
 }
 
+// every figure of one corner decision equal to the other's, to the bit
+void expect_same_decision(const CornerDecision& a, const CornerDecision& b) {
+  ASSERT_EQ(a.candidates.size(), b.candidates.size());
+  for (size_t k = 0; k <= a.candidates.size(); ++k) {
+    const CornerCandidate& x = k < a.candidates.size() ? a.candidates[k] : a.chosen;
+    const CornerCandidate& y = k < b.candidates.size() ? b.candidates[k] : b.chosen;
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.plan.treatment, y.plan.treatment);
+    EXPECT_EQ(x.plan.half_length_mm, y.plan.half_length_mm);
+    EXPECT_EQ(x.plan.trim_in_mm, y.plan.trim_in_mm);
+    EXPECT_EQ(x.plan.trim_out_mm, y.plan.trim_out_mm);
+    EXPECT_EQ(x.error_mm, y.error_mm);
+    EXPECT_EQ(x.extra_time_s, y.extra_time_s);
+    EXPECT_EQ(x.cost, y.cost);
+    EXPECT_EQ(x.speed_mm_s, y.speed_mm_s);
+    EXPECT_EQ(x.pruned, y.pruned);
+    EXPECT_EQ(x.abandoned, y.abandoned);
+  }
+}
+
+// A planar corner decided at one height is taken from the cache at another (a slicer's next
+// layer): the same decision to the bit as predicting it there. A corner moved in (x, y), one
+// whose points are not at one height, and any corner under limits that depend on the position
+// are predicted afresh, as is one printed at another speed.
+TEST(UniformPlanner, CornerDecisionCacheReusesOnlyEqualCorners) {
+  for (const ProcessType type : {ProcessType::aerosol, ProcessType::extrusion}) {
+    for (const double interior_deg : {45.0, 100.0, 150.0}) {
+      SCOPED_TRACE(std::string(process_type_name(type)) + " " + std::to_string(interior_deg));
+      PathMotionOptions options;
+      DepositModel model;
+      model.settings.type = type;
+      model.settings.bead_width_mm = 0.4;
+      model.settings.tau_s = 0.05;
+      if (type == ProcessType::aerosol) {
+        options.enter_at_speed = options.leave_at_speed = true;
+      } else {
+        options.lag_s = 0.05;
+        options.flow_follows_speed = options.loops_at_rest = true;
+      }
+      const TcpLimits limits = with_jerk_limits(kLimits, 0.01);
+      const auto fresh = [&](const PrintChain& chain) {
+        PredictionScratch scratch;
+        return choose_corner(chain, 1, corner_geometry(chain.points, 0.05), limits, options, model,
+                             0.2, scratch);
+      };
+      // decides `chain` through the cache, counting whether it was predicted
+      int predicted = 0;
+      PredictionScratch scratch;
+      const auto through = [&](CornerDecisionCache& cache, const PrintChain& chain) {
+        const std::vector<CornerGeometry> geometry = corner_geometry(chain.points, 0.05);
+        return cache.decision(chain, 1, geometry, [&]() {
+          ++predicted;
+          return choose_corner(chain, 1, geometry, limits, options, model, 0.2, scratch);
+        });
+      };
+      const auto moved = [](PrintChain chain, const Vec3& by) {
+        for (Vec3& p : chain.points) p += by;
+        return chain;
+      };
+      const PrintChain first = joint_chain(interior_deg);
+      const PrintChain layer_up = moved(first, Vec3(0, 0, 0.2));
+      PrintChain tilted = layer_up;
+      tilted.points[2].z() += 0.1;
+      const PrintChain shifted = moved(first, Vec3(0.4, 0, 0.2));
+      PrintChain slower = layer_up;
+      slower.edge_speed_mm_s[1] = 2.0;
+
+      CornerDecisionCache cache(limits, true);
+      const CornerDecision decided = through(cache, first);
+      const CornerDecision reused = through(cache, layer_up);
+      EXPECT_EQ(predicted, 1);
+      EXPECT_EQ(cache.reused(), 1u);
+      expect_same_decision(reused, fresh(layer_up));
+      expect_same_decision(decided, fresh(first));
+      through(cache, tilted);
+      through(cache, shifted);
+      through(cache, slower);
+      EXPECT_EQ(predicted, 4);
+      EXPECT_EQ(cache.reused(), 1u);
+      // (the tilted corner's second visit is reused: its heights are in its key)
+      through(cache, tilted);
+      EXPECT_EQ(cache.reused(), 2u);
+
+      // limits given per box, not declared the same everywhere (a delta's): nothing kept
+      const TcpLimits per_box(limits.requested(),
+                              [&](const Vec3&, const Vec3&) { return limits.requested(); });
+      CornerDecisionCache off(per_box, true);
+      through(off, first);
+      through(off, layer_up);
+      EXPECT_EQ(off.reused(), 0u);
+      EXPECT_EQ(predicted, 6);
+    }
+  }
+}
+
+// The cache keeps at most kMaxKept decisions: when full, it starts over (the latest kept).
+TEST(UniformPlanner, CornerDecisionCacheIsBounded) {
+  PrintChain chain = joint_chain(60.0);
+  const std::vector<CornerGeometry> geometry = corner_geometry(chain.points, 0.05);
+  CornerDecisionCache cache(with_jerk_limits(kLimits, 0.01), true);
+  size_t decided = 0;
+  // corners told apart by their point's x alone (the decision itself is not the point here)
+  const auto visit = [&](size_t k) {
+    chain.points[1].x() = 1e-3 * static_cast<double>(k);
+    cache.decision(chain, 1, geometry, [&]() {
+      ++decided;
+      return CornerDecision{};
+    });
+  };
+  for (size_t k = 0; k < CornerDecisionCache::kMaxKept; ++k) visit(k);
+  visit(0);
+  EXPECT_EQ(decided, CornerDecisionCache::kMaxKept);
+  EXPECT_EQ(cache.reused(), 1u);
+  visit(CornerDecisionCache::kMaxKept);  // the one past full: the kept ones start over
+  visit(CornerDecisionCache::kMaxKept);
+  visit(1);
+  EXPECT_EQ(decided, CornerDecisionCache::kMaxKept + 2);
+  EXPECT_EQ(cache.reused(), 2u);
+}
+
+// Layers that repeat (the same star of corners at three heights, every joint from 20 to
+// 160 deg): `uniform` with decisions reused plans exactly as with every corner predicted, the
+// pieces equal and the motion the same to the bit every 10 ms.
+TEST(UniformPlanner, ReusedCornerDecisionsPlanAsFreshOnes) {
+  Toolpath toolpath;
+  toolpath.start_mm = Vec3(-20, -20, 0);
+  toolpath.end_mm = Vec3(20, -20, 0);
+  for (int layer = 0; layer < 3; ++layer) {
+    PrintPath path;
+    path.speed_mm_s = 3.0;
+    path.layer = layer;
+    const double z = 0.2 * (layer + 1);
+    Vec3 p(-8, 0, z), d(1, 0, 0);
+    path.points.push_back(p);
+    for (const double interior_deg : {160.0, 20.0, 120.0, 45.0, 90.0, 70.0, 135.0}) {
+      p += 4.0 * d;
+      path.points.push_back(p);
+      const double turn = deg_to_rad(180.0 - interior_deg);
+      d = Vec3(std::cos(turn) * d.x() - std::sin(turn) * d.y(),
+               std::sin(turn) * d.x() + std::cos(turn) * d.y(), 0.0);
+    }
+    path.points.push_back(p + 4.0 * d);
+    toolpath.paths.push_back(path);
+  }
+  for (const ProcessType type : {ProcessType::aerosol, ProcessType::extrusion}) {
+    SCOPED_TRACE(process_type_name(type));
+    UniformSettings fresh_settings;
+    fresh_settings.reuse_corner_decisions = false;
+    const Trajectory reused =
+        UniformPlanner(UniformSettings{}).plan_in_context(toolpath, kLimits, context_for(type));
+    const Trajectory fresh =
+        UniformPlanner(fresh_settings).plan_in_context(toolpath, kLimits, context_for(type));
+    ASSERT_EQ(reused.pieces().size(), fresh.pieces().size());
+    ASSERT_EQ(reused.duration_s(), fresh.duration_s());
+    ASSERT_EQ(reused.decisions().size(), fresh.decisions().size());
+    ASSERT_EQ(reused.decisions().size(), 21u);
+    for (size_t i = 0; i < reused.decisions().size(); ++i) {
+      const PlanDecision &a = reused.decisions()[i], &b = fresh.decisions()[i];
+      EXPECT_EQ(a.choice, b.choice);
+      ASSERT_EQ(a.figures.size(), b.figures.size());
+      for (size_t f = 0; f < a.figures.size(); ++f)
+        EXPECT_EQ(a.figures[f].value, b.figures[f].value);
+    }
+    TrajectoryCursor a(reused), b(fresh);
+    for (double t = 0.0; t <= reused.duration_s(); t += 0.01) {
+      const TrajectorySample x = a.at(t), y = b.at(t);
+      ASSERT_EQ(x.position_mm, y.position_mm) << t;
+      ASSERT_EQ(x.velocity_mm_s, y.velocity_mm_s) << t;
+      ASSERT_EQ(x.depositing, y.depositing) << t;
+      ASSERT_EQ(x.flow_fraction, y.flow_fraction) << t;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace depotwin
