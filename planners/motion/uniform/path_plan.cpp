@@ -24,6 +24,8 @@ constexpr const char* kAxisName[3] = {"x", "y", "z"};
 // each half of a blend has at least this many sample periods (shorter than period_s when the
 // blend is short), so its motion is resolved by its own samples
 constexpr int kMinBlendHalfPeriods = 4;
+// merge_fine_edges looks at most this many points ahead for one edge (its cost per point)
+constexpr size_t kMaxMergedPoints = 256;
 
 // a straight line's piece of the path from `from` in direction u, timed by the 1-D profile
 PhaseMotion line_motion(const AxisProfile& along, const Vec3& from, const Vec3& u) {
@@ -169,7 +171,68 @@ TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s) {
   return filled;
 }
 
-std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm) {
+MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm) {
+  MergedChain merged;
+  const size_t n = chain.points.size();
+  if (chain.oriented || n < 3 || !(max_error_mm > 0.0)) {
+    merged.chain = chain;
+    merged.edge_error_mm.assign(chain.edges(), 0.0);
+    return merged;
+  }
+  PrintChain& out = merged.chain;
+  out.oriented = false;
+  const auto keep_point = [&](size_t i) {
+    out.points.push_back(chain.points[i]);
+    out.orientations.push_back(chain.orientations[i]);
+    out.point_path.push_back(chain.point_path[i]);
+    out.point_index.push_back(chain.point_index[i]);
+  };
+  // the largest distance of points first+1 .. last-1 from the segment first-last
+  const auto chord_error = [&](size_t first, size_t last) {
+    const Vec3& a = chain.points[first];
+    const Vec3 d = chain.points[last] - a;
+    const double length_squared = d.squaredNorm();
+    double error = 0.0;
+    for (size_t k = first + 1; k < last; ++k) {
+      const Vec3 p = chain.points[k] - a;
+      const double f = length_squared > 0.0 ? std::clamp(p.dot(d) / length_squared, 0.0, 1.0) : 0.0;
+      error = std::max(error, (p - f * d).norm());
+    }
+    return error;
+  };
+  keep_point(0);
+  size_t anchor = 0;
+  while (anchor + 1 < n) {
+    // extend the edge from the anchor while the next point's edge is of the same path and speed,
+    // every point passed stays within max_error_mm and the edge is at least as long as each one
+    // it replaces (no reversal folded into it; a bounded number of points at once)
+    size_t last = anchor + 1;
+    double error = 0.0;
+    double longest_edge = (chain.points[last] - chain.points[anchor]).norm();
+    while (last + 1 < n && last + 1 - anchor <= kMaxMergedPoints &&
+           chain.edge_path[last] == chain.edge_path[anchor] &&
+           chain.edge_speed_mm_s[last] == chain.edge_speed_mm_s[anchor]) {
+      const double next_edge = (chain.points[last + 1] - chain.points[last]).norm();
+      const double chord = (chain.points[last + 1] - chain.points[anchor]).norm();
+      if (!(chord >= std::max(longest_edge, next_edge))) break;
+      const double longer = chord_error(anchor, last + 1);
+      if (!(longer <= max_error_mm)) break;
+      ++last;
+      error = longer;
+      longest_edge = std::max(longest_edge, next_edge);
+    }
+    keep_point(last);
+    out.edge_speed_mm_s.push_back(chain.edge_speed_mm_s[anchor]);
+    out.edge_path.push_back(chain.edge_path[anchor]);
+    out.edge_source.push_back(chain.edge_source[anchor]);
+    merged.edge_error_mm.push_back(error);
+    anchor = last;
+  }
+  return merged;
+}
+
+std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm,
+                                            const std::vector<double>& edge_error_mm) {
   const size_t n = points.size();
   std::vector<CornerGeometry> corners(n);
   for (size_t i = 0; i < n; ++i) corners[i].point = points[i];
@@ -184,7 +247,10 @@ std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, dou
     c.tangent_per_length = ClothoidBlend::tangent_per_length(c.turn_rad);
     c.deviation_per_length = ClothoidBlend::deviation_per_length(c.turn_rad);
     c.shape = ClothoidBlend::unit_shape(c.d_in, c.d_out);
-    c.max_half_length_mm = max_blend_half_length(c, in.norm(), out.norm(), tolerance_mm);
+    const double merged_error =
+        edge_error_mm.empty() ? 0.0 : std::max(edge_error_mm[i - 1], edge_error_mm[i]);
+    c.max_half_length_mm =
+        max_blend_half_length(c, in.norm(), out.norm(), tolerance_mm - merged_error);
   }
   return corners;
 }

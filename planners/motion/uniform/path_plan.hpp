@@ -96,6 +96,26 @@ struct PathMotionOptions {
   bool loops_at_rest = false;
 };
 
+// A chain with its runs of fine edges merged (a block compressor, LinuxCNC's naive-CAM
+// tolerance `G64 Q`): slicers and CAM systems give curves as chords, often shorter than the
+// blend a corner needs at print speed under the jerk limit (0.3 mm chords of a 10 mm circle at
+// 50 mm/s: each corner's clothoid pair would need 0.2 mm of each chord). Blended one corner
+// at a time within half a chord, such a curve is a string of curvature spikes: every corner
+// slowed or looped. Here consecutive edges of one path (same print speed) become one edge
+// wherever every point dropped lies within max_error_mm of it (greedily, from each kept
+// point as far as the next edge would still hold), so the curve keeps points every
+// 2 sqrt(2 r max_error_mm) or so and their corners fit their blends. A point farther from the
+// chord is kept: the sharp corners the deposit decides stay as given. Chains that carry the
+// tool's orientation are left as they are. edge_error_mm: per merged edge, the largest
+// distance of a dropped point from it (0 where nothing was dropped); the original polyline
+// stays within that of the edge, so a corner's blend keeps to the tolerance less its edges'
+// errors (corner_geometry).
+struct MergedChain {
+  PrintChain chain;
+  std::vector<double> edge_error_mm;
+};
+MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm);
+
 // A corner's geometry (interior points only): its directions, turn and blend shape.
 struct CornerGeometry {
   Vec3 point = Vec3::Zero();
@@ -109,8 +129,10 @@ struct CornerGeometry {
 };
 // every point's corner geometry (index = point index; ends are straight placeholders),
 // with the largest blend within tolerance_mm that leaves each adjacent edge at least half for
-// its other end
-std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm);
+// its other end; with edge_error_mm (per edge, merge_fine_edges), within tolerance_mm less the
+// larger error of the corner's two edges
+std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm,
+                                            const std::vector<double>& edge_error_mm = {});
 // that largest blend at corner g (its turn set: tangent and deviation per length) between
 // edges of the given lengths; 0 for a corner taken straight or as a reversal
 double max_blend_half_length(const CornerGeometry& g, double edge_in_mm, double edge_out_mm,

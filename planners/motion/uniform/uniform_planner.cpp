@@ -15,6 +15,9 @@ namespace {
 
 // arcs become chords within this share of the tolerance before their corners are blended
 constexpr double kArcChordShare = 0.1;
+// fine edges are merged within this share of the tolerance (merge_fine_edges); the blends keep
+// to the rest
+constexpr double kMergeShare = 0.5;
 // the look-ahead's blend resizing (resize_held_blends): a blend planned below this share of
 // the print speed is resized for kResizeGrowth times its planned speed, at most this many times
 constexpr double kResizeBelowShare = 0.9;
@@ -277,10 +280,14 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
   };
   PredictionScratch scratch;  // the corner predictions' processes, reused
   CornerDecisionCache decided(jerk_limits, settings_.reuse_corner_decisions);
-  for (const PrintChain& chain : print_chains(chorded)) {
+  for (const PrintChain& given : print_chains(chorded)) {
+    // fine chords merged into edges their corners' blends fit (merge_fine_edges), each corner's
+    // blend within the tolerance left by its edges' merging
+    const MergedChain merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm);
+    const PrintChain& chain = merged.chain;
     // each corner's treatment, by the predicted deposit
     const std::vector<CornerGeometry> geometry =
-        corner_geometry(chain.points, settings_.tolerance_mm);
+        corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
     std::vector<CornerPlan> corners(chain.points.size());
     std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
     for (size_t i = 1; i + 1 < chain.points.size(); ++i) {

@@ -24,7 +24,9 @@
 //    or its speed held constant by the same cost (plan_on_joints in uniform_planner.cpp).
 // Joined paths (a path starting where the previous one ended) are printed in one go, their
 // joint a corner like any other. Arcs (PrintPath::arcs) are chorded within a tenth of the
-// tolerance first, and the chords' corners blended.
+// tolerance first; then every chain's fine edges (those chords, or a slicer's) are merged within
+// half the tolerance (merge_fine_edges in path_plan.hpp) and the merged corners blended within
+// the rest.
 //
 // Without a PlanningContext (Planner::plan) the process is the aerosol default.
 #pragma once
