@@ -153,7 +153,7 @@ TEST(MergeFineEdges, LeavesCoarseAndOrientedChainsAlone) {
 // corners (38 s); merged within half the tolerance, every corner is blended at print speed:
 // the circle is printed in its length over its speed (1.257 s) to 1 % (1.255 s), within the
 // tolerance of the given chords (0.020 and 0.025 mm). An extruder, from rest to rest, takes at
-// most 1.3 x what the same length of straight line takes (1.67 and 1.66 s against 1.48 s;
+// most 1.3 x what the same length of straight line takes (1.58 and 1.57 s against 1.48 s;
 // 6.1 s, 4.1 x, for the 3000 chords before).
 TEST(UniformPlanner, ChordedCircleIsPrintedAtItsPrintSpeed) {
   const MachineLimits limits = MachineLimits::uniform(100.0, 1000.0);

@@ -360,9 +360,10 @@ TEST(UniformPlanner, BlendsStayInsideTheToleranceBand) {
 // (a perimeter's last corner, rounded_square_3_layers.gcode) must still slow down only near
 // its end: the arc's 4.7 mm (a quarter circle of radius 3 in 14 chords, at 30 mm/s, the
 // clothoids holding it at 29 mm/s) take at most twice what the same length of straight line
-// ending at rest takes (0.34 s; 0.54 s measured, its chords merged within half the tolerance;
-// 0.58 s blended one at a time). Before the planner resized the blends the look-ahead held
-// back, the arc crawled at 3 mm/s: 1.64 s.
+// ending at rest takes (0.34 s; 0.47 s measured, its chords merged within half the tolerance
+// and held blends resized for 1.5 x their speed; 0.58 s blended one chord at a time and
+// resized for 4 x). Before the planner resized the blends the look-ahead held back, the arc
+// crawled at 3 mm/s: 1.64 s.
 TEST(UniformPlanner, PathEndingOnAChordedArcSlowsDownOnlyNearItsEnd) {
   const MachineLimits limits = MachineLimits::uniform(100.0, 1000.0);
   const auto print_time_from = [&](const std::vector<Vec3>& points, const Vec3& from) {
