@@ -198,5 +198,66 @@ TEST(UniformPlanner, ChordedCircleIsPrintedAtItsPrintSpeed) {
   }
 }
 
+// Random print jobs (seeded): 1-4 paths, joined or apart, of up to 60 edges from 0.1 um to
+// 10 mm, gently curving, reversing, turning at random, nearly straight or circling; print
+// speeds from 0.5 to 99 mm/s, tolerances from 1 um to 3 mm, accelerations from 10 to 20 000
+// mm/s^2, aerosol and extrusion. Every plan is finite and keeps to its tolerance of the given
+// polylines (merged, blended or looped), sampled every 0.2 ms.
+TEST(UniformPlanner, RandomJobsStayWithinTheTolerance) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double steps[] = {1e-4, 0.003, 0.02, 0.3, 2.0, 10.0};
+  const double speeds[] = {0.5, 3.0, 20.0, 50.0, 99.0};
+  const double tolerances[] = {0.001, 0.05, 0.5, 3.0};
+  const double accelerations[] = {10.0, 1000.0, 20000.0};
+  for (int trial = 0; trial < 30; ++trial) {
+    Toolpath toolpath;
+    Vec3 p(unit(rng) * 40 - 20, unit(rng) * 40 - 20, 0);
+    const int paths = 1 + static_cast<int>(rng() % 4);
+    for (int k = 0; k < paths; ++k) {
+      PrintPath path;
+      path.speed_mm_s = speeds[rng() % 5];
+      if (rng() % 3 != 0) p = Vec3(unit(rng) * 40 - 20, unit(rng) * 40 - 20, 0);
+      path.points.push_back(p);
+      const int edges = 1 + static_cast<int>(rng() % 60);
+      const int shape = static_cast<int>(rng() % 5);
+      double heading = unit(rng) * 2 * kPi;
+      for (int i = 0; i < edges; ++i) {
+        const double step = steps[rng() % 6];
+        if (shape == 0) heading += (unit(rng) - 0.5) * 0.1;         // a gentle curve
+        if (shape == 1) heading += kPi + (unit(rng) - 0.5) * 1e-3;  // nearly reversing
+        if (shape == 2) heading += (unit(rng) - 0.5) * 6.0;         // anywhere
+        if (shape == 3) heading += 1e-7;                            // nearly straight
+        if (shape == 4) heading += 0.05;                            // circling
+        Vec3 q = p + step * Vec3(std::cos(heading), std::sin(heading), 0);
+        q.x() = std::clamp(q.x(), -40.0, 40.0);
+        q.y() = std::clamp(q.y(), -40.0, 40.0);
+        if ((q - p).norm() < 1e-5) continue;
+        path.points.push_back(q);
+        p = q;
+      }
+      if (path.points.size() < 2) {
+        path.points.push_back(p + Vec3(1, 0, 0));
+        p = path.points.back();
+      }
+      path.source_index = k;
+      toolpath.paths.push_back(path);
+    }
+    toolpath.start_mm = toolpath.end_mm = Vec3::Zero();
+    UniformSettings settings;
+    settings.tolerance_mm = tolerances[rng() % 4];
+    const MachineLimits limits = MachineLimits::uniform(100.0, accelerations[rng() % 3]);
+    const ProcessType process = trial % 2 == 0 ? ProcessType::extrusion : ProcessType::aerosol;
+    const Trajectory plan =
+        UniformPlanner{settings}.plan_in_context(toolpath, limits, context_for(process));
+    const MotionSamples samples = sample_trajectory(plan, 2e-4);
+    for (size_t k = 0; k < samples.size(); ++k)
+      ASSERT_TRUE(samples.position_mm[k].allFinite() && samples.velocity_mm_s[k].allFinite())
+          << "trial " << trial << " sample " << k;
+    EXPECT_LE(path_error(samples, toolpath).max_mm, settings.tolerance_mm * (1 + 1e-9))
+        << "trial " << trial << ", tolerance " << settings.tolerance_mm;
+  }
+}
+
 }  // namespace
 }  // namespace depotwin
