@@ -9,20 +9,14 @@
 #include "contract/planner_checks.hpp"
 #include "core/error.hpp"
 #include "planners/motion/firmware.hpp"
+#include "planners/motion/polyline_job.hpp"
 
 namespace depotwin {
 namespace {
 
 // one polyline printed at `speed`, starting and ending where the job does (no travels)
 Toolpath polyline(const std::vector<Vec3>& points, double speed) {
-  Toolpath toolpath;
-  PrintPath path;
-  path.points = points;
-  path.speed_mm_s = speed;
-  toolpath.paths.push_back(path);
-  toolpath.start_mm = points.front();
-  toolpath.end_mm = points.back();
-  return toolpath;
+  return polyline_job(points, speed);
 }
 
 Trajectory plan_with(const PlannerSpec& spec, const Toolpath& toolpath,

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "metrics/motion_metrics.hpp"
+#include "planners/motion/polyline_job.hpp"
 #include "planners/motion/uniform/path_plan.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
 
@@ -29,17 +30,6 @@ std::vector<Vec3> chorded_circle(double r, int chords, double cx = 0.0) {
     points.emplace_back(cx + r * std::cos(angle), r * std::sin(angle), 0.2);
   }
   return points;
-}
-
-Toolpath one_path(const std::vector<Vec3>& points, double speed_mm_s) {
-  Toolpath toolpath;
-  PrintPath path;
-  path.points = points;
-  path.speed_mm_s = speed_mm_s;
-  toolpath.paths.push_back(path);
-  toolpath.start_mm = points.front();
-  toolpath.end_mm = points.back();
-  return toolpath;
 }
 
 PlanningContext context_for(ProcessType type) {
@@ -126,7 +116,7 @@ TEST(MergeFineEdges, DroppedPointsLieWithinTheirEdgesError) {
 // and any chain that carries the tool's orientation, stay as given.
 TEST(MergeFineEdges, LeavesCoarseAndOrientedChainsAlone) {
   const std::vector<Vec3> coarse = chorded_circle(10.0, 24);  // sagitta 0.086 mm > 0.025
-  const PrintChain chain = print_chains(one_path(coarse, 20.0)).front();
+  const PrintChain chain = print_chains(polyline_job(coarse, 20.0)).front();
   const MergedChain merged = merge_fine_edges(chain, 0.025);
   EXPECT_EQ(merged.chain.points, chain.points);
   for (const double error : merged.edge_error_mm) EXPECT_EQ(error, 0.0);
@@ -134,13 +124,13 @@ TEST(MergeFineEdges, LeavesCoarseAndOrientedChainsAlone) {
   // a reversal within the bound (out 0.02 mm and back) is not folded into a zero-length edge,
   // nor a step back along the line
   const PrintChain reversal =
-      print_chains(one_path({Vec3(0, 0, 0), Vec3(0.02, 0, 0), Vec3(0, 0, 0), Vec3(5, 0, 0),
-                             Vec3(4.99, 0, 0), Vec3(10, 0, 0)},
-                            20.0))
+      print_chains(polyline_job({Vec3(0, 0, 0), Vec3(0.02, 0, 0), Vec3(0, 0, 0), Vec3(5, 0, 0),
+                                 Vec3(4.99, 0, 0), Vec3(10, 0, 0)},
+                                20.0))
           .front();
   EXPECT_EQ(merge_fine_edges(reversal, 0.025).chain.points, reversal.points);
 
-  Toolpath oriented = one_path(chorded_circle(10.0, 600), 20.0);
+  Toolpath oriented = polyline_job(chorded_circle(10.0, 600), 20.0);
   oriented.paths[0].normals.assign(oriented.paths[0].points.size(), Vec3(0, 0, 1));
   const PrintChain with_normals = print_chains(oriented).front();
   ASSERT_TRUE(with_normals.oriented);
@@ -165,7 +155,7 @@ TEST(UniformPlanner, ChordedCircleIsPrintedAtItsPrintSpeed) {
     return t;
   };
   for (const int chords : {200, 3000}) {
-    const Toolpath toolpath = one_path(chorded_circle(radius, chords), speed);
+    const Toolpath toolpath = polyline_job(chorded_circle(radius, chords), speed);
     const double length = chords * 2.0 * radius * std::sin(kPi / chords);
     const UniformPlanner planner{UniformSettings{}};
     // aerosol: entered and left at print speed
@@ -188,8 +178,8 @@ TEST(UniformPlanner, ChordedCircleIsPrintedAtItsPrintSpeed) {
     const Trajectory extrusion =
         planner.plan_in_context(toolpath, limits, context_for(ProcessType::extrusion));
     const Trajectory line =
-        planner.plan_in_context(one_path({Vec3(0, 0, 0.2), Vec3(length, 0, 0.2)}, speed), limits,
-                                context_for(ProcessType::extrusion));
+        planner.plan_in_context(polyline_job({Vec3(0, 0, 0.2), Vec3(length, 0, 0.2)}, speed),
+                                limits, context_for(ProcessType::extrusion));
     EXPECT_LE(printing_s(extrusion), 1.3 * printing_s(line))
         << chords << " chords: " << printing_s(extrusion) << " s, line " << printing_s(line);
     EXPECT_LE(path_error(sample_trajectory(extrusion, 1e-4), toolpath).max_mm,
