@@ -22,12 +22,12 @@ double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
   return (a + f * d - p).norm();
 }
 
-// a circle of radius r about (cx, 0) in `chords` chords from angle 0, printed at `speed`
-std::vector<Vec3> chorded_circle(double r, int chords, double cx = 0.0) {
+// a closed circle of radius r about the origin at z = 0.2 in `chords` chords, from angle 0
+std::vector<Vec3> chorded_circle(double r, int chords) {
   std::vector<Vec3> points;
   for (int k = 0; k <= chords; ++k) {
     const double angle = 2.0 * kPi * k / chords;
-    points.emplace_back(cx + r * std::cos(angle), r * std::sin(angle), 0.2);
+    points.emplace_back(r * std::cos(angle), r * std::sin(angle), 0.2);
   }
   return points;
 }
