@@ -14,11 +14,6 @@
 namespace depotwin {
 namespace {
 
-// one polyline printed at `speed`, starting and ending where the job does (no travels)
-Toolpath polyline(const std::vector<Vec3>& points, double speed) {
-  return polyline_job(points, speed);
-}
-
 Trajectory plan_with(const PlannerSpec& spec, const Toolpath& toolpath,
                      const MachineLimits& limits) {
   return make_planner(spec)->plan(toolpath, limits);
@@ -41,7 +36,7 @@ TEST(Firmware, NinetyDegreeJunctionSpeedIsMarlinsFormula) {
   EXPECT_NEAR(junction_speed_squared(Vec3::UnitX(), Vec3::UnitY(), a, jd), expected2, 1e-12);
   // the planner takes the corner of a long L at that speed: the velocity there before the
   // blend turns it is sqrt(expected2) along x
-  const Toolpath toolpath = polyline({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const Toolpath toolpath = polyline_job({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
   const Trajectory plan = plan_with({"firmware", {}, 0}, toolpath, MachineLimits::uniform(100, a));
   ASSERT_EQ(plan.pieces().size(), 2u);
   const double v = std::sqrt(expected2), tau = v / a;  // max_i |dv_i| / a_i = v / a
@@ -62,7 +57,7 @@ TEST(Firmware, NinetyDegreeJunctionSpeedIsMarlinsFormula) {
 // E is tied to the motion: while printing, the commanded flow is |v| / v_des at every instant
 // (nominal volume per length), 0 at rest, 1 at the print speed
 TEST(Firmware, FlowFollowsTheSpeedAsTheEAxisDoes) {
-  const Toolpath toolpath = polyline({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const Toolpath toolpath = polyline_job({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
   const Trajectory plan =
       plan_with({"firmware", {}, 0}, toolpath, MachineLimits::uniform(100, 1000));
   bool cruised = false;
@@ -88,7 +83,7 @@ TEST(Firmware, KlipperSquareCornerVelocityIsTheNinetyDegreeSpeed) {
       firmware_lookahead(moves, klipper, klipper_junction_deviation(5.0, 1000.0));
   EXPECT_NEAR(profile.junction_speed_mm_s[1], 5.0, 1e-12);
   // through the planner, square_corner_velocity 7 at max_accel 1000: the corner at 7 mm/s
-  const Toolpath toolpath = polyline({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const Toolpath toolpath = polyline_job({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
   const PlannerSpec spec{"firmware",
                          {{"square_corner_velocity", {7.0}}, {"minimum_cruise_ratio", {0.0}}},
                          0,
@@ -100,7 +95,7 @@ TEST(Firmware, KlipperSquareCornerVelocityIsTheNinetyDegreeSpeed) {
 
 TEST(Firmware, CollinearMovesNeverSlowAtTheJoints) {
   // 30 mm in three collinear moves at 50 mm/s, a = 1000: one trapezoid, d / v + v / a
-  const Toolpath toolpath = polyline({{0, 0, 0}, {10, 0, 0}, {17, 0, 0}, {30, 0, 0}}, 50.0);
+  const Toolpath toolpath = polyline_job({{0, 0, 0}, {10, 0, 0}, {17, 0, 0}, {30, 0, 0}}, 50.0);
   for (const char* mode : {"marlin", "klipper"}) {
     SCOPED_TRACE(mode);
     const Trajectory plan = plan_with({"firmware", {}, 0, {{"mode", mode}}}, toolpath,
@@ -113,7 +108,7 @@ TEST(Firmware, CollinearMovesNeverSlowAtTheJoints) {
 
 TEST(Firmware, AReversalStops) {
   EXPECT_EQ(junction_speed_squared(Vec3::UnitX(), -Vec3::UnitX(), 1000, 0.013), 0.0);
-  const Toolpath toolpath = polyline({{0, 0, 0}, {10, 0, 0}, {0, 0, 0}}, 50.0);
+  const Toolpath toolpath = polyline_job({{0, 0, 0}, {10, 0, 0}, {0, 0, 0}}, 50.0);
   const Trajectory plan =
       plan_with({"firmware", {}, 0}, toolpath, MachineLimits::uniform(100, 1000));
   ASSERT_EQ(plan.pieces().size(), 2u);
@@ -155,31 +150,31 @@ TEST(Firmware, JunctionSpeedsAreReachableFromNeighbours) {
 TEST(Firmware, SingleTrapezoidTime) {
   const MachineLimits limits = MachineLimits::uniform(100, 1000);
   // trapezoid: d / v + v / a
-  EXPECT_NEAR(
-      plan_with({"firmware", {}, 0}, polyline({{0, 0, 0}, {10, 0, 0}}, 50), limits).duration_s(),
-      10.0 / 50 + 50.0 / 1000, 1e-12);
+  EXPECT_NEAR(plan_with({"firmware", {}, 0}, polyline_job({{0, 0, 0}, {10, 0, 0}}, 50), limits)
+                  .duration_s(),
+              10.0 / 50 + 50.0 / 1000, 1e-12);
   // triangle: 2 sqrt(d / a)
   EXPECT_NEAR(
-      plan_with({"firmware", {}, 0}, polyline({{0, 0, 0}, {1, 0, 0}}, 50), limits).duration_s(),
+      plan_with({"firmware", {}, 0}, polyline_job({{0, 0, 0}, {1, 0, 0}}, 50), limits).duration_s(),
       2 * std::sqrt(1.0 / 1000), 1e-12);
   // along a diagonal the move's acceleration is a / |u_y| (no axis beyond a): 3-4-5
   EXPECT_NEAR(
-      plan_with({"firmware", {}, 0}, polyline({{0, 0, 0}, {3, 4, 0}}, 50), limits).duration_s(),
+      plan_with({"firmware", {}, 0}, polyline_job({{0, 0, 0}, {3, 4, 0}}, 50), limits).duration_s(),
       5.0 / 50 + 50.0 / (1000 / 0.8), 1e-12);
   // Klipper's minimum_cruise_ratio 0.5: a 1.5 mm move cruises 0.75 mm (its docs' example) at
   // sqrt(a d / 2)
   const Trajectory klipper = plan_with({"firmware", {}, 0, {{"mode", "klipper"}}},
-                                       polyline({{0, 0, 0}, {1.5, 0, 0}}, 50), limits);
+                                       polyline_job({{0, 0, 0}, {1.5, 0, 0}}, 50), limits);
   const double peak = std::sqrt(1000 * 1.5 / 2);
   EXPECT_NEAR(klipper.duration_s(), 2 * peak / 1000 + 0.75 / peak, 1e-12);
   // the older max_accel_to_decel = 500 at max_accel 1000 is the same ratio
   const Trajectory older =
       plan_with({"firmware", {{"max_accel_to_decel", {500.0}}}, 0, {{"mode", "klipper"}}},
-                polyline({{0, 0, 0}, {1.5, 0, 0}}, 50), limits);
+                polyline_job({{0, 0, 0}, {1.5, 0, 0}}, 50), limits);
   EXPECT_NEAR(older.duration_s(), klipper.duration_s(), 1e-12);
   // max_velocity and max_accel cap the limits' own
   EXPECT_NEAR(plan_with({"firmware", {{"max_velocity", {20.0}}, {"max_accel", {400.0}}}, 0},
-                        polyline({{0, 0, 0}, {10, 0, 0}}, 50), limits)
+                        polyline_job({{0, 0, 0}, {10, 0, 0}}, 50), limits)
                   .duration_s(),
               10.0 / 20 + 20.0 / 400, 1e-12);
 }
@@ -192,7 +187,7 @@ TEST(Firmware, ZigZagKeepsTheContract) {
     points.emplace_back(x0, 0.4 * i, 0);
     points.emplace_back(10.0 - x0, 0.4 * i, 0);
   }
-  const Toolpath toolpath = polyline(points, 40);
+  const Toolpath toolpath = polyline_job(points, 40);
   const MachineLimits limits = MachineLimits::uniform(100, 1500);
   for (const char* mode : {"marlin", "klipper"}) {
     SCOPED_TRACE(mode);
@@ -238,7 +233,7 @@ TEST(FirmwareSCurve, SingleMoveTimeIsTwoBezierRampsAndACruise) {
     const MachineLimits limits = MachineLimits::uniform(100, 1000, jerk);
     const double T = s_curve_ramp_time(50, 1000, jerk);
     const Trajectory plan =
-        plan_with({"firmware", {}, 0}, polyline({{0, 0, 0}, {10, 0, 0}}, 50), limits);
+        plan_with({"firmware", {}, 0}, polyline_job({{0, 0, 0}, {10, 0, 0}}, 50), limits);
     EXPECT_NEAR(plan.duration_s(), 2 * T + (10.0 - 50 * T) / 50, 1e-12);
     // half-way through the ramp the speed is half the peak
     EXPECT_NEAR(plan.at(0.5 * T).velocity_mm_s.x(), 25.0, 1e-4);
@@ -257,7 +252,7 @@ TEST(FirmwareSCurve, SingleMoveTimeIsTwoBezierRampsAndACruise) {
 TEST(FirmwareSCurve, CornerBlendIsJerkLimited) {
   const double a = 1000.0, j = 30000.0, jd = 0.013, s = std::sqrt(0.5);
   const MachineLimits limits = MachineLimits::uniform(100, a, j);
-  const Toolpath toolpath = polyline({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const Toolpath toolpath = polyline_job({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
   const Trajectory plan = plan_with({"firmware", {}, 0}, toolpath, limits);
   ASSERT_EQ(plan.pieces().size(), 2u);
   const double v = std::sqrt(a * jd * s / (1 - s));
@@ -311,7 +306,7 @@ TEST(FirmwareSCurve, RandomToolpathsStayWithinTheJerkLimit) {
     points.emplace_back(x0, 0.4 * i, 0);
     points.emplace_back(10.0 - x0, 0.4 * i, 0);
   }
-  const Toolpath zigzag = polyline(points, 40);
+  const Toolpath zigzag = polyline_job(points, 40);
   const MachineLimits limits = MachineLimits::uniform(100, 1500, 20000);
   const Trajectory plan = plan_with({"firmware", {}, 0}, zigzag, limits);
   testing_support::expect_contract(plan, zigzag, limits);
@@ -329,7 +324,7 @@ TEST(FirmwareSCurve, ShortChordPerimeterSettles) {
     const double angle = 2.0 * kPi * i / chords;
     points.emplace_back(10.0 * std::cos(angle), 10.0 * std::sin(angle), 0.0);
   }
-  const Toolpath circle = polyline(points, 30.0);
+  const Toolpath circle = polyline_job(points, 30.0);
   const MachineLimits limits = MachineLimits::uniform(200, 1500, 30000);
   for (const char* mode : {"marlin", "klipper"}) {
     SCOPED_TRACE(mode);

@@ -8,19 +8,13 @@
 #include <random>
 
 #include "metrics/motion_metrics.hpp"
+#include "metrics/polyline_distance.hpp"
 #include "planners/motion/polyline_job.hpp"
 #include "planners/motion/uniform/path_plan.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
 
 namespace depotwin {
 namespace {
-
-// distance from p to the segment a-b
-double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 d = b - a;
-  const double f = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-  return (a + f * d - p).norm();
-}
 
 // a closed circle of radius r about the origin at z = 0.2 in `chords` chords, from angle 0
 std::vector<Vec3> chorded_circle(double r, int chords) {
@@ -87,8 +81,8 @@ TEST(MergeFineEdges, DroppedPointsLieWithinTheirEdgesError) {
       size_t next = g + 1;
       double farthest = 0.0;
       while (given.points[next] != chain.points[i + 1]) {
-        farthest = std::max(
-            farthest, segment_distance(given.points[next], chain.points[i], chain.points[i + 1]));
+        farthest = std::max(farthest, point_segment_distance(given.points[next], chain.points[i],
+                                                             chain.points[i + 1]));
         EXPECT_EQ(given.edge_path[next], chain.edge_path[i]) << "merged across a path";
         ++next;
       }
