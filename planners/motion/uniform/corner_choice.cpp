@@ -477,31 +477,31 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
   // other (in each row, from its first such cell to its last); and the one tile they all fall
   // in, if one does (their bounding box's corners do)
   {
-    // the cells read: each target, and the four around each centreline sample
-    std::vector<std::pair<int, int>> read_cells;
-    read_cells.reserve(w.cells.size() + 4 * w.centre.size());
-    for (const CornerWindow::TargetCell& cell : w.cells) read_cells.emplace_back(cell.ix, cell.iy);
-    for (const CornerWindow::CentreSample& sample : w.centre)
-      for (int dy = 0; dy < 2; ++dy)
-        for (int dx = 0; dx < 2; ++dx)
-          read_cells.emplace_back(sample.point.ix0 + dx, sample.point.iy0 + dy);
+    // the cells read: each target, and the four around each centreline sample (two passes:
+    // their rows' range, then each row's span)
+    const auto for_each_read_cell = [&w](auto&& visit) {
+      for (const CornerWindow::TargetCell& cell : w.cells) visit(cell.ix, cell.iy);
+      for (const CornerWindow::CentreSample& sample : w.centre)
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx) visit(sample.point.ix0 + dx, sample.point.iy0 + dy);
+    };
     ThicknessField::WriteRegion region;
-    if (!read_cells.empty()) {
-      const auto [low, high] =
-          std::minmax_element(read_cells.begin(), read_cells.end(),
-                              [](const auto& p, const auto& q) { return p.second < q.second; });
-      region.iy_lo = low->second;
-      region.spans.assign(static_cast<size_t>(high->second - low->second + 1),
+    if (!w.cells.empty() || !w.centre.empty()) {
+      int iy_low = std::numeric_limits<int>::max(), iy_high = std::numeric_limits<int>::min();
+      for_each_read_cell(
+          [&](int, int iy) { iy_low = std::min(iy_low, iy), iy_high = std::max(iy_high, iy); });
+      region.iy_lo = iy_low;
+      region.spans.assign(static_cast<size_t>(iy_high - iy_low + 1),
                           {std::numeric_limits<int>::max(), std::numeric_limits<int>::min()});
       int ix_first = std::numeric_limits<int>::max(), ix_last = std::numeric_limits<int>::min();
-      for (const auto& [ix, iy] : read_cells) {
+      for_each_read_cell([&](int ix, int iy) {
         std::pair<int, int>& span = region.spans[static_cast<size_t>(iy - region.iy_lo)];
         span.first = std::min(span.first, ix), span.second = std::max(span.second, ix);
         ix_first = std::min(ix_first, ix), ix_last = std::max(ix_last, ix);
-      }
+      });
       using Tiles = ThicknessField::Tiles;
-      w.tile_x = Tiles::tile_of(ix_first), w.tile_y = Tiles::tile_of(low->second);
-      w.one_tile = Tiles::tile_of(ix_last) == w.tile_x && Tiles::tile_of(high->second) == w.tile_y;
+      w.tile_x = Tiles::tile_of(ix_first), w.tile_y = Tiles::tile_of(iy_low);
+      w.one_tile = Tiles::tile_of(ix_last) == w.tile_x && Tiles::tile_of(iy_high) == w.tile_y;
     }
     rolls_process.limit_writes(region);
     w.scratch->limit_writes(std::move(region));
@@ -513,13 +513,13 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
 
   // the targets' readings of the rolls' field: the rolls alone, then as the shared ends are
   // deposited with them (after them in time)
-  struct Reading {
-    std::vector<double> cells, centre;
-  };
-  std::vector<Reading> readings;
-  readings.reserve(5);
-  const auto read = [&w, &rolls_process, &readings]() {
-    Reading& reading = readings.emplace_back();
+  // (in the scratch's buffers, kept from corner to corner)
+  using Reading = PredictionScratch::FieldReading;
+  std::vector<Reading>& readings = scratch.readings;
+  scratch.readings_used = 0;
+  const auto read = [&w, &rolls_process, &scratch]() {
+    if (scratch.readings_used == scratch.readings.size()) scratch.readings.emplace_back();
+    Reading& reading = scratch.readings[scratch.readings_used++];
     w.with_reader(rolls_process.field(), [&](auto&& reader) {
       reading.cells.resize(w.cells.size());
       for (size_t k = 0; k < w.cells.size(); ++k)
@@ -528,7 +528,7 @@ void add_targets(CornerWindow& w, const DepositModel& model, PredictionScratch& 
       for (size_t k = 0; k < w.centre.size(); ++k)
         reading.centre[k] = reader.interpolated(w.centre[k].point);
     });
-    return static_cast<int>(readings.size()) - 1;
+    return static_cast<int>(scratch.readings_used) - 1;
   };
   // what the window's own deposit should add: the target less the rolls'
   const int rolls_only = read();

@@ -90,6 +90,13 @@ struct CornerCandidate {
 // planning: not to be shared between threads).
 struct PredictionScratch {
   std::unique_ptr<Process> rolls, window;
+  // a corner's readings of the rolls' field at its target cells and centreline samples (the
+  // first `readings_used` are this corner's; each keeps its capacity from corner to corner)
+  struct FieldReading {
+    std::vector<double> cells, centre;
+  };
+  std::vector<FieldReading> readings;
+  size_t readings_used = 0;
 };
 
 struct CornerDecision {
