@@ -17,17 +17,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/segment_distance.hpp"
 #include "core/types.hpp"
 
 namespace depotwin {
-
-// the distance from `point` to the segment [a, b] (a point when a == b)
-inline double point_segment_distance(const Vec3& point, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double u = len2 > 0.0 ? std::clamp((point - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + u * ab - point).norm();
-}
 
 class PolylineDistance {
  public:

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/segment_distance.hpp"
 #include "planners/motion/path_check.hpp"
 #include "planners/motion/transition.hpp"
 
@@ -189,15 +190,10 @@ MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm) {
   };
   // the largest distance of points first+1 .. last-1 from the segment first-last
   const auto chord_error = [&](size_t first, size_t last) {
-    const Vec3& a = chain.points[first];
-    const Vec3 d = chain.points[last] - a;
-    const double length_squared = d.squaredNorm();
     double error = 0.0;
-    for (size_t k = first + 1; k < last; ++k) {
-      const Vec3 p = chain.points[k] - a;
-      const double f = length_squared > 0.0 ? std::clamp(p.dot(d) / length_squared, 0.0, 1.0) : 0.0;
-      error = std::max(error, (p - f * d).norm());
-    }
+    for (size_t k = first + 1; k < last; ++k)
+      error = std::max(
+          error, point_segment_distance(chain.points[k], chain.points[first], chain.points[last]));
     return error;
   };
   keep_point(0);

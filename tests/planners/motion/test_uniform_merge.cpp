@@ -7,8 +7,8 @@
 #include <memory>
 #include <random>
 
+#include "core/segment_distance.hpp"
 #include "metrics/motion_metrics.hpp"
-#include "metrics/polyline_distance.hpp"
 #include "planners/motion/polyline_job.hpp"
 #include "planners/motion/uniform/path_plan.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
