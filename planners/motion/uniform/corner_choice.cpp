@@ -930,6 +930,85 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
   return decision;
 }
 
+ConstantSpeedChain constant_speed_chain(const PrintChain& chain,
+                                        const std::vector<CornerGeometry>& geometry,
+                                        double tolerance_mm,
+                                        const std::vector<double>& edge_error_mm,
+                                        const TcpLimits& limits, const PathMotionOptions& options,
+                                        const DepositModel& model, double worth_below_mm) {
+  ConstantSpeedChain none;
+  if (!model.aerosol() || chain.oriented || chain.edges() == 0) return none;
+  const double print_speed = chain.edge_speed_mm_s.front();
+  for (const double speed : chain.edge_speed_mm_s)
+    if (speed != print_speed) return none;
+
+  // each corner's largest blend: geometry's, except that a corner next to an end of the chain
+  // may take that end's whole edge (no blend at the end shares it; the chain enters and
+  // leaves at the speed)
+  const size_t n = chain.points.size();
+  std::vector<double> largest(n, 0.0);
+  for (size_t i = 1; i + 1 < n; ++i) {
+    const CornerGeometry& g = geometry[i];
+    largest[i] = g.max_half_length_mm;
+    if ((i == 1 || i + 2 == n) && largest[i] > 0.0) {
+      const double edge_in = (chain.points[i] - chain.points[i - 1]).norm();
+      const double edge_out = (chain.points[i + 1] - chain.points[i]).norm();
+      // (max_blend_half_length leaves half of each edge: an end edge counted twice is whole)
+      largest[i] = max_blend_half_length(g, i == 1 ? 2.0 * edge_in : edge_in,
+                                         i + 2 == n ? 2.0 * edge_out : edge_out,
+                                         corner_tolerance_mm(tolerance_mm, edge_error_mm, i));
+    }
+  }
+  // the speed: what every corner's largest blend within the tolerance takes
+  double speed = print_speed;
+  for (size_t i = 1; i + 1 < n; ++i) {
+    const CornerGeometry& g = geometry[i];
+    if (taken_straight_on(g)) continue;
+    if (!(largest[i] > 0.0)) return none;  // a reversal: no blend
+    // (a joint sharper than 90 deg: its two lines overlap next to it, an error of the corner's
+    // own that the even line's does not count)
+    if (overlap_mm(g, model) > 0.0) return none;
+    speed = std::min(
+        speed, blend_speed_bound(g.shape, largest[i], corner_blend_limits(g, largest[i], limits)));
+  }
+  if (!(speed > 0.0)) return none;
+
+  // the even line's error against the target: the band's cells (the share erf(w / (2 sqrt 2
+  // sigma)) of the line's cross section) and the centreline's samples, per length of line
+  ConstantSpeedChain constant;
+  double length_mm = 0.0;
+  for (size_t e = 0; e < chain.edges(); ++e)
+    length_mm += (chain.points[e + 1] - chain.points[e]).norm();
+  const double sigma = model.settings.footprint_sigma_mm();
+  const double band_share =
+      std::erf(0.5 * model.settings.resolved_line_width_mm() / (std::sqrt(2.0) * sigma));
+  constant.error_mm = (print_speed / speed - 1.0) * (1.0 + band_share) * length_mm;
+  if (!(constant.error_mm < worth_below_mm)) return none;  // (not planned: it cannot win)
+
+  // the chain planned at it: each corner the least blend that takes it
+  constant.speed_mm_s = speed;
+  constant.corners.assign(n, CornerPlan{});
+  for (size_t i = 1; i + 1 < n; ++i) {
+    const CornerGeometry& g = geometry[i];
+    if (taken_straight_on(g)) continue;
+    const MachineLimits box = corner_blend_limits(g, largest[i], limits);
+    constant.corners[i].treatment = CornerTreatment::blend;
+    constant.corners[i].half_length_mm =
+        std::clamp(blend_half_length_for_speed(g.shape, speed, box), 1e-9 * largest[i], largest[i]);
+  }
+  PrintChain slowed = chain;
+  slowed.edge_speed_mm_s.assign(chain.edges(), speed);
+  constant.planned = plan_chain(slowed, geometry, constant.corners, limits, options, 0.0);
+  // (the look-ahead slows no node below it: the line is even throughout)
+  for (size_t i = 1; i + 1 < n; ++i)
+    if (constant.corners[i].treatment == CornerTreatment::blend &&
+        !(constant.planned.corner_speed_mm_s[i] >= speed * (1.0 - 1e-9)))
+      return none;
+  for (TrajectoryPiece& piece : constant.planned.pieces)
+    if (piece.depositing) piece.desired_speed_mm_s = print_speed;
+  return constant;
+}
+
 std::vector<uint64_t> CornerDecisionCache::corner_key(const PrintChain& chain, size_t corner,
                                                       const std::vector<CornerGeometry>& geometry) {
   std::vector<uint64_t> key;

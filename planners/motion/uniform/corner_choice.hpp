@@ -111,6 +111,36 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              const PathMotionOptions& options, const DepositModel& model,
                              double time_weight_mm_s, PredictionScratch& scratch);
 
+// Aerosol: the whole chain printed at one constant speed, every corner a blend at it (the
+// scale-down Shembekar et al. apply to a path and `conformal` does on the joints). A stream
+// that cannot follow the speed then lays an even line everywhere, thicker by print speed /
+// that speed, where a corner taken alone (slowed or looped) leaves a bump or a seam: on a
+// small circle of fine chords no corner keeps the print speed, and 25 loops take ten times
+// the print's own time. The speed is the largest every corner's largest blend within the
+// tolerance takes (blend_speed_bound; a corner next to an end of the chain may take that end's
+// whole edge), the print speed at the most; its thickness error is
+// the even line's against the target, summed as a corner's is (the band's cells and the
+// centreline's samples, E = (print speed / speed - 1) (1 + erf(w / (2 sqrt 2 sigma))) x the
+// chain's length, w the line width). speed_mm_s 0: no such plan (an extrusion chain, one of
+// several print speeds or carrying the tool's orientation, a corner with no blend or sharper
+// than 90 deg, where the two lines overlap next to it whatever the speed, or one the
+// look-ahead would slow further). The pieces keep the print speed as their desired speed: the
+// slow-down shows as a speed error.
+struct ConstantSpeedChain {
+  double speed_mm_s = 0.0;
+  std::vector<CornerPlan> corners;  // per point (ends and straights: straight)
+  PlannedPath planned;
+  double error_mm = 0.0;
+};
+// (geometry: corner_geometry(chain.points, tolerance_mm, edge_error_mm); not planned, speed
+// 0, when its error alone is worth_below_mm or more: it cannot beat what costs that)
+ConstantSpeedChain constant_speed_chain(const PrintChain& chain,
+                                        const std::vector<CornerGeometry>& geometry,
+                                        double tolerance_mm,
+                                        const std::vector<double>& edge_error_mm,
+                                        const TcpLimits& limits, const PathMotionOptions& options,
+                                        const DepositModel& model, double worth_below_mm);
+
 // The decisions of one planning's corners, kept so that a corner equal to one already decided
 // takes its decision instead of predicting it again (a slicer's layers repeat their perimeters
 // and infill: the same corners at another height). Equal means equal to the bit in everything

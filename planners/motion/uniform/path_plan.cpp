@@ -243,12 +243,16 @@ std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, dou
     c.tangent_per_length = ClothoidBlend::tangent_per_length(c.turn_rad);
     c.deviation_per_length = ClothoidBlend::deviation_per_length(c.turn_rad);
     c.shape = ClothoidBlend::unit_shape(c.d_in, c.d_out);
-    const double merged_error =
-        edge_error_mm.empty() ? 0.0 : std::max(edge_error_mm[i - 1], edge_error_mm[i]);
-    c.max_half_length_mm =
-        max_blend_half_length(c, in.norm(), out.norm(), tolerance_mm - merged_error);
+    c.max_half_length_mm = max_blend_half_length(
+        c, in.norm(), out.norm(), corner_tolerance_mm(tolerance_mm, edge_error_mm, i));
   }
   return corners;
+}
+
+double corner_tolerance_mm(double tolerance_mm, const std::vector<double>& edge_error_mm,
+                           size_t corner) {
+  if (edge_error_mm.empty()) return tolerance_mm;
+  return tolerance_mm - std::max(edge_error_mm[corner - 1], edge_error_mm[corner]);
 }
 
 double max_blend_half_length(const CornerGeometry& g, double edge_in_mm, double edge_out_mm,

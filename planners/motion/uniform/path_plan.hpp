@@ -127,12 +127,21 @@ struct CornerGeometry {
   BlendShape shape;                   // per-axis maxima at half-length 1
   double max_half_length_mm = 0.0;    // tolerance and room on the adjacent edges
 };
+// whether the planner takes corner g straight on (no treatment): no turn, or a turn below
+// 90 deg with no room for a blend (a kink within rounding of straight)
+inline bool taken_straight_on(const CornerGeometry& g) {
+  return g.turn_rad <= 0.0 || (g.max_half_length_mm <= 0.0 && g.turn_rad < 0.5 * kPi);
+}
 // every point's corner geometry (index = point index; ends are straight placeholders),
 // with the largest blend within tolerance_mm that leaves each adjacent edge at least half for
 // its other end; with edge_error_mm (per edge, merge_fine_edges), within tolerance_mm less the
 // larger error of the corner's two edges
 std::vector<CornerGeometry> corner_geometry(const std::vector<Vec3>& points, double tolerance_mm,
                                             const std::vector<double>& edge_error_mm = {});
+// the tolerance a corner's blend keeps to: tolerance_mm less the larger merge error of its two
+// edges (none without edge errors)
+double corner_tolerance_mm(double tolerance_mm, const std::vector<double>& edge_error_mm,
+                           size_t corner);
 // that largest blend at corner g (its turn set: tangent and deviation per length) between
 // edges of the given lengths; 0 for a corner taken straight or as a reversal
 double max_blend_half_length(const CornerGeometry& g, double edge_in_mm, double edge_out_mm,

@@ -73,7 +73,8 @@ PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerG
                        "mm/s"});
   // (a corner blended at print speed had nothing to weigh: its deposit was not predicted)
   if (!c.pruned) d.figures.push_back({"predicted_error_mm", c.error_mm, "mm"});
-  d.figures.push_back({"extra_time_s", c.extra_time_s, "s"});
+  // (a corner of a chain at constant speed has no time of its own: the path decision has it)
+  if (c.name != "constant_speed") d.figures.push_back({"extra_time_s", c.extra_time_s, "s"});
   if (!c.pruned) d.figures.push_back({"cost_mm", c.cost, "mm"});
   const double deviation = c.plan.treatment == CornerTreatment::blend
                                ? c.plan.half_length_mm * g.deviation_per_length
@@ -294,9 +295,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     std::vector<CornerPlan> corners(chain.points.size());
     std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
     for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
-      if (geometry[i].turn_rad <= 0.0 ||
-          (geometry[i].max_half_length_mm <= 0.0 && geometry[i].turn_rad < 0.5 * kPi))
-        continue;  // straight on
+      if (taken_straight_on(geometry[i])) continue;
       chain_decisions.emplace_back(i, decided.decision(chain, i, geometry, [&]() {
         return choose_corner(chain, i, geometry, jerk_limits, options, model,
                              settings_.time_weight_mm_s, scratch);
@@ -319,8 +318,58 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
         corners = trial;  // the quickest plan so far is kept
       }
     }
-    // each corner reported as planned: its blend (deviation) and the speed it is taken at
+    // aerosol: the whole chain at one constant speed instead (constant_speed_chain), where some
+    // corner is not taken at print speed and the even, thicker line costs less than the
+    // corners' own choices (their predicted errors and the chain's time)
+    bool at_constant_speed = false;
+    if (aerosol && !chain_decisions.empty()) {
+      const bool all_at_print_speed =
+          std::all_of(chain_decisions.begin(), chain_decisions.end(), [&](const auto& entry) {
+            const size_t i = entry.first;
+            return corners[i].treatment == CornerTreatment::blend &&
+                   planned.corner_speed_mm_s[i] >=
+                       (1.0 - 1e-9) *
+                           std::min(chain.edge_speed_mm_s[i - 1], chain.edge_speed_mm_s[i]);
+          });
+      double corners_error_mm = 0.0;
+      for (const auto& entry : chain_decisions)
+        if (!entry.second.chosen.pruned) corners_error_mm += entry.second.chosen.error_mm;
+      const double corners_cost = corners_error_mm + settings_.time_weight_mm_s * planned.t_end_s;
+      ConstantSpeedChain constant;
+      if (!all_at_print_speed)
+        constant =
+            constant_speed_chain(chain, geometry, settings_.tolerance_mm, merged.edge_error_mm,
+                                 jerk_limits, options, model, corners_cost);
+      if (constant.speed_mm_s > 0.0) {
+        const double constant_cost =
+            constant.error_mm + settings_.time_weight_mm_s * constant.planned.t_end_s;
+        if (constant_cost < corners_cost) {
+          PlanDecision d;
+          d.path_index = chain.point_path.front();
+          d.point_index = chain.point_index.front();
+          d.kind = "path";
+          d.choice = "constant_speed";
+          d.figures.push_back({"print_speed_mm_s", chain.edge_speed_mm_s.front(), "mm/s"});
+          d.figures.push_back({"constant_speed_mm_s", constant.speed_mm_s, "mm/s"});
+          d.figures.push_back({"constant_speed_error_mm", constant.error_mm, "mm"});
+          d.figures.push_back({"constant_speed_time_s", constant.planned.t_end_s, "s"});
+          d.figures.push_back({"corners_error_mm", corners_error_mm, "mm"});
+          d.figures.push_back({"corners_time_s", planned.t_end_s, "s"});
+          decisions.push_back(std::move(d));
+          planned = std::move(constant.planned);
+          corners = std::move(constant.corners);
+          at_constant_speed = true;
+        }
+      }
+    }
+    // each corner reported as planned: its blend (deviation) and the speed it is taken at (at
+    // the chain's constant speed: that choice, the corner's own candidates for comparison)
     for (auto& [i, decision] : chain_decisions) {
+      if (at_constant_speed) {
+        decision.chosen = CornerCandidate{};
+        decision.chosen.name = "constant_speed";
+        decision.chosen.pruned = true;  // (its deposit is the chain's: no error of its own)
+      }
       decision.chosen.plan = corners[i];
       decision.chosen.speed_mm_s = planned.corner_speed_mm_s[i];
       decisions.push_back(corner_report(chain, i, geometry[i], decision));
