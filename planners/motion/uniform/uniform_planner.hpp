@@ -13,7 +13,9 @@
 //  - Deposition coupling (corner_choice.hpp): per corner, a constant-speed blend, a slowed
 //    corner, a loop (aerosol: the shutter closed at print speed; extrusion: rest to rest with
 //    the flow off) or a stop (extrusion), by the predicted thickness
-//    error over the target region plus `time_weight` times the time; extrusion's commanded flow
+//    error over the target region plus `time_weight` times the time; an aerosol chain whose
+//    corners cannot all keep the print speed is also weighed whole at one constant speed
+//    (constant_speed_chain), an even, thicker line, by the same cost; extrusion's commanded flow
 //    leads the planned speed by the flow lag (pressure advance), and its decelerations stay
 //    within what the lagging flow can follow (line_profile.hpp).
 //  - Transitions between print paths: jerk-limited synchronised minimum-time moves with the
