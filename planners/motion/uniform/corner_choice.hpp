@@ -115,10 +115,10 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
 // scale-down Shembekar et al. apply to a path and `conformal` does on the joints). A stream
 // that cannot follow the speed then lays an even line everywhere, thicker by print speed /
 // that speed, where a corner taken alone (slowed or looped) leaves a bump or a seam: on a
-// small circle of fine chords no corner keeps the print speed, and 25 loops take ten times
-// the print's own time. The speed is the largest every corner's largest blend within the
-// tolerance takes (blend_speed_bound; a corner next to an end of the chain may take that end's
-// whole edge), the print speed at the most; its thickness error is
+// small circle of fine chords no corner keeps the print speed (4 mm at 50 mm/s: 27 loops in
+// 31 corners, 6.25 s against lspb_mtt's 0.74 s). The speed is the largest every corner's
+// largest blend within the tolerance takes (blend_speed_bound; a corner next to an end of the
+// chain may take that end's whole edge), the print speed at the most; its thickness error is
 // the even line's against the target, summed as a corner's is (the band's cells and the
 // centreline's samples, E = (print speed / speed - 1) (1 + erf(w / (2 sqrt 2 sigma))) x the
 // chain's length, w the line width). speed_mm_s 0: no such plan (an extrusion chain, one of
