@@ -6,10 +6,10 @@
 #include <cmath>
 #include <memory>
 #include <random>
-#include <string>
 
 #include "core/segment_distance.hpp"
 #include "metrics/motion_metrics.hpp"
+#include "planners/motion/plan_figure.hpp"
 #include "planners/motion/polyline_job.hpp"
 #include "planners/motion/uniform/path_plan.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
@@ -183,13 +183,6 @@ TEST(UniformPlanner, ChordedCircleIsPrintedAtItsPrintSpeed) {
   }
 }
 
-// the figure of that name in a decision (NaN when it has none)
-double figure_of(const PlanDecision& decision, const std::string& name) {
-  for (const PlanFigure& figure : decision.figures)
-    if (figure.name == name) return figure.value;
-  return std::nan("");
-}
-
 // A 4 mm circle of 0.2 mm chords at 50 mm/s (625 mm/s^2 on the true circle, 1000 allowed):
 // merged, its corners' clothoid pairs cannot keep that speed within the tolerance, and taken
 // one at a time an aerosol stage looped 27 of its 31 corners (6.25 s, against lspb_mtt's
@@ -219,20 +212,20 @@ TEST(UniformPlanner, SmallAerosolCircleIsPrintedAtOneConstantSpeed) {
     if (decision.kind != "path") continue;
     ++path_decisions;
     EXPECT_EQ(decision.choice, "constant_speed");
-    speed = figure_of(decision, "constant_speed_mm_s");
-    EXPECT_EQ(figure_of(decision, "print_speed_mm_s"), print_speed);
+    speed = figure(decision, "constant_speed_mm_s");
+    EXPECT_EQ(figure(decision, "print_speed_mm_s"), print_speed);
     // cheaper by the planner's own cost
-    EXPECT_LT(figure_of(decision, "constant_speed_error_mm") +
-                  settings.time_weight_mm_s * figure_of(decision, "constant_speed_time_s"),
-              figure_of(decision, "corners_error_mm") +
-                  settings.time_weight_mm_s * figure_of(decision, "corners_time_s"));
+    EXPECT_LT(figure(decision, "constant_speed_error_mm") +
+                  settings.time_weight_mm_s * figure(decision, "constant_speed_time_s"),
+              figure(decision, "corners_error_mm") +
+                  settings.time_weight_mm_s * figure(decision, "corners_time_s"));
     // the even line's error (its length the merged chords', shorter than the given by less
     // than 0.2 %)
     const double band_share = std::erf(0.5 * aerosol.process->resolved_line_width_mm() /
                                        (std::sqrt(2.0) * aerosol.process->footprint_sigma_mm()));
-    EXPECT_NEAR(figure_of(decision, "constant_speed_error_mm"),
+    EXPECT_NEAR(figure(decision, "constant_speed_error_mm"),
                 (print_speed / speed - 1.0) * (1.0 + band_share) * length,
-                0.002 * figure_of(decision, "constant_speed_error_mm"));
+                0.002 * figure(decision, "constant_speed_error_mm"));
   }
   ASSERT_EQ(path_decisions, 1);
   ASSERT_GT(speed, 0.5 * print_speed);
@@ -241,7 +234,7 @@ TEST(UniformPlanner, SmallAerosolCircleIsPrintedAtOneConstantSpeed) {
     if (decision.kind != "corner") continue;
     ++corners;
     EXPECT_EQ(decision.choice, "constant_speed") << "point " << decision.point_index;
-    EXPECT_NEAR(figure_of(decision, "speed_mm_s"), speed, 1e-9 * speed);
+    EXPECT_NEAR(figure(decision, "speed_mm_s"), speed, 1e-9 * speed);
   }
   EXPECT_GT(corners, 20);
   // printed at that speed throughout, its length over that speed, within the tolerance

@@ -12,6 +12,7 @@
 #include "deposition/deposition_metrics.hpp"
 #include "metrics/motion_metrics.hpp"
 #include "motion/sync.hpp"
+#include "planners/motion/plan_figure.hpp"
 #include "planners/motion/transition.hpp"
 #include "planners/motion/uniform/corner_choice.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
@@ -111,13 +112,6 @@ TEST(UniformPlanner, IsolatedAerosolLineIsEnteredAtSpeedByTheAnalyticMove) {
 const PlanDecision& only_corner(const Trajectory& plan) {
   EXPECT_EQ(plan.decisions().size(), 1u);
   return plan.decisions().front();
-}
-
-double figure(const PlanDecision& d, const std::string& name) {
-  for (const PlanFigure& f : d.figures)
-    if (f.name == name) return f.value;
-  ADD_FAILURE() << "no figure " << name;
-  return 0.0;
 }
 
 // the largest relative speed error over the samples that deposit (the plan every 0.1 ms)
