@@ -813,7 +813,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
                              const PathMotionOptions& options, const DepositModel& model,
                              double time_weight_mm_s, PredictionScratch& scratch) {
   const CornerGeometry& g = geometry[corner];
-  const double speed = std::min(chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]);
+  const double speed = chain.corner_print_speed_mm_s(corner);
   CornerWindow window = corner_window(chain, corner, g, limits, options, model);
   std::vector<CornerCandidate> candidates;
   double best = std::numeric_limits<double>::infinity();

@@ -31,6 +31,7 @@
 // pieces' commanded flow leads the planned speed (TrajectoryPiece::flow_lead_s).
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,10 @@ struct PrintChain {
   bool oriented = false;  // some path has normals or rolls: the tool axis is carried
 
   size_t edges() const { return points.empty() ? 0 : points.size() - 1; }
+  // the print speed at interior point `corner`: the lower of its two edges'
+  double corner_print_speed_mm_s(size_t corner) const {
+    return std::min(edge_speed_mm_s[corner - 1], edge_speed_mm_s[corner]);
+  }
   // the orientation at a fraction of edge e (slerp of the axes, rolls linear)
   ToolOrientation edge_orientation(size_t e, double fraction) const;
   // the orientation at the point of edges e and e + 1 nearest to p (a blend's sample)

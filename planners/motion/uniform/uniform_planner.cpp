@@ -42,7 +42,7 @@ bool resize_held_blends(const PrintChain& chain, const std::vector<CornerGeometr
   for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
     CornerPlan& plan = corners[i];
     if (plan.treatment != CornerTreatment::blend) continue;
-    const double print_speed = std::min(chain.edge_speed_mm_s[i - 1], chain.edge_speed_mm_s[i]);
+    const double print_speed = chain.corner_print_speed_mm_s(i);
     const double speed = corner_speeds[i];
     if (!(speed > 0.0 && speed < kResizeBelowShare * print_speed)) continue;
     const CornerGeometry& g = geometry[i];
@@ -68,9 +68,7 @@ PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerG
   d.choice = c.name;
   d.figures.push_back({"interior_angle_deg", g.interior_deg, "deg"});
   d.figures.push_back({"speed_mm_s", c.speed_mm_s, "mm/s"});
-  d.figures.push_back({"print_speed_mm_s",
-                       std::min(chain.edge_speed_mm_s[corner - 1], chain.edge_speed_mm_s[corner]),
-                       "mm/s"});
+  d.figures.push_back({"print_speed_mm_s", chain.corner_print_speed_mm_s(corner), "mm/s"});
   // (a corner blended at print speed had nothing to weigh: its deposit was not predicted)
   if (!c.pruned) d.figures.push_back({"predicted_error_mm", c.error_mm, "mm"});
   // (a corner of a chain at constant speed has no time of its own: the path decision has it)
@@ -327,9 +325,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
           std::all_of(chain_decisions.begin(), chain_decisions.end(), [&](const auto& entry) {
             const size_t i = entry.first;
             return corners[i].treatment == CornerTreatment::blend &&
-                   planned.corner_speed_mm_s[i] >=
-                       (1.0 - 1e-9) *
-                           std::min(chain.edge_speed_mm_s[i - 1], chain.edge_speed_mm_s[i]);
+                   planned.corner_speed_mm_s[i] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
           });
       double corners_error_mm = 0.0;
       for (const auto& entry : chain_decisions)
