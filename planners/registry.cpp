@@ -50,11 +50,12 @@ const std::vector<PlannerInfo>& planner_registry() {
        /*honours_jerk_limit=*/true},
       {"uniform",
        "beyond the papers: deposit-aware, time-optimal and jerk-limited; clothoid corner blends "
-       "within tolerance_mm, each corner blended, slowed, looped (aerosol: the shutter closed at "
-       "print speed; extrusion: rest to rest with the flow off) or stopped (extrusion) by the "
-       "predicted thickness error plus time_weight x time (aerosol: or a whole chain at one "
-       "constant speed, by the same cost), extrusion flow led by the nozzle lag (pressure "
-       "advance)",
+       "within tolerance_mm (a chorded circle's corners that cannot keep the print speed one by "
+       "one: one clothoid-arc-clothoid curve at it), each corner blended, slowed, looped "
+       "(aerosol: the shutter closed at print speed; extrusion: rest to rest with the flow off) "
+       "or stopped (extrusion) by the predicted thickness error plus time_weight x time "
+       "(aerosol: or a whole chain at one constant speed, by the same cost), extrusion flow led "
+       "by the nozzle lag (pressure advance)",
        uniform_parameters(), [](const PlannerSpec& spec) { return make_uniform_planner(spec); },
        true, /*consumes_arcs=*/true},
   };

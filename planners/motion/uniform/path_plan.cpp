@@ -9,6 +9,7 @@
 #include "core/segment_distance.hpp"
 #include "planners/motion/path_check.hpp"
 #include "planners/motion/transition.hpp"
+#include "planners/motion/uniform/arc_run.hpp"
 
 namespace depotwin {
 
@@ -135,6 +136,8 @@ const char* corner_treatment_name(CornerTreatment treatment) {
       return "loop";
     case CornerTreatment::stop:
       return "stop";
+    case CornerTreatment::arc:
+      return "arc";
   }
   return "?";
 }
@@ -178,6 +181,8 @@ MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm) {
   if (chain.oriented || n < 3 || !(max_error_mm > 0.0)) {
     merged.chain = chain;
     merged.edge_error_mm.assign(chain.edges(), 0.0);
+    merged.source_point.resize(n);
+    for (size_t i = 0; i < n; ++i) merged.source_point[i] = i;
     return merged;
   }
   PrintChain& out = merged.chain;
@@ -187,6 +192,7 @@ MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm) {
     out.orientations.push_back(chain.orientations[i]);
     out.point_path.push_back(chain.point_path[i]);
     out.point_index.push_back(chain.point_index[i]);
+    merged.source_point.push_back(i);
   };
   // the largest distance of points first+1 .. last-1 from the segment first-last
   const auto chord_error = [&](size_t first, size_t last) {
@@ -301,12 +307,17 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
       if (c.treatment == CornerTreatment::blend)
         trim0 = c.half_length_mm * geometry[e].tangent_per_length;
       if (c.treatment == CornerTreatment::loop) trim0 = c.trim_out_mm;
+      // (an arc run's inner edge is taken whole by its curve)
+      if (c.treatment == CornerTreatment::arc)
+        trim0 = c.arc->last_corner() == e ? c.arc->exit_trim_mm : edge_length;
     }
     if (e + 1 < edges) {
       const CornerPlan& c = corners[e + 1];
       if (c.treatment == CornerTreatment::blend)
         trim1 = c.half_length_mm * geometry[e + 1].tangent_per_length;
       if (c.treatment == CornerTreatment::loop) trim1 = c.trim_in_mm;
+      if (c.treatment == CornerTreatment::arc)
+        trim1 = c.arc->first_corner() == e + 1 ? c.arc->entry_trim_mm : edge_length;
     }
     line.length = std::max(0.0, edge_length - trim0 - trim1);
     line.from = p0 + trim0 * line.u;
@@ -339,6 +350,7 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
       cap = std::min(cap, blend_speed_bound(geometry[k].shape, c.half_length_mm,
                                             blend_limits(limits.over(lo, hi))));
     }
+    if (c.treatment == CornerTreatment::arc) cap = std::min(cap, c.arc->speed_bound_mm_s);
     if (c.treatment == CornerTreatment::stop) cap = 0.0;
     if (c.treatment == CornerTreatment::loop) {
       split[k] = 1;
@@ -441,6 +453,37 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
         planned.pieces.push_back(std::move(piece));
         t = planned.pieces.back().t_end_s;
       }
+    } else if (c.treatment == CornerTreatment::arc && c.arc->first_corner() == i) {
+      // the run's curve, once, at its first corner (its inner lines are empty, its other
+      // corners add nothing): a piece per section, each of equal periods, so the joints of
+      // the transitions and the arc, where the curvature rate jumps, fall on samples
+      const ArcRun& run = *c.arc;
+      const double w = v_end[k];
+      if (!(w > 0.0)) throw InternalError("uniform: an arc run planned at rest");
+      double s_begin = 0.0;
+      for (int section = 0; section < 3; ++section) {
+        const double length = run.section_length_mm(section);
+        if (!(length > 0.0)) continue;
+        const double duration = length / w;
+        const size_t periods = static_cast<size_t>(
+            std::max(double(kMinBlendHalfPeriods), std::ceil(duration / options.period_s)));
+        const double period = duration / static_cast<double>(periods);
+        SampledMotion motion;
+        motion.period_s = period;
+        for (size_t m = 0; m <= periods; ++m) {
+          const double s =
+              s_begin + (m == periods ? length : length * static_cast<double>(m) / periods);
+          Vec3 p, d1, d2, d3;
+          run.at(s, p, d1, d2, d3);
+          motion.position_mm.push_back(p);
+          motion.velocity_mm_s.push_back(w * d1);
+        }
+        TrajectoryPiece piece = base_piece(static_cast<double>(periods) * period, k);
+        piece.motion = std::move(motion);
+        planned.pieces.push_back(std::move(piece));
+        t = planned.pieces.back().t_end_s;
+        s_begin += length;
+      }
     } else if (c.treatment == CornerTreatment::loop) {
       // shutter closed: from the end of this line to the start of the next, at their speeds
       const Line& next = lines[k + 1];
@@ -454,8 +497,17 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
       planned.pieces.push_back(std::move(loop));
     }
   }
-  planned.start_velocity = v_start.front() * lines.front().u;
-  planned.end_velocity = v_end.back() * lines.back().u;
+  // (an arc run that takes a chain's end edge whole leaves or enters it along its own end)
+  const CornerPlan& first_corner = corners[1];
+  const CornerPlan& last_corner = corners[edges - 1];
+  const bool starts_on_run =
+      edges > 1 && first_corner.treatment == CornerTreatment::arc && lines.front().length <= 0.0;
+  const bool ends_on_run =
+      edges > 1 && last_corner.treatment == CornerTreatment::arc && lines.back().length <= 0.0;
+  planned.start_velocity =
+      v_start.front() * (starts_on_run ? first_corner.arc->start_direction() : lines.front().u);
+  planned.end_velocity =
+      v_end.back() * (ends_on_run ? last_corner.arc->end_direction() : lines.back().u);
   planned.t_end_s = t;
   return planned;
 }

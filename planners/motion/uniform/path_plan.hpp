@@ -10,10 +10,13 @@
 //             the shutter closed (a jerk-limited synchronised move, motion/sync.hpp, leaving
 //             and entering at the lines' velocities) and printing resumes `trim_out` after the
 //             corner;
-//   stop      the path comes to rest at the corner (a reversal an extruder cannot loop).
+//   stop      the path comes to rest at the corner (a reversal an extruder cannot loop);
+//   arc       one of a run of corners along a circle taken as one clothoid-arc-clothoid curve
+//             at constant speed (arc_run.hpp): the run's end edges lose what it takes of them,
+//             its inner edges are taken whole.
 //
-// Time law. Speed changes happen on the straight lines only; every curved section (blend) is
-// traversed at one constant speed, its "node" speed. Between two nodes a line runs the
+// Time law. Speed changes happen on the straight lines only; every curved section (blend, arc
+// run) is traversed at one constant speed, its "node" speed. Between two nodes a line runs the
 // time-optimal jerk-limited profile of line_profile.hpp (zero acceleration at both ends), so
 // the acceleration is continuous everywhere: a line meets a blend where the blend's curvature
 // (and so its acceleration) is 0. Each node's speed is capped by its section's limits
@@ -32,6 +35,7 @@
 #pragma once
 
 #include <algorithm>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -43,15 +47,18 @@
 
 namespace depotwin {
 
-enum class CornerTreatment { straight, blend, loop, stop };
+class ArcRun;
+
+enum class CornerTreatment { straight, blend, loop, stop, arc };
 const char* corner_treatment_name(CornerTreatment treatment);
 
 // How one interior point of a path is taken.
 struct CornerPlan {
   CornerTreatment treatment = CornerTreatment::straight;
-  double half_length_mm = 0.0;  // blend: the clothoids' half-length
-  double trim_in_mm = 0.0;      // loop: printing stops this far before the corner
-  double trim_out_mm = 0.0;     // loop: and resumes this far after it
+  double half_length_mm = 0.0;        // blend: the clothoids' half-length
+  double trim_in_mm = 0.0;            // loop: printing stops this far before the corner
+  double trim_out_mm = 0.0;           // loop: and resumes this far after it
+  std::shared_ptr<const ArcRun> arc;  // arc: the run the corner is in
 };
 
 // What is printed in one go: consecutive print paths joined end to start (one path, or several
@@ -118,6 +125,7 @@ struct PathMotionOptions {
 struct MergedChain {
   PrintChain chain;
   std::vector<double> edge_error_mm;
+  std::vector<size_t> source_point;  // per kept point, its index in the given chain
 };
 MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm);
 

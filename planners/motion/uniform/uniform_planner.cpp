@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "planners/motion/conformal.hpp"
 #include "planners/motion/transition.hpp"
+#include "planners/motion/uniform/arc_run.hpp"
 
 namespace depotwin {
 
@@ -72,12 +73,22 @@ PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerG
   // (a corner blended at print speed had nothing to weigh: its deposit was not predicted)
   if (!c.pruned) d.figures.push_back({"predicted_error_mm", c.error_mm, "mm"});
   // (a corner of a chain at constant speed has no time of its own: the path decision has it)
-  if (c.name != "constant_speed") d.figures.push_back({"extra_time_s", c.extra_time_s, "s"});
+  // (nor one of an arc run: at print speed, it is planned but not weighed)
+  if (c.name != "constant_speed" && c.name != "arc")
+    d.figures.push_back({"extra_time_s", c.extra_time_s, "s"});
   if (!c.pruned) d.figures.push_back({"cost_mm", c.cost, "mm"});
-  const double deviation = c.plan.treatment == CornerTreatment::blend
-                               ? c.plan.half_length_mm * g.deviation_per_length
-                               : 0.0;
+  double deviation = 0.0;
+  if (c.plan.treatment == CornerTreatment::blend)
+    deviation = c.plan.half_length_mm * g.deviation_per_length;
+  if (c.plan.treatment == CornerTreatment::arc) deviation = c.plan.arc->deviation_mm;
   d.figures.push_back({"deviation_mm", deviation, "mm"});
+  // (an arc run's circle, and how many corners it takes)
+  if (c.plan.treatment == CornerTreatment::arc) {
+    d.figures.push_back({"radius_mm", c.plan.arc->radius_mm(), "mm"});
+    d.figures.push_back(
+        {"run_corners",
+         static_cast<double>(c.plan.arc->last_corner() - c.plan.arc->first_corner() + 1), "count"});
+  }
   d.figures.push_back({"trim_in_mm", c.plan.trim_in_mm, "mm"});
   d.figures.push_back({"trim_out_mm", c.plan.trim_out_mm, "mm"});
   // the best of each other kind, for comparison (of a kind whose every prediction was
@@ -290,32 +301,92 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     // each corner's treatment, by the predicted deposit
     const std::vector<CornerGeometry> geometry =
         corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
+    // runs of corners along a circle that keep the print speed as one curve (arc_run.hpp),
+    // where a corner alone cannot: not weighed (an even line within the tolerance at print
+    // speed), their corners reported as "arc"
+    const std::vector<std::shared_ptr<const ArcRun>> runs =
+        settings_.arc_runs
+            ? find_arc_runs(merged, given, geometry, settings_.tolerance_mm, jerk_limits, options)
+            : std::vector<std::shared_ptr<const ArcRun>>{};
     std::vector<CornerPlan> corners(chain.points.size());
+    for (const std::shared_ptr<const ArcRun>& run : runs)
+      for (size_t i = run->first_corner(); i <= run->last_corner(); ++i) {
+        corners[i].treatment = CornerTreatment::arc;
+        corners[i].arc = run;
+      }
     std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
-    for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
-      if (taken_straight_on(geometry[i])) continue;
+    const auto decide = [&](size_t i) {
       chain_decisions.emplace_back(i, decided.decision(chain, i, geometry, [&]() {
         return choose_corner(chain, i, geometry, jerk_limits, options, model,
                              settings_.time_weight_mm_s, scratch);
       }));
-      corners[i] = chain_decisions.back().second.chosen.plan;
+      return chain_decisions.back().second.chosen.plan;
+    };
+    for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
+      if (taken_straight_on(geometry[i]) || corners[i].treatment == CornerTreatment::arc) continue;
+      corners[i] = decide(i);
     }
     // planned from 0, then placed after the transition that brings the nozzle to its start;
-    // blends that hold the look-ahead back are shrunk and the chain planned again
-    PlannedPath planned = plan_chain(chain, geometry, corners, jerk_limits, options, 0.0);
-    const std::vector<CornerPlan> chosen = corners;
-    std::vector<CornerPlan> trial = corners;
-    std::vector<double> trial_speeds = planned.corner_speed_mm_s;
-    for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
-                                                                  jerk_limits, chosen, trial);
-         ++pass) {
-      PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
-      trial_speeds = replanned.corner_speed_mm_s;
-      if (replanned.t_end_s < planned.t_end_s) {
-        planned = std::move(replanned);
-        corners = trial;  // the quickest plan so far is kept
+    // blends that hold the look-ahead back are shrunk and the chain planned again (the quickest
+    // plan kept, its corners in `plan`)
+    const auto plan_resizing = [&](std::vector<CornerPlan>& plan) {
+      PlannedPath planned = plan_chain(chain, geometry, plan, jerk_limits, options, 0.0);
+      const std::vector<CornerPlan> chosen = plan;
+      std::vector<CornerPlan> trial = plan;
+      std::vector<double> trial_speeds = planned.corner_speed_mm_s;
+      for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
+                                                                    jerk_limits, chosen, trial);
+           ++pass) {
+        PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
+        trial_speeds = replanned.corner_speed_mm_s;
+        if (replanned.t_end_s < planned.t_end_s) {
+          planned = std::move(replanned);
+          plan = trial;
+        }
+      }
+      return planned;
+    };
+    PlannedPath planned = plan_resizing(corners);
+    // extrusion: a run below the print speed (sized below it for its arc, or held by the
+    // look-ahead on a circle the path starts or ends on, at rest) may take longer than its
+    // corners one by one; those are then chosen too and the chain planned without such runs;
+    // the cheaper plan is kept (their predicted errors plus time_weight x its time, against
+    // time_weight x the runs' plan time)
+    if (!aerosol) {
+      std::vector<CornerPlan> without = corners;
+      const size_t decided_before = chain_decisions.size();
+      for (const std::shared_ptr<const ArcRun>& run : runs) {
+        const size_t first = run->first_corner();
+        if (planned.corner_speed_mm_s[first] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
+          continue;
+        for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(i);
+      }
+      if (chain_decisions.size() > decided_before) {
+        PlannedPath alternative = plan_resizing(without);
+        double corners_error_mm = 0.0;
+        for (size_t k = decided_before; k < chain_decisions.size(); ++k)
+          if (!chain_decisions[k].second.chosen.pruned)
+            corners_error_mm += chain_decisions[k].second.chosen.error_mm;
+        if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <
+            settings_.time_weight_mm_s * planned.t_end_s) {
+          planned = std::move(alternative);
+          corners = std::move(without);
+        } else {
+          chain_decisions.resize(decided_before);
+        }
       }
     }
+    // the runs' corners, reported in order with the others
+    for (size_t i = 1; i + 1 < chain.points.size(); ++i)
+      if (corners[i].treatment == CornerTreatment::arc) {
+        CornerDecision taken;
+        taken.chosen.name = "arc";
+        taken.chosen.pruned = true;  // (at print speed within the tolerance: nothing weighed)
+        taken.chosen.plan = corners[i];
+        chain_decisions.emplace_back(i, taken);
+      }
+    std::sort(chain_decisions.begin(), chain_decisions.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
     // aerosol: the whole chain at one constant speed instead (constant_speed_chain), where some
     // corner is not taken at print speed and the even, thicker line costs less than the
     // corners' own choices (their predicted errors and the chain's time)
@@ -324,7 +395,8 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
       const bool all_at_print_speed =
           std::all_of(chain_decisions.begin(), chain_decisions.end(), [&](const auto& entry) {
             const size_t i = entry.first;
-            return corners[i].treatment == CornerTreatment::blend &&
+            return (corners[i].treatment == CornerTreatment::blend ||
+                    corners[i].treatment == CornerTreatment::arc) &&
                    planned.corner_speed_mm_s[i] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
           });
       double corners_error_mm = 0.0;

@@ -4,7 +4,9 @@
 // what the motion alone cannot.
 //
 //  - Path: corners blended within `tolerance_mm` by clothoid pairs (clothoid_blend.hpp): the
-//    curvature is continuous, so a constant-speed blend has a continuous acceleration.
+//    curvature is continuous, so a constant-speed blend has a continuous acceleration. A run
+//    of corners along a chorded circle that cannot keep the print speed one by one is taken
+//    as one clothoid-arc-clothoid curve at it (arc_run.hpp).
 //  - Time law: jerk-limited and time-optimal for its family (path_plan.hpp): speed changes on
 //    the straight lines (exact per-axis limits along each line's direction, over its box, so a
 //    machine's joint limits come mapped where the line is), constant speed on every blend, a
@@ -52,6 +54,10 @@ struct UniformSettings {
   // (CornerDecisionCache; not a scenario parameter: off, every corner is predicted, as the
   // tests compare)
   bool reuse_corner_decisions = true;
+  // runs of corners along a chorded circle taken as one curve where they cannot keep the print
+  // speed one by one (find_arc_runs; not a scenario parameter: off, every corner is its own, as
+  // the tests compare)
+  bool arc_runs = true;
 };
 
 class UniformPlanner : public Planner {

@@ -183,8 +183,10 @@ TEST(UniformPlanner, ChordedCircleIsPrintedAtItsPrintSpeed) {
   }
 }
 
-// A 4 mm circle of 0.2 mm chords at 50 mm/s (625 mm/s^2 on the true circle, 1000 allowed):
-// merged, its corners' clothoid pairs cannot keep that speed within the tolerance, and taken
+// A 4 mm circle of 0.2 mm chords at 50 mm/s (625 mm/s^2 on the true circle, 1000 allowed),
+// its corners each its own (no arc runs: as one, the circle keeps the print speed,
+// test_uniform_arc.cpp): merged, its corners' clothoid pairs cannot keep that speed within the
+// tolerance, and taken
 // one at a time an aerosol stage looped 27 of its 31 corners (6.25 s, against lspb_mtt's
 // 0.74 s). The whole chain at the one speed all its corners' largest blends take (about 42.5
 // mm/s) lays an even line 1.18 x the target: predicted 8.6 mm of misplaced line in 0.59 s,
@@ -200,7 +202,9 @@ TEST(UniformPlanner, SmallAerosolCircleIsPrintedAtOneConstantSpeed) {
   const int chords = 126;
   const Toolpath toolpath = polyline_job(chorded_circle(radius, chords), print_speed);
   const double length = chords * 2.0 * radius * std::sin(kPi / chords);
-  const UniformSettings settings;
+  // (its corners one by one: as one arc run it keeps the print speed, test_uniform_arc.cpp)
+  UniformSettings settings;
+  settings.arc_runs = false;
   const UniformPlanner planner{settings};
   const PlanningContext aerosol = context_for(ProcessType::aerosol);
   const Trajectory plan = planner.plan_in_context(toolpath, limits, aerosol);
