@@ -10,6 +10,7 @@
 #include "metrics/motion_metrics.hpp"
 #include "planners/motion/plan_figure.hpp"
 #include "planners/motion/polyline_job.hpp"
+#include "planners/motion/process_context.hpp"
 #include "planners/motion/uniform/arc_run.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
 
@@ -27,15 +28,6 @@ std::vector<Vec3> slot(double r) {
   }
   points.emplace_back(0, 2 * r, 0.2);
   return points;
-}
-
-PlanningContext context_for(ProcessType type) {
-  DepositionSettings process;
-  process.type = type;
-  process.bead_width_mm = 0.4;
-  PlanningContext context;
-  context.process = std::make_shared<const DepositionSettings>(process);
-  return context;
 }
 
 // the runs the planner finds on a polyline (merged and measured as it does)
@@ -195,7 +187,7 @@ TEST(UniformPlanner, ChordedHalfCircleIsOneArcAtPrintSpeed) {
   for (size_t k = 0; k + 1 < points.size(); ++k) length += (points[k + 1] - points[k]).norm();
   for (const ProcessType type : {ProcessType::aerosol, ProcessType::extrusion}) {
     SCOPED_TRACE(process_type_name(type));
-    const Trajectory plan = planner.plan_in_context(toolpath, axes, context_for(type));
+    const Trajectory plan = planner.plan_in_context(toolpath, axes, process_context(type));
     int arcs = 0;
     for (const PlanDecision& decision : plan.decisions()) {
       ASSERT_EQ(decision.kind, "corner");
@@ -240,7 +232,7 @@ TEST(UniformPlanner, ChordedHalfCircleIsOneArcAtPrintSpeed) {
     UniformSettings one_by_one;
     one_by_one.arc_runs = false;
     const Trajectory corners =
-        UniformPlanner{one_by_one}.plan_in_context(toolpath, axes, context_for(type));
+        UniformPlanner{one_by_one}.plan_in_context(toolpath, axes, process_context(type));
     EXPECT_LT(plan.duration_s(), corners.duration_s());
   }
 }
@@ -261,7 +253,7 @@ TEST(UniformPlanner, ClosedAerosolCircleIsOneArcRunFromEndToEnd) {
   }
   const Toolpath toolpath = polyline_job(circle, speed);
   const UniformSettings settings;
-  const PlanningContext aerosol = context_for(ProcessType::aerosol);
+  const PlanningContext aerosol = process_context(ProcessType::aerosol);
   const Trajectory plan = UniformPlanner{settings}.plan_in_context(toolpath, axes, aerosol);
   int arcs = 0;
   for (const PlanDecision& decision : plan.decisions()) {

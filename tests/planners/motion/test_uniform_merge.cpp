@@ -11,6 +11,7 @@
 #include "metrics/motion_metrics.hpp"
 #include "planners/motion/plan_figure.hpp"
 #include "planners/motion/polyline_job.hpp"
+#include "planners/motion/process_context.hpp"
 #include "planners/motion/uniform/path_plan.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
 
@@ -25,15 +26,6 @@ std::vector<Vec3> chorded_circle(double r, int chords) {
     points.emplace_back(r * std::cos(angle), r * std::sin(angle), 0.2);
   }
   return points;
-}
-
-PlanningContext context_for(ProcessType type) {
-  DepositionSettings process;
-  process.type = type;
-  process.bead_width_mm = 0.4;
-  PlanningContext context;
-  context.process = std::make_shared<const DepositionSettings>(process);
-  return context;
 }
 
 // A chain of three paths: a circle of 0.1 mm chords with noise of 2 um, then (joined) a sharp
@@ -155,7 +147,7 @@ TEST(UniformPlanner, ChordedCircleIsPrintedAtItsPrintSpeed) {
     const UniformPlanner planner{UniformSettings{}};
     // aerosol: entered and left at print speed
     const Trajectory aerosol =
-        planner.plan_in_context(toolpath, limits, context_for(ProcessType::aerosol));
+        planner.plan_in_context(toolpath, limits, process_context(ProcessType::aerosol));
     for (const PlanDecision& decision : aerosol.decisions()) {
       EXPECT_EQ(decision.choice, "blend") << chords << " chords, point " << decision.point_index;
       for (const PlanFigure& figure : decision.figures) {
@@ -171,10 +163,10 @@ TEST(UniformPlanner, ChordedCircleIsPrintedAtItsPrintSpeed) {
         << chords;
     // extrusion: from rest to rest, against a straight line of the same length
     const Trajectory extrusion =
-        planner.plan_in_context(toolpath, limits, context_for(ProcessType::extrusion));
+        planner.plan_in_context(toolpath, limits, process_context(ProcessType::extrusion));
     const Trajectory line =
         planner.plan_in_context(polyline_job({Vec3(0, 0, 0.2), Vec3(length, 0, 0.2)}, speed),
-                                limits, context_for(ProcessType::extrusion));
+                                limits, process_context(ProcessType::extrusion));
     EXPECT_LE(printing_s(extrusion), 1.3 * printing_s(line))
         << chords << " chords: " << printing_s(extrusion) << " s, line " << printing_s(line);
     EXPECT_LE(path_error(sample_trajectory(extrusion, 1e-4), toolpath).max_mm,
@@ -206,7 +198,7 @@ TEST(UniformPlanner, SmallAerosolCircleIsPrintedAtOneConstantSpeed) {
   UniformSettings settings;
   settings.arc_runs = false;
   const UniformPlanner planner{settings};
-  const PlanningContext aerosol = context_for(ProcessType::aerosol);
+  const PlanningContext aerosol = process_context(ProcessType::aerosol);
   const Trajectory plan = planner.plan_in_context(toolpath, limits, aerosol);
 
   // one path decision, and every corner at its speed
@@ -266,7 +258,7 @@ TEST(UniformPlanner, SmallAerosolCircleIsPrintedAtOneConstantSpeed) {
   EXPECT_GT(loops, 0);
   // extrusion: never
   const Trajectory extrusion =
-      planner.plan_in_context(toolpath, limits, context_for(ProcessType::extrusion));
+      planner.plan_in_context(toolpath, limits, process_context(ProcessType::extrusion));
   for (const PlanDecision& decision : extrusion.decisions()) {
     EXPECT_EQ(decision.kind, "corner");
     EXPECT_NE(decision.choice, "constant_speed");
@@ -324,7 +316,7 @@ TEST(UniformPlanner, RandomJobsStayWithinTheTolerance) {
     const MachineLimits limits = MachineLimits::uniform(100.0, accelerations[rng() % 3]);
     const ProcessType process = trial % 2 == 0 ? ProcessType::extrusion : ProcessType::aerosol;
     const Trajectory plan =
-        UniformPlanner{settings}.plan_in_context(toolpath, limits, context_for(process));
+        UniformPlanner{settings}.plan_in_context(toolpath, limits, process_context(process));
     const MotionSamples samples = sample_trajectory(plan, 2e-4);
     for (size_t k = 0; k < samples.size(); ++k)
       ASSERT_TRUE(samples.position_mm[k].allFinite() && samples.velocity_mm_s[k].allFinite())
