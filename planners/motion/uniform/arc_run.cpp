@@ -199,11 +199,11 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
   bounds.limits = blend_limits(limits.over(lo - pad, hi + pad));
   for (int axis = 0; axis < 3; ++axis) bounds.reach[axis] = std::hypot(e1[axis], e2[axis]);
 
-  // the radius: the nearer line's distance less the shift of the transition the print speed
-  // needs there (a fixed point: the shift grows as the radius shrinks)
-  // (at the print speed; where that fails and the flow follows the speed, an extruder's, at a
-  // share of what the arc alone allows: a slower run lays the same bead, and the planner weighs
-  // it against the corners' own choices)
+  // the radius: the nearer end's distance less the shift of the transition the speed needs
+  // there (a fixed point: the shift grows as the radius shrinks), at the print speed; where
+  // that fails and the flow follows the speed (an extruder's), at a share of what the arc alone
+  // allows: a slower run lays the same bead, and the planner weighs it against the corners'
+  // own choices
   const auto radius_for = [&](double speed) {
     double radius = std::min(h_in, h_out);
     for (int k = 0; k < kRadiusIterations; ++k) {
