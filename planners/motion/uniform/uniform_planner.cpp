@@ -73,7 +73,7 @@ PlanDecision corner_report(const PrintChain& chain, size_t corner, const CornerG
   // (a corner blended at print speed had nothing to weigh: its deposit was not predicted)
   if (!c.pruned) d.figures.push_back({"predicted_error_mm", c.error_mm, "mm"});
   // (a corner of a chain at constant speed has no time of its own: the path decision has it)
-  // (nor one of an arc run: at print speed, it is planned but not weighed)
+  // (nor one of an arc run: the run is planned as a whole)
   if (c.name != "constant_speed" && c.name != "arc")
     d.figures.push_back({"extra_time_s", c.extra_time_s, "s"});
   if (!c.pruned) d.figures.push_back({"cost_mm", c.cost, "mm"});
@@ -301,9 +301,10 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     // each corner's treatment, by the predicted deposit
     const std::vector<CornerGeometry> geometry =
         corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
-    // runs of corners along a circle that keep the print speed as one curve (arc_run.hpp),
-    // where a corner alone cannot: not weighed (an even line within the tolerance at print
-    // speed), their corners reported as "arc"
+    // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),
+    // where a corner alone cannot keep the print speed: at the print speed, not weighed (an
+    // even line within the tolerance); an extruder's below it, weighed below; their corners
+    // reported as "arc"
     const std::vector<std::shared_ptr<const ArcRun>> runs =
         settings_.arc_runs
             ? find_arc_runs(merged, given, geometry, settings_.tolerance_mm, jerk_limits, options)
@@ -381,7 +382,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
       if (corners[i].treatment == CornerTreatment::arc) {
         CornerDecision taken;
         taken.chosen.name = "arc";
-        taken.chosen.pruned = true;  // (at print speed within the tolerance: nothing weighed)
+        taken.chosen.pruned = true;  // (its deposit not predicted: an even line, see above)
         taken.chosen.plan = corners[i];
         chain_decisions.emplace_back(i, taken);
       }
