@@ -201,9 +201,8 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
 
   // the radius: the nearer end's distance less the shift of the transition the speed needs
   // there (a fixed point: the shift grows as the radius shrinks), at the print speed; where
-  // that fails and the flow follows the speed (an extruder's), at a share of what the arc alone
-  // allows: a slower run lays the same bead, and the planner weighs it against the corners'
-  // own choices
+  // that fails, at a share of what the arc alone allows (the planner weighs a slower run
+  // against the corners' own choices)
   const auto radius_for = [&](double speed) {
     double radius = std::min(h_in, h_out);
     for (int k = 0; k < kRadiusIterations; ++k) {
@@ -217,7 +216,7 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
   };
   double speed = chain.edge_speed_mm_s[a];
   double radius = radius_for(speed);
-  if (!(radius > 0.0) && options.flow_follows_speed) {
+  if (!(radius > 0.0)) {
     speed = std::min(speed, kSlowRunShare * bounds.arc_speed_bound(std::min(h_in, h_out)));
     radius = radius_for(speed);
   }

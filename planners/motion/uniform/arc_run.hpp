@@ -82,9 +82,9 @@ class ArcRun {
 // The runs of a chain's corners taken as arcs: runs of at least kMinArcRunCorners consecutive
 // corners that turn one way in one plane, each by less than 90 deg, on edges of one print path
 // and speed, at least one of which cannot keep the print speed on its own largest blend, where
-// one such curve keeps the print speed under the limits (over the run's box; where the flow
-// follows the speed, an extruder's, at most 0.9 of the speed its arc alone allows, which the
-// planner weighs against the corners' own choices), stays within the
+// one such curve keeps the print speed under the limits (over the run's box; where its arc
+// alone cannot, 0.9 of the speed the arc allows, which the planner weighs against the
+// corners' own choices), stays within the
 // tolerance of the polyline (tolerance_mm less the run's edges' merge errors, checked on its
 // samples both ways) and starts and ends on the run's end edges, leaving each at least half for
 // its other end (the whole edge at an end of the chain the path enters or leaves at speed).

@@ -930,6 +930,11 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
   return decision;
 }
 
+double even_line_error_per_mm(const DepositModel& model) {
+  const double sigma = model.settings.footprint_sigma_mm();
+  return 1.0 + std::erf(0.5 * model.settings.resolved_line_width_mm() / (std::sqrt(2.0) * sigma));
+}
+
 ConstantSpeedChain constant_speed_chain(const PrintChain& chain,
                                         const std::vector<CornerGeometry>& geometry,
                                         double tolerance_mm,
@@ -973,16 +978,12 @@ ConstantSpeedChain constant_speed_chain(const PrintChain& chain,
   }
   if (!(speed > 0.0)) return none;
 
-  // the even line's error against the target: the band's cells (the share erf(w / (2 sqrt 2
-  // sigma)) of the line's cross section) and the centreline's samples, per length of line
+  // the even line's error against the target
   ConstantSpeedChain constant;
   double length_mm = 0.0;
   for (size_t e = 0; e < chain.edges(); ++e)
     length_mm += (chain.points[e + 1] - chain.points[e]).norm();
-  const double sigma = model.settings.footprint_sigma_mm();
-  const double band_share =
-      std::erf(0.5 * model.settings.resolved_line_width_mm() / (std::sqrt(2.0) * sigma));
-  constant.error_mm = (print_speed / speed - 1.0) * (1.0 + band_share) * length_mm;
+  constant.error_mm = (print_speed / speed - 1.0) * even_line_error_per_mm(model) * length_mm;
   if (!(constant.error_mm < worth_below_mm)) return none;  // (not planned: it cannot win)
 
   // the chain planned at it: each corner the least blend that takes it

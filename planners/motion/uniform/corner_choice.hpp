@@ -132,6 +132,10 @@ struct ConstantSpeedChain {
   PlannedPath planned;
   double error_mm = 0.0;
 };
+// the misplaced line per mm of path where an even line is laid thicker than the target by its
+// whole cross section (summed as a corner's error is: the band's cells, the share
+// erf(w / (2 sqrt 2 sigma)) of the line's cross section, and the centreline's samples)
+double even_line_error_per_mm(const DepositModel& model);
 // (geometry: corner_geometry(chain.points, tolerance_mm, edge_error_mm); not planned, speed
 // 0, when its error alone is worth_below_mm or more: it cannot beat what costs that)
 ConstantSpeedChain constant_speed_chain(const PrintChain& chain,

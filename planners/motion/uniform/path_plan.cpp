@@ -402,6 +402,11 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     if (line.length > 0.0) {
       const AxisProfile along = line_profile(line.length, v_start[k], v_end[k], line.limits);
       const double duration = along.duration_s();
+      const bool next_to_run = (k > 0 && corners[k].treatment == CornerTreatment::arc) ||
+                               (k + 1 < edges && corners[k + 1].treatment == CornerTreatment::arc);
+      if (next_to_run)
+        planned.run_speed_deficit_mm +=
+            std::max(0.0, chain.edge_speed_mm_s[k] * duration - line.length);
       if (duration > 0.0) {
         TrajectoryPiece piece = base_piece(duration, k);
         piece.motion = line_motion(along, line.from, line.u);
@@ -479,6 +484,8 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
           motion.velocity_mm_s.push_back(w * d1);
         }
         TrajectoryPiece piece = base_piece(static_cast<double>(periods) * period, k);
+        planned.run_speed_deficit_mm +=
+            std::max(0.0, length * (piece.desired_speed_mm_s / w - 1.0));
         piece.motion = std::move(motion);
         planned.pieces.push_back(std::move(piece));
         t = planned.pieces.back().t_end_s;

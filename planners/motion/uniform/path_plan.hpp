@@ -168,6 +168,10 @@ struct PlannedPath {
   // per corner (point index), the constant speed it was taken at (blends), or the line speeds
   // into and out of it (loops, straights, stops: the lower)
   std::vector<double> corner_speed_mm_s;
+  // on the arc runs and the lines next to them, the integral of (print speed - speed) dt: how
+  // much longer a line laid at the print speed would be (what a stream that cannot follow the
+  // speed lays thicker there)
+  double run_speed_deficit_mm = 0.0;
 };
 
 // The limits a planner needs with a jerk limit on every axis: the user's where given, else

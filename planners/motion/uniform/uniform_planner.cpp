@@ -303,8 +303,8 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
         corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
     // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),
     // where a corner alone cannot keep the print speed: at the print speed, not weighed (an
-    // even line within the tolerance); an extruder's below it, weighed below; their corners
-    // reported as "arc"
+    // even line within the tolerance); below it, weighed below; their corners reported as
+    // "arc"
     const std::vector<std::shared_ptr<const ArcRun>> runs =
         settings_.arc_runs
             ? find_arc_runs(merged, given, geometry, settings_.tolerance_mm, jerk_limits, options)
@@ -348,12 +348,14 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
       return planned;
     };
     PlannedPath planned = plan_resizing(corners);
-    // extrusion: a run below the print speed (sized below it for its arc, or held by the
-    // look-ahead on a circle the path starts or ends on, at rest) may take longer than its
-    // corners one by one; those are then chosen too and the chain planned without such runs;
-    // the cheaper plan is kept (their predicted errors plus time_weight x its time, against
-    // time_weight x the runs' plan time)
-    if (!aerosol) {
+    // A run below the print speed (sized below it for its arc, or held by the look-ahead on a
+    // circle an extrusion path starts or ends on, at rest) may cost more than its corners one
+    // by one: those are then chosen too and the chain planned without such runs, and the
+    // cheaper plan kept: their predicted errors plus time_weight x its time, against the runs'
+    // plan's time_weight x time and, for a stream that cannot follow the speed (aerosol), the
+    // thicker line it lays on the runs and their ramps (run_speed_deficit_mm x
+    // even_line_error_per_mm); an extruder's flow follows the speed: its bead stays even.
+    {
       std::vector<CornerPlan> without = corners;
       const size_t decided_before = chain_decisions.size();
       for (const std::shared_ptr<const ArcRun>& run : runs) {
@@ -368,8 +370,10 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
         for (size_t k = decided_before; k < chain_decisions.size(); ++k)
           if (!chain_decisions[k].second.chosen.pruned)
             corners_error_mm += chain_decisions[k].second.chosen.error_mm;
+        const double runs_error_mm =
+            aerosol ? planned.run_speed_deficit_mm * even_line_error_per_mm(model) : 0.0;
         if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <
-            settings_.time_weight_mm_s * planned.t_end_s) {
+            runs_error_mm + settings_.time_weight_mm_s * planned.t_end_s) {
           planned = std::move(alternative);
           corners = std::move(without);
         } else {

@@ -6,7 +6,8 @@
 //  - Path: corners blended within `tolerance_mm` by clothoid pairs (clothoid_blend.hpp): the
 //    curvature is continuous, so a constant-speed blend has a continuous acceleration. A run
 //    of corners along a chorded circle that cannot keep the print speed one by one is taken
-//    as one clothoid-arc-clothoid curve at it (arc_run.hpp).
+//    as one clothoid-arc-clothoid curve at it, or below it where that costs less than the
+//    corners' own choices (arc_run.hpp).
 //  - Time law: jerk-limited and time-optimal for its family (path_plan.hpp): speed changes on
 //    the straight lines (exact per-axis limits along each line's direction, over its box, so a
 //    machine's joint limits come mapped where the line is), constant speed on every blend, a

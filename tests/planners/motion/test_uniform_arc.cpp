@@ -287,3 +287,70 @@ TEST(UniformPlanner, ClosedAerosolCircleIsOneArcRunFromEndToEnd) {
 
 }  // namespace
 }  // namespace depotwin
+
+namespace depotwin {
+namespace {
+
+// Where even the arc cannot take the print speed (a 2 mm radius at 50 mm/s needs 1250 mm/s^2
+// of a 1000 mm/s^2 stage), a run is sized for 0.9 of what its arc allows, sqrt(0.99 a R), and
+// weighed against its corners' own choices (the bound below allows for the run's radius being
+// within the tolerance of the circle's). Extrusion, whose bead follows the speed: the slot's
+// half circle is one run at that speed, quicker than its slowed corners. Aerosol, whose stream
+// lays a run below the print speed thicker (1.25 x here, and on the ramps to it): at the
+// default time_weight its closed 2 mm circle keeps its corners' loops, whose predicted error
+// is less; at time_weight 2 mm/s the run's 3.9 s saved are worth more, and it is taken.
+TEST(UniformPlanner, ArcRunBelowThePrintSpeedIsWeighedAgainstItsCorners) {
+  const MachineLimits axes = MachineLimits::uniform(100.0, 1000.0);
+  const double speed = 50.0, r = 2.0;
+  // (the run's own radius: within the tolerance of the circle's)
+  const double arc_limit = std::sqrt(0.99 * axes.axes[0].a_max_mm_s2 * (r + 0.05));
+  UniformSettings one_by_one;
+  one_by_one.arc_runs = false;
+
+  const Toolpath slot_job = polyline_job(slot(r), speed);
+  const PlanningContext extrusion = process_context(ProcessType::extrusion);
+  const Trajectory plan =
+      UniformPlanner{UniformSettings{}}.plan_in_context(slot_job, axes, extrusion);
+  int arcs = 0;
+  for (const PlanDecision& decision : plan.decisions()) {
+    if (decision.choice != "arc") continue;
+    ++arcs;
+    EXPECT_LE(figure(decision, "speed_mm_s"), 0.9 * arc_limit * (1 + 1e-9));
+    EXPECT_GT(figure(decision, "speed_mm_s"), 0.85 * arc_limit);
+  }
+  EXPECT_GT(arcs, 10);
+  EXPECT_LE(path_error(sample_trajectory(plan, 1e-4), slot_job).max_mm, 0.05);
+  EXPECT_LT(plan.duration_s(),
+            UniformPlanner{one_by_one}.plan_in_context(slot_job, axes, extrusion).duration_s());
+
+  std::vector<Vec3> circle;
+  for (int k = 0; k <= 63; ++k) {
+    const double angle = 2.0 * kPi * k / 63;
+    circle.emplace_back(r * std::cos(angle), r * std::sin(angle), 0.2);
+  }
+  const Toolpath circle_job = polyline_job(circle, speed);
+  const PlanningContext aerosol = process_context(ProcessType::aerosol);
+  const auto arc_corners = [](const Trajectory& planned) {
+    int count = 0;
+    for (const PlanDecision& decision : planned.decisions()) count += decision.choice == "arc";
+    return count;
+  };
+  const Trajectory by_default =
+      UniformPlanner{UniformSettings{}}.plan_in_context(circle_job, axes, aerosol);
+  EXPECT_EQ(arc_corners(by_default), 0);
+  UniformSettings hurried;
+  hurried.time_weight_mm_s = 2.0;
+  const Trajectory hurried_plan =
+      UniformPlanner{hurried}.plan_in_context(circle_job, axes, aerosol);
+  EXPECT_GT(arc_corners(hurried_plan), 10);
+  EXPECT_LT(hurried_plan.duration_s(), 0.25 * by_default.duration_s());
+  const MotionSamples samples = sample_trajectory(hurried_plan, 1e-4);
+  EXPECT_LE(path_error(samples, circle_job).max_mm, 0.05);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    if (!samples.depositing[k]) continue;
+    EXPECT_LE(samples.velocity_mm_s[k].norm(), 0.9 * arc_limit * (1 + 1e-5));
+  }
+}
+
+}  // namespace
+}  // namespace depotwin
