@@ -15,8 +15,9 @@
 //   p(Lc) = Lc Y(1) - R (1 - cos tau),  tau = Lc / (2 R)   (its turn),
 // and starts k(Lc) = Lc X(1) - R sin tau before the foot of c on its line (X, Y of
 // clothoid_integrals at phi = tau). R is the nearer line's distance from c less the shift of
-// the transition the print speed needs; each transition is then the length whose shift takes
-// its line to the circle. The arc turns the run's total turn less tau_in + tau_out.
+// the transition the run's speed needs (the print speed, or below it: find_arc_runs); each
+// transition is then the length whose shift takes its line to the circle. The arc turns the
+// run's total turn less tau_in + tau_out.
 //
 // Bounds at constant speed v (per axis k, m_k the plane's extent along axis k, sqrt(e1_k^2 +
 // e2_k^2), the most any in-plane unit vector has on it): v m_k <= v_max, v^2 m_k / R <= a_max,
