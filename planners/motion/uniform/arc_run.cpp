@@ -416,11 +416,12 @@ std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(
   std::vector<std::shared_ptr<const ArcRun>> runs;
   const size_t n = chain.points.size();
   if (chain.oriented || n < kMinArcRunCorners + 2) return runs;
-  // a corner a run may hold: it turns, by less than 90 deg, and its edges are of one path
+  // a corner a run may hold: it turns, by less than 90 deg, between edges of one print speed
+  // (a run's inner edges are of one path, its end edges may be of the paths joined to it: a
+  // G-code arc between its lines)
   const auto turning = [&](size_t i) {
     const CornerGeometry& g = geometry[i];
     return !taken_straight_on(g) && g.turn_rad < 0.5 * kPi && g.max_half_length_mm > 0.0 &&
-           chain.edge_path[i - 1] == chain.edge_path[i] &&
            chain.edge_speed_mm_s[i - 1] == chain.edge_speed_mm_s[i];
   };
   const auto turn_normal = [&](size_t i) {
@@ -444,7 +445,8 @@ std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(
     const Vec3 normal = turn_normal(first);
     size_t last = first;
     while (last + 2 < n && last + 1 - first < kMaxArcRunCorners && turning(last + 1) &&
-           turn_normal(last + 1).dot(normal) >= kParallelNormals)
+           turn_normal(last + 1).dot(normal) >= kParallelNormals &&
+           chain.edge_path[last] == chain.edge_path[first])
       ++last;
     i = last + 1;
     if (last + 1 - first < kMinArcRunCorners) continue;

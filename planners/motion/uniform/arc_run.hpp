@@ -81,17 +81,17 @@ class ArcRun {
 };
 
 // The runs of a chain's corners taken as arcs: runs of at least kMinArcRunCorners consecutive
-// corners that turn one way in one plane, each by less than 90 deg, on edges of one print path
-// and speed, at least one of which cannot keep the print speed on its own largest blend, where
-// one such curve keeps the print speed under the limits (over the run's box; where its arc
-// alone cannot, 0.9 of the speed the arc allows, which the planner weighs against the
-// corners' own choices), stays within the
-// tolerance of the polyline (tolerance_mm less the run's edges' merge errors, checked on its
-// samples both ways) and starts and ends on the run's end edges, leaving each at least half for
-// its other end (the whole edge at an end of the chain the path enters or leaves at speed).
-// There, where the edge is too short for that (a chorded circle's closing chords), the curve
-// may start or end at the chain's end point itself, free: its transition's line turned to pass
-// through that point (the transition move to or from the chain takes its direction).
+// corners that turn one way in one plane, each by less than 90 deg, at one print speed, their
+// inner edges of one print path (the end edges may be of the paths joined to it), at least one
+// of which cannot keep the print speed on its own largest blend, where one such curve keeps
+// the print speed under the limits over the run's box (where its arc alone cannot, 0.9 of the
+// speed the arc allows, which the planner weighs against the corners' own choices), stays
+// within tolerance_mm of the polyline as given (before merge_fine_edges: `given`, checked on
+// its samples both ways) and starts and ends on the run's end edges, leaving each at least
+// half for its other end (the whole edge at an end of the chain the path enters or leaves at
+// speed). There, where the edge is too short for that (a chorded circle's closing chords), the
+// curve may start or end at the chain's end point itself, free: its transition's line turned
+// to pass through that point (the transition move to or from the chain takes its direction).
 // Longest first, from each corner on. Chains carrying the tool's orientation have none.
 constexpr size_t kMinArcRunCorners = 3;
 std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(

@@ -483,7 +483,9 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
           motion.position_mm.push_back(p);
           motion.velocity_mm_s.push_back(w * d1);
         }
-        TrajectoryPiece piece = base_piece(static_cast<double>(periods) * period, k);
+        // (the transitions belong to the end edges' paths, the arc to the inner edges')
+        const size_t edge = section == 0 ? k : section == 1 ? k + 1 : run.last_corner();
+        TrajectoryPiece piece = base_piece(static_cast<double>(periods) * period, edge);
         planned.run_speed_deficit_mm +=
             std::max(0.0, length * (piece.desired_speed_mm_s / w - 1.0));
         piece.motion = std::move(motion);

@@ -370,6 +370,23 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
         for (size_t k = decided_before; k < chain_decisions.size(); ++k)
           if (!chain_decisions[k].second.chosen.pruned)
             corners_error_mm += chain_decisions[k].second.chosen.error_mm;
+        // (aerosol: two loops closer than the shutter's travel v T leave the line between them
+        // barely open, d / (2 T) of it let through, d = e / v < T; each corner's window sees its
+        // neighbours printed in full, so that loss is added here: on a finely chorded arc
+        // looped corner by corner almost nothing is printed)
+        if (aerosol) {
+          double unopened_mm = 0.0;
+          for (const std::shared_ptr<const ArcRun>& run : runs)
+            for (size_t i = run->first_corner(); i < run->last_corner(); ++i) {
+              if (without[i].treatment != CornerTreatment::loop ||
+                  without[i + 1].treatment != CornerTreatment::loop)
+                continue;
+              const double edge = (chain.points[i + 1] - chain.points[i]).norm();
+              const double travel = chain.edge_speed_mm_s[i] * model.shutter_time_s;
+              if (edge < travel) unopened_mm += edge * (1.0 - edge / (2.0 * travel));
+            }
+          corners_error_mm += unopened_mm * even_line_error_per_mm(model);
+        }
         const double runs_error_mm =
             aerosol ? planned.run_speed_deficit_mm * even_line_error_per_mm(model) : 0.0;
         if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <

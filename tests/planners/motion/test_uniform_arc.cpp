@@ -296,9 +296,11 @@ namespace {
 // weighed against its corners' own choices (the bound below allows for the run's radius being
 // within the tolerance of the circle's). Extrusion, whose bead follows the speed: the slot's
 // half circle is one run at that speed, quicker than its slowed corners. Aerosol, whose stream
-// lays a run below the print speed thicker (1.25 x here, and on the ramps to it): at the
-// default time_weight its closed 2 mm circle keeps its corners' loops, whose predicted error
-// is less; at time_weight 2 mm/s the run's 3.9 s saved are worth more, and it is taken.
+// lays a run below the print speed thicker (1.25 x here, and on the ramps to it): a closed
+// 2 mm circle is one run, where its corners' loops would leave the chords between them
+// barely open (a 20 ms shutter); with a 1 ms shutter the loops' predicted errors are less and
+// they are kept at the default time_weight, and at 2 mm/s the run's 3.9 s saved are worth
+// more.
 TEST(UniformPlanner, ArcRunBelowThePrintSpeedIsWeighedAgainstItsCorners) {
   const MachineLimits axes = MachineLimits::uniform(100.0, 1000.0);
   const double speed = 50.0, r = 2.0;
@@ -329,19 +331,26 @@ TEST(UniformPlanner, ArcRunBelowThePrintSpeedIsWeighedAgainstItsCorners) {
     circle.emplace_back(r * std::cos(angle), r * std::sin(angle), 0.2);
   }
   const Toolpath circle_job = polyline_job(circle, speed);
-  const PlanningContext aerosol = process_context(ProcessType::aerosol);
   const auto arc_corners = [](const Trajectory& planned) {
     int count = 0;
     for (const PlanDecision& decision : planned.decisions()) count += decision.choice == "arc";
     return count;
   };
+  // the scenario's shutter (20 ms): the loops' lines of 0.63 mm (13 ms) would barely open
+  const PlanningContext aerosol = process_context(ProcessType::aerosol);
+  EXPECT_GT(
+      arc_corners(UniformPlanner{UniformSettings{}}.plan_in_context(circle_job, axes, aerosol)),
+      10);
+  // a shutter of 1 ms: the loops' own predicted errors stand
+  PlanningContext quick_shutter = aerosol;
+  quick_shutter.shutter_time_s = 0.001;
   const Trajectory by_default =
-      UniformPlanner{UniformSettings{}}.plan_in_context(circle_job, axes, aerosol);
+      UniformPlanner{UniformSettings{}}.plan_in_context(circle_job, axes, quick_shutter);
   EXPECT_EQ(arc_corners(by_default), 0);
   UniformSettings hurried;
   hurried.time_weight_mm_s = 2.0;
   const Trajectory hurried_plan =
-      UniformPlanner{hurried}.plan_in_context(circle_job, axes, aerosol);
+      UniformPlanner{hurried}.plan_in_context(circle_job, axes, quick_shutter);
   EXPECT_GT(arc_corners(hurried_plan), 10);
   EXPECT_LT(hurried_plan.duration_s(), 0.25 * by_default.duration_s());
   const MotionSamples samples = sample_trajectory(hurried_plan, 1e-4);
