@@ -51,7 +51,8 @@ const std::vector<PlannerInfo>& planner_registry() {
       {"uniform",
        "beyond the papers: deposit-aware, time-optimal and jerk-limited; clothoid corner blends "
        "within tolerance_mm (a chorded circle's corners that cannot keep the print speed one by "
-       "one: one clothoid-arc-clothoid curve), each corner blended, slowed, looped "
+       "one: one clothoid-arc-clothoid curve; a hole printed from rest to rest: one such curve "
+       "with its speed changing on it), each corner blended, slowed, looped "
        "(aerosol: the shutter closed at print speed; extrusion: rest to rest with the flow off) "
        "or stopped (extrusion) by the predicted thickness error plus time_weight x time "
        "(aerosol: or a whole chain at one constant speed, by the same cost), extrusion flow led "

@@ -30,6 +30,8 @@ constexpr int kRadiusIterations = 12;
 // of the speed its arc alone allows (the rest leaves its transitions a finite length)
 constexpr double kSlowRunShare = 0.9;
 constexpr int kBisections = 60;
+// a run from rest to rest tries transitions sized for these shares of the print speed
+constexpr double kRestTransitionSpeedShares[] = {1.0, 0.5, 0.25, 0.125};
 // the tolerance check's samples are this share of the tolerance apart (each sample's distance
 // from the polyline plus half the spacing bounds the curve's between them), at most this many
 constexpr double kSampleShareOfTolerance = 0.1;
@@ -132,12 +134,17 @@ struct RunBounds {
 };
 
 // Fits corners a..b of the chain (a run candidate: one plane, one sense, one path and speed) as
-// one curve, or null (see find_arc_runs).
+// one curve, or null (see find_arc_runs). A run from rest to rest (both ends free, the chain
+// entered and left at rest) has its transitions sized for transition_speed_share of the print
+// speed and keeps the arc's own bound: it passes them at its ramps' speeds, which its law
+// checks (plan_chain).
 std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const PrintChain& given,
                                           const std::vector<CornerGeometry>& geometry, size_t a,
                                           size_t b, double tolerance, const TcpLimits& limits,
                                           const PathMotionOptions& options, bool free_start,
-                                          bool free_end) {
+                                          bool free_end, double transition_speed_share = 1.0) {
+  const bool from_rest_to_rest =
+      free_start && free_end && !options.enter_at_speed && !options.leave_at_speed;
   const PrintChain& chain = merged.chain;
   const std::vector<Vec3>& points = chain.points;
   const size_t n = points.size();
@@ -149,14 +156,17 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
     if (std::abs((points[k] - points[a]).dot(e3)) > kPlanarTolerance_mm) return nullptr;
 
   // the vertices' least-squares circle (Kasa: x^2 + y^2 + D x + E y + F = 0), in the plane
-  // about the vertices' mean
+  // about the vertices' mean (from rest to rest, the chain's ends too: the curve starts and
+  // ends at them, and a transition from an end off the circle is long)
+  const size_t fit_first = from_rest_to_rest ? a - 1 : a;
+  const size_t fit_last = from_rest_to_rest ? b + 1 : b;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (size_t k = a; k <= b; ++k)
+  for (size_t k = fit_first; k <= fit_last; ++k)
     mean += Eigen::Vector2d((points[k] - points[a]).dot(e1), (points[k] - points[a]).dot(e2));
-  mean /= static_cast<double>(b - a + 1);
+  mean /= static_cast<double>(fit_last - fit_first + 1);
   Eigen::Matrix3d normal_matrix = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-  for (size_t k = a; k <= b; ++k) {
+  for (size_t k = fit_first; k <= fit_last; ++k) {
     const Eigen::Vector2d q =
         Eigen::Vector2d((points[k] - points[a]).dot(e1), (points[k] - points[a]).dot(e2)) - mean;
     const Eigen::Vector3d row(q.x(), q.y(), 1.0);
@@ -170,7 +180,7 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
   const double fit_radius = std::sqrt(fit_radius_sq);
   const Vec3 centre = points[a] + centre_2d.x() * e1 + centre_2d.y() * e2;
   // (cheap first) every vertex within the tolerance of that circle
-  for (size_t k = a; k <= b; ++k)
+  for (size_t k = fit_first; k <= fit_last; ++k)
     if (std::abs((points[k] - centre).norm() - fit_radius) > tolerance) return nullptr;
   const Vec3 n_in = e3.cross(d_in), n_out = e3.cross(d_out);
 
@@ -214,11 +224,12 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
     }
     return radius;
   };
+  const double share = from_rest_to_rest ? transition_speed_share : 1.0;
   double speed = chain.edge_speed_mm_s[a];
-  double radius = radius_for(speed);
+  double radius = radius_for(share * speed);
   if (!(radius > 0.0)) {
     speed = std::min(speed, kSlowRunShare * bounds.arc_speed_bound(std::min(h_in, h_out)));
-    radius = radius_for(speed);
+    radius = radius_for(share * speed);
   }
   if (!(radius > 0.0)) return nullptr;
   const double transition_in = transition_for_shift(h_in - radius, radius, shift_in);
@@ -250,8 +261,13 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
   total_turn += signed_turn(start_direction, d_in) + signed_turn(d_out, end_direction);
   const double tau_sum = (transition_in + transition_out) / (2.0 * radius);
   if (!(tau_sum <= total_turn)) return nullptr;
-  const double speed_bound = bounds.speed_bound(radius, std::min(transition_in, transition_out));
-  if (!(speed_bound >= speed * (1.0 - 1e-9))) return nullptr;
+  // (from rest to rest: the print speed where the arc allows it, else a share of what it allows)
+  const double arc_bound = bounds.arc_speed_bound(radius);
+  const double speed_bound =
+      !from_rest_to_rest   ? bounds.speed_bound(radius, std::min(transition_in, transition_out))
+      : arc_bound >= speed ? speed
+                           : kSlowRunShare * arc_bound;
+  if (!(speed_bound >= (from_rest_to_rest ? 0.5 : 1.0 - 1e-9) * speed)) return nullptr;
 
   // On an edge, the curve's end leaves half the edge for its other end (the whole edge at an
   // end of the chain the path enters or leaves at speed); a free end takes it whole.
@@ -265,8 +281,10 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
                : Vec3(points[b] + (centre - points[b]).dot(d_out) * d_out + start_out * d_out);
   const double entry_trim = free_start ? edge_in : (points[a] - start).dot(d_in);
   const double exit_trim = free_end ? edge_out : (end - points[b]).dot(d_out);
-  const double room_in = (a == 1 && options.enter_at_speed) ? edge_in : 0.5 * edge_in;
-  const double room_out = (b + 2 == n && options.leave_at_speed) ? edge_out : 0.5 * edge_out;
+  const double room_in =
+      (a == 1 && (options.enter_at_speed || free_start)) ? edge_in : 0.5 * edge_in;
+  const double room_out =
+      (b + 2 == n && (options.leave_at_speed || free_end)) ? edge_out : 0.5 * edge_out;
   if (!(entry_trim >= 0.0 && entry_trim <= room_in && exit_trim >= 0.0 && exit_trim <= room_out))
     return nullptr;
 
@@ -283,6 +301,7 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
   run->entry_trim_mm = entry_trim;
   run->exit_trim_mm = exit_trim;
   run->speed_bound_mm_s = speed_bound;
+  run->from_rest_to_rest = from_rest_to_rest;
 
   // within the tolerance of the polyline as given (before merge_fine_edges) both ways, on
   // samples: each sample's distance from it (the nearest of the next few edges: the curve
@@ -403,6 +422,10 @@ void ArcRun::at(double s, Vec3& position, Vec3& d1, Vec3& d2, Vec3& d3) const {
   if (s == length) position = end_;
 }
 
+Vec3 ArcRun::normal() const {
+  return d_in_.cross(n_in_);
+}
+
 Vec3 ArcRun::position(double s) const {
   Vec3 p, d1, d2, d3;
   at(s, p, d1, d2, d3);
@@ -459,15 +482,30 @@ std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(
     while (a + kMinArcRunCorners - 1 <= last) {
       std::shared_ptr<const ArcRun> found;
       for (size_t b = last; b >= a + kMinArcRunCorners - 1 && !found; --b) {
-        if (slow[b - first + 1] == slow[a - first]) break;  // no slow corner left in a..b
-        found =
-            fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options, false, false);
+        const bool whole_at_rest =
+            a == 1 && b + 2 == n && !options.enter_at_speed && !options.leave_at_speed;
+        // no slow corner left in a..b (a whole chain from rest to rest needs none: its lines
+        // ramp one at a time between blends at constant speeds, where the run ramps on the
+        // curve)
+        if (!whole_at_rest && slow[b - first + 1] == slow[a - first]) break;
         // (at an end of the chain entered or left at speed, the curve may run to the end
         // itself: a chorded circle's closing chords are seldom the length its transitions
-        // need)
-        const bool free_start = a == 1 && options.enter_at_speed;
-        const bool free_end = b + 2 == n && options.leave_at_speed;
-        if (!found && (free_start || free_end))
+        // need. So may a run that is the whole chain, entered and left at rest, its speed
+        // changing on the curve: tried first there, as lines at its ends would have to reach
+        // the run's one speed from rest within half an edge)
+        const bool free_start = a == 1 && (options.enter_at_speed || whole_at_rest);
+        const bool free_end = b + 2 == n && (options.leave_at_speed || whole_at_rest);
+        // (its transitions sized for the print speed, else for less: shorter, they leave the
+        // arc nearer the circle)
+        for (const double share : kRestTransitionSpeedShares) {
+          if (!whole_at_rest || found) break;
+          found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options, true,
+                              true, share);
+        }
+        if (!found)
+          found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options, false,
+                              false);
+        if (!found && !whole_at_rest && (free_start || free_end))
           found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options,
                               free_start, free_end);
       }

@@ -1,12 +1,12 @@
 // A run of corners along a circle taken as one curve: a clothoid from the run's entry line up to
 // the circle's curvature, an arc, and a clothoid back down to its exit line, at one constant
-// speed. A circle given as fine chords (a G-code arc, a slicer's hole) merges into edges whose
-// corners each need a clothoid pair of their own (clothoid_blend.hpp): each pair takes the
-// curvature from 0 up to twice the circle's and back within about one chord, and its curvature
-// rate, v^3 kappa' of jerk, caps the speed (a 4 mm circle at 50 mm/s on a 1000 mm/s^2 stage:
-// 42.5 mm/s at the most, with 0.9 mm chords). On the arc the curvature is constant (jerk
-// v^3 / R^2, acceleration v^2 / R) and it changes only on the two transitions, whose length is
-// chosen for the speed.
+// speed (a run from rest to rest, the whole chain, changes speed on it: path_plan.cpp). A circle
+// given as fine chords (a G-code arc, a slicer's hole) merges into edges whose corners each need a
+// clothoid pair of their own (clothoid_blend.hpp): each pair takes the curvature from 0 up to twice
+// the circle's and back within about one chord, and its curvature rate, v^3 kappa' of jerk, caps
+// the speed (a 4 mm circle at 50 mm/s on a 1000 mm/s^2 stage: 42.5 mm/s at the most, with 0.9 mm
+// chords). On the arc the curvature is constant (jerk v^3 / R^2, acceleration v^2 / R) and it
+// changes only on the two transitions, whose length is chosen for the speed.
 //
 // Geometry (in the run's plane, turning left about its normal e3): the circle (centre c, the
 // vertices' least-squares circle; radius R) lies p_in inside the entry line's offset at R and
@@ -58,6 +58,8 @@ class ArcRun {
   const Vec3& end_direction() const { return d_out_; }
   double transition_in_mm() const { return transition_in_; }
   double transition_out_mm() const { return transition_out_; }
+  // the unit normal of its plane (it turns left about it)
+  Vec3 normal() const;
 
   // position and the arc-length derivatives p', p'', p''' at arc length s in [0, length]
   void at(double s_mm, Vec3& position_mm, Vec3& d1, Vec3& d2, Vec3& d3) const;
@@ -69,6 +71,9 @@ class ArcRun {
   double entry_trim_mm = 0.0, exit_trim_mm = 0.0;
   double deviation_mm = 0.0;
   double speed_bound_mm_s = 0.0;
+  // the run is its whole chain, which starts and ends at rest (an extrusion path along one
+  // chorded circle, a slicer's hole): its speed changes on the curve itself (plan_chain)
+  bool from_rest_to_rest = false;
 
  private:
   size_t first_corner_, last_corner_;
@@ -92,6 +97,7 @@ class ArcRun {
 // speed). There, where the edge is too short for that (a chorded circle's closing chords), the
 // curve may start or end at the chain's end point itself, free: its transition's line turned
 // to pass through that point (the transition move to or from the chain takes its direction).
+// A chain entered and left at rest may be one run with both ends free (from_rest_to_rest).
 // Longest first, from each corner on. Chains carrying the tool's orientation have none.
 constexpr size_t kMinArcRunCorners = 3;
 std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(

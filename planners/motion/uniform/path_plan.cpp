@@ -51,6 +51,151 @@ void blend_box(const ClothoidBlend& blend, Vec3& lo, Vec3& hi) {
   hi = blend.start_mm().cwiseMax(blend.end_mm()).cwiseMax(blend.corner_mm());
 }
 
+// a depositing piece of the chain's edge `edge` over [t, t + duration] (its motion unset)
+TrajectoryPiece depositing_piece(const PrintChain& chain, size_t edge,
+                                 const PathMotionOptions& options, double t_s, double duration_s) {
+  TrajectoryPiece piece;
+  piece.t_begin_s = t_s;
+  piece.t_end_s = t_s + duration_s;
+  piece.path_index = chain.edge_path[edge];
+  piece.depositing = true;
+  piece.desired_speed_mm_s = chain.edge_speed_mm_s[edge];
+  piece.flow_lead_s = options.flow_follows_speed ? options.lag_s : -1.0;
+  piece.flow_may_retract = options.flow_follows_speed && options.flow_may_retract;
+  return piece;
+}
+
+// A chain that is one arc run from rest to rest (ArcRun::from_rest_to_rest: an extrusion path
+// along one chorded circle, a slicer's hole), its speed changing on the curve itself. The speed
+// along it is line_profile's jerk-limited law in arc length (decelerations under the flow
+// lag's rule) up to the run's speed; per axis k the curve adds its own terms,
+//   a_k = p'_k sddot + p''_k sdot^2,   j_k = p'_k sdddot + 3 p''_k sdot sddot + p'''_k sdot^3,
+// so the law's acceleration and jerk start at the least of the axes' limits over their reach
+// in the run's plane and are lowered (kRampLimitScale a round) until every axis keeps
+// blend_limits over the run's box at every quarter period: where an axis' acceleration is
+// exceeded, the law's acceleration; where its jerk is, the law's jerk if p'_k sdddot is the
+// larger of the two terms the law sets there, else its acceleration (the cross term, which on
+// a tight circle binds first). Sampled at the period, a piece per section (its edge's path).
+constexpr double kRampLimitScale = 0.9;
+constexpr double kRampCruiseScale = 0.99;
+constexpr int kRampRounds = 80;
+constexpr int kRampBoxSamples = 64;
+PlannedPath plan_run_from_rest(const PrintChain& chain, const ArcRun& run, const TcpLimits& limits,
+                               const PathMotionOptions& options, double t_begin_s) {
+  const double length = run.length_mm();
+  // the run's box: its curve's samples, padded by the most the curve bulges between them
+  Vec3 lo = run.start_mm(), hi = run.start_mm();
+  for (int m = 1; m <= kRampBoxSamples; ++m) {
+    const Vec3 p = run.position(length * m / kRampBoxSamples);
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double step = length / kRampBoxSamples;
+  const Vec3 pad = Vec3::Constant(step * step / (8.0 * run.radius_mm()));
+  const MachineLimits axes = blend_limits(limits.over(lo - pad, hi + pad));
+  const double print_speed = chain.edge_speed_mm_s[run.first_corner()];
+  LineLimits law;
+  law.v_max_mm_s = std::min(run.speed_bound_mm_s, print_speed);
+  // (an axis takes at most its reach, sqrt(1 - normal_k^2), of the law's)
+  law.a_max_mm_s2 = law.j_max_mm_s3 = kInf;
+  const Vec3 normal = run.normal();
+  for (int axis = 0; axis < 3; ++axis) {
+    const double reach = std::sqrt(std::max(0.0, 1.0 - normal[axis] * normal[axis]));
+    if (!(reach > 0.0)) continue;
+    law.a_max_mm_s2 = std::min(law.a_max_mm_s2, axes.axes[axis].a_max_mm_s2 / reach);
+    law.j_max_mm_s3 = std::min(law.j_max_mm_s3, axes.axes[axis].j_max_mm_s3 / reach);
+  }
+  law.lag_s = options.deceleration_lag_s();
+  AxisProfile profile;
+  for (int round = 0;; ++round) {
+    profile = line_profile(length, 0.0, 0.0, law);
+    const double duration = profile.duration_s();
+    const size_t checks =
+        std::max<size_t>(8, static_cast<size_t>(std::ceil(4.0 * duration / options.period_s)));
+    double accel_ratio = 0.0, jerk_ratio = 0.0;
+    bool jerk_by_cross_term = false;  // at the worst jerk, the cross term is the larger
+    size_t phase = 0;
+    for (size_t m = 0; m <= checks; ++m) {
+      const double t = duration * static_cast<double>(m) / static_cast<double>(checks);
+      const AxisState state = profile.at(t, phase);
+      const double jerk = profile.jerk_at(t);
+      Vec3 p, d1, d2, d3;
+      run.at(std::clamp(state.q, 0.0, length), p, d1, d2, d3);
+      const double v = state.v, a = state.a;
+      for (int axis = 0; axis < 3; ++axis) {
+        const double accel = d1[axis] * a + d2[axis] * v * v;
+        const double cross = 3.0 * d2[axis] * v * a;
+        const double axis_jerk = d1[axis] * jerk + cross + d3[axis] * v * v * v;
+        accel_ratio = std::max(accel_ratio, std::abs(accel) / axes.axes[axis].a_max_mm_s2);
+        const double ratio = std::abs(axis_jerk) / axes.axes[axis].j_max_mm_s3;
+        if (ratio > jerk_ratio) {
+          jerk_ratio = ratio;
+          jerk_by_cross_term = std::abs(cross) > std::abs(d1[axis] * jerk);
+        }
+      }
+    }
+    if (accel_ratio <= 1.0 + 1e-9 && jerk_ratio <= 1.0 + 1e-9) break;
+    if (round == kRampRounds)
+      throw InternalError("uniform: an arc run from rest does not keep its limits");
+    if (accel_ratio > 1.0 + 1e-9 || (jerk_ratio > 1.0 + 1e-9 && jerk_by_cross_term))
+      law.a_max_mm_s2 *= kRampLimitScale;
+    if (jerk_ratio > 1.0 + 1e-9 && !jerk_by_cross_term) law.j_max_mm_s3 *= kRampLimitScale;
+    // (past half the rounds, the jerk and the cruise too: a cruise at its arc's bound leaves a
+    // ramp's end no room unless the jerk is at most about 2 a^2 / v)
+    if (2 * round >= kRampRounds) {
+      law.j_max_mm_s3 *= kRampLimitScale;
+      law.v_max_mm_s *= kRampCruiseScale;
+    }
+  }
+
+  // the samples
+  const double duration = profile.duration_s();
+  const size_t periods =
+      std::max<size_t>(2, static_cast<size_t>(std::ceil(duration / options.period_s)));
+  const double period = duration / static_cast<double>(periods);
+  std::vector<double> s(periods + 1);
+  std::vector<Vec3> position(periods + 1), velocity(periods + 1);
+  size_t phase = 0;
+  for (size_t m = 0; m <= periods; ++m) {
+    const AxisState state = profile.at(period * static_cast<double>(m), phase);
+    s[m] = m == periods ? length : std::clamp(state.q, 0.0, length);
+    Vec3 d1, d2, d3;
+    run.at(s[m], position[m], d1, d2, d3);
+    velocity[m] = m == periods || m == 0 ? Vec3::Zero() : Vec3(d1 * state.v);
+  }
+  // a piece per section, split at the first sample on or past its start (the transitions belong
+  // to the end edges' paths, the arc to the inner edges')
+  PlannedPath planned;
+  double t = t_begin_s;
+  size_t begin = 0;
+  double section_end = 0.0;
+  for (int section = 0; section < 3; ++section) {
+    section_end += run.section_length_mm(section);
+    size_t end = begin;
+    while (end < periods && (section == 2 || s[end] < section_end)) ++end;
+    if (end == begin) continue;
+    const size_t edge = section == 0   ? run.first_corner() - 1
+                        : section == 1 ? run.first_corner()
+                                       : run.last_corner();
+    TrajectoryPiece piece =
+        depositing_piece(chain, edge, options, t, static_cast<double>(end - begin) * period);
+    SampledMotion motion;
+    motion.period_s = period;
+    motion.position_mm.assign(position.begin() + begin, position.begin() + end + 1);
+    motion.velocity_mm_s.assign(velocity.begin() + begin, velocity.begin() + end + 1);
+    piece.motion = std::move(motion);
+    planned.pieces.push_back(std::move(piece));
+    t = planned.pieces.back().t_end_s;
+    begin = end;
+  }
+  planned.t_end_s = t;
+  planned.corner_speed_mm_s.assign(chain.points.size(), 0.0);
+  for (size_t i = run.first_corner(); i <= run.last_corner(); ++i)
+    planned.corner_speed_mm_s[i] = std::min(law.v_max_mm_s, profile.peak_speed());
+  planned.run_speed_deficit_mm = std::max(0.0, print_speed * duration - length);
+  return planned;
+}
+
 }  // namespace
 
 MachineLimits blend_limits(MachineLimits limits) {
@@ -274,6 +419,9 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
                        const PathMotionOptions& options, double t_begin_s) {
   const size_t n = chain.points.size();
   const size_t edges = n - 1;
+  if (edges >= 2 && corners[1].treatment == CornerTreatment::arc &&
+      corners[1].arc->from_rest_to_rest)
+    return plan_run_from_rest(chain, *corners[1].arc, limits, options, t_begin_s);
 
   // the trimmed lines: each edge loses the blend's tangent (or the loop's trim) at its ends
   struct Line {
@@ -384,17 +532,8 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
 
   // the pieces
   double t = t_begin_s;
-  const double lead = options.flow_follows_speed ? options.lag_s : -1.0;
   const auto base_piece = [&](double duration, size_t edge) {
-    TrajectoryPiece piece;
-    piece.t_begin_s = t;
-    piece.t_end_s = t + duration;
-    piece.path_index = chain.edge_path[edge];
-    piece.depositing = true;
-    piece.desired_speed_mm_s = chain.edge_speed_mm_s[edge];
-    piece.flow_lead_s = lead;
-    piece.flow_may_retract = options.flow_follows_speed && options.flow_may_retract;
-    return piece;
+    return depositing_piece(chain, edge, options, t, duration);
   };
   for (size_t k = 0; k < edges; ++k) {
     const Line& line = lines[k];

@@ -13,18 +13,20 @@
 //   stop      the path comes to rest at the corner (a reversal an extruder cannot loop);
 //   arc       one of a run of corners along a circle taken as one clothoid-arc-clothoid curve
 //             at constant speed (arc_run.hpp): the run's end edges lose what it takes of them,
-//             its inner edges are taken whole.
+//             its inner edges are taken whole. A run from rest to rest (the whole chain, a
+//             slicer's hole) changes speed on the curve itself (see path_plan.cpp,
+//             plan_run_from_rest).
 //
-// Time law. Speed changes happen on the straight lines only; every curved section (blend, arc
-// run) is traversed at one constant speed, its "node" speed. Between two nodes a line runs the
-// time-optimal jerk-limited profile of line_profile.hpp (zero acceleration at both ends), so
-// the acceleration is continuous everywhere: a line meets a blend where the blend's curvature
-// (and so its acceleration) is 0. Each node's speed is capped by its section's limits
-// (blend_speed_bound over the blend's box), the print speed and the adjacent lines' caps; a
-// backward and a forward pass (the classic look-ahead) lower the caps to what the lines can
-// reach (reachable_speed), which makes every line's profile feasible and the whole law the
-// fastest jerk-limited one of this family. Per-axis limits map exactly onto a line:
-// v <= v_k / |u_k|, a <= a_k / |u_k|, j <= j_k / |u_k| for its direction u, over the line's box
+// Time law. Speed changes happen on the straight lines only (but on a run from rest to rest);
+// every curved section (blend, arc run) is traversed at one constant speed, its "node" speed.
+// Between two nodes a line runs the time-optimal jerk-limited profile of line_profile.hpp (zero
+// acceleration at both ends), so the acceleration is continuous everywhere: a line meets a blend
+// where the blend's curvature (and so its acceleration) is 0. Each node's speed is capped by its
+// section's limits (blend_speed_bound over the blend's box), the print speed and the adjacent
+// lines' caps; a backward and a forward pass (the classic look-ahead) lower the caps to what the
+// lines can reach (reachable_speed), which makes every line's profile feasible and the whole law
+// the fastest jerk-limited one of this family. Per-axis limits map exactly onto a line: v <= v_k /
+// |u_k|, a <= a_k / |u_k|, j <= j_k / |u_k| for its direction u, over the line's box
 // (TcpLimits::along: a machine's joint limits mapped where the line is).
 //
 // Pieces. A line is a PhaseMotion (per axis p0_k + u_k s(t): constant-jerk phases, exact); a

@@ -349,8 +349,10 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     };
     PlannedPath planned = plan_resizing(corners);
     // A run below the print speed (sized below it for its arc, or held by the look-ahead on a
-    // circle an extrusion path starts or ends on, at rest) may cost more than its corners one
-    // by one: those are then chosen too and the chain planned without such runs, and the
+    // circle an extrusion path starts or ends on, at rest), or one from rest to rest (its ramps
+    // on the curve, under limits lowered for the curve's own terms, may take longer than lines
+    // ramping between blends at the print speed), may cost more than its corners one by one:
+    // those are then chosen too and the chain planned without such runs, and the
     // cheaper plan kept: their predicted errors plus time_weight x its time, against the runs'
     // plan's time_weight x time and, for a stream that cannot follow the speed (aerosol), the
     // thicker line it lays on the runs and their ramps (run_speed_deficit_mm x
@@ -360,7 +362,8 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
       const size_t decided_before = chain_decisions.size();
       for (const std::shared_ptr<const ArcRun>& run : runs) {
         const size_t first = run->first_corner();
-        if (planned.corner_speed_mm_s[first] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
+        if (!run->from_rest_to_rest &&
+            planned.corner_speed_mm_s[first] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
           continue;
         for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(i);
       }

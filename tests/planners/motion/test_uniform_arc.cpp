@@ -363,3 +363,108 @@ TEST(UniformPlanner, ArcRunBelowThePrintSpeedIsWeighedAgainstItsCorners) {
 
 }  // namespace
 }  // namespace depotwin
+
+namespace depotwin {
+namespace {
+
+// A slicer's hole: an extrusion path once around a circle of 0.2 mm chords, from rest to rest
+// at its first point, at 50 mm/s on a 1000 mm/s^2 stage. The whole chain is one run whose
+// curve starts and ends at that point (free ends, the circle fitted through the ends too),
+// its speed changing on the curve: line_profile's law in arc length (decelerations under the
+// flow lag's rule), its acceleration and jerk lowered until every axis keeps its limits with
+// the curve's own terms. At 4 mm the corners alone cannot keep 50 mm/s (each was slowed:
+// 1.11 s); at 6 mm each can, but their lines ramp one at a time between blends at constant
+// speeds (1.27 s). Checked: every corner in the run, the plan from rest to rest at the first
+// point, the print speed reached and not passed, within the tolerance, every axis within its
+// acceleration and jerk limits by finite differences, the led flow command never below 0
+// (v + lag dv/dt, above the lag rule's last 3 %), and quicker than the corners one by one.
+TEST(UniformPlanner, ExtrusionHoleFromRestIsOneRunRampingOnTheCurve) {
+  const MachineLimits axes = MachineLimits::uniform(100.0, 1000.0);
+  const double speed = 50.0;
+  const UniformSettings settings;
+  UniformSettings one_by_one;
+  one_by_one.arc_runs = false;
+  const PlanningContext extrusion = process_context(ProcessType::extrusion);
+  const double lag_s = extrusion.process->tau_s;
+  for (const double r : {4.0, 6.0}) {
+    SCOPED_TRACE("r " + std::to_string(r));
+    const int chords = static_cast<int>(std::ceil(2.0 * kPi * r / 0.2));
+    std::vector<Vec3> hole;
+    for (int k = 0; k <= chords; ++k) {
+      const double angle = 2.0 * kPi * k / chords;
+      hole.emplace_back(10.0 + r * std::cos(angle), 5.0 + r * std::sin(angle), 0.2);
+    }
+    // the run itself: the whole chain, from its first point to its last
+    const TcpLimits limits = with_jerk_limits(axes, settings.jerk_ramp_s);
+    const Found found = find_runs(hole, speed, limits, false, settings.tolerance_mm);
+    ASSERT_EQ(found.runs.size(), 1u);
+    const ArcRun& run = *found.runs.front();
+    EXPECT_TRUE(run.from_rest_to_rest);
+    EXPECT_EQ(run.first_corner(), 1u);
+    EXPECT_EQ(run.last_corner(), found.merged.chain.points.size() - 2);
+    EXPECT_EQ(run.start_mm(), hole.front());
+    EXPECT_EQ(run.end_mm(), hole.back());
+    EXPECT_NEAR(run.radius_mm(), r, settings.tolerance_mm);
+
+    const Toolpath toolpath = polyline_job(hole, speed);
+    const Trajectory plan = UniformPlanner{settings}.plan_in_context(toolpath, axes, extrusion);
+    for (const PlanDecision& decision : plan.decisions()) {
+      ASSERT_EQ(decision.kind, "corner");
+      EXPECT_EQ(decision.choice, "arc") << "point " << decision.point_index;
+      EXPECT_EQ(figure(decision, "run_corners"), static_cast<double>(plan.decisions().size()));
+    }
+    // from rest to rest at the first point, printing throughout
+    const TrajectoryPiece* first = nullptr;
+    const TrajectoryPiece* last = nullptr;
+    for (const TrajectoryPiece& piece : plan.pieces())
+      if (piece.depositing) {
+        if (first == nullptr) first = &piece;
+        last = &piece;
+      }
+    ASSERT_NE(first, nullptr);
+    for (const double t : {first->t_begin_s, last->t_end_s}) {
+      const TrajectorySample at = plan.at(t);
+      EXPECT_LT((at.position_mm - hole.front()).norm(), 1e-9) << "t " << t;
+      EXPECT_LT(at.velocity_mm_s.norm(), 1e-9) << "t " << t;
+    }
+    const MotionSamples samples = sample_trajectory(plan, 1e-4);
+    EXPECT_LE(path_error(samples, toolpath).max_mm, settings.tolerance_mm);
+    double peak_speed = 0.0;
+    for (size_t k = 0; k < samples.size(); ++k) {
+      if (!samples.depositing[k]) continue;
+      const Vec3& v = samples.velocity_mm_s[k];
+      peak_speed = std::max(peak_speed, v.norm());
+      const TrajectorySample at = plan.at(samples.t_s[k]);
+      const double rate = v.norm() > 0.0 ? v.dot(at.acceleration_mm_s2) / v.norm() : 0.0;
+      if (v.norm() > 0.03 * speed) {
+        EXPECT_GE(v.norm() + lag_s * rate, -0.01 * speed) << "t " << samples.t_s[k];
+      }
+    }
+    // (between the 1 ms samples their cubic interpolation on the circle passes the speed by
+    // about (v T / r)^2 / 8 of it)
+    EXPECT_NEAR(peak_speed, speed, 1e-4 * speed);
+    // every axis by finite differences every millisecond
+    const double dt = 0.001, j_max = axes.axes[0].a_max_mm_s2 / settings.jerk_ramp_s;
+    std::vector<Vec3> q;
+    for (double t = first->t_begin_s; t <= last->t_end_s; t += dt)
+      q.push_back(plan.at(t).position_mm);
+    double peak_a = 0.0, peak_j = 0.0;
+    for (size_t k = 0; k + 3 < q.size(); ++k) {
+      peak_a =
+          std::max(peak_a, ((q[k + 2] - 2 * q[k + 1] + q[k]) / (dt * dt)).cwiseAbs().maxCoeff());
+      peak_j = std::max(
+          peak_j,
+          ((q[k + 3] - 3 * q[k + 2] + 3 * q[k + 1] - q[k]) / (dt * dt * dt)).cwiseAbs().maxCoeff());
+    }
+    EXPECT_LE(peak_a, axes.axes[0].a_max_mm_s2 * (1 + 1e-3));
+    EXPECT_LE(peak_j, j_max * (1 + 1e-2));
+    // the centripetal v^2 / r at least, on the arc
+    EXPECT_GT(peak_a, 0.99 * speed * speed / r);
+    const double corners_s =
+        UniformPlanner{one_by_one}.plan_in_context(toolpath, axes, extrusion).duration_s();
+    EXPECT_LT(plan.duration_s(), 0.8 * corners_s);
+  }
+}
+
+}  // namespace
+}  // namespace depotwin
