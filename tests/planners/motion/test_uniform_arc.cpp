@@ -50,6 +50,25 @@ Found find_runs(const std::vector<Vec3>& points, double speed, const TcpLimits& 
   return found;
 }
 
+// The largest acceleration and jerk of any axis over [t0, t1], by finite differences of the
+// positions every dt (the XY stage's and the gantry's joints are their axes)
+struct AxisPeaks {
+  double acceleration = 0.0, jerk = 0.0;
+};
+AxisPeaks finite_difference_peaks(const Trajectory& plan, double t0, double t1, double dt) {
+  std::vector<Vec3> q;
+  for (double t = t0; t <= t1; t += dt) q.push_back(plan.at(t).position_mm);
+  AxisPeaks peaks;
+  for (size_t k = 0; k + 3 < q.size(); ++k) {
+    peaks.acceleration = std::max(
+        peaks.acceleration, ((q[k + 2] - 2 * q[k + 1] + q[k]) / (dt * dt)).cwiseAbs().maxCoeff());
+    peaks.jerk = std::max(
+        peaks.jerk,
+        ((q[k + 3] - 3 * q[k + 2] + 3 * q[k + 1] - q[k]) / (dt * dt * dt)).cwiseAbs().maxCoeff());
+  }
+  return peaks;
+}
+
 // The curve of a run: continuous in position, tangent and curvature, its derivatives those of
 // its position (central differences), the curvature 0 at its ends and 1 / R on the arc; it
 // leaves and joins its end edges tangentially, stays within the tolerance of the given
@@ -212,22 +231,13 @@ TEST(UniformPlanner, ChordedHalfCircleIsOneArcAtPrintSpeed) {
       EXPECT_LE(printing_s, length / speed);
       EXPECT_GT(printing_s, 0.99 * length / speed);
     }
-    // every axis by finite differences every millisecond (the XY stage's joints are its
-    // axes; the slack covers the cubic interpolation of the samples)
-    const double dt = 0.001, j_max = axes.axes[0].a_max_mm_s2 / settings.jerk_ramp_s;
-    std::vector<Vec3> q;
-    for (double t = 0.0; t <= plan.duration_s(); t += dt) q.push_back(plan.at(t).position_mm);
-    double peak_a = 0.0, peak_j = 0.0;
-    for (size_t k = 0; k + 3 < q.size(); ++k) {
-      peak_a =
-          std::max(peak_a, ((q[k + 2] - 2 * q[k + 1] + q[k]) / (dt * dt)).cwiseAbs().maxCoeff());
-      peak_j = std::max(
-          peak_j,
-          ((q[k + 3] - 3 * q[k + 2] + 3 * q[k + 1] - q[k]) / (dt * dt * dt)).cwiseAbs().maxCoeff());
-    }
-    EXPECT_LE(peak_a, axes.axes[0].a_max_mm_s2 * (1 + 1e-3));
-    EXPECT_LE(peak_j, j_max * (1 + 1e-2));
-    EXPECT_GT(peak_a, 0.5 * axes.axes[0].a_max_mm_s2);
+    // every axis by finite differences every millisecond (the slack covers the cubic
+    // interpolation of the samples)
+    const double j_max = axes.axes[0].a_max_mm_s2 / settings.jerk_ramp_s;
+    const AxisPeaks peaks = finite_difference_peaks(plan, 0.0, plan.duration_s(), 0.001);
+    EXPECT_LE(peaks.acceleration, axes.axes[0].a_max_mm_s2 * (1 + 1e-3));
+    EXPECT_LE(peaks.jerk, j_max * (1 + 1e-2));
+    EXPECT_GT(peaks.acceleration, 0.5 * axes.axes[0].a_max_mm_s2);
     // quicker than its corners one by one (aerosol: loops; extrusion: slowed corners)
     UniformSettings one_by_one;
     one_by_one.arc_runs = false;
@@ -444,22 +454,12 @@ TEST(UniformPlanner, ExtrusionHoleFromRestIsOneRunRampingOnTheCurve) {
     // about (v T / r)^2 / 8 of it)
     EXPECT_NEAR(peak_speed, speed, 1e-4 * speed);
     // every axis by finite differences every millisecond
-    const double dt = 0.001, j_max = axes.axes[0].a_max_mm_s2 / settings.jerk_ramp_s;
-    std::vector<Vec3> q;
-    for (double t = first->t_begin_s; t <= last->t_end_s; t += dt)
-      q.push_back(plan.at(t).position_mm);
-    double peak_a = 0.0, peak_j = 0.0;
-    for (size_t k = 0; k + 3 < q.size(); ++k) {
-      peak_a =
-          std::max(peak_a, ((q[k + 2] - 2 * q[k + 1] + q[k]) / (dt * dt)).cwiseAbs().maxCoeff());
-      peak_j = std::max(
-          peak_j,
-          ((q[k + 3] - 3 * q[k + 2] + 3 * q[k + 1] - q[k]) / (dt * dt * dt)).cwiseAbs().maxCoeff());
-    }
-    EXPECT_LE(peak_a, axes.axes[0].a_max_mm_s2 * (1 + 1e-3));
-    EXPECT_LE(peak_j, j_max * (1 + 1e-2));
+    const double j_max = axes.axes[0].a_max_mm_s2 / settings.jerk_ramp_s;
+    const AxisPeaks peaks = finite_difference_peaks(plan, first->t_begin_s, last->t_end_s, 0.001);
+    EXPECT_LE(peaks.acceleration, axes.axes[0].a_max_mm_s2 * (1 + 1e-3));
+    EXPECT_LE(peaks.jerk, j_max * (1 + 1e-2));
     // the centripetal v^2 / r at least, on the arc
-    EXPECT_GT(peak_a, 0.99 * speed * speed / r);
+    EXPECT_GT(peaks.acceleration, 0.99 * speed * speed / r);
     const double corners_s =
         UniformPlanner{one_by_one}.plan_in_context(toolpath, axes, extrusion).duration_s();
     EXPECT_LT(plan.duration_s(), 0.8 * corners_s);
