@@ -97,7 +97,9 @@ class ArcRun {
 // speed). There, where the edge is too short for that (a chorded circle's closing chords), the
 // curve may start or end at the chain's end point itself, free: its transition's line turned
 // to pass through that point (the transition move to or from the chain takes its direction).
-// A chain entered and left at rest may be one run with both ends free (from_rest_to_rest).
+// A chain entered and left at rest may be one run with both ends free (from_rest_to_rest),
+// tried first there and with no slow corner needed: its speed changes on the curve, where the
+// corners one by one ramp on the lines between their blends only.
 // Longest first, from each corner on. Chains carrying the tool's orientation have none.
 constexpr size_t kMinArcRunCorners = 3;
 std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(
