@@ -419,6 +419,23 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
                        const PathMotionOptions& options, double t_begin_s) {
   const size_t n = chain.points.size();
   const size_t edges = n - 1;
+  // the print speed must be possible along every whole edge
+  for (size_t e = 0; e < edges; ++e) {
+    const Vec3& p0 = chain.points[e];
+    const Vec3& p1 = chain.points[e + 1];
+    const double speed = chain.edge_speed_mm_s[e];
+    const Vec3 u = (p1 - p0) / (p1 - p0).norm();
+    const MachineLimits edge_limits = limits.along(p0, p1);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (std::abs(speed * u[axis]) > edge_limits.axes[axis].v_max_mm_s * (1 + 1e-12)) {
+        std::ostringstream msg;
+        msg << "segment " << e << " needs " << std::abs(speed * u[axis]) << " mm/s on axis "
+            << kAxisName[axis] << " at print speed " << speed << " mm/s, above v_max "
+            << edge_limits.axes[axis].v_max_mm_s;
+        throw InputError("toolpath path " + std::to_string(chain.edge_source[e]), msg.str());
+      }
+    }
+  }
   if (edges >= 2 && corners[1].treatment == CornerTreatment::arc &&
       corners[1].arc->from_rest_to_rest)
     return plan_run_from_rest(chain, *corners[1].arc, limits, options, t_begin_s);
@@ -438,17 +455,6 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     Line& line = lines[e];
     const double edge_length = (p1 - p0).norm();
     line.u = (p1 - p0) / edge_length;
-    // the print speed must be possible along the whole edge
-    const MachineLimits edge_limits = limits.along(p0, p1);
-    for (int axis = 0; axis < 3; ++axis) {
-      if (std::abs(speed * line.u[axis]) > edge_limits.axes[axis].v_max_mm_s * (1 + 1e-12)) {
-        std::ostringstream msg;
-        msg << "segment " << e << " needs " << std::abs(speed * line.u[axis]) << " mm/s on axis "
-            << kAxisName[axis] << " at print speed " << speed << " mm/s, above v_max "
-            << edge_limits.axes[axis].v_max_mm_s;
-        throw InputError("toolpath path " + std::to_string(chain.edge_source[e]), msg.str());
-      }
-    }
     double trim0 = 0.0, trim1 = 0.0;
     if (e > 0) {
       const CornerPlan& c = corners[e];

@@ -6,6 +6,7 @@
 #include <memory>
 #include <random>
 
+#include "core/error.hpp"
 #include "core/segment_distance.hpp"
 #include "metrics/motion_metrics.hpp"
 #include "planners/motion/plan_figure.hpp"
@@ -415,6 +416,20 @@ TEST(UniformPlanner, ExtrusionHoleFromRestIsOneRunRampingOnTheCurve) {
     EXPECT_EQ(run.start_mm(), hole.front());
     EXPECT_EQ(run.end_mm(), hole.back());
     EXPECT_NEAR(run.radius_mm(), r, settings.tolerance_mm);
+    // planned as given, the print speed is still checked against each axis' v_max on every
+    // edge: at 50 mm/s on axes of 45 mm/s, an InputError
+    {
+      std::vector<CornerPlan> corners(found.merged.chain.points.size());
+      for (size_t i = run.first_corner(); i <= run.last_corner(); ++i) {
+        corners[i].treatment = CornerTreatment::arc;
+        corners[i].arc = found.runs.front();
+      }
+      PathMotionOptions at_rest;
+      EXPECT_THROW(
+          plan_chain(found.merged.chain, found.geometry, corners,
+                     with_jerk_limits(MachineLimits::uniform(45.0, 1000.0), 0.01), at_rest, 0.0),
+          InputError);
+    }
 
     const Toolpath toolpath = polyline_job(hole, speed);
     const Trajectory plan = UniformPlanner{settings}.plan_in_context(toolpath, axes, extrusion);
