@@ -422,6 +422,10 @@ void ArcRun::at(double s, Vec3& position, Vec3& d1, Vec3& d2, Vec3& d3) const {
   if (s == length) position = end_;
 }
 
+size_t ArcRun::section_edge(int section) const {
+  return section == 0 ? first_corner_ - 1 : section == 1 ? first_corner_ : last_corner_;
+}
+
 Vec3 ArcRun::normal() const {
   return d_in_.cross(n_in_);
 }
@@ -488,15 +492,10 @@ std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(
         // ramp one at a time between blends at constant speeds, where the run ramps on the
         // curve)
         if (!whole_at_rest && slow[b - first + 1] == slow[a - first]) break;
-        // (at an end of the chain entered or left at speed, the curve may run to the end
-        // itself: a chorded circle's closing chords are seldom the length its transitions
-        // need. So may a run that is the whole chain, entered and left at rest, its speed
-        // changing on the curve: tried first there, as lines at its ends would have to reach
-        // the run's one speed from rest within half an edge)
-        const bool free_start = a == 1 && (options.enter_at_speed || whole_at_rest);
-        const bool free_end = b + 2 == n && (options.leave_at_speed || whole_at_rest);
-        // (its transitions sized for the print speed, else for less: shorter, they leave the
-        // arc nearer the circle)
+        // (a run that is the whole chain, entered and left at rest, its speed changing on the
+        // curve, is tried first there, as lines at its ends would have to reach the run's one
+        // speed from rest within half an edge: its transitions sized for the print speed, else
+        // for less: shorter, they leave the arc nearer the circle)
         for (const double share : kRestTransitionSpeedShares) {
           if (!whole_at_rest || found) break;
           found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options, true,
@@ -505,7 +504,12 @@ std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(
         if (!found)
           found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options, false,
                               false);
-        if (!found && !whole_at_rest && (free_start || free_end))
+        // (at an end of the chain entered or left at speed, the curve may run to the end
+        // itself: a chorded circle's closing chords are seldom the length its transitions
+        // need)
+        const bool free_start = a == 1 && options.enter_at_speed;
+        const bool free_end = b + 2 == n && options.leave_at_speed;
+        if (!found && (free_start || free_end))
           found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options,
                               free_start, free_end);
       }

@@ -49,6 +49,9 @@ class ArcRun {
   const Vec3& centre_mm() const { return centre_; }
   // the sections: 0 the entry transition, 1 the arc, 2 the exit transition
   double section_length_mm(int section) const;
+  // the chain's edge a section's piece belongs to: the transitions the end edges, the arc the
+  // first inner edge (the inner edges are of one path)
+  size_t section_edge(int section) const;
   double length_mm() const { return transition_in_ + arc_length_ + transition_out_; }
   const Vec3& start_mm() const { return start_; }
   const Vec3& end_mm() const { return end_; }

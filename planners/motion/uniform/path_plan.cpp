@@ -174,11 +174,8 @@ PlannedPath plan_run_from_rest(const PrintChain& chain, const ArcRun& run, const
     size_t end = begin;
     while (end < periods && (section == 2 || s[end] < section_end)) ++end;
     if (end == begin) continue;
-    const size_t edge = section == 0   ? run.first_corner() - 1
-                        : section == 1 ? run.first_corner()
-                                       : run.last_corner();
-    TrajectoryPiece piece =
-        depositing_piece(chain, edge, options, t, static_cast<double>(end - begin) * period);
+    TrajectoryPiece piece = depositing_piece(chain, run.section_edge(section), options, t,
+                                             static_cast<double>(end - begin) * period);
     SampledMotion motion;
     motion.period_s = period;
     motion.position_mm.assign(position.begin() + begin, position.begin() + end + 1);
@@ -628,9 +625,8 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
           motion.position_mm.push_back(p);
           motion.velocity_mm_s.push_back(w * d1);
         }
-        // (the transitions belong to the end edges' paths, the arc to the inner edges')
-        const size_t edge = section == 0 ? k : section == 1 ? k + 1 : run.last_corner();
-        TrajectoryPiece piece = base_piece(static_cast<double>(periods) * period, edge);
+        TrajectoryPiece piece =
+            base_piece(static_cast<double>(periods) * period, run.section_edge(section));
         planned.run_speed_deficit_mm +=
             std::max(0.0, length * (piece.desired_speed_mm_s / w - 1.0));
         piece.motion = std::move(motion);
