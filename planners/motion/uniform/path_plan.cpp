@@ -190,6 +190,7 @@ PlannedPath plan_run_from_rest(const PrintChain& chain, const ArcRun& run, const
   for (size_t i = run.first_corner(); i <= run.last_corner(); ++i)
     planned.corner_speed_mm_s[i] = std::min(law.v_max_mm_s, profile.peak_speed());
   planned.run_speed_deficit_mm = std::max(0.0, print_speed * duration - length);
+  planned.lookahead_corner_speed_mm_s = planned.corner_speed_mm_s;
   return planned;
 }
 
@@ -411,6 +412,227 @@ double max_blend_half_length(const CornerGeometry& g, double edge_in_mm, double 
   return std::min(tolerance_mm / g.deviation_per_length, room / g.tangent_per_length);
 }
 
+namespace {
+
+// an edge less the blends' (or loops') trims at its ends, with its limits along it
+struct TrimmedLine {
+  Vec3 from, to, u;
+  double length = 0.0;
+  LineLimits limits;
+};
+
+// A stretch of a chain from or to rest across blended (or straight) corners: lines first_line
+// to last_line with the blends between them, planned as one curve in arc length. The
+// look-ahead changes speed on the lines only (each line's profile starts and ends with zero
+// acceleration, the blends are taken at constant speed), so a ramp over short chords crawls up
+// chord by chord. Here it is line_profile's law over the whole stretch, held to every axis'
+// limits by the same check as a run from rest (plan_run_from_rest): per axis k the curve adds
+// a_k = p'_k sddot + p''_k sdot^2 and j_k = p'_k sdddot + 3 p''_k sdot sddot + p'''_k sdot^3,
+// checked on the blends at every quarter sample period against blend_limits over each blend's
+// box, and each blend's speed against its corner's cap.
+struct CurvedRamp {
+  struct Section {
+    double s_begin = 0.0, length = 0.0;
+    const TrimmedLine* line = nullptr;     // a line, or
+    const ClothoidBlend* blend = nullptr;  // a blend's half (the second: from its apex)
+    bool second_half = false;
+    size_t edge = 0;  // the edge whose path it prints
+    MachineLimits axes;
+    double speed_cap_mm_s = 0.0;  // a line's cruise cap, a blend's corner cap
+  };
+  size_t first_line = 0, last_line = 0;
+  std::vector<Section> sections;
+  double length = 0.0;
+  double shortest_blend_half_mm = kInf;
+  AxisProfile profile;
+
+  // the longest sample period for the law: period_s, shorter where a blend's half would have
+  // fewer than kMinBlendHalfPeriods samples at the law's peak speed (as a blend on its own)
+  double sample_period_s(double period_s) const {
+    const double peak = profile.peak_speed();
+    return peak > 0.0 ? std::min(period_s, shortest_blend_half_mm / peak / kMinBlendHalfPeriods)
+                      : period_s;
+  }
+
+  // the curve at arc length s (section: a hint, advanced to the section that holds s)
+  void at(double s, size_t& section, Vec3& p, Vec3& d1, Vec3& d2, Vec3& d3) const {
+    while (section + 1 < sections.size() &&
+           s > sections[section].s_begin + sections[section].length)
+      ++section;
+    const Section& sec = sections[section];
+    const double local = std::clamp(s - sec.s_begin, 0.0, sec.length);
+    if (sec.line != nullptr) {
+      p = sec.line->from + local * sec.line->u;
+      d1 = sec.line->u;
+      d2 = d3 = Vec3::Zero();
+      return;
+    }
+    sec.blend->at(local + (sec.second_half ? sec.length : 0.0), p, d1, d2, d3);
+  }
+};
+
+constexpr int kCurvedRampRounds = 40;
+
+// Plans lines first..last (and the blends between them) from v0 to v1 as one CurvedRamp; false
+// where the law cannot join the speeds in the stretch or is not faster than standard_s, the
+// look-ahead's time over the stretch. node_cap: each node's speed cap (its blend's bound).
+bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
+                      const std::vector<ClothoidBlend>& blends,
+                      const std::vector<CornerPlan>& corners, const std::vector<double>& node_cap,
+                      size_t first, size_t last, double v0, double v1, double standard_s,
+                      const TcpLimits& limits, const PathMotionOptions& options, CurvedRamp& ramp) {
+  ramp.first_line = first;
+  ramp.last_line = last;
+  ramp.sections.clear();
+  ramp.length = 0.0;
+  ramp.shortest_blend_half_mm = kInf;
+  LineLimits law;
+  law.v_max_mm_s = law.a_max_mm_s2 = law.j_max_mm_s3 = kInf;
+  law.lag_s = options.deceleration_lag_s();
+  const auto add = [&](CurvedRamp::Section section, const Vec3& lo, const Vec3& hi,
+                       double speed_cap) {
+    if (!(section.length > 0.0)) return;
+    section.speed_cap_mm_s = speed_cap;
+    section.s_begin = ramp.length;
+    section.axes = blend_limits(limits.over(lo, hi));
+    ramp.length += section.length;
+    ramp.sections.push_back(section);
+  };
+  for (size_t k = first; k <= last; ++k) {
+    // the line; its limits (with the blends' share: it is sampled) are the law's first bound
+    const TrimmedLine& line = lines[k];
+    law.v_max_mm_s = std::min(law.v_max_mm_s, line.limits.v_max_mm_s);
+    law.a_max_mm_s2 = std::min(law.a_max_mm_s2, kBlendLimitShare * line.limits.a_max_mm_s2);
+    law.j_max_mm_s3 = std::min(law.j_max_mm_s3, kBlendLimitShare * line.limits.j_max_mm_s3);
+    CurvedRamp::Section section;
+    section.line = &line;
+    section.length = line.length;
+    section.edge = k;
+    add(section, line.from.cwiseMin(line.to), line.from.cwiseMax(line.to), line.limits.v_max_mm_s);
+    if (k == last || corners[k + 1].treatment != CornerTreatment::blend) continue;
+    // the blend after it, in halves (its apex splits the two edges' paths)
+    const ClothoidBlend& blend = blends[k + 1];
+    Vec3 lo, hi;
+    blend_box(blend, lo, hi);
+    section = CurvedRamp::Section();
+    section.blend = &blend;
+    section.length = blend.half_length_mm();
+    ramp.shortest_blend_half_mm = std::min(ramp.shortest_blend_half_mm, section.length);
+    section.edge = k;
+    add(section, lo, hi, node_cap[k + 1]);
+    section.second_half = true;
+    section.edge = k + 1;
+    add(section, lo, hi, node_cap[k + 1]);
+  }
+  const double lowest = std::max(v0, v1);
+  if (ramp.sections.empty() || lowest > law.v_max_mm_s) return false;
+  // (checked once a sample period while the law is lowered, then every quarter of one)
+  bool fine = false;
+  for (int round = 0;; ++round) {
+    if (speed_change_distance(v0, lowest, law) + speed_change_distance(lowest, v1, law) >
+        ramp.length)
+      return false;
+    ramp.profile = line_profile(ramp.length, v0, v1, law);
+    const double duration = ramp.profile.duration_s();
+    if (!(duration < standard_s)) return false;
+    // every axis on the blends, against their boxes' limits (on the lines the law keeps the
+    // lines' own limits)
+    const size_t checks =
+        std::max<size_t>(8, static_cast<size_t>(std::ceil((fine ? 4.0 : 1.0) * duration /
+                                                          ramp.sample_period_s(options.period_s))));
+    double speed_ratio = 0.0, accel_ratio = 0.0, jerk_ratio = 0.0;
+    bool jerk_by_cross_term = false;  // at the worst jerk, the cross term is the larger
+    size_t phase = 0, section = 0;
+    for (size_t m = 0; m <= checks; ++m) {
+      const double t = duration * static_cast<double>(m) / static_cast<double>(checks);
+      const AxisState state = ramp.profile.at(t, phase);
+      Vec3 p, d1, d2, d3;
+      ramp.at(std::clamp(state.q, 0.0, ramp.length), section, p, d1, d2, d3);
+      if (ramp.sections[section].line != nullptr) continue;
+      const double jerk = ramp.profile.jerk_at(t);
+      const MachineLimits& axes = ramp.sections[section].axes;
+      const double v = state.v, a = state.a;
+      speed_ratio = std::max(speed_ratio, v / ramp.sections[section].speed_cap_mm_s);
+      for (int axis = 0; axis < 3; ++axis) {
+        const AxisLimits& bound = axes.axes[axis];
+        speed_ratio = std::max(speed_ratio, std::abs(d1[axis] * v) / bound.v_max_mm_s);
+        const double accel = d1[axis] * a + d2[axis] * v * v;
+        const double cross = 3.0 * d2[axis] * v * a;
+        const double axis_jerk = d1[axis] * jerk + cross + d3[axis] * v * v * v;
+        accel_ratio = std::max(accel_ratio, std::abs(accel) / bound.a_max_mm_s2);
+        const double ratio = std::abs(axis_jerk) / bound.j_max_mm_s3;
+        if (ratio > jerk_ratio) {
+          jerk_ratio = ratio;
+          jerk_by_cross_term = std::abs(cross) > std::abs(d1[axis] * jerk);
+        }
+      }
+    }
+    if (speed_ratio <= 1.0 + 1e-9 && accel_ratio <= 1.0 + 1e-9 && jerk_ratio <= 1.0 + 1e-9) {
+      if (fine) return true;
+      fine = true;
+      continue;
+    }
+    if (round >= kCurvedRampRounds) return false;
+    // lower what was exceeded (as plan_run_from_rest does); past half the rounds the jerk and
+    // the cruise too
+    if (speed_ratio > 1.0 + 1e-9) law.v_max_mm_s /= speed_ratio;
+    if (accel_ratio > 1.0 + 1e-9 || (jerk_ratio > 1.0 + 1e-9 && jerk_by_cross_term))
+      law.a_max_mm_s2 *= kRampLimitScale;
+    if (jerk_ratio > 1.0 + 1e-9 && !jerk_by_cross_term) law.j_max_mm_s3 *= kRampLimitScale;
+    if (2 * round >= kCurvedRampRounds) {
+      law.j_max_mm_s3 *= kRampLimitScale;
+      law.v_max_mm_s *= kRampCruiseScale;
+    }
+    if (lowest > law.v_max_mm_s) return false;
+  }
+}
+
+// The ramp's pieces from t_begin_s, sampled at its sample period, a piece per section (split at
+// the first sample on or past its start); each inner corner's speed at its apex's sample into
+// planned.corner_speed_mm_s. Returns the time the ramp ends.
+double emit_curved_ramp(const CurvedRamp& ramp, const PrintChain& chain,
+                        const PathMotionOptions& options, double t_begin_s, PlannedPath& planned) {
+  const double duration = ramp.profile.duration_s();
+  const size_t periods = std::max<size_t>(
+      2, static_cast<size_t>(std::ceil(duration / ramp.sample_period_s(options.period_s))));
+  const double period = duration / static_cast<double>(periods);
+  std::vector<double> s(periods + 1), speed(periods + 1);
+  std::vector<Vec3> position(periods + 1), velocity(periods + 1);
+  size_t phase = 0, section = 0;
+  for (size_t m = 0; m <= periods; ++m) {
+    const AxisState state = ramp.profile.at(period * static_cast<double>(m), phase);
+    s[m] = m == periods ? ramp.length : std::clamp(state.q, 0.0, ramp.length);
+    speed[m] = m == periods ? ramp.profile.v_end() : state.v;
+    Vec3 d1, d2, d3;
+    ramp.at(s[m], section, position[m], d1, d2, d3);
+    velocity[m] = d1 * speed[m];
+  }
+  double t = t_begin_s;
+  size_t begin = 0;
+  for (size_t k = 0; k < ramp.sections.size(); ++k) {
+    const CurvedRamp::Section& sec = ramp.sections[k];
+    const bool last_section = k + 1 == ramp.sections.size();
+    const double section_end = sec.s_begin + sec.length;
+    if (sec.second_half) planned.corner_speed_mm_s[sec.edge] = speed[begin];
+    size_t end = begin;
+    while (end < periods && (last_section || s[end] < section_end)) ++end;
+    if (end == begin) continue;
+    TrajectoryPiece piece =
+        depositing_piece(chain, sec.edge, options, t, static_cast<double>(end - begin) * period);
+    SampledMotion motion;
+    motion.period_s = period;
+    motion.position_mm.assign(position.begin() + begin, position.begin() + end + 1);
+    motion.velocity_mm_s.assign(velocity.begin() + begin, velocity.begin() + end + 1);
+    piece.motion = std::move(motion);
+    planned.pieces.push_back(std::move(piece));
+    t = planned.pieces.back().t_end_s;
+    begin = end;
+  }
+  return t;
+}
+
+}  // namespace
+
 PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry>& geometry,
                        const std::vector<CornerPlan>& corners, const TcpLimits& limits,
                        const PathMotionOptions& options, double t_begin_s) {
@@ -438,18 +660,13 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     return plan_run_from_rest(chain, *corners[1].arc, limits, options, t_begin_s);
 
   // the trimmed lines: each edge loses the blend's tangent (or the loop's trim) at its ends
-  struct Line {
-    Vec3 from, to, u;
-    double length = 0.0;
-    LineLimits limits;
-  };
-  std::vector<Line> lines(edges);
+  std::vector<TrimmedLine> lines(edges);
   std::vector<ClothoidBlend> blends(n);
   for (size_t e = 0; e < edges; ++e) {
     const Vec3& p0 = chain.points[e];
     const Vec3& p1 = chain.points[e + 1];
     const double speed = chain.edge_speed_mm_s[e];
-    Line& line = lines[e];
+    TrimmedLine& line = lines[e];
     const double edge_length = (p1 - p0).norm();
     line.u = (p1 - p0) / edge_length;
     double trim0 = 0.0, trim1 = 0.0;
@@ -524,6 +741,7 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     v_start[k] = std::min(
         v_start[k], reachable_speed(v_end[k], lines[k].length, v_start[k], lines[k].limits, true));
   }
+  const std::vector<double> backward_bound = v_start;  // what the rests ahead allow at each node
   for (size_t k = 0; k < edges; ++k) {
     if (k > 0 && !split[k]) v_start[k] = std::min(v_start[k], v_end[k - 1]);
     v_end[k] = std::min(
@@ -533,15 +751,98 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
   for (size_t k = 0; k + 1 < edges; ++k)
     if (!split[k + 1]) v_start[k + 1] = v_end[k] = std::min(v_end[k], v_start[k + 1]);
 
+  // ramps from and to rest across blended corners, where the look-ahead leaves corners below
+  // their caps (speeds the lines between them and the rest could not reach): each such
+  // stretch, from the rest to the first corner that rest does not hold, as one CurvedRamp where
+  // that is faster (the look-ahead's corner speeds kept for resize_held_blends)
+  std::vector<CurvedRamp> ramps;
+  std::vector<int> ramp_of_line(edges, -1);
+  planned.lookahead_corner_speed_mm_s.assign(n, 0.0);
+  for (size_t k = 1; k < edges; ++k)
+    planned.lookahead_corner_speed_mm_s[k] = std::min(v_end[k - 1], v_start[k]);
+  if (options.curved_ramps && !chain.oriented) {
+    const auto line_time = [&](size_t k) {
+      return lines[k].length > 0.0
+                 ? line_profile(lines[k].length, v_start[k], v_end[k], lines[k].limits).duration_s()
+                 : 0.0;
+    };
+    // node i (0 < i < edges) may be inside a ramp: a blend or straight, taken below its cap;
+    // held by a rest behind it (the forward pass: inside a ramp out of that rest) or by one
+    // ahead (the backward pass: inside a ramp into that rest)
+    const auto inner = [&](size_t i, bool held_from_behind) {
+      const CornerTreatment treatment = corners[i].treatment;
+      const double speed = v_end[i - 1];
+      if (!(treatment == CornerTreatment::blend || treatment == CornerTreatment::straight) ||
+          split[i] || !(speed > 0.0) || !(speed < cap_before[i] * (1.0 - 1e-9)))
+        return false;
+      return held_from_behind == (speed < backward_bound[i] * (1.0 - 1e-9));
+    };
+    // a ramp over lines first..last, if one fits and is quicker: its gain over the look-ahead
+    const auto ramp_gain = [&](size_t first, size_t last, CurvedRamp& ramp) {
+      if (last <= first) return 0.0;  // (no inner corner)
+      double standard_s = 0.0;
+      for (size_t k = first; k <= last; ++k) {
+        standard_s += line_time(k);
+        if (k < last && corners[k + 1].treatment == CornerTreatment::blend)
+          standard_s += blends[k + 1].length_mm() / v_end[k];
+      }
+      return plan_curved_ramp(lines, blends, corners, cap_before, first, last, v_start[first],
+                              v_end[last], standard_s, limits, options, ramp)
+                 ? standard_s - ramp.profile.duration_s()
+                 : 0.0;
+    };
+    // the stretch first..last, or without its line farthest from the rest (which may change
+    // speed quicker on its own, under its own limits), whichever gains more
+    const auto try_ramp = [&](size_t first, size_t last, bool rest_at_first) {
+      if (last <= first) return;  // (no inner corner)
+      for (size_t k = first; k <= last; ++k)
+        if (ramp_of_line[k] >= 0) return;
+      CurvedRamp whole, shorter;
+      const double whole_gain = ramp_gain(first, last, whole);
+      const double shorter_gain =
+          rest_at_first ? ramp_gain(first, last - 1, shorter) : ramp_gain(first + 1, last, shorter);
+      if (!(std::max(whole_gain, shorter_gain) > 0.0)) return;
+      CurvedRamp& ramp = whole_gain >= shorter_gain ? whole : shorter;
+      for (size_t k = ramp.first_line; k <= ramp.last_line; ++k)
+        ramp_of_line[k] = static_cast<int>(ramps.size());
+      ramps.push_back(std::move(ramp));
+    };
+    for (size_t r = 0; r <= edges; ++r) {
+      // node r at rest: the chain's ends, stops, loops at rest
+      const bool at_rest = (r == edges || v_start[r] == 0.0) && (r == 0 || v_end[r - 1] == 0.0);
+      if (!at_rest) continue;
+      // into it (lines first..r-1), then out of it (lines r..last); neither ends at a run
+      if (r > 0) {
+        size_t first = r - 1;
+        while (first > 0 && inner(first, false)) --first;
+        if (first == 0 || corners[first].treatment != CornerTreatment::arc)
+          try_ramp(first, r - 1, false);
+      }
+      if (r < edges) {
+        size_t last = r;
+        while (last + 1 < edges && inner(last + 1, true)) ++last;
+        if (last + 1 == edges || corners[last + 1].treatment != CornerTreatment::arc)
+          try_ramp(r, last, true);
+      }
+    }
+  }
+
   // the pieces
   double t = t_begin_s;
   const auto base_piece = [&](double duration, size_t edge) {
     return depositing_piece(chain, edge, options, t, duration);
   };
   for (size_t k = 0; k < edges; ++k) {
-    const Line& line = lines[k];
+    const TrimmedLine& line = lines[k];
+    if (ramp_of_line[k] >= 0) {
+      // a ramp: its curve once, at its first line; its inner corners add nothing
+      const CurvedRamp& ramp = ramps[static_cast<size_t>(ramp_of_line[k])];
+      if (k == ramp.first_line) t = emit_curved_ramp(ramp, chain, options, t, planned);
+      if (k + 1 == edges) break;
+      if (k < ramp.last_line) continue;
+    }
     // the line
-    if (line.length > 0.0) {
+    if (ramp_of_line[k] < 0 && line.length > 0.0) {
       const AxisProfile along = line_profile(line.length, v_start[k], v_end[k], line.limits);
       const double duration = along.duration_s();
       const bool next_to_run = (k > 0 && corners[k].treatment == CornerTreatment::arc) ||
@@ -636,7 +937,7 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
       }
     } else if (c.treatment == CornerTreatment::loop) {
       // shutter closed: from the end of this line to the start of the next, at their speeds
-      const Line& next = lines[k + 1];
+      const TrimmedLine& next = lines[k + 1];
       const double edge_in = (chain.points[i] - chain.points[i - 1]).norm();
       const double edge_out = (chain.points[i + 1] - chain.points[i]).norm();
       TrajectoryPiece loop =

@@ -108,6 +108,9 @@ struct PathMotionOptions {
   // loops leave and re-enter their lines at rest (extrusion: the line ends at rest, the nozzle
   // travels with the flow off, the next line starts from rest); else at the lines' speeds
   bool loops_at_rest = false;
+  // a speed change from or to rest across blended corners whose lines are too short for it is
+  // planned as one curve (the look-ahead changes speed on the lines only)
+  bool curved_ramps = true;
 };
 
 // A chain with its runs of fine edges merged (a block compressor, LinuxCNC's naive-CAM
@@ -174,6 +177,9 @@ struct PlannedPath {
   // much longer a line laid at the print speed would be (what a stream that cannot follow the
   // speed lays thicker there)
   double run_speed_deficit_mm = 0.0;
+  // the corners' speeds as the look-ahead gave them, speeds changing on the lines only (before
+  // any curved ramp): what tells a blend that holds its lines back (resize_held_blends)
+  std::vector<double> lookahead_corner_speed_mm_s;
 };
 
 // The limits a planner needs with a jerk limit on every axis: the user's where given, else
@@ -182,7 +188,10 @@ TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s);
 
 // Plans a chain from t_begin with the corners as given (one per point; ends ignored). `limits`
 // must carry jerk limits (with_jerk_limits). InputError when a print speed exceeds an axis'
-// limit along its edge.
+// limit along its edge. Speeds change on the lines (a backward and a forward look-ahead), on a
+// run from rest to rest, and (options.curved_ramps) on a curved ramp: a stretch from or to a
+// rest across blended corners the look-ahead leaves below their caps, planned as one curve
+// where that is quicker.
 PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry>& geometry,
                        const std::vector<CornerPlan>& corners, const TcpLimits& limits,
                        const PathMotionOptions& options, double t_begin_s);

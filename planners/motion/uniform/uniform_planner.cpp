@@ -273,6 +273,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
   options.flow_may_retract = !aerosol && model.settings.retract;
   options.loops_at_rest = !aerosol;
   options.period_s = settings_.period_s;
+  options.curved_ramps = settings_.curved_ramps;
 
   // arcs as fine chords (their corners are blended like any other)
   Toolpath chorded = toolpath;
@@ -334,12 +335,14 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
       PlannedPath planned = plan_chain(chain, geometry, plan, jerk_limits, options, 0.0);
       const std::vector<CornerPlan> chosen = plan;
       std::vector<CornerPlan> trial = plan;
-      std::vector<double> trial_speeds = planned.corner_speed_mm_s;
+      // (the look-ahead's corner speeds, without curved ramps: the trials are the same with
+      // or without them, each plan with them no slower)
+      std::vector<double> trial_speeds = planned.lookahead_corner_speed_mm_s;
       for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
                                                                     jerk_limits, chosen, trial);
            ++pass) {
         PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
-        trial_speeds = replanned.corner_speed_mm_s;
+        trial_speeds = replanned.lookahead_corner_speed_mm_s;
         if (replanned.t_end_s < planned.t_end_s) {
           planned = std::move(replanned);
           plan = trial;

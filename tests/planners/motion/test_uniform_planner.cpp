@@ -350,14 +350,14 @@ TEST(UniformPlanner, BlendsStayInsideTheToleranceBand) {
 }
 
 // A slicer's arc is a run of short chords; blends sized for the print speed fill them whole,
-// and speed changes happen on straight lines only. An extruder's path that ends on such an arc
-// (a perimeter's last corner, rounded_square_3_layers.gcode) must still slow down only near
-// its end: the arc's 4.7 mm (a quarter circle of radius 3 in 14 chords, at 30 mm/s, the
-// clothoids holding it at 29 mm/s) take at most twice what the same length of straight line
-// ending at rest takes (0.34 s; 0.47 s measured, its chords merged within half the tolerance
-// and held blends resized for 1.5 x their speed; 0.58 s blended one chord at a time and
-// resized for 4 x). Before the planner resized the blends the look-ahead held back, the arc
-// crawled at 3 mm/s: 1.64 s.
+// leaving no line to change speed on. An extruder's path that ends on such an arc (a
+// perimeter's last corner, rounded_square_3_layers.gcode) must still slow down only near its
+// end: the arc's 4.7 mm (a quarter circle of radius 3 in 14 chords, at 30 mm/s) take at most
+// 1.1 x what the same length of straight line ending at rest takes (0.344 s; 0.348 s measured,
+// the stop a curved ramp along the arc). With speeds changing on the lines only it took
+// 0.47 s (its chords merged within half the tolerance, held blends resized for 1.5 x their
+// speed); before the planner resized the blends the look-ahead held back, the arc crawled at
+// 3 mm/s: 1.64 s.
 TEST(UniformPlanner, PathEndingOnAChordedArcSlowsDownOnlyNearItsEnd) {
   const MachineLimits limits = MachineLimits::uniform(100.0, 1000.0);
   const auto print_time_from = [&](const std::vector<Vec3>& points, const Vec3& from) {
@@ -390,7 +390,7 @@ TEST(UniformPlanner, PathEndingOnAChordedArcSlowsDownOnlyNearItsEnd) {
   const double on_line =
       print_time_from({Vec3(0, 0, 0), Vec3(14.0 + quarter, 0, 0)}, Vec3(14, 0, 0));
   EXPECT_GT(on_line, quarter / 30.0);
-  EXPECT_LE(on_arc, 2.0 * on_line) << "arc " << on_arc << " s, line " << on_line << " s";
+  EXPECT_LE(on_arc, 1.1 * on_line) << "arc " << on_arc << " s, line " << on_line << " s";
 }
 
 // Extrusion: the commanded flow leads the planned speed by the lag, so the nozzle's lagging

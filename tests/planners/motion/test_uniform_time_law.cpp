@@ -6,9 +6,13 @@
 
 #include <cmath>
 
+#include "contract/planner_checks.hpp"
 #include "kinematics/linear_delta.hpp"
 #include "kinematics/xy_stage.hpp"
+#include "metrics/motion_metrics.hpp"
 #include "motion/jerk.hpp"
+#include "planners/motion/polyline_job.hpp"
+#include "planners/motion/process_context.hpp"
 #include "planners/motion/uniform/line_profile.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
 
@@ -201,6 +205,63 @@ TEST(UniformTimeLaw, DeltaCarriagesWithinTheirLimits) {
   EXPECT_LE(peak_v, carriage.v_max);
   EXPECT_LE(peak_a, carriage.a_max);
   EXPECT_GT(peak_v, 0.0);
+}
+
+// A print path that comes to rest on a curve (a slicer's rounded corner at a perimeter's end:
+// a 10 mm line, then a quarter circle of 3 mm radius in 0.2 mm chords), or starts from rest on
+// one (the same reversed), at 30 mm/s. The chords' blends leave the lines between them too
+// short for the speed to change on: the look-ahead alone crawls the curve chord by chord,
+// and coming to rest under the extruder's deceleration rule (|dv/dt| <= v / tau) that costs
+// most. A curved ramp changes speed on the curve itself: quicker than with curved_ramps off
+// (ending on the curve by more than 10 %; starting on it, where accelerations have no such
+// rule, by less), the same corner choices, within the tolerance, every axis within its limits
+// by finite differences, the rule kept (the led flow v + tau dv/dt never below 0), and at rest
+// at the path's ends.
+TEST(UniformTimeLaw, RampToAndFromRestOnACurveChangesSpeedOnTheCurve) {
+  const MachineLimits axes = MachineLimits::uniform(100.0, 1000.0);
+  const double speed = 30.0, r = 3.0;
+  std::vector<Vec3> ending = {Vec3(0, 0, 0.2)};
+  const int chords = static_cast<int>(std::ceil(0.5 * kPi * r / 0.2));
+  for (int k = 0; k <= chords; ++k) {
+    const double angle = -0.5 * kPi + 0.5 * kPi * k / chords;
+    ending.emplace_back(10.0 + r * std::cos(angle), r + r * std::sin(angle), 0.2);
+  }
+  const std::vector<Vec3> starting(ending.rbegin(), ending.rend());
+  const std::vector<Vec3>* both[] = {&ending, &starting};
+  const UniformSettings settings;
+  UniformSettings lines_only;
+  lines_only.curved_ramps = false;
+  const PlanningContext extrusion = process_context(ProcessType::extrusion);
+  const double lag_s = extrusion.process->tau_s;
+  MachineLimits jerk_limited = axes;
+  for (AxisLimits& axis : jerk_limited.axes)
+    axis.j_max_mm_s3 = axis.a_max_mm_s2 / settings.jerk_ramp_s;
+  for (const std::vector<Vec3>* points : both) {
+    SCOPED_TRACE(points == &ending ? "ends on the curve" : "starts on the curve");
+    const Toolpath toolpath = polyline_job(*points, speed);
+    const Trajectory plan = UniformPlanner{settings}.plan_in_context(toolpath, axes, extrusion);
+    const Trajectory chord_by_chord =
+        UniformPlanner{lines_only}.plan_in_context(toolpath, axes, extrusion);
+    EXPECT_LT(plan.duration_s(), (points == &ending ? 0.9 : 1.0) * chord_by_chord.duration_s());
+    ASSERT_EQ(plan.decisions().size(), chord_by_chord.decisions().size());
+    for (size_t k = 0; k < plan.decisions().size(); ++k) {
+      EXPECT_EQ(plan.decisions()[k].choice, chord_by_chord.decisions()[k].choice);
+    }
+    const MotionSamples samples = sample_trajectory(plan, 1e-4);
+    EXPECT_LE(path_error(samples, toolpath).max_mm, settings.tolerance_mm);
+    testing_support::expect_finite_difference_limits(plan, jerk_limited, 0.01);
+    for (size_t k = 0; k < samples.size(); ++k) {
+      const Vec3& v = samples.velocity_mm_s[k];
+      if (!samples.depositing[k] || !(v.norm() > 0.03 * speed)) continue;
+      const double rate = v.dot(plan.at(samples.t_s[k]).acceleration_mm_s2) / v.norm();
+      EXPECT_GE(v.norm() + lag_s * rate, -0.01 * speed) << "t " << samples.t_s[k];
+    }
+    for (const double t : {0.0, plan.duration_s()}) {
+      EXPECT_LT(plan.at(t).velocity_mm_s.norm(), 1e-9) << "t " << t;
+    }
+    EXPECT_LT((plan.at(0.0).position_mm - points->front()).norm(), 1e-9);
+    EXPECT_LT((plan.at(plan.duration_s()).position_mm - points->back()).norm(), 1e-9);
+  }
 }
 
 }  // namespace
