@@ -65,6 +65,21 @@ TrajectoryPiece depositing_piece(const PrintChain& chain, size_t edge,
   return piece;
 }
 
+// a depositing piece of edge `edge` from t_s made of the samples begin..end (one period apart)
+TrajectoryPiece sampled_piece(const PrintChain& chain, size_t edge,
+                              const PathMotionOptions& options, double t_s, double period_s,
+                              const std::vector<Vec3>& position, const std::vector<Vec3>& velocity,
+                              size_t begin, size_t end) {
+  TrajectoryPiece piece =
+      depositing_piece(chain, edge, options, t_s, static_cast<double>(end - begin) * period_s);
+  SampledMotion motion;
+  motion.period_s = period_s;
+  motion.position_mm.assign(position.begin() + begin, position.begin() + end + 1);
+  motion.velocity_mm_s.assign(velocity.begin() + begin, velocity.begin() + end + 1);
+  piece.motion = std::move(motion);
+  return piece;
+}
+
 // A chain that is one arc run from rest to rest (ArcRun::from_rest_to_rest: an extrusion path
 // along one chorded circle, a slicer's hole), its speed changing on the curve itself. The speed
 // along it is line_profile's jerk-limited law in arc length (decelerations under the flow
@@ -174,14 +189,8 @@ PlannedPath plan_run_from_rest(const PrintChain& chain, const ArcRun& run, const
     size_t end = begin;
     while (end < periods && (section == 2 || s[end] < section_end)) ++end;
     if (end == begin) continue;
-    TrajectoryPiece piece = depositing_piece(chain, run.section_edge(section), options, t,
-                                             static_cast<double>(end - begin) * period);
-    SampledMotion motion;
-    motion.period_s = period;
-    motion.position_mm.assign(position.begin() + begin, position.begin() + end + 1);
-    motion.velocity_mm_s.assign(velocity.begin() + begin, velocity.begin() + end + 1);
-    piece.motion = std::move(motion);
-    planned.pieces.push_back(std::move(piece));
+    planned.pieces.push_back(sampled_piece(chain, run.section_edge(section), options, t, period,
+                                           position, velocity, begin, end));
     t = planned.pieces.back().t_end_s;
     begin = end;
   }
@@ -617,14 +626,8 @@ double emit_curved_ramp(const CurvedRamp& ramp, const PrintChain& chain,
     size_t end = begin;
     while (end < periods && (last_section || s[end] < section_end)) ++end;
     if (end == begin) continue;
-    TrajectoryPiece piece =
-        depositing_piece(chain, sec.edge, options, t, static_cast<double>(end - begin) * period);
-    SampledMotion motion;
-    motion.period_s = period;
-    motion.position_mm.assign(position.begin() + begin, position.begin() + end + 1);
-    motion.velocity_mm_s.assign(velocity.begin() + begin, velocity.begin() + end + 1);
-    piece.motion = std::move(motion);
-    planned.pieces.push_back(std::move(piece));
+    planned.pieces.push_back(
+        sampled_piece(chain, sec.edge, options, t, period, position, velocity, begin, end));
     t = planned.pieces.back().t_end_s;
     begin = end;
   }
