@@ -437,7 +437,7 @@ struct TrimmedLine {
 // chord by chord. Here it is line_profile's law over the whole stretch, held to every axis'
 // limits by the same check as a run from rest (plan_run_from_rest): per axis k the curve adds
 // a_k = p'_k sddot + p''_k sdot^2 and j_k = p'_k sdddot + 3 p''_k sdot sddot + p'''_k sdot^3,
-// checked on the blends at every quarter sample period against blend_limits over each blend's
+// checked on the blends at every quarter period against blend_limits over each blend's
 // box, and each blend's speed against its corner's cap.
 struct CurvedRamp {
   struct Section {
@@ -535,7 +535,7 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
   }
   const double lowest = std::max(v0, v1);
   if (ramp.sections.empty() || lowest > law.v_max_mm_s) return false;
-  // (checked once a sample period while the law is lowered, then every quarter of one)
+  // (checked once a period while the law is lowered, then every quarter period)
   bool fine = false;
   for (int round = 0;; ++round) {
     if (speed_change_distance(v0, lowest, law) + speed_change_distance(lowest, v1, law) >
@@ -545,10 +545,9 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
     const double duration = ramp.profile.duration_s();
     if (!(duration < standard_s)) return false;
     // every axis on the blends, against their boxes' limits (on the lines the law keeps the
-    // lines' own limits)
-    const size_t checks =
-        std::max<size_t>(8, static_cast<size_t>(std::ceil((fine ? 4.0 : 1.0) * duration /
-                                                          ramp.sample_period_s(options.period_s))));
+    // lines' own limits), once a period (fine: every quarter period)
+    const size_t checks = std::max<size_t>(
+        8, static_cast<size_t>(std::ceil((fine ? 4.0 : 1.0) * duration / options.period_s)));
     double speed_ratio = 0.0, accel_ratio = 0.0, jerk_ratio = 0.0;
     bool jerk_by_cross_term = false;  // at the worst jerk, the cross term is the larger
     size_t phase = 0, section = 0;
