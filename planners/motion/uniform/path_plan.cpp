@@ -481,6 +481,10 @@ struct CurvedRamp {
 };
 
 constexpr int kCurvedRampRounds = 40;
+// a ramp is sampled at most this much finer than period_s (its blends' halves keep
+// kMinBlendHalfPeriods samples at the law's peak speed): a ramp over blends shorter than that
+// allows is not tried (the look-ahead samples each blend on its own)
+constexpr double kMaxRampRefinement = 16.0;
 
 // Plans lines first..last (and the blends between them) from v0 to v1 as one CurvedRamp; false
 // where the law cannot join the speeds in the stretch or is not faster than standard_s, the
@@ -535,6 +539,9 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
   }
   const double lowest = std::max(v0, v1);
   if (ramp.sections.empty() || lowest > law.v_max_mm_s) return false;
+  if (ramp.shortest_blend_half_mm / law.v_max_mm_s / kMinBlendHalfPeriods <
+      options.period_s / kMaxRampRefinement)
+    return false;
   // (checked once a period while the law is lowered, then every quarter period)
   bool fine = false;
   for (int round = 0;; ++round) {
