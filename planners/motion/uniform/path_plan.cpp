@@ -80,6 +80,35 @@ TrajectoryPiece sampled_piece(const PrintChain& chain, size_t edge,
   return piece;
 }
 
+// The worst per-axis acceleration and jerk against their limits of a speed law along a curve:
+// per axis k, a_k = p'_k sddot + p''_k sdot^2, j_k = p'_k sdddot + 3 p''_k sdot sddot +
+// p'''_k sdot^3 (plan_run_from_rest, plan_curved_ramp)
+struct CurveLimitRatios {
+  double accel = 0.0, jerk = 0.0;
+  bool jerk_by_cross_term = false;  // at the worst jerk, the cross term is the larger
+  void add(const Vec3& d1, const Vec3& d2, const Vec3& d3, double v, double a, double law_jerk,
+           const MachineLimits& axes) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const double axis_accel = d1[axis] * a + d2[axis] * v * v;
+      const double cross = 3.0 * d2[axis] * v * a;
+      const double axis_jerk = d1[axis] * law_jerk + cross + d3[axis] * v * v * v;
+      accel = std::max(accel, std::abs(axis_accel) / axes.axes[axis].a_max_mm_s2);
+      const double ratio = std::abs(axis_jerk) / axes.axes[axis].j_max_mm_s3;
+      if (ratio > jerk) {
+        jerk = ratio;
+        jerk_by_cross_term = std::abs(cross) > std::abs(d1[axis] * law_jerk);
+      }
+    }
+  }
+  bool within() const { return accel <= 1.0 + 1e-9 && jerk <= 1.0 + 1e-9; }
+  // lowers the law where exceeded: an exceeded acceleration, or a jerk the cross term sets,
+  // lowers its acceleration; a jerk p' sdddot sets, its jerk
+  void lower(LineLimits& law, double scale) const {
+    if (accel > 1.0 + 1e-9 || (jerk > 1.0 + 1e-9 && jerk_by_cross_term)) law.a_max_mm_s2 *= scale;
+    if (jerk > 1.0 + 1e-9 && !jerk_by_cross_term) law.j_max_mm_s3 *= scale;
+  }
+};
+
 // A chain that is one arc run from rest to rest (ArcRun::from_rest_to_rest: an extrusion path
 // along one chorded circle, a slicer's hole), its speed changing on the curve itself. The speed
 // along it is line_profile's jerk-limited law in arc length (decelerations under the flow
@@ -127,34 +156,19 @@ PlannedPath plan_run_from_rest(const PrintChain& chain, const ArcRun& run, const
     const double duration = profile.duration_s();
     const size_t checks =
         std::max<size_t>(8, static_cast<size_t>(std::ceil(4.0 * duration / options.period_s)));
-    double accel_ratio = 0.0, jerk_ratio = 0.0;
-    bool jerk_by_cross_term = false;  // at the worst jerk, the cross term is the larger
+    CurveLimitRatios ratios;
     size_t phase = 0;
     for (size_t m = 0; m <= checks; ++m) {
       const double t = duration * static_cast<double>(m) / static_cast<double>(checks);
       const AxisState state = profile.at(t, phase);
-      const double jerk = profile.jerk_at(t);
       Vec3 p, d1, d2, d3;
       run.at(std::clamp(state.q, 0.0, length), p, d1, d2, d3);
-      const double v = state.v, a = state.a;
-      for (int axis = 0; axis < 3; ++axis) {
-        const double accel = d1[axis] * a + d2[axis] * v * v;
-        const double cross = 3.0 * d2[axis] * v * a;
-        const double axis_jerk = d1[axis] * jerk + cross + d3[axis] * v * v * v;
-        accel_ratio = std::max(accel_ratio, std::abs(accel) / axes.axes[axis].a_max_mm_s2);
-        const double ratio = std::abs(axis_jerk) / axes.axes[axis].j_max_mm_s3;
-        if (ratio > jerk_ratio) {
-          jerk_ratio = ratio;
-          jerk_by_cross_term = std::abs(cross) > std::abs(d1[axis] * jerk);
-        }
-      }
+      ratios.add(d1, d2, d3, state.v, state.a, profile.jerk_at(t), axes);
     }
-    if (accel_ratio <= 1.0 + 1e-9 && jerk_ratio <= 1.0 + 1e-9) break;
+    if (ratios.within()) break;
     if (round == kRampRounds)
       throw InternalError("uniform: an arc run from rest does not keep its limits");
-    if (accel_ratio > 1.0 + 1e-9 || (jerk_ratio > 1.0 + 1e-9 && jerk_by_cross_term))
-      law.a_max_mm_s2 *= kRampLimitScale;
-    if (jerk_ratio > 1.0 + 1e-9 && !jerk_by_cross_term) law.j_max_mm_s3 *= kRampLimitScale;
+    ratios.lower(law, kRampLimitScale);
     // (past half the rounds, the jerk and the cruise too: a cruise at its arc's bound leaves a
     // ramp's end no room unless the jerk is at most about 2 a^2 / v)
     if (2 * round >= kRampRounds) {
@@ -555,8 +569,8 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
     // lines' own limits), once a period (fine: every quarter period)
     const size_t checks = std::max<size_t>(
         8, static_cast<size_t>(std::ceil((fine ? 4.0 : 1.0) * duration / options.period_s)));
-    double speed_ratio = 0.0, accel_ratio = 0.0, jerk_ratio = 0.0;
-    bool jerk_by_cross_term = false;  // at the worst jerk, the cross term is the larger
+    double speed_ratio = 0.0;
+    CurveLimitRatios ratios;
     size_t phase = 0, section = 0;
     for (size_t m = 0; m <= checks; ++m) {
       const double t = duration * static_cast<double>(m) / static_cast<double>(checks);
@@ -564,25 +578,14 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
       Vec3 p, d1, d2, d3;
       ramp.at(std::clamp(state.q, 0.0, ramp.length), section, p, d1, d2, d3);
       if (ramp.sections[section].line != nullptr) continue;
-      const double jerk = ramp.profile.jerk_at(t);
       const MachineLimits& axes = ramp.sections[section].axes;
-      const double v = state.v, a = state.a;
+      const double v = state.v;
       speed_ratio = std::max(speed_ratio, v / ramp.sections[section].speed_cap_mm_s);
-      for (int axis = 0; axis < 3; ++axis) {
-        const AxisLimits& bound = axes.axes[axis];
-        speed_ratio = std::max(speed_ratio, std::abs(d1[axis] * v) / bound.v_max_mm_s);
-        const double accel = d1[axis] * a + d2[axis] * v * v;
-        const double cross = 3.0 * d2[axis] * v * a;
-        const double axis_jerk = d1[axis] * jerk + cross + d3[axis] * v * v * v;
-        accel_ratio = std::max(accel_ratio, std::abs(accel) / bound.a_max_mm_s2);
-        const double ratio = std::abs(axis_jerk) / bound.j_max_mm_s3;
-        if (ratio > jerk_ratio) {
-          jerk_ratio = ratio;
-          jerk_by_cross_term = std::abs(cross) > std::abs(d1[axis] * jerk);
-        }
-      }
+      for (int axis = 0; axis < 3; ++axis)
+        speed_ratio = std::max(speed_ratio, std::abs(d1[axis] * v) / axes.axes[axis].v_max_mm_s);
+      ratios.add(d1, d2, d3, v, state.a, ramp.profile.jerk_at(t), axes);
     }
-    if (speed_ratio <= 1.0 + 1e-9 && accel_ratio <= 1.0 + 1e-9 && jerk_ratio <= 1.0 + 1e-9) {
+    if (speed_ratio <= 1.0 + 1e-9 && ratios.within()) {
       if (fine) return true;
       fine = true;
       continue;
@@ -591,9 +594,7 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
     // lower what was exceeded (as plan_run_from_rest does); past half the rounds the jerk and
     // the cruise too
     if (speed_ratio > 1.0 + 1e-9) law.v_max_mm_s /= speed_ratio;
-    if (accel_ratio > 1.0 + 1e-9 || (jerk_ratio > 1.0 + 1e-9 && jerk_by_cross_term))
-      law.a_max_mm_s2 *= kRampLimitScale;
-    if (jerk_ratio > 1.0 + 1e-9 && !jerk_by_cross_term) law.j_max_mm_s3 *= kRampLimitScale;
+    ratios.lower(law, kRampLimitScale);
     if (2 * round >= kCurvedRampRounds) {
       law.j_max_mm_s3 *= kRampLimitScale;
       law.v_max_mm_s *= kRampCruiseScale;
