@@ -444,15 +444,15 @@ struct TrimmedLine {
   LineLimits limits;
 };
 
-// A stretch of a chain from or to rest across blended (or straight) corners: lines first_line
-// to last_line with the blends between them, planned as one curve in arc length. The
-// look-ahead changes speed on the lines only (each line's profile starts and ends with zero
-// acceleration, the blends are taken at constant speed), so a ramp over short chords crawls up
-// chord by chord. Here it is line_profile's law over the whole stretch, held to every axis'
-// limits by the same check as a run from rest (plan_run_from_rest): per axis k the curve adds
-// a_k = p'_k sddot + p''_k sdot^2 and j_k = p'_k sdddot + 3 p''_k sdot sddot + p'''_k sdot^3,
-// checked on the blends at every quarter period against blend_limits over each blend's
-// box, and each blend's speed against its corner's cap.
+// A stretch of a chain from or to rest (or a corner held at its cap) across blended (or
+// straight) corners: lines first_line to last_line with the blends between them, planned as one
+// curve in arc length. The look-ahead changes speed on the lines only (each line's profile
+// starts and ends with zero acceleration, the blends are taken at constant speed), so a ramp
+// over short chords crawls up chord by chord. Here it is line_profile's law over the whole stretch,
+// held to every axis' limits by the same check as a run from rest (plan_run_from_rest): per axis k
+// the curve adds a_k = p'_k sddot + p''_k sdot^2 and j_k = p'_k sdddot + 3 p''_k sdot sddot +
+// p'''_k sdot^3, checked on the blends at every quarter period (and twice per emitted sample)
+// against blend_limits over each blend's box, and each blend's speed against its corner's cap.
 struct CurvedRamp {
   struct Section {
     double s_begin = 0.0, length = 0.0;
@@ -556,7 +556,9 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
   if (ramp.shortest_blend_half_mm / law.v_max_mm_s / kMinBlendHalfPeriods <
       options.period_s / kMaxRampRefinement)
     return false;
-  // (checked once a period while the law is lowered, then every quarter period)
+  // (checked once a period while the law is lowered, then at every quarter period and at least
+  // twice per emitted sample, so each half blend is checked kMinBlendHalfPeriods * 2 times or
+  // more however short it is)
   bool fine = false;
   for (int round = 0;; ++round) {
     if (speed_change_distance(v0, lowest, law) + speed_change_distance(lowest, v1, law) >
@@ -566,9 +568,12 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
     const double duration = ramp.profile.duration_s();
     if (!(duration < standard_s)) return false;
     // every axis on the blends, against their boxes' limits (on the lines the law keeps the
-    // lines' own limits), once a period (fine: every quarter period)
-    const size_t checks = std::max<size_t>(
-        8, static_cast<size_t>(std::ceil((fine ? 4.0 : 1.0) * duration / options.period_s)));
+    // lines' own limits), once a period (fine: as above)
+    const double check_step_s =
+        fine ? std::min(options.period_s / 4.0, ramp.sample_period_s(options.period_s) / 2.0)
+             : options.period_s;
+    const size_t checks =
+        std::max<size_t>(8, static_cast<size_t>(std::ceil(duration / check_step_s)));
     double speed_ratio = 0.0;
     CurveLimitRatios ratios;
     size_t phase = 0, section = 0;
@@ -761,10 +766,11 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
   for (size_t k = 0; k + 1 < edges; ++k)
     if (!split[k + 1]) v_start[k + 1] = v_end[k] = std::min(v_end[k], v_start[k + 1]);
 
-  // ramps from and to rest across blended corners, where the look-ahead leaves corners below
-  // their caps (speeds the lines between them and the rest could not reach): each such
-  // stretch, from the rest to the first corner that rest does not hold, as one CurvedRamp where
-  // that is faster (the look-ahead's corner speeds kept for resize_held_blends)
+  // ramps from and to rest (or a corner held at its cap) across blended corners, where the
+  // look-ahead leaves corners below their caps (speeds the lines between them and that node
+  // could not reach): each such stretch, from the node to the first corner it does not hold,
+  // as one CurvedRamp where that is faster (the look-ahead's corner speeds kept for
+  // resize_held_blends)
   std::vector<CurvedRamp> ramps;
   std::vector<int> ramp_of_line(edges, -1);
   planned.lookahead_corner_speed_mm_s.assign(n, 0.0);
@@ -818,9 +824,14 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
       ramps.push_back(std::move(ramp));
     };
     for (size_t r = 0; r <= edges; ++r) {
-      // node r at rest: the chain's ends, stops, loops at rest
+      // node r at rest (the chain's ends, stops, loops at rest) or held at its own cap (a
+      // blend or straight the look-ahead takes at its bound: a sharp corner's slow blend)
       const bool at_rest = (r == edges || v_start[r] == 0.0) && (r == 0 || v_end[r - 1] == 0.0);
-      if (!at_rest) continue;
+      const bool at_cap = r > 0 && r < edges && !split[r] &&
+                          (corners[r].treatment == CornerTreatment::blend ||
+                           corners[r].treatment == CornerTreatment::straight) &&
+                          v_start[r] >= cap_before[r] * (1.0 - 1e-9);
+      if (!at_rest && !at_cap) continue;
       // into it (lines first..r-1), then out of it (lines r..last); neither ends at a run
       if (r > 0) {
         size_t first = r - 1;

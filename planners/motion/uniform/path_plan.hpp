@@ -108,8 +108,9 @@ struct PathMotionOptions {
   // loops leave and re-enter their lines at rest (extrusion: the line ends at rest, the nozzle
   // travels with the flow off, the next line starts from rest); else at the lines' speeds
   bool loops_at_rest = false;
-  // a speed change from or to rest across blended corners whose lines are too short for it is
-  // planned as one curve (the look-ahead changes speed on the lines only)
+  // a speed change from or to rest (or a corner held at its cap) across blended corners whose
+  // lines are too short for it is planned as one curve (the look-ahead changes speed on the
+  // lines only)
   bool curved_ramps = true;
 };
 
@@ -190,8 +191,8 @@ TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s);
 // must carry jerk limits (with_jerk_limits). InputError when a print speed exceeds an axis'
 // limit along its edge. Speeds change on the lines (a backward and a forward look-ahead), on a
 // run from rest to rest, and (options.curved_ramps) on a curved ramp: a stretch from or to a
-// rest across blended corners the look-ahead leaves below their caps, planned as one curve
-// where that is quicker.
+// rest or a corner held at its cap across blended corners the look-ahead leaves below their
+// caps, planned as one curve where that is quicker.
 PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry>& geometry,
                        const std::vector<CornerPlan>& corners, const TcpLimits& limits,
                        const PathMotionOptions& options, double t_begin_s);

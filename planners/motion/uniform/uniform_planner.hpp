@@ -59,9 +59,9 @@ struct UniformSettings {
   // speed one by one (find_arc_runs; not a scenario parameter: off, every corner is its own, as
   // the tests compare)
   bool arc_runs = true;
-  // speed changes from and to rest across blended corners planned as one curve (plan_chain's
-  // curved ramps; not a scenario parameter: off, they change on the lines only, as the tests
-  // compare)
+  // speed changes from and to rest (or a held corner) across blended corners planned as one
+  // curve (plan_chain's curved ramps; not a scenario parameter: off, they change on the lines
+  // only, as the tests compare)
   bool curved_ramps = true;
 };
 

@@ -207,27 +207,15 @@ TEST(UniformTimeLaw, DeltaCarriagesWithinTheirLimits) {
   EXPECT_GT(peak_v, 0.0);
 }
 
-// A print path that comes to rest on a curve (a slicer's rounded corner at a perimeter's end:
-// a 10 mm line, then a quarter circle of 3 mm radius in 0.2 mm chords), or starts from rest on
-// one (the same reversed), at 30 mm/s. The chords' blends leave the lines between them too
-// short for the speed to change on: the look-ahead alone crawls the curve chord by chord,
-// and coming to rest under the extruder's deceleration rule (|dv/dt| <= v / tau) that costs
-// most. A curved ramp changes speed on the curve itself: quicker than with curved_ramps off
-// (ending on the curve by more than 10 %; starting on it, where accelerations have no such
-// rule, by less), the same corner choices, within the tolerance, every axis within its limits
-// by finite differences, the rule kept (the led flow v + tau dv/dt never below 0), and at rest
-// at the path's ends.
-TEST(UniformTimeLaw, RampToAndFromRestOnACurveChangesSpeedOnTheCurve) {
-  const MachineLimits axes = MachineLimits::uniform(100.0, 1000.0);
-  const double speed = 30.0, r = 3.0;
-  std::vector<Vec3> ending = {Vec3(0, 0, 0.2)};
-  const int chords = static_cast<int>(std::ceil(0.5 * kPi * r / 0.2));
-  for (int k = 0; k <= chords; ++k) {
-    const double angle = -0.5 * kPi + 0.5 * kPi * k / chords;
-    ending.emplace_back(10.0 + r * std::cos(angle), r + r * std::sin(angle), 0.2);
-  }
-  const std::vector<Vec3> starting(ending.rbegin(), ending.rend());
-  const std::vector<Vec3>* both[] = {&ending, &starting};
+// Plans an extrusion polyline at `speed` with curved ramps and without (speeds changing on the
+// lines only) and checks the ramps' plan: quicker than below_ratio x the other, the same corner
+// choices, within the tolerance, every axis within its limits by finite differences, the
+// extruder's deceleration rule kept (the led flow v + tau dv/dt never below 0), at rest at the
+// path's ends. Returns the two plans (with ramps first).
+std::pair<Trajectory, Trajectory> expect_quicker_with_curved_ramps(const std::vector<Vec3>& points,
+                                                                   double speed,
+                                                                   const MachineLimits& axes,
+                                                                   double below_ratio) {
   const UniformSettings settings;
   UniformSettings lines_only;
   lines_only.curved_ramps = false;
@@ -236,32 +224,89 @@ TEST(UniformTimeLaw, RampToAndFromRestOnACurveChangesSpeedOnTheCurve) {
   MachineLimits jerk_limited = axes;
   for (AxisLimits& axis : jerk_limited.axes)
     axis.j_max_mm_s3 = axis.a_max_mm_s2 / settings.jerk_ramp_s;
-  for (const std::vector<Vec3>* points : both) {
-    SCOPED_TRACE(points == &ending ? "ends on the curve" : "starts on the curve");
-    const Toolpath toolpath = polyline_job(*points, speed);
-    const Trajectory plan = UniformPlanner{settings}.plan_in_context(toolpath, axes, extrusion);
-    const Trajectory chord_by_chord =
-        UniformPlanner{lines_only}.plan_in_context(toolpath, axes, extrusion);
-    EXPECT_LT(plan.duration_s(), (points == &ending ? 0.9 : 1.0) * chord_by_chord.duration_s());
-    ASSERT_EQ(plan.decisions().size(), chord_by_chord.decisions().size());
-    for (size_t k = 0; k < plan.decisions().size(); ++k) {
-      EXPECT_EQ(plan.decisions()[k].choice, chord_by_chord.decisions()[k].choice);
-    }
-    const MotionSamples samples = sample_trajectory(plan, 1e-4);
-    EXPECT_LE(path_error(samples, toolpath).max_mm, settings.tolerance_mm);
-    testing_support::expect_finite_difference_limits(plan, jerk_limited, 0.01);
-    for (size_t k = 0; k < samples.size(); ++k) {
-      const Vec3& v = samples.velocity_mm_s[k];
-      if (!samples.depositing[k] || !(v.norm() > 0.03 * speed)) continue;
-      const double rate = v.dot(plan.at(samples.t_s[k]).acceleration_mm_s2) / v.norm();
-      EXPECT_GE(v.norm() + lag_s * rate, -0.01 * speed) << "t " << samples.t_s[k];
-    }
-    for (const double t : {0.0, plan.duration_s()}) {
-      EXPECT_LT(plan.at(t).velocity_mm_s.norm(), 1e-9) << "t " << t;
-    }
-    EXPECT_LT((plan.at(0.0).position_mm - points->front()).norm(), 1e-9);
-    EXPECT_LT((plan.at(plan.duration_s()).position_mm - points->back()).norm(), 1e-9);
+  const Toolpath toolpath = polyline_job(points, speed);
+  Trajectory plan = UniformPlanner{settings}.plan_in_context(toolpath, axes, extrusion);
+  Trajectory chord_by_chord = UniformPlanner{lines_only}.plan_in_context(toolpath, axes, extrusion);
+  EXPECT_LT(plan.duration_s(), below_ratio * chord_by_chord.duration_s());
+  EXPECT_EQ(plan.decisions().size(), chord_by_chord.decisions().size());
+  for (size_t k = 0; k < std::min(plan.decisions().size(), chord_by_chord.decisions().size()); ++k)
+    EXPECT_EQ(plan.decisions()[k].choice, chord_by_chord.decisions()[k].choice) << "corner " << k;
+  const MotionSamples samples = sample_trajectory(plan, 1e-4);
+  EXPECT_LE(path_error(samples, toolpath).max_mm, settings.tolerance_mm);
+  testing_support::expect_finite_difference_limits(plan, jerk_limited, 0.01);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const Vec3& v = samples.velocity_mm_s[k];
+    if (!samples.depositing[k] || !(v.norm() > 0.03 * speed)) continue;
+    const double rate = v.dot(plan.at(samples.t_s[k]).acceleration_mm_s2) / v.norm();
+    EXPECT_GE(v.norm() + lag_s * rate, -0.01 * speed) << "t " << samples.t_s[k];
   }
+  for (const double t : {0.0, plan.duration_s()}) {
+    EXPECT_LT(plan.at(t).velocity_mm_s.norm(), 1e-9) << "t " << t;
+  }
+  EXPECT_LT((plan.at(0.0).position_mm - points.front()).norm(), 1e-9);
+  EXPECT_LT((plan.at(plan.duration_s()).position_mm - points.back()).norm(), 1e-9);
+  return {std::move(plan), std::move(chord_by_chord)};
+}
+
+// A print path that comes to rest on a curve (a slicer's rounded corner at a perimeter's end:
+// a 10 mm line, then a quarter circle of 3 mm radius in 0.2 mm chords), or starts from rest on
+// one (the same reversed), at 30 mm/s. The chords' blends leave the lines between them too
+// short for the speed to change on: the look-ahead alone crawls the curve chord by chord,
+// and coming to rest under the extruder's deceleration rule (|dv/dt| <= v / tau) that costs
+// most. A curved ramp changes speed on the curve itself: quicker than with curved_ramps off
+// (ending on the curve by more than 10 %; starting on it, where accelerations have no such
+// rule, by less), with the checks of expect_quicker_with_curved_ramps.
+TEST(UniformTimeLaw, RampToAndFromRestOnACurveChangesSpeedOnTheCurve) {
+  const MachineLimits axes = MachineLimits::uniform(100.0, 1000.0);
+  const double r = 3.0;
+  std::vector<Vec3> ending = {Vec3(0, 0, 0.2)};
+  const int chords = static_cast<int>(std::ceil(0.5 * kPi * r / 0.2));
+  for (int k = 0; k <= chords; ++k) {
+    const double angle = -0.5 * kPi + 0.5 * kPi * k / chords;
+    ending.emplace_back(10.0 + r * std::cos(angle), r + r * std::sin(angle), 0.2);
+  }
+  const std::vector<Vec3> starting(ending.rbegin(), ending.rend());
+  {
+    SCOPED_TRACE("ends on the curve");
+    expect_quicker_with_curved_ramps(ending, 30.0, axes, 0.9);
+  }
+  {
+    SCOPED_TRACE("starts on the curve");
+    expect_quicker_with_curved_ramps(starting, 30.0, axes, 1.0);
+  }
+}
+
+// A curve between two sharp corners, none of it near rest: a 20 mm line, a 90 deg turn onto
+// half an ellipse (semi-axes 3 and 5 mm, 80 chords, no circle an arc run would take), a 70 deg
+// turn onto a 15 mm line, at 30 mm/s. Each sharp corner's slow blend holds the chords next to
+// it below their caps; a curved ramp from (and to) that held corner changes speed on the
+// curve: quicker than speeds changing on the lines only, and the corner before the exit's
+// sharp turn taken faster. (Ramps only out of and into rest gain nothing here: the rests sit
+// at the ends of the long lines.)
+TEST(UniformTimeLaw, RampOutOfAndIntoAHeldSharpCornerChangesSpeedOnTheCurve) {
+  const MachineLimits axes = MachineLimits::uniform(100.0, 1000.0);
+  std::vector<Vec3> points = {Vec3(-10, 0, 0.2), Vec3(10, 0, 0.2)};
+  const int chords = 80;
+  for (int k = 1; k <= chords; ++k) {
+    const double angle = kPi * k / chords;
+    points.emplace_back(7.0 + 3.0 * std::cos(angle), 5.0 * std::sin(angle), 0.2);
+  }
+  points.emplace_back(-10, -5, 0.2);
+  const auto [plan, chord_by_chord] = expect_quicker_with_curved_ramps(points, 30.0, axes, 0.999);
+  // the last corner reported before the exit's sharp turn (points[chords + 1]): its speed
+  const auto last_before_exit = [&](const Trajectory& t) {
+    std::pair<int, double> found{-1, 0.0};
+    for (const PlanDecision& d : t.decisions())
+      if (d.point_index > found.first && d.point_index < chords + 1)
+        for (const PlanFigure& f : d.figures)
+          if (f.name == "speed_mm_s") found = {d.point_index, f.value};
+    return found;
+  };
+  const std::pair<int, double> ramped = last_before_exit(plan);
+  const std::pair<int, double> crawled = last_before_exit(chord_by_chord);
+  ASSERT_GT(ramped.first, chords / 2);
+  ASSERT_EQ(ramped.first, crawled.first);
+  EXPECT_GT(ramped.second, 1.05 * crawled.second) << "corner " << ramped.first;
 }
 
 }  // namespace
