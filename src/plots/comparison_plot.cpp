@@ -177,12 +177,44 @@ HeightMap crop_map(const HeightMap& map, const ZoomWindow& window) {
   return out;
 }
 
-double shared_thickness_max_um(const ComparisonInput& input) {
-  double peak_um = 0.0;
+SharedThicknessScale shared_thickness_scale(const ComparisonInput& input) {
+  SharedThicknessScale scale;
+  std::vector<const HeightMap*> maps;
   for (const ComparisonColumn& column : input.columns)
-    if (has_map(column.thickness))
-      peak_um = std::max(peak_um, static_cast<double>(column.thickness->max_value()));
-  return peak_um > 0.0 ? peak_um : 1.0;
+    if (has_map(column.thickness)) {
+      maps.push_back(column.thickness);
+      scale.peak_um = std::max(scale.peak_um, static_cast<double>(column.thickness->max_value()));
+    }
+  if (!(scale.peak_um > 0.0)) return scale;
+  // each map's deposit cells' 95th percentile, from a histogram over [0, peak] (its bins a
+  // 4096th of the peak: fine for a colour scale), read at the bin's upper edge
+  constexpr int kBins = 4096;
+  constexpr double kDepositFloor = 0.01, kQuantile = 0.95;
+  const double bin_um = scale.peak_um / kBins;
+  std::vector<double> quantiles_um;
+  std::vector<size_t> histogram(kBins);
+  for (const HeightMap* map : maps) {
+    std::fill(histogram.begin(), histogram.end(), 0);
+    const double floor_um = kDepositFloor * map->max_value();
+    size_t cells = 0;
+    for (const float value : map->thickness_um) {
+      if (!(value > floor_um)) continue;
+      ++histogram[std::min(kBins - 1, static_cast<int>(value / bin_um))];
+      ++cells;
+    }
+    if (cells == 0) continue;
+    const size_t rank = static_cast<size_t>(std::ceil(kQuantile * static_cast<double>(cells)));
+    size_t below = 0;
+    int bin = 0;
+    while (bin + 1 < kBins && below + histogram[bin] < rank) below += histogram[bin++];
+    quantiles_um.push_back((bin + 1) * bin_um);
+  }
+  // the median run's (the lower of the middle two)
+  std::sort(quantiles_um.begin(), quantiles_um.end());
+  const double median_um = quantiles_um[(quantiles_um.size() - 1) / 2];
+  scale.top_um = std::min(scale.peak_um, kSharedScaleCap * median_um);
+  scale.capped = scale.top_um < scale.peak_um;
+  return scale;
 }
 
 PlotResult render_comparison(const ComparisonInput& input, const std::string& png_path,
@@ -219,7 +251,7 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
     if (!column.t_s.empty()) duration_s = std::max(duration_s, column.t_s.back());
     if (column.total_time_s) duration_s = std::max(duration_s, *column.total_time_s);
   }
-  const double cb_max_um = shared_thickness_max_um(input);
+  const SharedThicknessScale scale = shared_thickness_scale(input);
   const ZoomWindow zoom = orders ? ZoomWindow{} : thickest_spot_window(full_maps);
   if (zoom.found)
     for (size_t c = 0; c < columns; ++c)
@@ -231,10 +263,15 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
        style::quoted(input.title + (orders ? ": print order comparison" : ": planner comparison")) +
        " font \"" + style::title_font() + "\"\n";
   s += style::thickness_palette();
-  s += format("set cbrange [0:%.9g]\n", cb_max_um);
-  s += "set cblabel " +
-       style::quoted(style::axis_label("thickness, one colour scale for all runs", "µm")) +
-       " offset 0,0.4\n";
+  s += format("set cbrange [0:%.9g]\n", scale.top_um);
+  // (capped: a second line says so; gnuplot's double quotes take the \n)
+  const std::string scale_text =
+      style::axis_label("thickness, one colour scale for all runs", "µm") +
+      (scale.capped ? format("\\ntopped at %g × the median run's 95th percentile (thicker: the "
+                             "top colour); peak %.3g µm",
+                             kSharedScaleCap, scale.peak_um)
+                    : std::string());
+  s += "set cblabel \"" + scale_text + "\" offset 0,0.4\n";
   s += format("set colorbox horizontal user origin screen 0.2,%.4f size screen 0.6,%.4f\n",
               kColourBarY, kColourBarHeight);
   s += format(

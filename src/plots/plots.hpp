@@ -226,8 +226,18 @@ struct ComparisonInput {
   std::vector<ComparisonColumn> columns;
 };
 
-// the colour range every map shares: [0, max over all maps] (1 um when all are empty)
-double shared_thickness_max_um(const ComparisonInput& input);
+// The colour range every map shares, [0, top_um]: the largest peak of all maps, capped at
+// kSharedScaleCap (2) x the median run's 95th percentile of its deposit cells (cells above 1 %
+// of its peak; the lower middle one of an even count), so one run's blob does not wash the
+// other runs' lines out (its cells above the top take the top colour; the colour bar's label
+// then gives the peak). 1 um when all are empty.
+struct SharedThicknessScale {
+  double top_um = 1.0;
+  double peak_um = 0.0;  // the largest cell of all maps
+  bool capped = false;   // top_um < peak_um
+};
+constexpr double kSharedScaleCap = 2.0;
+SharedThicknessScale shared_thickness_scale(const ComparisonInput& input);
 
 // comparison.png at png_path: one column per run: its thickness map on a shared colour scale
 // with, below it, a zoom on the thickest spot (or, in an orders comparison, its print paths

@@ -1,5 +1,6 @@
 // The comparison sheet's data: the zoom window on the thickest spot and its crop, the print
-// order's travels and 0-based path numbers, orders comparisons told apart; the target note.
+// order's travels and 0-based path numbers, orders comparisons told apart; the target note;
+// the shared colour scale.
 #include <gtest/gtest.h>
 
 #include "plots/plots.hpp"
@@ -43,6 +44,49 @@ TEST(ComparisonZoom, WindowCentresOnTheThickestCellOfAllMaps) {
   HeightMap empty = spotted_map(0.0f);
   for (float& v : empty.thickness_um) v = 0.0f;
   EXPECT_FALSE(plots::thickest_spot_window({&empty}).found);
+}
+
+// The shared colour scale: the largest peak of all maps, unless that is more than twice the
+// median run's 95th percentile of its deposit, where it is topped there so one run's blob
+// does not wash the other runs' lines out.
+TEST(ComparisonScale, TopIsThePeakUnlessABlobWouldWashTheLinesOut) {
+  // even maps (every cell 1 um, one of 1.5 um): the peak
+  const HeightMap even = spotted_map(1.0f), slightly = spotted_map(1.5f);
+  plots::ComparisonInput input;
+  for (const HeightMap* map : {&even, &slightly}) {
+    plots::ComparisonColumn column;
+    column.thickness = map;
+    input.columns.push_back(column);
+  }
+  plots::SharedThicknessScale scale = plots::shared_thickness_scale(input);
+  EXPECT_FALSE(scale.capped);
+  EXPECT_DOUBLE_EQ(scale.top_um, 1.5);
+  EXPECT_DOUBLE_EQ(scale.peak_um, 1.5);
+  // a blob of 50 um over a tenth of the second (more than its 5 %): topped at 2 x the lower
+  // run's 95th percentile (1 um, to a bin of 50 / 4096 um), the peak kept for the label
+  HeightMap blob = spotted_map(50.0f);
+  for (size_t k = 0; k < blob.thickness_um.size(); k += 10) blob.thickness_um[k] = 50.0f;
+  input.columns[1].thickness = &blob;
+  scale = plots::shared_thickness_scale(input);
+  EXPECT_TRUE(scale.capped);
+  EXPECT_DOUBLE_EQ(scale.peak_um, 50.0);
+  EXPECT_GE(scale.top_um, plots::kSharedScaleCap * 1.0);
+  EXPECT_LE(scale.top_um, plots::kSharedScaleCap * (1.0 + 50.0 / 4096));
+  // with a third, even run the median run is an even one: the same top
+  input.columns.push_back(input.columns[0]);
+  EXPECT_DOUBLE_EQ(plots::shared_thickness_scale(input).top_um, scale.top_um);
+  // with two of the three blobbed the median run is blobbed: the blob's 95th percentile
+  input.columns[0].thickness = &blob;
+  EXPECT_DOUBLE_EQ(plots::shared_thickness_scale(input).top_um, 50.0);
+  // nothing deposited: 1 um
+  HeightMap empty = spotted_map(0.0f);
+  for (float& v : empty.thickness_um) v = 0.0f;
+  plots::ComparisonInput none;
+  none.columns.resize(1);
+  none.columns[0].thickness = &empty;
+  scale = plots::shared_thickness_scale(none);
+  EXPECT_FALSE(scale.capped);
+  EXPECT_DOUBLE_EQ(scale.top_um, 1.0);
 }
 
 TEST(ComparisonTravels, PathsNumberedFromZeroInPrintOrder) {

@@ -207,7 +207,7 @@ TEST(RunPlots, ManyLinesShareOneProfileKeyEntry) {
 TEST(Comparison, OneColumnPerPlannerOnASharedScale) {
   const auto a = make_plot_fixture(testing_support::thompson_like_toolpath(), 1.5);
   const auto b = make_plot_fixture(testing_support::thompson_like_toolpath(), 3.0);
-  // a thinner second map: the shared colour range is the thicker one's peak
+  // a thinner second map: the shared colour range is set by the thicker one
   HeightMap thinner = b.thickness;
   for (float& v : thinner.thickness_um) v *= 0.5f;
   plots::ComparisonInput input;
@@ -227,8 +227,12 @@ TEST(Comparison, OneColumnPerPlannerOnASharedScale) {
     column.total_time_s = f.trajectory.duration_s();
     input.columns.push_back(column);
   }
-  EXPECT_FLOAT_EQ(static_cast<float>(plots::shared_thickness_max_um(input)),
-                  a.thickness.max_value());
+  // (its top: that peak, or 2 x the deposit's 95th percentile where lower; see
+  // test_comparison_data.cpp)
+  const plots::SharedThicknessScale scale = plots::shared_thickness_scale(input);
+  EXPECT_FLOAT_EQ(static_cast<float>(scale.peak_um), a.thickness.max_value());
+  EXPECT_LE(scale.top_um, scale.peak_um);
+  EXPECT_EQ(scale.capped, scale.top_um < scale.peak_um);
   const std::string directory = output_directory("comparison");
   const auto result = plots::render_comparison(input, directory + "/comparison.png");
   EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
