@@ -823,27 +823,32 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
         ramp_of_line[k] = static_cast<int>(ramps.size());
       ramps.push_back(std::move(ramp));
     };
-    for (size_t r = 0; r <= edges; ++r) {
-      // node r at rest (the chain's ends, stops, loops at rest) or held at its own cap (a
-      // blend or straight the look-ahead takes at its bound: a sharp corner's slow blend)
-      const bool at_rest = (r == edges || v_start[r] == 0.0) && (r == 0 || v_end[r - 1] == 0.0);
-      const bool at_cap = r > 0 && r < edges && !split[r] &&
-                          (corners[r].treatment == CornerTreatment::blend ||
-                           corners[r].treatment == CornerTreatment::straight) &&
-                          v_start[r] >= cap_before[r] * (1.0 - 1e-9);
-      if (!at_rest && !at_cap) continue;
-      // into it (lines first..r-1), then out of it (lines r..last); neither ends at a run
-      if (r > 0) {
-        size_t first = r - 1;
-        while (first > 0 && inner(first, false)) --first;
-        if (first == 0 || corners[first].treatment != CornerTreatment::arc)
-          try_ramp(first, r - 1, false);
-      }
-      if (r < edges) {
-        size_t last = r;
-        while (last + 1 < edges && inner(last + 1, true)) ++last;
-        if (last + 1 == edges || corners[last + 1].treatment != CornerTreatment::arc)
-          try_ramp(r, last, true);
+    // the rests' ramps first (near rest the lines' crawl costs most, under the lag rule), then
+    // the held corners' on the lines left: each ramp keeps its ends' speeds, so the rests'
+    // ramps are those they would be alone
+    for (const bool rests : {true, false}) {
+      for (size_t r = 0; r <= edges; ++r) {
+        // node r at rest (the chain's ends, stops, loops at rest) or held at its own cap (a
+        // blend or straight the look-ahead takes at its bound: a sharp corner's slow blend)
+        const bool at_rest = (r == edges || v_start[r] == 0.0) && (r == 0 || v_end[r - 1] == 0.0);
+        const bool at_cap = r > 0 && r < edges && !split[r] &&
+                            (corners[r].treatment == CornerTreatment::blend ||
+                             corners[r].treatment == CornerTreatment::straight) &&
+                            v_start[r] >= cap_before[r] * (1.0 - 1e-9);
+        if (rests ? !at_rest : at_rest || !at_cap) continue;
+        // into it (lines first..r-1), then out of it (lines r..last); neither ends at a run
+        if (r > 0) {
+          size_t first = r - 1;
+          while (first > 0 && inner(first, false)) --first;
+          if (first == 0 || corners[first].treatment != CornerTreatment::arc)
+            try_ramp(first, r - 1, false);
+        }
+        if (r < edges) {
+          size_t last = r;
+          while (last + 1 < edges && inner(last + 1, true)) ++last;
+          if (last + 1 == edges || corners[last + 1].treatment != CornerTreatment::arc)
+            try_ramp(r, last, true);
+        }
       }
     }
   }
