@@ -782,14 +782,17 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
                  ? line_profile(lines[k].length, v_start[k], v_end[k], lines[k].limits).duration_s()
                  : 0.0;
     };
-    // node i (0 < i < edges) may be inside a ramp: a blend or straight, taken below its cap;
-    // held by a rest behind it (the forward pass: inside a ramp out of that rest) or by one
-    // ahead (the backward pass: inside a ramp into that rest)
+    // node i (0 < i < edges) a ramp may pass or start at: a blend or a straight, not split
+    const auto ramp_corner = [&](size_t i) {
+      return !split[i] && (corners[i].treatment == CornerTreatment::blend ||
+                           corners[i].treatment == CornerTreatment::straight);
+    };
+    // node i inside a ramp: a ramp corner taken below its cap; held by a rest behind it (the
+    // forward pass: inside a ramp out of that rest) or by one ahead (the backward pass: inside
+    // a ramp into that rest)
     const auto inner = [&](size_t i, bool held_from_behind) {
-      const CornerTreatment treatment = corners[i].treatment;
       const double speed = v_end[i - 1];
-      if (!(treatment == CornerTreatment::blend || treatment == CornerTreatment::straight) ||
-          split[i] || !(speed > 0.0) || !(speed < cap_before[i] * (1.0 - 1e-9)))
+      if (!ramp_corner(i) || !(speed > 0.0) || !(speed < cap_before[i] * (1.0 - 1e-9)))
         return false;
       return held_from_behind == (speed < backward_bound[i] * (1.0 - 1e-9));
     };
@@ -831,10 +834,8 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
         // node r at rest (the chain's ends, stops, loops at rest) or held at its own cap (a
         // blend or straight the look-ahead takes at its bound: a sharp corner's slow blend)
         const bool at_rest = (r == edges || v_start[r] == 0.0) && (r == 0 || v_end[r - 1] == 0.0);
-        const bool at_cap = r > 0 && r < edges && !split[r] &&
-                            (corners[r].treatment == CornerTreatment::blend ||
-                             corners[r].treatment == CornerTreatment::straight) &&
-                            v_start[r] >= cap_before[r] * (1.0 - 1e-9);
+        const bool at_cap =
+            r > 0 && r < edges && ramp_corner(r) && v_start[r] >= cap_before[r] * (1.0 - 1e-9);
         if (rests ? !at_rest : at_rest || !at_cap) continue;
         // into it (lines first..r-1), then out of it (lines r..last); neither ends at a run
         if (r > 0) {
