@@ -291,7 +291,8 @@ std::vector<SchemaSection> make_schema() {
           other("open", "text", "", gcode.open_code, "the shutter rule's open code (e.g. M106)"),
           other("close", "text", "", gcode.close_code, "the shutter rule's close code (e.g. M107)"),
           other("layers", "[from, to], whole numbers >= 0, from <= to", "", "every layer",
-                "the file's layers to print, 0-based, inclusive (layers by increasing z)"),
+                "the file's layers to print, 0-based, inclusive (layers by increasing z; a "
+                "print run's z is that of its first move at one height)"),
           word("feed", {"clamp", "error"}, gcode.feed,
                "feed rates above the machine's limits: clamp slows each move to what every "
                "axis can do along it (as firmware does; metrics.json counts them), error "

@@ -707,6 +707,20 @@ void for_each_print_run(const GcodeProgram& program, PrintRule rule, OnRun on_ru
   }
 }
 
+// The z level of the print run first..end: the height of its first move in a plane of
+// constant z, a line or a G17 arc (a CAM program's run may plunge from its safe height with the
+// spindle or shutter already on, a dispenser's may ramp down), else, where every move changes z (a
+// spiral vase's climb, a lone plunge), where the run starts.
+double print_run_level(const GcodeProgram& program, std::size_t first, std::size_t end) {
+  for (std::size_t i = first; i < end; ++i) {
+    const GcodeMove& move = program.moves[i];
+    const bool in_xy = !move.arc.is_arc() || move.arc.axis.z() != 0.0;  // a line or a G17 arc
+    if (in_xy && std::abs(move.to_mm.z() - move.from_mm.z()) <= kLayerTolerance_mm)
+      return move.from_mm.z();
+  }
+  return program.moves[first].from_mm.z();
+}
+
 }  // namespace
 
 const char* print_rule_name(PrintRule rule) {
@@ -810,8 +824,8 @@ bool move_prints(const GcodeMove& move, PrintRule resolved_rule) {
 
 std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
   std::vector<double> levels;
-  for_each_print_run(program, resolved_rule, [&](std::size_t first, std::size_t) {
-    levels.push_back(program.moves[first].from_mm.z());
+  for_each_print_run(program, resolved_rule, [&](std::size_t first, std::size_t end) {
+    levels.push_back(print_run_level(program, first, end));
   });
   std::sort(levels.begin(), levels.end());
   // levels within the tolerance of the previous kept one are that layer
@@ -838,7 +852,7 @@ GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions
   std::vector<Problem> problems;
   bool reported_missing_feed = false;
   for_each_print_run(program, result.rule, [&](std::size_t first, std::size_t end) {
-    const int layer = level_index(result.layer_z_mm, program.moves[first].from_mm.z());
+    const int layer = level_index(result.layer_z_mm, print_run_level(program, first, end));
     if (layer < options.first_layer || layer > last_layer) return;
     PrintPath path;
     std::vector<int> lines;

@@ -167,6 +167,36 @@ TEST(Gcode, InchesAndSetPosition) {
   expect_points(shifted.toolpath.paths[0], {Vec3(10, 0, 0), Vec3(15, 0, 0)});
 }
 
+TEST(Gcode, RunsThatPlungeWhileOpenAreLayeredWhereTheyPrintFlat) {
+  // a CAM-style shutter program: two passes, each plunging from the 5 mm safe height with the
+  // shutter already open (the first straight down, the second on a ramp), then a flat square
+  // side; and a climbing run whose every move changes z (a spiral vase's)
+  const std::string text =
+      "G21 G90\nM3\nG0 X0 Y0 Z5\nG1 Z-0.2 F300\nG1 X10 F600\nG0 Z5\n"
+      "G0 X0 Y5\nG1 X2 Z-0.4 F300\nG1 X10 F600\nG0 Z5\n"
+      "G0 X0 Y10 Z1\nG1 X5 Z1.1\nG1 X10 Z1.2\nM5\n";
+  const GcodeProgram program = parse_gcode_program(text, "cam.nc", GcodeOptions{});
+  const GcodeImport all = import_gcode_program(program, GcodeOptions{});
+  EXPECT_EQ(all.rule, PrintRule::shutter);
+  // the levels: the passes' flat heights (not their 5 mm start) and the climb's start
+  EXPECT_EQ(all.layer_z_mm, (std::vector<double>{-0.4, -0.2, 1.0}));
+  EXPECT_EQ(print_layer_levels(program, PrintRule::shutter), all.layer_z_mm);
+  // five paths (a new one at each feed change): each takes its run's layer
+  ASSERT_EQ(all.toolpath.paths.size(), 5u);
+  const std::vector<int> layers = {1, 1, 0, 0, 2};
+  for (std::size_t i = 0; i < layers.size(); ++i)
+    EXPECT_EQ(all.toolpath.paths[i].layer, layers[i]) << "path " << i;
+  // the plunge is printed, from the safe height
+  expect_points(all.toolpath.paths[0], {Vec3(0, 0, 5), Vec3(0, 0, -0.2)});
+  // layers [1, 1] is the first pass alone
+  GcodeOptions first_pass;
+  first_pass.first_layer = first_pass.last_layer = 1;
+  const GcodeImport selected = import_gcode_program(program, first_pass);
+  ASSERT_EQ(selected.toolpath.paths.size(), 2u);
+  expect_points(selected.toolpath.paths[1], {Vec3(0, 0, -0.2), Vec3(10, 0, -0.2)});
+  EXPECT_EQ(selected.toolpath.paths[0].layer, 0);
+}
+
 TEST(Gcode, DefaultSpeedUntilTheFirstFeedRate) {
   const GcodeImport imported = parse("G1 X1 E1\nG1 X2 E2 F120\n", 7.0);
   ASSERT_EQ(imported.toolpath.paths.size(), 2u);

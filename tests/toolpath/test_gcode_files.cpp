@@ -90,6 +90,8 @@ TEST(GcodeFiles, HelixAndG18Arc) {
   EXPECT_NEAR(facts.feed_rate_time_s, (std::hypot(10.0 * kPi, 2.0) + 5.0 * kPi) / 5.0, 1e-9);
   EXPECT_GT(facts.estimated_time_s, facts.feed_rate_time_s);
   EXPECT_EQ(facts.n_moves_without_feed, 1);
+  // no move stays at one z (the G18 arc ends where it starts, but dips): the run's start
+  EXPECT_EQ(facts.layer_z_values, std::vector<double>{0.0});
   // a helix reversed is the same curve
   const GcodeImport imported = read_gcode(kDir + "helix.ngc", GcodeOptions{});
   const PrintPath& path = imported.toolpath.paths.at(0);
