@@ -466,15 +466,32 @@ struct CurvedRamp {
   size_t first_line = 0, last_line = 0;
   std::vector<Section> sections;
   double length = 0.0;
-  double shortest_blend_half_mm = kInf;
   AxisProfile profile;
+
+  // the least time any blend half takes at speeds up to `speed`; infinite without blends
+  double shortest_blend_half_s(double speed) const {
+    double shortest = kInf;
+    for (const Section& section : sections)
+      if (section.blend != nullptr) shortest = std::min(shortest, section.length / speed);
+    return shortest;
+  }
 
   // the longest sample period for the law: period_s, shorter where a blend's half would have
   // fewer than kMinBlendHalfPeriods samples at the law's peak speed (as a blend on its own)
   double sample_period_s(double period_s) const {
     const double peak = profile.peak_speed();
-    return peak > 0.0 ? std::min(period_s, shortest_blend_half_mm / peak / kMinBlendHalfPeriods)
+    return peak > 0.0 ? std::min(period_s, shortest_blend_half_s(peak) / kMinBlendHalfPeriods)
                       : period_s;
+  }
+
+  // the time in [lo_s, hi_s] at which the law reaches arc length s (bisection: s grows with
+  // time), to 1e-12 s
+  double time_at(double s, double lo_s, double hi_s) const {
+    for (int step = 0; step < 60 && hi_s - lo_s > 1e-12; ++step) {
+      const double mid = 0.5 * (lo_s + hi_s);
+      (profile.at(mid).q < s ? lo_s : hi_s) = mid;
+    }
+    return hi_s;
   }
 
   // the curve at arc length s (section: a hint, advanced to the section that holds s)
@@ -512,7 +529,6 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
   ramp.last_line = last;
   ramp.sections.clear();
   ramp.length = 0.0;
-  ramp.shortest_blend_half_mm = kInf;
   LineLimits law;
   law.v_max_mm_s = law.a_max_mm_s2 = law.j_max_mm_s3 = kInf;
   law.lag_s = options.deceleration_lag_s();
@@ -544,7 +560,6 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
     section = CurvedRamp::Section();
     section.blend = &blend;
     section.length = blend.half_length_mm();
-    ramp.shortest_blend_half_mm = std::min(ramp.shortest_blend_half_mm, section.length);
     section.edge = k;
     add(section, lo, hi, node_cap[k + 1]);
     section.second_half = true;
@@ -553,7 +568,7 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
   }
   const double lowest = std::max(v0, v1);
   if (ramp.sections.empty() || lowest > law.v_max_mm_s) return false;
-  if (ramp.shortest_blend_half_mm / law.v_max_mm_s / kMinBlendHalfPeriods <
+  if (ramp.shortest_blend_half_s(law.v_max_mm_s) / kMinBlendHalfPeriods <
       options.period_s / kMaxRampRefinement)
     return false;
   // (checked once a period while the law is lowered, then at every quarter period and at least
@@ -576,19 +591,35 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
         std::max<size_t>(8, static_cast<size_t>(std::ceil(duration / check_step_s)));
     double speed_ratio = 0.0;
     CurveLimitRatios ratios;
-    size_t phase = 0, section = 0;
-    for (size_t m = 0; m <= checks; ++m) {
-      const double t = duration * static_cast<double>(m) / static_cast<double>(checks);
-      const AxisState state = ramp.profile.at(t, phase);
+    // one check: the state at t, in section `hint` or past it (updated)
+    const auto check = [&](double t, const AxisState& state, size_t& hint) {
       Vec3 p, d1, d2, d3;
-      ramp.at(std::clamp(state.q, 0.0, ramp.length), section, p, d1, d2, d3);
-      if (ramp.sections[section].line != nullptr) continue;
-      const MachineLimits& axes = ramp.sections[section].axes;
+      ramp.at(std::clamp(state.q, 0.0, ramp.length), hint, p, d1, d2, d3);
+      if (ramp.sections[hint].line != nullptr) return;
+      const MachineLimits& axes = ramp.sections[hint].axes;
       const double v = state.v;
-      speed_ratio = std::max(speed_ratio, v / ramp.sections[section].speed_cap_mm_s);
+      speed_ratio = std::max(speed_ratio, v / ramp.sections[hint].speed_cap_mm_s);
       for (int axis = 0; axis < 3; ++axis)
         speed_ratio = std::max(speed_ratio, std::abs(d1[axis] * v) / axes.axes[axis].v_max_mm_s);
       ratios.add(d1, d2, d3, v, state.a, ramp.profile.jerk_at(t), axes);
+    };
+    size_t phase = 0, section = 0;
+    double t_before = 0.0;
+    for (size_t m = 0; m <= checks; ++m) {
+      const double t = duration * static_cast<double>(m) / static_cast<double>(checks);
+      const AxisState state = ramp.profile.at(t, phase);
+      const size_t section_before = section;
+      check(t, state, section);
+      // a blend half passed between two checks (faster than its cap allows, or the grid
+      // still coarse): checked at its middle, found by bisection in time
+      for (size_t skipped = section_before + 1; skipped < section; ++skipped) {
+        const CurvedRamp::Section& half = ramp.sections[skipped];
+        if (half.blend == nullptr) continue;
+        const double middle = ramp.time_at(half.s_begin + 0.5 * half.length, t_before, t);
+        size_t hint = skipped;
+        check(middle, ramp.profile.at(middle), hint);
+      }
+      t_before = t;
     }
     if (speed_ratio <= 1.0 + 1e-9 && ratios.within()) {
       if (fine) return true;
@@ -608,40 +639,53 @@ bool plan_curved_ramp(const std::vector<TrimmedLine>& lines,
   }
 }
 
-// The ramp's pieces from t_begin_s, sampled at its sample period, a piece per section (split at
-// the first sample on or past its start); each inner corner's speed at its apex's sample into
-// planned.corner_speed_mm_s. Returns the time the ramp ends.
+// The ramp's pieces from t_begin_s, a piece per section from the time the law reaches its
+// start to the time it reaches its end (so each sample lies on its own edge, and a chain's
+// joined paths meet exactly), each sampled at most the ramp's sample period apart; each inner
+// corner's speed at its apex into planned.corner_speed_mm_s; the speed deficit of its lines
+// that meet an arc run (next_to_run(edge)) into planned.run_speed_deficit_mm, as for such a
+// line on its own. Returns the time the ramp ends.
+template <typename NextToRun>
 double emit_curved_ramp(const CurvedRamp& ramp, const PrintChain& chain,
-                        const PathMotionOptions& options, double t_begin_s, PlannedPath& planned) {
+                        const PathMotionOptions& options, double t_begin_s, PlannedPath& planned,
+                        NextToRun next_to_run) {
   const double duration = ramp.profile.duration_s();
-  const size_t periods = std::max<size_t>(
-      2, static_cast<size_t>(std::ceil(duration / ramp.sample_period_s(options.period_s))));
-  const double period = duration / static_cast<double>(periods);
-  std::vector<double> s(periods + 1), speed(periods + 1);
-  std::vector<Vec3> position(periods + 1), velocity(periods + 1);
-  size_t phase = 0, section = 0;
-  for (size_t m = 0; m <= periods; ++m) {
-    const AxisState state = ramp.profile.at(period * static_cast<double>(m), phase);
-    s[m] = m == periods ? ramp.length : std::clamp(state.q, 0.0, ramp.length);
-    speed[m] = m == periods ? ramp.profile.v_end() : state.v;
-    Vec3 d1, d2, d3;
-    ramp.at(s[m], section, position[m], d1, d2, d3);
-    velocity[m] = d1 * speed[m];
-  }
-  double t = t_begin_s;
-  size_t begin = 0;
+  const double sample_period = ramp.sample_period_s(options.period_s);
+  double t = t_begin_s, section_begin = 0.0;  // (section_begin: in the ramp's own time)
+  std::vector<Vec3> position, velocity;
   for (size_t k = 0; k < ramp.sections.size(); ++k) {
     const CurvedRamp::Section& sec = ramp.sections[k];
     const bool last_section = k + 1 == ramp.sections.size();
-    const double section_end = sec.s_begin + sec.length;
-    if (sec.second_half) planned.corner_speed_mm_s[sec.edge] = speed[begin];
-    size_t end = begin;
-    while (end < periods && (last_section || s[end] < section_end)) ++end;
-    if (end == begin) continue;
+    const double section_end =
+        last_section ? duration : ramp.time_at(sec.s_begin + sec.length, section_begin, duration);
+    const double span = section_end - section_begin;
+    if (!(span > 0.0)) continue;
+    const size_t periods =
+        std::max<size_t>(1, static_cast<size_t>(std::ceil(span / sample_period)));
+    const double period = span / static_cast<double>(periods);
+    position.resize(periods + 1);
+    velocity.resize(periods + 1);
+    double first_speed = 0.0;
+    size_t phase = 0, hint = k;
+    for (size_t m = 0; m <= periods; ++m) {
+      const bool ramp_end = last_section && m == periods;
+      const AxisState state =
+          ramp.profile.at(section_begin + period * static_cast<double>(m), phase);
+      const double speed = ramp_end ? ramp.profile.v_end() : state.v;
+      Vec3 d1, d2, d3;
+      ramp.at(ramp_end ? ramp.length : std::clamp(state.q, 0.0, ramp.length), hint, position[m], d1,
+              d2, d3);
+      velocity[m] = d1 * speed;
+      if (m == 0) first_speed = speed;
+    }
+    if (sec.second_half) planned.corner_speed_mm_s[sec.edge] = first_speed;
     planned.pieces.push_back(
-        sampled_piece(chain, sec.edge, options, t, period, position, velocity, begin, end));
+        sampled_piece(chain, sec.edge, options, t, period, position, velocity, 0, periods));
+    if (sec.line != nullptr && next_to_run(sec.edge))
+      planned.run_speed_deficit_mm +=
+          std::max(0.0, chain.edge_speed_mm_s[sec.edge] * span - sec.length);
     t = planned.pieces.back().t_end_s;
-    begin = end;
+    section_begin = section_end;
   }
   return t;
 }
@@ -859,12 +903,17 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
   const auto base_piece = [&](double duration, size_t edge) {
     return depositing_piece(chain, edge, options, t, duration);
   };
+  // line k starts or ends at an arc run (a slow line there is the run's deficit)
+  const auto next_to_run = [&](size_t k) {
+    return (k > 0 && corners[k].treatment == CornerTreatment::arc) ||
+           (k + 1 < edges && corners[k + 1].treatment == CornerTreatment::arc);
+  };
   for (size_t k = 0; k < edges; ++k) {
     const TrimmedLine& line = lines[k];
     if (ramp_of_line[k] >= 0) {
       // a ramp: its curve once, at its first line; its inner corners add nothing
       const CurvedRamp& ramp = ramps[static_cast<size_t>(ramp_of_line[k])];
-      if (k == ramp.first_line) t = emit_curved_ramp(ramp, chain, options, t, planned);
+      if (k == ramp.first_line) t = emit_curved_ramp(ramp, chain, options, t, planned, next_to_run);
       if (k + 1 == edges) break;
       if (k < ramp.last_line) continue;
     }
@@ -872,9 +921,7 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
     if (ramp_of_line[k] < 0 && line.length > 0.0) {
       const AxisProfile along = line_profile(line.length, v_start[k], v_end[k], line.limits);
       const double duration = along.duration_s();
-      const bool next_to_run = (k > 0 && corners[k].treatment == CornerTreatment::arc) ||
-                               (k + 1 < edges && corners[k + 1].treatment == CornerTreatment::arc);
-      if (next_to_run)
+      if (next_to_run(k))
         planned.run_speed_deficit_mm +=
             std::max(0.0, chain.edge_speed_mm_s[k] * duration - line.length);
       if (duration > 0.0) {

@@ -6,7 +6,10 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <string>
+#include <vector>
 
+#include "contract/planner_checks.hpp"
 #include "core/segment_distance.hpp"
 #include "metrics/motion_metrics.hpp"
 #include "planners/motion/plan_figure.hpp"
@@ -269,7 +272,8 @@ TEST(UniformPlanner, SmallAerosolCircleIsPrintedAtOneConstantSpeed) {
 // 10 mm, gently curving, reversing, turning at random, nearly straight or circling; print
 // speeds from 0.5 to 99 mm/s, tolerances from 1 um to 3 mm, accelerations from 10 to 20 000
 // mm/s^2, aerosol and extrusion. Every plan is finite and keeps to its tolerance of the given
-// polylines (merged, blended or looped), sampled every 0.2 ms.
+// polylines (merged, blended or looped), sampled every 0.2 ms, and every axis' speed and
+// acceleration within its limits by finite differences on the controller's grid.
 TEST(UniformPlanner, RandomJobsStayWithinTheTolerance) {
   std::mt19937_64 rng(31);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -323,6 +327,72 @@ TEST(UniformPlanner, RandomJobsStayWithinTheTolerance) {
           << "trial " << trial << " sample " << k;
     EXPECT_LE(path_error(samples, toolpath).max_mm, settings.tolerance_mm * (1 + 1e-9))
         << "trial " << trial << ", tolerance " << settings.tolerance_mm;
+    // (1e-5: one job, at 10 mm/s^2, peaks 1.2e-6 above its limit on the grid: rounding, not
+    // a law planned over its limit)
+    const testing_support::FiniteDifferencePeaks peaks =
+        testing_support::finite_difference_peaks(plan, limits);
+    EXPECT_LE(peaks.max_speed_ratio(), 1.0 + 1e-5) << "trial " << trial;
+    EXPECT_LE(peaks.max_accel_ratio(), 1.0 + 1e-5) << "trial " << trial;
+  }
+}
+
+// Two cases the random jobs above found (a wider run of them), each a curved ramp across two
+// joined paths, extrusion:
+// - a 2 mm line at 50 mm/s joined to a 0.1 um edge turning 29 deg, at 10 mm/s^2 and a 0.5 mm
+//   tolerance: the ramp to rest passes the turn's blend (halves of 2 nm, capped at 2 um/s).
+//   Judged at its cap, that blend no longer rules the ramp out, so the ramp's check must land
+//   on it however fast the law first runs: a blend passed between two checks is checked at
+//   its middle. Without that, 1.9 x the acceleration limit at the turn.
+// - collinear edges along x = -40 (a random walk clamped at the box), a path at 99 mm/s joined
+//   to one at 50 mm/s, 1 um tolerance: each ramp section is its own piece from the time the law
+//   reaches its start, so no sample of the second path is labelled with the first (which put
+//   samples 2.9 um past the first path's end, against its own polyline).
+// Each keeps its limits on the controller's grid and its tolerance of its own path.
+TEST(UniformPlanner, CurvedRampsAcrossJoinedPathsKeepLimitsAndTheirOwnPaths) {
+  struct Case {
+    double a_max_mm_s2, tolerance_mm, speeds[2];
+    std::vector<Vec3> first, second;
+  };
+  const std::vector<Case> cases = {
+      {10.0,
+       0.5,
+       {50.0, 50.0},
+       {Vec3(-1.1409277849645865, 1.5951741983550456, 0),
+        Vec3(-3.0879857029845343, 1.1380467939306056, 0)},
+       {Vec3(-3.0879857029845343, 1.1380467939306056, 0),
+        Vec3(-3.0880820301063459, 1.1380736469677428, 0)}},
+      {1000.0,
+       0.001,
+       {99.0, 50.0},
+       {Vec3(-40, 13.887798941033363, 0), Vec3(-40, 13.980162669199636, 0),
+        Vec3(-40, 13.98019345709951, 0), Vec3(-40, 13.986351035171559, 0),
+        Vec3(-40, 14.602108652091385, 0), Vec3(-40, 14.602139439962716, 0)},
+       {Vec3(-40, 14.602139439962716, 0), Vec3(-40, 14.68507175728675, 0),
+        Vec3(-40, 14.75569582494721, 0), Vec3(-40, 14.813697874435329, 0),
+        Vec3(-40, 14.858820214326972, 0), Vec3(-40, 14.890862375153743, 0)}}};
+  for (size_t c = 0; c < cases.size(); ++c) {
+    SCOPED_TRACE("case " + std::to_string(c));
+    const Case& job = cases[c];
+    Toolpath toolpath;
+    for (int k = 0; k < 2; ++k) {
+      PrintPath path;
+      path.points = k == 0 ? job.first : job.second;
+      path.speed_mm_s = job.speeds[k];
+      path.source_index = k;
+      toolpath.paths.push_back(path);
+    }
+    toolpath.start_mm = toolpath.end_mm = Vec3::Zero();
+    UniformSettings settings;
+    settings.tolerance_mm = job.tolerance_mm;
+    const MachineLimits limits = MachineLimits::uniform(100.0, job.a_max_mm_s2);
+    const Trajectory plan = UniformPlanner{settings}.plan_in_context(
+        toolpath, limits, process_context(ProcessType::extrusion));
+    const testing_support::FiniteDifferencePeaks peaks =
+        testing_support::finite_difference_peaks(plan, limits);
+    EXPECT_LE(peaks.max_accel_ratio(), 1.0 + 1e-6);
+    EXPECT_LE(peaks.max_speed_ratio(), 1.0 + 1e-6);
+    EXPECT_LE(path_error(sample_trajectory(plan, 1e-4), toolpath).max_mm,
+              job.tolerance_mm * (1 + 1e-9));
   }
 }
 
