@@ -468,11 +468,13 @@ struct CurvedRamp {
   double length = 0.0;
   AxisProfile profile;
 
-  // the least time any blend half takes at speeds up to `speed`; infinite without blends
+  // the least time any blend half takes at speeds up to `speed` (each half also under its
+  // corner's cap, which the ramp's check holds); infinite without blends
   double shortest_blend_half_s(double speed) const {
     double shortest = kInf;
     for (const Section& section : sections)
-      if (section.blend != nullptr) shortest = std::min(shortest, section.length / speed);
+      if (section.blend != nullptr)
+        shortest = std::min(shortest, section.length / std::min(speed, section.speed_cap_mm_s));
     return shortest;
   }
 
@@ -513,8 +515,8 @@ struct CurvedRamp {
 
 constexpr int kCurvedRampRounds = 40;
 // a ramp is sampled at most this much finer than period_s (its blends' halves keep
-// kMinBlendHalfPeriods samples at the law's peak speed): a ramp over blends shorter than that
-// allows is not tried (the look-ahead samples each blend on its own)
+// kMinBlendHalfPeriods samples at the law's peak speed, or their caps where lower): a ramp over
+// blends shorter than that allows is not tried (the look-ahead samples each blend on its own)
 constexpr double kMaxRampRefinement = 16.0;
 
 // Plans lines first..last (and the blends between them) from v0 to v1 as one CurvedRamp; false
@@ -881,18 +883,16 @@ PlannedPath plan_chain(const PrintChain& chain, const std::vector<CornerGeometry
         const bool at_cap =
             r > 0 && r < edges && ramp_corner(r) && v_start[r] >= cap_before[r] * (1.0 - 1e-9);
         if (rests ? !at_rest : at_rest || !at_cap) continue;
-        // into it (lines first..r-1), then out of it (lines r..last); neither ends at a run
+        // into it (lines first..r-1), then out of it (lines r..last)
         if (r > 0) {
           size_t first = r - 1;
           while (first > 0 && inner(first, false)) --first;
-          if (first == 0 || corners[first].treatment != CornerTreatment::arc)
-            try_ramp(first, r - 1, false);
+          try_ramp(first, r - 1, false);
         }
         if (r < edges) {
           size_t last = r;
           while (last + 1 < edges && inner(last + 1, true)) ++last;
-          if (last + 1 == edges || corners[last + 1].treatment != CornerTreatment::arc)
-            try_ramp(r, last, true);
+          try_ramp(r, last, true);
         }
       }
     }
