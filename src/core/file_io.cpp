@@ -41,4 +41,15 @@ std::string read_text_file(const std::string& path) {
   return content;
 }
 
+std::string missing_file_problem(const std::string& kind, const std::string& given,
+                                 const std::string& resolved) {
+  std::error_code error;
+  const fs::file_status status = fs::status(resolved, error);
+  const std::string file = kind + " file '" + given + "'";
+  if (fs::is_regular_file(status)) return "";
+  if (fs::is_directory(status)) return file + " is a directory (" + resolved + "), not a file";
+  if (fs::exists(status)) return file + " is not a regular file (" + resolved + ")";
+  return file + " not found (looked for " + resolved + ")";
+}
+
 }  // namespace depotwin

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <unordered_map>
 
+#include "core/file_io.hpp"
 #include "core/input_ranges.hpp"
 #include "core/number_text.hpp"
 #include "kinematics/machine.hpp"
@@ -351,11 +352,11 @@ void Loader::read_machine(const Field& field) {
     if (!model) return;
     const fs::path resolved = resolve(*model);
     std::error_code error;
+    std::string problem;
     if (fs::path(*model).extension() != ".xml") {
       problems_.add(f->line, f->key, "'" + *model + "' is not an MJCF .xml file");
-    } else if (!fs::is_regular_file(resolved, error)) {
-      problems_.add(f->line, f->key,
-                    "MJCF file '" + *model + "' not found (looked for " + resolved.string() + ")");
+    } else if (!(problem = missing_file_problem("MJCF", *model, resolved.string())).empty()) {
+      problems_.add(f->line, f->key, problem);
     } else {
       scenario_.model_path = fs::absolute(resolved, error).lexically_normal().string();
     }
@@ -836,10 +837,9 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   options.last_layer = settings->last_layer;
   scenario_.gcode = settings;
 
-  std::error_code error;
-  if (!fs::is_regular_file(resolved, error)) {
-    problems_.add(file_field->line, file_field->key,
-                  "G-code file '" + *given + "' not found (looked for " + resolved.string() + ")");
+  if (const std::string problem = missing_file_problem("G-code", *given, resolved.string());
+      !problem.empty()) {
+    problems_.add(file_field->line, file_field->key, problem);
     return;
   }
   GcodeImport imported;
@@ -1114,10 +1114,9 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     if (const std::optional<std::string> file = read_string(*f, problems_)) {
       given_file = *file;
       const fs::path resolved = resolve(*file);
-      std::error_code error;
-      if (!fs::is_regular_file(resolved, error))
-        problems_.add(f->line, f->key,
-                      "STL file '" + *file + "' not found (looked for " + resolved.string() + ")");
+      const std::string problem = missing_file_problem("STL", *file, resolved.string());
+      if (!problem.empty())
+        problems_.add(f->line, f->key, problem);
       else
         surface->file = resolved.string();
     }

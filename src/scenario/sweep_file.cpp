@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/file_io.hpp"
 #include "core/number_text.hpp"
 #include "scenario/override_tree.hpp"
 
@@ -220,11 +221,9 @@ class SweepReader {
     const std::optional<std::string> base = read_string(*field, problems_);
     if (!base) return;
     const fs::path resolved = (fs::path(spec_.file).parent_path() / *base).lexically_normal();
-    std::error_code error;
-    if (!fs::is_regular_file(resolved, error)) {
-      problems_.add(
-          field->line, field->key,
-          "scenario file '" + *base + "' not found (looked for " + resolved.string() + ")");
+    if (const std::string problem = missing_file_problem("scenario", *base, resolved.string());
+        !problem.empty()) {
+      problems_.add(field->line, field->key, problem);
       return;
     }
     spec_.base = resolved.string();

@@ -1,6 +1,8 @@
 // Atomic writes: the file holds exactly what was written, an older file is replaced whole,
-// no temporary is left behind, and a failure leaves the target untouched.
+// no temporary is left behind, and a failure leaves the target untouched; a file a scenario
+// names that is missing, a directory or not a regular file is told apart.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <filesystem>
 #include <iterator>
@@ -46,6 +48,24 @@ TEST(FileIo, FailureNamesTheFileAndLeavesTheTargetUntouched) {
   EXPECT_TRUE(fs::is_directory(blocked / "inside"));
   EXPECT_EQ(std::distance(fs::directory_iterator(directory), fs::directory_iterator()), 2);
   fs::remove_all(directory);
+}
+
+// The four answers: a regular file (no problem), a directory, something else that exists (a
+// FIFO), nothing there.
+TEST(FileIo, MissingFileProblemSaysWhatIsThereInstead) {
+  const fs::path directory = fresh_directory("file_io_missing");
+  const fs::path file = directory / "part.gcode";
+  write_file_atomically(file.string(), "G1 X1\n");
+  EXPECT_EQ(missing_file_problem("G-code", "part.gcode", file.string()), "");
+  EXPECT_EQ(missing_file_problem("G-code", "jobs", directory.string()),
+            "G-code file 'jobs' is a directory (" + directory.string() + "), not a file");
+  const fs::path fifo = directory / "pipe.gcode";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(missing_file_problem("G-code", "pipe.gcode", fifo.string()),
+            "G-code file 'pipe.gcode' is not a regular file (" + fifo.string() + ")");
+  const fs::path nowhere = directory / "none.stl";
+  EXPECT_EQ(missing_file_problem("STL", "none.stl", nowhere.string()),
+            "STL file 'none.stl' not found (looked for " + nowhere.string() + ")");
 }
 
 }  // namespace

@@ -364,6 +364,15 @@ toolpath:
                  "G-code file 'parts/missing.gcode' not found");
 }
 
+TEST_F(ScenarioErrors, GcodeFileThatIsADirectory) {
+  std::filesystem::create_directories(dir_ / "parts");
+  const auto problems = problems_of("toolpath: {speed: 3, gcode: {file: parts}}\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(
+      problems, scenario_path(), "toolpath.gcode.file", 1,
+      "G-code file 'parts' is a directory (" + (dir_ / "parts").string() + "), not a file");
+}
+
 TEST_F(ScenarioErrors, GcodeWithoutPrintMoves) {
   write("travel.gcode", "G0 X10 Y10\nG1 X20 Y10 F600\n");
   const auto problems = problems_of("toolpath: {speed: 3, gcode: {file: travel.gcode, rule: e}}\n");
