@@ -45,11 +45,13 @@ std::string missing_file_problem(const std::string& kind, const std::string& giv
                                  const std::string& resolved) {
   std::error_code error;
   const fs::file_status status = fs::status(resolved, error);
-  const std::string file = kind + " file '" + given + "'";
+  // (given empty: the message's prefix names the path already)
+  const std::string file = given.empty() ? kind + " file" : kind + " file '" + given + "'";
+  const std::string where = given.empty() ? "" : " (" + resolved + ")";
   if (fs::is_regular_file(status)) return "";
-  if (fs::is_directory(status)) return file + " is a directory (" + resolved + "), not a file";
-  if (fs::exists(status)) return file + " is not a regular file (" + resolved + ")";
-  return file + " not found (looked for " + resolved + ")";
+  if (fs::is_directory(status)) return file + " is a directory" + where + ", not a file";
+  if (fs::exists(status)) return file + " is not a regular file" + where;
+  return file + " not found" + (given.empty() ? "" : " (looked for " + resolved + ")");
 }
 
 }  // namespace depotwin

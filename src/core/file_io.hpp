@@ -15,7 +15,8 @@ std::string read_text_file(const std::string& path);
 
 // Why the file a scenario names cannot be used, or "" when `resolved` is a regular file: kind
 // and given name it as the user wrote it ("G-code file 'part.gcode' not found (looked for
-// /jobs/part.gcode)", "... is a directory (/jobs), not a file").
+// /jobs/part.gcode)", "... is a directory (/jobs), not a file"); given empty, for a message
+// already prefixed with the path: "G-code file not found", "G-code file is a directory, ...".
 std::string missing_file_problem(const std::string& kind, const std::string& given,
                                  const std::string& resolved);
 

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -16,6 +15,7 @@
 #endif
 
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 
 namespace depotwin {
 
@@ -773,9 +773,8 @@ GcodeProgram parse_gcode_program(const std::string& text, const std::string& fil
 }
 
 GcodeProgram read_gcode_program(const std::string& path, const GcodeOptions& options) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error))
-    throw InputError(path, 0, kKey, "G-code file not found");
+  if (const std::string problem = missing_file_problem("G-code", "", path); !problem.empty())
+    throw InputError(path, 0, kKey, problem);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, kKey, "cannot read the G-code file");
   std::string text;

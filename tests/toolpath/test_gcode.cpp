@@ -264,6 +264,16 @@ TEST(Gcode, MissingFileNamesIt) {
     EXPECT_EQ(e.problems()[0].str(),
               "/nonexistent/dir/part.gcode: toolpath.gcode: G-code file not found");
   }
+  // a directory (`inspect` given a folder) is told as one
+  const std::string folder = std::string(DEPOTWIN_SOURCE_DIR) + "/tests/toolpath/data";
+  try {
+    import_gcode(folder, 3.0);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 1u);
+    EXPECT_EQ(e.problems()[0].str(),
+              folder + ": toolpath.gcode: G-code file is a directory, not a file");
+  }
 }
 
 }  // namespace
