@@ -34,10 +34,12 @@ void write_file_atomically(const std::string& path, const std::string& content) 
 }
 
 std::string read_text_file(const std::string& path) {
+  // checked before opening: reading a FIFO would wait for a writer
+  const std::string problem = missing_file_problem("", "", path);
+  if (!problem.empty()) throw InputError(path, 0, "", problem);
   std::ifstream in(path, std::ios::binary);
   std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (!in && !in.eof()) throw InputError(path, 0, "", "cannot read the file");
-  if (!fs::is_regular_file(path)) throw InputError(path, 0, "", "no such file");
   return content;
 }
 
@@ -46,7 +48,8 @@ std::string missing_file_problem(const std::string& kind, const std::string& giv
   std::error_code error;
   const fs::file_status status = fs::status(resolved, error);
   // (given empty: the message's prefix names the path already)
-  const std::string file = given.empty() ? kind + " file" : kind + " file '" + given + "'";
+  const std::string noun = kind.empty() ? "file" : kind + " file";
+  const std::string file = given.empty() ? noun : noun + " '" + given + "'";
   const std::string where = given.empty() ? "" : " (" + resolved + ")";
   if (fs::is_regular_file(status)) return "";
   if (fs::is_directory(status)) return file + " is a directory" + where + ", not a file";

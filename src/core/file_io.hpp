@@ -10,13 +10,15 @@ namespace depotwin {
 // Throws InternalError on I/O failure (the target is then untouched).
 void write_file_atomically(const std::string& path, const std::string& content);
 
-// The whole file's bytes; InputError naming the path when it cannot be read.
+// The whole file's bytes; InputError naming the path when it is not a regular file (checked
+// first: a FIFO would block the read) or cannot be read.
 std::string read_text_file(const std::string& path);
 
 // Why the file a scenario names cannot be used, or "" when `resolved` is a regular file: kind
 // and given name it as the user wrote it ("G-code file 'part.gcode' not found (looked for
 // /jobs/part.gcode)", "... is a directory (/jobs), not a file"); given empty, for a message
-// already prefixed with the path: "G-code file not found", "G-code file is a directory, ...".
+// already prefixed with the path: "G-code file not found", "G-code file is a directory, ...";
+// kind empty: "file not found".
 std::string missing_file_problem(const std::string& kind, const std::string& given,
                                  const std::string& resolved);
 

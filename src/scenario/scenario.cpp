@@ -271,14 +271,11 @@ bool Loader::read_document(YAML::Node& root) {
   if (text_ != nullptr) {
     text = *text_;
   } else {
-    const fs::path file_path(problems_.file());
-    std::error_code error;
-    if (!fs::exists(file_path, error)) {
-      problems_.add(0, "", "scenario file not found");
-      return false;
-    }
-    if (fs::is_directory(file_path, error)) {
-      problems_.add(0, "", "is a directory, expected a scenario .yaml file");
+    // a directory, a FIFO (reading it would wait for a writer) or nothing at all
+    const std::string& file_path = problems_.file();
+    const std::string problem = missing_file_problem("scenario", "", file_path);
+    if (!problem.empty()) {
+      problems_.add(0, "", problem);
       return false;
     }
     std::ifstream in(file_path);

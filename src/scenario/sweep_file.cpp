@@ -173,11 +173,9 @@ class SweepReader {
  private:
   bool read_document(YAML::Node& root) {
     const std::string& path = problems_.file();
-    std::error_code error;
-    if (!fs::is_regular_file(path, error)) {
-      problems_.add(0, "",
-                    fs::is_directory(path, error) ? "is a directory, expected a sweep file"
-                                                  : "sweep file not found");
+    const std::string problem = missing_file_problem("sweep", "", path);
+    if (!problem.empty()) {
+      problems_.add(0, "", problem);
       return false;
     }
     std::ifstream in(path);

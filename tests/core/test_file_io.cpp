@@ -1,6 +1,7 @@
 // Atomic writes: the file holds exactly what was written, an older file is replaced whole,
 // no temporary is left behind, and a failure leaves the target untouched; a file a scenario
-// names that is missing, a directory or not a regular file is told apart.
+// names that is missing, a directory or not a regular file is told apart, and read_text_file
+// refuses it before it opens it.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -66,6 +67,28 @@ TEST(FileIo, MissingFileProblemSaysWhatIsThereInstead) {
   const fs::path nowhere = directory / "none.stl";
   EXPECT_EQ(missing_file_problem("STL", "none.stl", nowhere.string()),
             "STL file 'none.stl' not found (looked for " + nowhere.string() + ")");
+}
+
+// read_text_file checks before it opens: a FIFO is refused at once (reading it would wait
+// for a writer), as are a directory and a missing file; the message names the path
+TEST(FileIo, ReadTextFileRefusesWhatIsNotARegularFile) {
+  const fs::path directory = fresh_directory("file_io_read");
+  const fs::path fifo = directory / "pipe.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::vector<std::pair<fs::path, std::string>> cases = {
+      {fifo, "file is not a regular file"},
+      {directory, "file is a directory, not a file"},
+      {directory / "none.json", "file not found"}};
+  for (const auto& [path, message] : cases) {
+    try {
+      read_text_file(path.string());
+      ADD_FAILURE() << "no InputError for " << path;
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()), path.string() + ": " + message);
+    }
+  }
+  write_file_atomically((directory / "a.json").string(), "{}\n");
+  EXPECT_EQ(read_text_file((directory / "a.json").string()), "{}\n");
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Bad scenario files: each problem names the file, the 1-based line and the dotted key,
 // and says what is wrong; every problem of a file is reported, not only the first.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <fstream>
 
@@ -156,6 +157,18 @@ TEST_F(ScenarioErrors, MissingFile) {
   EXPECT_EQ(problems[0].file, path);
   EXPECT_EQ(problems[0].str(), path + ": scenario file not found");
   EXPECT_THROW(load_scenario(path), InputError);
+}
+
+// a directory or a FIFO (which a read would wait on for ever) is named, not opened
+TEST_F(ScenarioErrors, ScenarioPathThatIsNotARegularFile) {
+  const std::string fifo = (dir_ / "pipe.yaml").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto problems = validate_scenario_file(fifo);
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].str(), fifo + ": scenario file is not a regular file");
+  problems = validate_scenario_file(dir_.string());
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].str(), dir_.string() + ": scenario file is a directory, not a file");
 }
 
 TEST_F(ScenarioErrors, MalformedYaml) {

@@ -2,6 +2,7 @@
 // the overrides applied to the scenario's YAML tree and validated by the loader (problems at
 // the sweep file's lines), input hashes, and every bad input listed at once.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -149,6 +150,18 @@ TEST(SweepFile, AnEmptyGridAndAMissingBaseAreErrors) {
             (std::vector<std::string>{
                 file + ":1: base: missing: the scenario every task starts from (base: FILE.yaml)",
                 file + ":1: grid: is empty: name at least one key and its values"}));
+}
+
+TEST(SweepFile, APathThatIsNotARegularFileIsNamed) {
+  const std::string dir = fresh_directory("sweep_not_a_file");
+  const std::string fifo = dir + "/pipe.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(problems_of([&] { read_sweep_file(fifo); }),
+            std::vector<std::string>{fifo + ": sweep file is not a regular file"});
+  EXPECT_EQ(problems_of([&] { read_sweep_file(dir); }),
+            std::vector<std::string>{dir + ": sweep file is a directory, not a file"});
+  EXPECT_EQ(problems_of([&] { read_sweep_file(dir + "/none.yaml"); }),
+            std::vector<std::string>{dir + "/none.yaml: sweep file not found"});
 }
 
 // the base scenario's text with overrides, as the loader reads it
