@@ -31,8 +31,9 @@ struct SurfaceProjector::Impl {
   std::vector<std::array<Vec3, 3>> corner_normals;
   Vec3 lo = Vec3::Zero();
   Vec3 hi = Vec3::Zero();
-  Vec3 center = Vec3::Zero();  // Embree works in float about this point
-  float ray_z = 1.0f;          // ray origins' z (centred frame), above the mesh
+  Vec3 center = Vec3::Zero();   // Embree works in float about this point
+  float ray_z = 1.0f;           // ray origins' z (centred frame), above the mesh
+  double edge_offset_mm = 0.0;  // how far edge_hit looks beside a point (see there)
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
 
@@ -43,6 +44,8 @@ struct SurfaceProjector::Impl {
     center = 0.5 * (lo + hi);
     const double extent = (hi - lo).maxCoeff();
     ray_z = static_cast<float>(hi.z() - center.z() + 1.0 + 1e-3 * extent);
+    // a hundred times the float rounding of the centred coordinates (6e-8 of the extent)
+    edge_offset_mm = 1e-5 * std::max((hi - lo).head<2>().maxCoeff(), 1.0);
     corner_normals = mesh.corner_normals(deg_to_rad(options.crease_angle_deg));
 
     // one thread: the build is deterministic and leaves the shared cores alone
@@ -87,6 +90,60 @@ struct SurfaceProjector::Impl {
     const Vec3 sum = b[0] * n[0] + b[1] * n[1] + b[2] * n[2];
     const double length = sum.norm();
     return length > 0.0 ? Vec3(sum / length) : mesh.facet_normal(static_cast<std::size_t>(t));
+  }
+
+  // Embree decides a ray exactly on a boundary edge of the surface (the outline, a hole's
+  // edge) for one side only, so a part a whole number of grid cells wide is hit along one rim
+  // and missed along the other. A ray that misses, or meets the edge of a wall, is tried again
+  // at four points edge_offset_mm away (diagonally); the highest hit facing up among them is
+  // taken, recomputed exactly at (x, y) on its triangle's plane. Nothing if none.
+  std::optional<SurfaceHit> edge_hit(double x, double y) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    alignas(16) RTCRayHit4 packet;
+    alignas(16) int valid[4] = {-1, -1, -1, -1};
+    for (int k = 0; k < 4; ++k) {
+      const double dx = (k & 1) ? -edge_offset_mm : edge_offset_mm;
+      const double dy = (k & 2) ? -edge_offset_mm : edge_offset_mm;
+      set_down_ray(packet, k, x + dx, y + dy);
+    }
+    rtcIntersect4(valid, scene, &context, &packet);
+    std::optional<SurfaceHit> best;
+    for (int k = 0; k < 4; ++k) {
+      if (packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
+      SurfaceHit hit = exact_hit(x, y, static_cast<int>(packet.hit.primID[k]),
+                                 static_cast<double>(ray_z - packet.ray.tfar[k]), packet.hit.u[k],
+                                 packet.hit.v[k]);
+      if (hit.facet_normal.z() > 0.0 && (!best || hit.point_mm.z() > best->point_mm.z()))
+        best = hit;
+    }
+    return best;
+  }
+
+  // hit: the ray's own answer at (x, y); edge_hit where it misses or meets a wall's edge
+  std::optional<SurfaceHit> settle(double x, double y, std::optional<SurfaceHit> hit) const {
+    if (hit && hit->facet_normal.z() > 0.0) return hit;
+    std::optional<SurfaceHit> beside = edge_hit(x, y);
+    return beside ? beside : hit;
+  }
+
+  // ray k of a packet: straight down from above the mesh at (x, y)
+  template <typename Packet>
+  void set_down_ray(Packet& packet, int k, double x, double y) const {
+    packet.ray.org_x[k] = static_cast<float>(x - center.x());
+    packet.ray.org_y[k] = static_cast<float>(y - center.y());
+    packet.ray.org_z[k] = ray_z;
+    packet.ray.dir_x[k] = 0.0f;
+    packet.ray.dir_y[k] = 0.0f;
+    packet.ray.dir_z[k] = -1.0f;
+    packet.ray.tnear[k] = 0.0f;
+    packet.ray.tfar[k] = std::numeric_limits<float>::infinity();
+    packet.ray.mask[k] = ~0u;
+    packet.ray.flags[k] = 0;
+    packet.ray.time[k] = 0.0f;
+    packet.ray.id[k] = static_cast<unsigned>(k);
+    packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
   }
 
   // the exact hit at (x, y) on triangle t; embree_z: Embree's hit height (centred frame),
@@ -147,9 +204,11 @@ std::optional<SurfaceHit> SurfaceProjector::project_down(double x_mm, double y_m
   rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(im.scene, &context, &rayhit);
-  if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-  return im.exact_hit(x_mm, y_mm, static_cast<int>(rayhit.hit.primID),
-                      static_cast<double>(im.ray_z - rayhit.ray.tfar), rayhit.hit.u, rayhit.hit.v);
+  std::optional<SurfaceHit> hit;
+  if (rayhit.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+    hit = im.exact_hit(x_mm, y_mm, static_cast<int>(rayhit.hit.primID),
+                       static_cast<double>(im.ray_z - rayhit.ray.tfar), rayhit.hit.u, rayhit.hit.v);
+  return im.settle(x_mm, y_mm, std::move(hit));
 }
 
 void SurfaceProjector::project_down(const std::vector<Vec2>& xy,
@@ -166,32 +225,18 @@ void SurfaceProjector::project_down(const std::vector<Vec2>& xy,
     for (int k = 0; k < kPacket; ++k) {
       const Vec2& p = xy[start + static_cast<std::size_t>(std::min(k, count - 1))];
       valid[k] = k < count ? -1 : 0;
-      packet.ray.org_x[k] = static_cast<float>(p.x() - im.center.x());
-      packet.ray.org_y[k] = static_cast<float>(p.y() - im.center.y());
-      packet.ray.org_z[k] = im.ray_z;
-      packet.ray.dir_x[k] = 0.0f;
-      packet.ray.dir_y[k] = 0.0f;
-      packet.ray.dir_z[k] = -1.0f;
-      packet.ray.tnear[k] = 0.0f;
-      packet.ray.tfar[k] = std::numeric_limits<float>::infinity();
-      packet.ray.mask[k] = ~0u;
-      packet.ray.flags[k] = 0;
-      packet.ray.time[k] = 0.0f;
-      packet.ray.id[k] = static_cast<unsigned>(k);
-      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+      im.set_down_ray(packet, k, p.x(), p.y());
     }
     rtcIntersect16(valid, im.scene, &context, &packet);
     for (int k = 0; k < count; ++k) {
       std::optional<SurfaceHit>& out = hits[start + static_cast<std::size_t>(k)];
-      if (packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
-        out.reset();
-        continue;
-      }
       const Vec2& p = xy[start + static_cast<std::size_t>(k)];
-      out = im.exact_hit(p.x(), p.y(), static_cast<int>(packet.hit.primID[k]),
-                         static_cast<double>(im.ray_z - packet.ray.tfar[k]), packet.hit.u[k],
-                         packet.hit.v[k]);
+      out.reset();
+      if (packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID)
+        out = im.exact_hit(p.x(), p.y(), static_cast<int>(packet.hit.primID[k]),
+                           static_cast<double>(im.ray_z - packet.ray.tfar[k]), packet.hit.u[k],
+                           packet.hit.v[k]);
+      out = im.settle(p.x(), p.y(), std::move(out));
     }
   }
 }

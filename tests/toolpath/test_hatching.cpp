@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 
 #include "core/error.hpp"
@@ -86,6 +87,45 @@ TEST(Hatching, FlatPlateGridAndZigZag) {
     }
   }
   EXPECT_EQ(hatch.describe(1, 0), "layer 0, line 1, point 20");
+}
+
+TEST(Hatching, PartAWholeNumberOfSpacingsWideKeepsItsRim) {
+  // 10 x 6 mm at 0.5 mm: the grid's rim lies on the outline, where a ray meets only triangle
+  // edges. Every rim line and point is kept, on the exact grid, at 0 and at 90 degrees, on a
+  // flat plate and on a tilted plane z = 1 + 0.2 x + 0.1 y (the rim point is on its plane).
+  HeightField tilted = plane(10.0, 6.0, 0.0);
+  tilted.z = [](double x, double y) { return 1.0 + 0.2 * x + 0.1 * y; };
+  tilted.gradient = [](double, double) { return Eigen::Vector2d(0.2, 0.1); };
+  const std::vector<std::pair<TriangleMesh, std::function<double(double, double)>>> parts = {
+      {plate(10.0, 6.0, 2.0), [](double, double) { return 2.0; }},
+      {tessellate(tilted, TessellationOptions{}), tilted.z}};
+  for (const auto& [mesh, height] : parts) {
+    for (const double angle : {0.0, 90.0}) {
+      SCOPED_TRACE("angle " + std::to_string(angle));
+      SurfaceHatchSpec spec;
+      spec.angles_deg = {angle};
+      const SurfaceHatch hatch = hatch_surface(mesh, spec);
+      expect_well_formed(hatch);
+      const bool along_x = angle == 0.0;
+      const std::size_t lines = along_x ? 13 : 21, points = along_x ? 21 : 13;
+      ASSERT_EQ(hatch.toolpath.paths.size(), lines);
+      double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+      for (const PrintPath& path : hatch.toolpath.paths) {
+        ASSERT_EQ(path.points.size(), points);
+        for (const Vec3& p : path.points) {
+          EXPECT_NEAR(p.x() / 0.5, std::round(p.x() / 0.5), 1e-9);
+          EXPECT_NEAR(p.y() / 0.5, std::round(p.y() / 0.5), 1e-9);
+          EXPECT_NEAR(p.z(), height(p.x(), p.y()), 1e-9);
+          x_lo = std::min(x_lo, p.x()), x_hi = std::max(x_hi, p.x());
+          y_lo = std::min(y_lo, p.y()), y_hi = std::max(y_hi, p.y());
+        }
+      }
+      EXPECT_NEAR(x_lo, 0.0, 1e-9);
+      EXPECT_NEAR(x_hi, 10.0, 1e-9);
+      EXPECT_NEAR(y_lo, 0.0, 1e-9);
+      EXPECT_NEAR(y_hi, 6.0, 1e-9);
+    }
+  }
 }
 
 TEST(Hatching, AnglesAlternatePerLayerAndLayersStack) {

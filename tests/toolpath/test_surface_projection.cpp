@@ -1,7 +1,8 @@
 // Projection straight down onto a surface (Embree BVH, exact double recompute): points on the
 // hit triangle's plane, on the analytic surface at mesh vertices, within the chordal bound
-// elsewhere; smooth normals within the tessellation bound; holes and edges give no hit; the
-// first hit on a closed solid is its top; undersides are reported as not facing up.
+// elsewhere; smooth normals within the tessellation bound; holes and the outside give no hit,
+// a point exactly on the outline or a hole's edge does; the first hit on a closed solid is its
+// top; undersides are reported as not facing up.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -153,6 +154,46 @@ TEST(SurfaceProjection, HolesAndOutsideGiveNoHit) {
     EXPECT_TRUE(projector.project_down(-10.0, 6.5));
     EXPECT_TRUE(projector.project_down(0.0, 0.0));
   }
+}
+
+TEST(SurfaceProjection, PointsOnTheOutlineHitTheTopOnEverySide) {
+  // a solid z = 1 + 0.2 x + 0.1 y over [0, 10] x [0, 6] with a 2 x 2 mm square hole at (5, 3):
+  // a ray exactly on the outline or the hole's edge meets only triangle edges (and walls),
+  // which Embree counts on one side; every such point is on the top, at its exact height
+  HeightField field;
+  field.z = [](double x, double y) { return 1.0 + 0.2 * x + 0.1 * y; };
+  field.gradient = [](double, double) { return Vec2(0.2, 0.1); };
+  field.hessian = [](double, double) { return Eigen::Matrix2d::Zero().eval(); };
+  field.x_max = 10.0;
+  field.y_max = 6.0;
+  TessellationOptions options;
+  options.holes = {SurfaceHole::rectangle(Vec2(5, 3), Vec2(1, 1))};
+  const SurfaceProjector projector(tessellate(field, options));
+  std::vector<Vec2> rim;
+  for (int i = 0; i <= 20; ++i) {
+    const double x = 0.5 * i, y = 0.3 * i;
+    rim.insert(rim.end(), {{x, 0.0}, {x, 6.0}, {0.0, y}, {10.0, y}});
+  }
+  for (int i = 0; i <= 4; ++i) {
+    const double t = 4.0 + 0.5 * i;
+    rim.insert(rim.end(), {{t, 2.0}, {t, 4.0}, {4.0, t - 1.0}, {6.0, t - 1.0}});
+  }
+  std::vector<std::optional<SurfaceHit>> hits;
+  projector.project_down(rim, hits);
+  for (std::size_t k = 0; k < rim.size(); ++k) {
+    const double x = rim[k].x(), y = rim[k].y();
+    const std::optional<SurfaceHit> hit = projector.project_down(x, y);
+    ASSERT_TRUE(hit) << x << ", " << y;
+    ASSERT_TRUE(hits[k]) << x << ", " << y;
+    EXPECT_TRUE(hit->faces_up()) << x << ", " << y;
+    EXPECT_EQ(hit->point_mm, hits[k]->point_mm);
+    EXPECT_EQ(hit->point_mm.head<2>(), rim[k]);
+    EXPECT_NEAR(hit->point_mm.z(), field.z(x, y), 1e-12);
+  }
+  // a micrometre off the outline, or inside the hole, is off the part
+  for (const Vec2& off : {Vec2(-1e-3, 3.0), Vec2(10.001, 3.0), Vec2(5.0, -1e-3), Vec2(5.0, 6.001),
+                          Vec2(5.0, 3.0), Vec2(4.001, 2.999)})
+    EXPECT_FALSE(projector.project_down(off.x(), off.y())) << off.transpose();
 }
 
 TEST(SurfaceProjection, FirstHitOnAClosedSolidIsTheTop) {
