@@ -59,8 +59,10 @@ class SurfaceProjector {
   SurfaceProjector& operator=(const SurfaceProjector&) = delete;
 
   // The first surface a ray straight down from above the mesh meets at (x, y): the top
-  // surface. Nothing where the ray misses (outside the part, through a hole). The hit may
-  // face sideways or down (see SurfaceHit::faces_up).
+  // surface. Nothing where the ray misses (outside the part, through a hole); a point on the
+  // outline or a hole's edge (within 1e-5 of the part's size) is on the part, its hit on the
+  // plane of the top triangle there. The hit may face sideways or down (see
+  // SurfaceHit::faces_up).
   std::optional<SurfaceHit> project_down(double x_mm, double y_mm) const;
   // Many points at once (packets of 16 rays); `hits` is resized to xy.size().
   void project_down(const std::vector<Vec2>& xy,
