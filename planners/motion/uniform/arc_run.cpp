@@ -29,6 +29,9 @@ constexpr int kRadiusIterations = 12;
 // a run slower than the print speed (where the flow follows the speed) is sized for this share
 // of the speed its arc alone allows (the rest leaves its transitions a finite length)
 constexpr double kSlowRunShare = 0.9;
+// the speed shares a run whose transitions do not fit its end edges at the print speed is
+// tried at (shorter transitions)
+constexpr double kShortTransitionSpeedShares[] = {0.9, 0.75, 0.6};
 constexpr int kBisections = 60;
 // a run from rest to rest tries transitions sized for these shares of the print speed
 constexpr double kRestTransitionSpeedShares[] = {1.0, 0.5, 0.25, 0.125};
@@ -142,7 +145,9 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
                                           const std::vector<CornerGeometry>& geometry, size_t a,
                                           size_t b, double tolerance, const TcpLimits& limits,
                                           const PathMotionOptions& options, bool free_start,
-                                          bool free_end, double transition_speed_share = 1.0) {
+                                          bool free_end, double transition_speed_share = 1.0,
+                                          double run_speed_share = 1.0,
+                                          bool* ends_too_long = nullptr) {
   const bool from_rest_to_rest =
       free_start && free_end && !options.enter_at_speed && !options.leave_at_speed;
   const PrintChain& chain = merged.chain;
@@ -225,7 +230,7 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
     return radius;
   };
   const double share = from_rest_to_rest ? transition_speed_share : 1.0;
-  double speed = chain.edge_speed_mm_s[a];
+  double speed = run_speed_share * chain.edge_speed_mm_s[a];
   double radius = radius_for(share * speed);
   if (!(radius > 0.0)) {
     speed = std::min(speed, kSlowRunShare * bounds.arc_speed_bound(std::min(h_in, h_out)));
@@ -285,8 +290,10 @@ std::shared_ptr<const ArcRun> fit_arc_run(const MergedChain& merged, const Print
       (a == 1 && (options.enter_at_speed || free_start)) ? edge_in : 0.5 * edge_in;
   const double room_out =
       (b + 2 == n && (options.leave_at_speed || free_end)) ? edge_out : 0.5 * edge_out;
-  if (!(entry_trim >= 0.0 && entry_trim <= room_in && exit_trim >= 0.0 && exit_trim <= room_out))
+  if (!(entry_trim >= 0.0 && entry_trim <= room_in && exit_trim >= 0.0 && exit_trim <= room_out)) {
+    if (ends_too_long != nullptr) *ends_too_long = true;
     return nullptr;
+  }
 
   // (cheap first) every vertex within the tolerance of the curve's radial range about the
   // centre: from R on the arc out to the farther end's distance
@@ -501,9 +508,18 @@ std::vector<std::shared_ptr<const ArcRun>> find_arc_runs(
           found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options, true,
                               true, share);
         }
+        bool ends_too_long = false;
         if (!found)
           found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options, false,
-                              false);
+                              false, 1.0, 1.0, &ends_too_long);
+        // (its transitions too long for its end edges at the print speed: sized for less, the
+        // run below the print speed, weighed against its corners by the planner)
+        for (const double share : kShortTransitionSpeedShares) {
+          if (found || !ends_too_long || whole_at_rest) break;
+          ends_too_long = false;
+          found = fit_arc_run(merged, given, geometry, a, b, tolerance_mm, limits, options, false,
+                              false, 1.0, share, &ends_too_long);
+        }
         // (at an end of the chain entered or left at speed, the curve may run to the end
         // itself: a chorded circle's closing chords are seldom the length its transitions
         // need)

@@ -93,7 +93,9 @@ class ArcRun {
 // inner edges of one print path (the end edges may be of the paths joined to it), at least one
 // of which cannot keep the print speed on its own largest blend, where one such curve keeps
 // the print speed under the limits over the run's box (where its arc alone cannot, 0.9 of the
-// speed the arc allows, which the planner weighs against the corners' own choices), stays
+// speed the arc allows; where its transitions at the print speed do not fit its end edges, 0.9,
+// 0.75 or 0.6 of it, for shorter ones; the planner weighs a slower run against the corners' own
+// choices), stays
 // within tolerance_mm of the polyline as given (before merge_fine_edges: `given`, checked on
 // its samples both ways) and starts and ends on the run's end edges, leaving each at least
 // half for its other end (the whole edge at an end of the chain the path enters or leaves at
