@@ -312,6 +312,18 @@ TEST(UniformTimeLaw, RampOutOfAndIntoAHeldSharpCornerChangesSpeedOnTheCurve) {
   EXPECT_GT(ramped.second, 1.05 * crawled.second) << "corner " << ramped.first;
 }
 
+// A 20 mm line, a sharp turn onto half an ellipse (semi-axes 3 and 5 mm) in `chords` chords,
+// and a near reversal onto a last line (a loop), at 60 mm/s
+Toolpath ellipse_into_a_loop(int chords) {
+  std::vector<Vec3> points = {Vec3(-10, 0, 0.2), Vec3(10, 0, 0.2)};
+  for (int k = 1; k <= chords; ++k) {
+    const double angle = kPi * k / chords;
+    points.emplace_back(7.0 + 3.0 * std::cos(angle), 5.0 * std::sin(angle), 0.2);
+  }
+  points.emplace_back(3, 10, 0.2);
+  return polyline_job(points, 60.0);
+}
+
 // The same curve in more chords plans in about the same time. Half an ellipse (semi-axes 3
 // and 5 mm) entered from a 20 mm line at a sharp turn and left by a near reversal (a loop: the
 // line ends at rest), in 40 to 200 chords at 60 mm/s, extrusion. Which chords an arc run takes
@@ -330,13 +342,7 @@ TEST(UniformTimeLaw, MoreChordsOfTheSameCurveAreNotSlower) {
   double quickest = std::numeric_limits<double>::infinity(), slowest = 0.0;
   for (const int chords : {40, 80, 120, 160, 200}) {
     SCOPED_TRACE("chords " + std::to_string(chords));
-    std::vector<Vec3> points = {Vec3(-10, 0, 0.2), Vec3(10, 0, 0.2)};
-    for (int k = 1; k <= chords; ++k) {
-      const double angle = kPi * k / chords;
-      points.emplace_back(7.0 + 3.0 * std::cos(angle), 5.0 * std::sin(angle), 0.2);
-    }
-    points.emplace_back(3, 10, 0.2);
-    const Toolpath toolpath = polyline_job(points, 60.0);
+    const Toolpath toolpath = ellipse_into_a_loop(chords);
     const Trajectory plan =
         UniformPlanner{UniformSettings{}}.plan_in_context(toolpath, axes, extrusion);
     const Trajectory chord_by_chord =
@@ -366,13 +372,7 @@ TEST(UniformTimeLaw, MoreChordsOfTheSameCurveAerosol) {
   std::map<int, int> arc_corners;
   for (const int chords : {40, 60, 80, 120}) {
     SCOPED_TRACE("chords " + std::to_string(chords));
-    std::vector<Vec3> points = {Vec3(-10, 0, 0.2), Vec3(10, 0, 0.2)};
-    for (int k = 1; k <= chords; ++k) {
-      const double angle = kPi * k / chords;
-      points.emplace_back(7.0 + 3.0 * std::cos(angle), 5.0 * std::sin(angle), 0.2);
-    }
-    points.emplace_back(3, 10, 0.2);
-    const Toolpath toolpath = polyline_job(points, 60.0);
+    const Toolpath toolpath = ellipse_into_a_loop(chords);
     const Trajectory plan =
         UniformPlanner{UniformSettings{}}.plan_in_context(toolpath, axes, aerosol);
     EXPECT_LE(path_error(sample_trajectory(plan, 1e-4), toolpath).max_mm,
