@@ -110,11 +110,8 @@ struct SurfaceProjector::Impl {
     rtcIntersect4(valid, scene, &context, &packet);
     std::optional<SurfaceHit> best;
     for (int k = 0; k < 4; ++k) {
-      if (packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
-      SurfaceHit hit = exact_hit(x, y, static_cast<int>(packet.hit.primID[k]),
-                                 static_cast<double>(ray_z - packet.ray.tfar[k]), packet.hit.u[k],
-                                 packet.hit.v[k]);
-      if (hit.facet_normal.z() > 0.0 && (!best || hit.point_mm.z() > best->point_mm.z()))
+      const std::optional<SurfaceHit> hit = lane_hit(packet, k, x, y);
+      if (hit && hit->facet_normal.z() > 0.0 && (!best || hit->point_mm.z() > best->point_mm.z()))
         best = hit;
     }
     return best;
@@ -144,6 +141,20 @@ struct SurfaceProjector::Impl {
     packet.ray.id[k] = static_cast<unsigned>(k);
     packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
     packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+  }
+
+  // a ray's answer as the exact hit at (x, y); nothing if the ray missed
+  std::optional<SurfaceHit> ray_hit(double x, double y, unsigned geom_id, unsigned prim_id,
+                                    float tfar, float u, float v) const {
+    if (geom_id == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+    return exact_hit(x, y, static_cast<int>(prim_id), static_cast<double>(ray_z - tfar), u, v);
+  }
+
+  // ray k of a packet's answer (see ray_hit)
+  template <typename Packet>
+  std::optional<SurfaceHit> lane_hit(const Packet& packet, int k, double x, double y) const {
+    return ray_hit(x, y, packet.hit.geomID[k], packet.hit.primID[k], packet.ray.tfar[k],
+                   packet.hit.u[k], packet.hit.v[k]);
   }
 
   // the exact hit at (x, y) on triangle t; embree_z: Embree's hit height (centred frame),
@@ -204,11 +215,9 @@ std::optional<SurfaceHit> SurfaceProjector::project_down(double x_mm, double y_m
   rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(im.scene, &context, &rayhit);
-  std::optional<SurfaceHit> hit;
-  if (rayhit.hit.geomID != RTC_INVALID_GEOMETRY_ID)
-    hit = im.exact_hit(x_mm, y_mm, static_cast<int>(rayhit.hit.primID),
-                       static_cast<double>(im.ray_z - rayhit.ray.tfar), rayhit.hit.u, rayhit.hit.v);
-  return im.settle(x_mm, y_mm, std::move(hit));
+  return im.settle(x_mm, y_mm,
+                   im.ray_hit(x_mm, y_mm, rayhit.hit.geomID, rayhit.hit.primID, rayhit.ray.tfar,
+                              rayhit.hit.u, rayhit.hit.v));
 }
 
 void SurfaceProjector::project_down(const std::vector<Vec2>& xy,
@@ -229,14 +238,9 @@ void SurfaceProjector::project_down(const std::vector<Vec2>& xy,
     }
     rtcIntersect16(valid, im.scene, &context, &packet);
     for (int k = 0; k < count; ++k) {
-      std::optional<SurfaceHit>& out = hits[start + static_cast<std::size_t>(k)];
       const Vec2& p = xy[start + static_cast<std::size_t>(k)];
-      out.reset();
-      if (packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID)
-        out = im.exact_hit(p.x(), p.y(), static_cast<int>(packet.hit.primID[k]),
-                           static_cast<double>(im.ray_z - packet.ray.tfar[k]), packet.hit.u[k],
-                           packet.hit.v[k]);
-      out = im.settle(p.x(), p.y(), std::move(out));
+      hits[start + static_cast<std::size_t>(k)] =
+          im.settle(p.x(), p.y(), im.lane_hit(packet, k, p.x(), p.y()));
     }
   }
 }
