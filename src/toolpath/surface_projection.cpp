@@ -117,11 +117,12 @@ struct SurfaceProjector::Impl {
     return best;
   }
 
-  // hit: the ray's own answer at (x, y); edge_hit where it misses or meets a wall's edge
-  std::optional<SurfaceHit> settle(double x, double y, std::optional<SurfaceHit> hit) const {
-    if (hit && hit->facet_normal.z() > 0.0) return hit;
+  // hit: the ray's own answer at (x, y), replaced by edge_hit's where it misses or meets a
+  // wall's edge and edge_hit finds one (in place: most points keep theirs, uncopied)
+  void settle(double x, double y, std::optional<SurfaceHit>& hit) const {
+    if (hit && hit->facet_normal.z() > 0.0) return;
     std::optional<SurfaceHit> beside = edge_hit(x, y);
-    return beside ? beside : hit;
+    if (beside) hit = beside;
   }
 
   // ray k of a packet: straight down from above the mesh at (x, y)
@@ -215,9 +216,10 @@ std::optional<SurfaceHit> SurfaceProjector::project_down(double x_mm, double y_m
   rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(im.scene, &context, &rayhit);
-  return im.settle(x_mm, y_mm,
-                   im.ray_hit(x_mm, y_mm, rayhit.hit.geomID, rayhit.hit.primID, rayhit.ray.tfar,
-                              rayhit.hit.u, rayhit.hit.v));
+  std::optional<SurfaceHit> hit = im.ray_hit(x_mm, y_mm, rayhit.hit.geomID, rayhit.hit.primID,
+                                             rayhit.ray.tfar, rayhit.hit.u, rayhit.hit.v);
+  im.settle(x_mm, y_mm, hit);
+  return hit;
 }
 
 void SurfaceProjector::project_down(const std::vector<Vec2>& xy,
@@ -239,8 +241,9 @@ void SurfaceProjector::project_down(const std::vector<Vec2>& xy,
     rtcIntersect16(valid, im.scene, &context, &packet);
     for (int k = 0; k < count; ++k) {
       const Vec2& p = xy[start + static_cast<std::size_t>(k)];
-      hits[start + static_cast<std::size_t>(k)] =
-          im.settle(p.x(), p.y(), im.lane_hit(packet, k, p.x(), p.y()));
+      std::optional<SurfaceHit>& hit = hits[start + static_cast<std::size_t>(k)];
+      hit = im.lane_hit(packet, k, p.x(), p.y());
+      im.settle(p.x(), p.y(), hit);
     }
   }
 }
