@@ -327,8 +327,10 @@ TEST(UniformPlanner, RandomJobsStayWithinTheTolerance) {
           << "trial " << trial << " sample " << k;
     EXPECT_LE(path_error(samples, toolpath).max_mm, settings.tolerance_mm * (1 + 1e-9))
         << "trial " << trial << ", tolerance " << settings.tolerance_mm;
-    // (1e-5: one job, at 10 mm/s^2, peaks 1.2e-6 above its limit on the grid: rounding, not
-    // a law planned over its limit)
+    // (1e-5: one job, at 10 mm/s^2, peaks 1.2e-6 above its limit on the grid, 598 s into its
+    // 885 s plan, on a transition whose law is at its limit to the last digit: the grid's times
+    // are rounded to ulp(598 s) = 1.1e-13 s, 1.1e-11 mm at its 98 mm/s, and d2p / h^2 turns that
+    // into 1e-5 mm/s^2. Traced on the plan sampled as here, every 1 ms.)
     const testing_support::FiniteDifferencePeaks peaks =
         testing_support::finite_difference_peaks(plan, limits);
     EXPECT_LE(peaks.max_speed_ratio(), 1.0 + 1e-5) << "trial " << trial;
