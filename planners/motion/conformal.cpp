@@ -454,7 +454,11 @@ PathGeometry print_geometry(const PrintPath& path, const ConformalSettings& sett
     }
     const double shorter = std::min((path.points[i] - path.points[i - 1]).norm(),
                                     (path.points[i + 1] - path.points[i]).norm());
-    double delta = std::min(settings.zone_mm, 0.5 * shorter);
+    // (the apex (delta / 2) sin(turn / 2) from P_i: within zone_mm / 2 up to zone_mm / sin)
+    const double zone = settings.zone_bounds_deviation_only
+                            ? settings.zone_mm / std::max(std::sin(0.5 * turn), 1e-12)
+                            : settings.zone_mm;
+    double delta = std::min(zone, 0.5 * shorter);
     const bool turning = !path.normals.empty() && (path.normals[i - 1] != path.normals[i] ||
                                                    path.normals[i] != path.normals[i + 1]);
     for (int round = 0; turning && round < 40 && delta >= kMinBlendMm; ++round) {

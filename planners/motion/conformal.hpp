@@ -89,6 +89,12 @@ struct ConformalSettings {
   // its command by this time can follow when the command leads the speed (`uniform` sets it;
   // not a scenario parameter). 0: no such bound.
   double flow_lag_s = 0.0;
+  // true: zone_mm bounds each blend's deviation, not its size. A blend at a turn theta may be
+  // as long as keeps its apex within zone_mm / 2 of its point, zone_mm / sin(theta / 2) (still
+  // at most half the shorter edge, and shrunk for the orientation as above): a faceted
+  // surface's slight turns are flown by over their whole edges (`uniform` sets it, its
+  // tolerance the bound; not a scenario parameter: the paper's zones keep their size).
+  bool zone_bounds_deviation_only = false;
 };
 
 // The gap test over a toolpath: every pair of consecutive points of every path.

@@ -164,7 +164,9 @@ bool turns_tool(const Toolpath& toolpath) {
 // the TOPP-RA law `conformal` uses (path_parametrization.hpp, jerk_time_law.hpp: every joint's
 // speed and acceleration limit along the path, the TCP jerk limits of `jerk_limits`), its corners
 // flown by within the tolerance (zone_mm = 2 x tolerance: a blend passes zone_mm / 2 from its
-// point) by curvature-continuous blends. Per path, two time laws:
+// point; each as long as that allows, zone_bounds_deviation_only: a short blend's curvature
+// rate holds a jerk-limited law back on a faceted surface's slight turns) by
+// curvature-continuous blends. Per path, two time laws:
 //   flow   time-optimal under one more bound, decelerations of at most |v| / tau
 //          (ConformalSettings::flow_lag_s), the flow following the planned speed led by the
 //          lag (pressure advance, never a negative command): the lagging flow keeps up;
@@ -184,6 +186,7 @@ Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits
   const auto plan_with = [&](ConformalControl control, ConformalPlanReport* report) {
     ConformalSettings conformal;
     conformal.zone_mm = 2.0 * settings.tolerance_mm;
+    conformal.zone_bounds_deviation_only = true;
     conformal.period_s = settings.period_s;
     conformal.control = control;
     // decelerations the led flow can follow (any, when the extruder may retract)

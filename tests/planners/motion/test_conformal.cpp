@@ -9,8 +9,10 @@
 #include <memory>
 
 #include "core/error.hpp"
+#include "core/segment_distance.hpp"
 #include "planners/motion/conformal.hpp"
 #include "planners/motion/path_parametrization.hpp"
+#include "planners/motion/process_context.hpp"
 #include "planners/motion/uniform/uniform_planner.hpp"
 
 namespace depotwin {
@@ -347,6 +349,75 @@ TEST(ConformalPlanner, BlendsStayWithinTheStatedDeviation) {
   EXPECT_EQ(report.paths[0].stop_points, 0);
 }
 
+// A faceted convex arc (a surface's triangles crossed): radius 20 mm over 45 deg in 32 chords of
+// 0.491 mm, each point turning phi = 1.41 deg, the tool axis the arc's normal, under a TCP jerk
+// limit of 1e4 mm/s^3: the jerk-limited law's quartic blends turn the tangent over 2 delta, so
+// a short blend caps the speed.
+PrintPath faceted_arc(double speed_mm_s) {
+  PrintPath path;
+  path.speed_mm_s = speed_mm_s;
+  const double radius = 20.0;
+  const Vec3 centre(0, 0, -radius);
+  for (int i = 0; i <= 32; ++i) {
+    const double angle = -kPi / 8 + (kPi / 4) * i / 32;
+    const Vec3 normal(std::sin(angle), 0, std::cos(angle));
+    path.points.push_back(centre + radius * normal);
+    path.normals.push_back(normal);
+  }
+  return path;
+}
+
+TcpLimits with_tilt_joint_and_jerk(double j_max) {
+  const MachineLimits tcp = MachineLimits::uniform(1000.0, 5000.0, j_max);
+  return TcpLimits(
+      tcp, [tcp](const Vec3&, const Vec3&) { return tcp; }, tilt_joint_map());
+}
+
+// zone_bounds_deviation_only: zone_mm bounds a blend's deviation, not its size; each blend of
+// the arc is then half a chord long (zone_mm / sin(phi / 2) = 8.1 mm is longer), its deviation
+// the quartic's (3/8) delta sin(phi / 2) = 0.0011 mm, within zone_mm / 2, and the line keeps
+// the desired speed where 0.1 mm blends held it to 8.2 mm/s. The same blends as a zone of half
+// a chord: the same plan.
+TEST(ConformalPlanner, AZoneThatBoundsTheDeviationOnlyFliesFacetsByOverHalfTheirChords) {
+  const PrintPath path = faceted_arc(10.0);
+  const double chord = (path.points[1] - path.points[0]).norm();
+  const double phi = (kPi / 4) / 32;
+  const TcpLimits limits = with_tilt_joint_and_jerk(1e4);
+  const auto plan = [&](double zone_mm, bool deviation_only, ConformalPlanReport& report) {
+    ConformalSettings settings;
+    settings.control = ConformalControl::speed;
+    settings.zone_mm = zone_mm;
+    settings.zone_bounds_deviation_only = deviation_only;
+    return ConformalPlanner(settings).plan(one_path(path), limits, &report);
+  };
+  ConformalPlanReport sized, bounded, half_chord;
+  const Trajectory sized_plan = plan(0.1, false, sized);
+  const Trajectory bounded_plan = plan(0.1, true, bounded);
+  const Trajectory half_chord_plan = plan(0.5 * chord, false, half_chord);
+  EXPECT_LT(sized.paths[0].line_speed_mm_s, 0.9 * 10.0);
+  EXPECT_EQ(bounded.paths[0].line_speed_mm_s, 10.0);
+  EXPECT_NEAR(bounded.paths[0].max_blend_deviation_mm, 0.375 * 0.5 * chord * std::sin(phi / 2),
+              1e-9);
+  EXPECT_LE(bounded.paths[0].max_blend_deviation_mm, bounded.blend_deviation_bound_mm);
+  EXPECT_EQ(bounded.blend_deviation_bound_mm, 0.05);
+  EXPECT_TRUE(bounded_plan.warnings().empty());
+  EXPECT_EQ(bounded_plan.duration_s(), half_chord_plan.duration_s());
+  EXPECT_LT(bounded_plan.duration_s(), sized_plan.duration_s());
+  // within the tilt joint's limits and the TCP's
+  double velocity = 0.0, acceleration = 0.0;
+  tilt_excess(bounded_plan, velocity, acceleration);
+  EXPECT_LE(velocity, 5e-3);
+  EXPECT_LE(acceleration, 5e-3);
+  // every blend's samples within zone_mm / 2 of the polyline
+  const SampledMotion& motion = samples_of(*print_pieces(bounded_plan).front());
+  for (const Vec3& p : motion.position_mm) {
+    double nearest = 1e9;
+    for (size_t i = 0; i + 1 < path.points.size(); ++i)
+      nearest = std::min(nearest, point_segment_distance(p, path.points[i], path.points[i + 1]));
+    ASSERT_LE(nearest, 0.05);
+  }
+}
+
 TEST(ConformalPlanner, ReversalsAndZoneZeroAreFinePoints) {
   // a reversal cannot be flown by: the path stops there, with a warning
   PrintPath path;
@@ -611,6 +682,28 @@ TEST(UniformOnJoints, TimesATurningToolOnTheJointsAndChoosesTheLawPerPath) {
   }
   // the time-optimal law is the quicker (the constant speed is the fillet's ~2 mm/s throughout)
   EXPECT_LT(durations[1], 0.5 * durations[0]);
+
+  // aerosol on a faceted arc under a jerk limit: the constant speed is the print speed, each
+  // blend half a chord (its zone bounds the deviation only); 0.1 mm blends held it to 8.2 mm/s
+  {
+    const Trajectory faceted =
+        UniformPlanner(UniformSettings{})
+            .plan_in_context(one_path(faceted_arc(10.0)), with_tilt_joint_and_jerk(1e4),
+                             process_context(ProcessType::aerosol));
+    ASSERT_EQ(faceted.decisions().size(), 1u);
+    int figures = 0;
+    for (const PlanFigure& figure : faceted.decisions()[0].figures) {
+      if (figure.name == "constant_speed_mm_s") {
+        EXPECT_EQ(figure.value, 10.0);
+        ++figures;
+      }
+      if (figure.name == "deviation_mm") {
+        EXPECT_LE(figure.value, 0.05);
+        ++figures;
+      }
+    }
+    EXPECT_EQ(figures, 2);
+  }
 
   // a vertical tool throughout: nothing turns, the TCP law with its corner choices
   PrintPath vertical = fillet_path(20.0);
