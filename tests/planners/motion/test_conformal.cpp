@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "contract/planner_checks.hpp"
 #include "core/error.hpp"
 #include "core/segment_distance.hpp"
 #include "planners/motion/conformal.hpp"
@@ -403,11 +404,13 @@ TEST(ConformalPlanner, AZoneThatBoundsTheDeviationOnlyFliesFacetsByOverHalfTheir
   EXPECT_TRUE(bounded_plan.warnings().empty());
   EXPECT_EQ(bounded_plan.duration_s(), half_chord_plan.duration_s());
   EXPECT_LT(bounded_plan.duration_s(), sized_plan.duration_s());
-  // within the tilt joint's limits and the TCP's
+  // within the tilt joint's limits and the TCP's (its jerk too) by finite differences
   double velocity = 0.0, acceleration = 0.0;
   tilt_excess(bounded_plan, velocity, acceleration);
   EXPECT_LE(velocity, 5e-3);
   EXPECT_LE(acceleration, 5e-3);
+  testing_support::expect_finite_difference_limits(
+      bounded_plan, MachineLimits::uniform(1000.0, 5000.0, 1e4), 0.01);
   // every blend's samples within zone_mm / 2 of the polyline
   const SampledMotion& motion = samples_of(*print_pieces(bounded_plan).front());
   for (const Vec3& p : motion.position_mm) {
