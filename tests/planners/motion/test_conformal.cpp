@@ -10,7 +10,7 @@
 
 #include "contract/planner_checks.hpp"
 #include "core/error.hpp"
-#include "core/segment_distance.hpp"
+#include "metrics/motion_metrics.hpp"
 #include "planners/motion/conformal.hpp"
 #include "planners/motion/path_parametrization.hpp"
 #include "planners/motion/process_context.hpp"
@@ -72,8 +72,7 @@ std::shared_ptr<JointMap> tilt_joint_map() {
 
 const MachineLimits kFastTcp = MachineLimits::uniform(1000.0, 5000.0);
 
-TcpLimits with_tilt_joint() {
-  const MachineLimits tcp = kFastTcp;
+TcpLimits with_tilt_joint(const MachineLimits& tcp = kFastTcp) {
   return TcpLimits(
       tcp, [tcp](const Vec3&, const Vec3&) { return tcp; }, tilt_joint_map());
 }
@@ -368,12 +367,6 @@ PrintPath faceted_arc(double speed_mm_s) {
   return path;
 }
 
-TcpLimits with_tilt_joint_and_jerk(double j_max) {
-  const MachineLimits tcp = MachineLimits::uniform(1000.0, 5000.0, j_max);
-  return TcpLimits(
-      tcp, [tcp](const Vec3&, const Vec3&) { return tcp; }, tilt_joint_map());
-}
-
 // zone_bounds_deviation_only: zone_mm bounds a blend's deviation, not its size; each blend of
 // the arc is then half a chord long (zone_mm / sin(phi / 2) = 8.1 mm is longer), its deviation
 // the quartic's (3/8) delta sin(phi / 2) = 0.0011 mm, within zone_mm / 2, and the line keeps
@@ -383,7 +376,8 @@ TEST(ConformalPlanner, AZoneThatBoundsTheDeviationOnlyFliesFacetsByOverHalfTheir
   const PrintPath path = faceted_arc(10.0);
   const double chord = (path.points[1] - path.points[0]).norm();
   const double phi = (kPi / 4) / 32;
-  const TcpLimits limits = with_tilt_joint_and_jerk(1e4);
+  const MachineLimits tcp = MachineLimits::uniform(1000.0, 5000.0, 1e4);
+  const TcpLimits limits = with_tilt_joint(tcp);
   const auto plan = [&](double zone_mm, bool deviation_only, ConformalPlanReport& report) {
     ConformalSettings settings;
     settings.control = ConformalControl::speed;
@@ -409,16 +403,9 @@ TEST(ConformalPlanner, AZoneThatBoundsTheDeviationOnlyFliesFacetsByOverHalfTheir
   tilt_excess(bounded_plan, velocity, acceleration);
   EXPECT_LE(velocity, 5e-3);
   EXPECT_LE(acceleration, 5e-3);
-  testing_support::expect_finite_difference_limits(
-      bounded_plan, MachineLimits::uniform(1000.0, 5000.0, 1e4), 0.01);
-  // every blend's samples within zone_mm / 2 of the polyline
-  const SampledMotion& motion = samples_of(*print_pieces(bounded_plan).front());
-  for (const Vec3& p : motion.position_mm) {
-    double nearest = 1e9;
-    for (size_t i = 0; i + 1 < path.points.size(); ++i)
-      nearest = std::min(nearest, point_segment_distance(p, path.points[i], path.points[i + 1]));
-    ASSERT_LE(nearest, 0.05);
-  }
+  testing_support::expect_finite_difference_limits(bounded_plan, tcp, 0.01);
+  // every printing sample within zone_mm / 2 of the polyline
+  EXPECT_LE(path_error(sample_trajectory(bounded_plan, 1e-3), one_path(path)).max_mm, 0.05);
 }
 
 TEST(ConformalPlanner, ReversalsAndZoneZeroAreFinePoints) {
@@ -691,7 +678,8 @@ TEST(UniformOnJoints, TimesATurningToolOnTheJointsAndChoosesTheLawPerPath) {
   {
     const Trajectory faceted =
         UniformPlanner(UniformSettings{})
-            .plan_in_context(one_path(faceted_arc(10.0)), with_tilt_joint_and_jerk(1e4),
+            .plan_in_context(one_path(faceted_arc(10.0)),
+                             with_tilt_joint(MachineLimits::uniform(1000.0, 5000.0, 1e4)),
                              process_context(ProcessType::aerosol));
     ASSERT_EQ(faceted.decisions().size(), 1u);
     int figures = 0;
