@@ -676,6 +676,141 @@ bool cap_decelerations(PathGrid& grid, const PathSamples& samples, double lag_s,
   return lowered;
 }
 
+// One print path planned: its flown-by geometry, the constant speed no limit slows (NaN where
+// it was not asked), the cruise speed and the time law.
+struct PlannedPath {
+  PathGeometry geometry;
+  double bound = 0.0;
+  double line_speed = 0.0;
+  TimedPath timed;
+  // lead_in: when the law passes the path's first and last point (0 and its duration: no leads)
+  double print_from_s = 0.0, print_to_s = 0.0;
+};
+
+// The orientation a lead of length_mm ahead of point `end` of the path (0 or the last) takes
+// at its far end: the path's own turn over as long a stretch from that end, continued the
+// other way (by at most kLeadTurnRad), so that the tool turns at about the same rate per mm
+// through the end point: at cruise speed a lead that held the axis still would step the
+// joints' speeds there.
+constexpr double kLeadTurnRad = 15.0 * kPi / 180.0;
+ToolOrientation lead_orientation(const PrintPath& path, size_t end, double length_mm) {
+  const size_t n = path.points.size();
+  const int step = end == 0 ? 1 : -1;
+  // the first point at least length_mm along the path from the end (or the other end)
+  double along = 0.0;
+  size_t k = end;
+  while (along < length_mm && k != (end == 0 ? n - 1 : 0)) {
+    along += (path.points[k + step] - path.points[k]).norm();
+    k += step;
+  }
+  const ToolOrientation at_end = path.orientation(end), there = path.orientation(k);
+  const double angle = axis_angle_rad(at_end.axis, there.axis);
+  double share = length_mm / along;  // of the stretch's turn, continued beyond the end
+  if (angle * share > kLeadTurnRad) share = kLeadTurnRad / angle;
+  return ToolOrientation{slerp_axis(at_end.axis, there.axis, -share),
+                         at_end.roll_rad - share * (there.roll_rad - at_end.roll_rad)};
+}
+
+// The path extended by straight lines along its end edges, in_mm before its first point and
+// out_mm after its last (a lead-in and a lead-out), the tool turning on them as the path does
+// next to them (lead_orientation).
+PrintPath with_leads(const PrintPath& path, double in_mm, double out_mm) {
+  const size_t n = path.points.size();
+  const Vec3 u_in = (path.points[1] - path.points[0]).normalized();
+  const Vec3 u_out = (path.points[n - 1] - path.points[n - 2]).normalized();
+  const ToolOrientation o_in = lead_orientation(path, 0, in_mm);
+  const ToolOrientation o_out = lead_orientation(path, n - 1, out_mm);
+  PrintPath out = path;
+  out.points.insert(out.points.begin(), path.points.front() - in_mm * u_in);
+  out.points.push_back(path.points.back() + out_mm * u_out);
+  if (!path.normals.empty()) {
+    out.normals.insert(out.normals.begin(), o_in.axis);
+    out.normals.push_back(o_out.axis);
+  }
+  if (!path.rolls.empty()) {
+    out.rolls.insert(out.rolls.begin(), o_in.roll_rad);
+    out.rolls.push_back(o_out.roll_rad);
+  }
+  return out;
+}
+
+// How far a law from rest to rest runs before it first reaches its cruise (within 0.1 % of the
+// cruise speed, or of the highest speed it reaches where the joints keep it below), and how
+// far after it last leaves it.
+struct RampLengths {
+  double in_mm = 0.0, out_mm = 0.0;
+};
+RampLengths ramp_lengths(const PathSamples& samples, double cruise_mm_s) {
+  const double top = *std::max_element(samples.sdot.begin(), samples.sdot.end());
+  const double reached = (1 - 1e-3) * std::min(top, cruise_mm_s);
+  size_t first = 0, last = samples.sdot.size() - 1;
+  while (first < last && samples.sdot[first] < reached) ++first;
+  while (last > first && samples.sdot[last] < reached) --last;
+  return {samples.s_mm[first], samples.s_mm.back() - samples.s_mm[last]};
+}
+
+// The time in a law's piece (`whole`, from rest) at which its position crosses the plane
+// through `point` normal to u: the first crossing from below, or (from_end) the last; by
+// bisection in the sample interval where the signed distance (p - point) . u turns >= 0. NaN
+// where it never does.
+double crossing_time(const TrajectoryPiece& whole, const Vec3& point, const Vec3& u,
+                     bool from_end) {
+  const auto& sampled = std::get<SampledMotion>(whole.motion);
+  const std::vector<Vec3>& p = sampled.position_mm;
+  const auto side = [&](const Vec3& q) { return (q - point).dot(u); };
+  size_t k = 0;
+  bool found = false;
+  if (!from_end) {
+    for (; k + 1 < p.size() && !found; ++k) found = side(p[k]) < 0.0 && side(p[k + 1]) >= 0.0;
+  } else {
+    for (k = p.size() - 1; k > 0 && !found; --k) found = side(p[k - 1]) <= 0.0 && side(p[k]) > 0.0;
+  }
+  if (!found) return std::numeric_limits<double>::quiet_NaN();
+  // (the loops stepped once past the interval [k - 1, k] or [k, k + 1] resp.)
+  const size_t first = from_end ? k : k - 1;
+  double lo = static_cast<double>(first) * sampled.period_s, hi = lo + sampled.period_s;
+  for (int step = 0; step < 60; ++step) {
+    const double mid = 0.5 * (lo + hi);
+    Vec3 q, v, a;
+    evaluate_motion(whole, mid, q, v, a);
+    (side(q) < 0.0 ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+// The law's piece `whole` from t0 to t1 as a piece of its own starting at t_begin: its
+// interpolation sampled again at the period that divides the span into whole periods no
+// longer than max_period_s, so that the piece starts and ends exactly at t0 and t1.
+TrajectoryPiece resampled_piece(const TrajectoryPiece& whole, double t0, double t1, double t_begin,
+                                double max_period_s) {
+  const int intervals = std::max(1, static_cast<int>(std::ceil((t1 - t0) / max_period_s - 1e-9)));
+  SampledMotion motion;
+  motion.period_s = (t1 - t0) / intervals;
+  std::vector<double> rolls;
+  for (int j = 0; j <= intervals; ++j) {
+    const double tau = j == intervals ? t1 : t0 + j * motion.period_s;
+    Vec3 position, velocity, acceleration, axis, angular;
+    double roll = 0.0;
+    evaluate_motion(whole, tau, position, velocity, acceleration);
+    evaluate_tool_axis(whole, tau, position, velocity, axis, angular, roll);
+    motion.position_mm.push_back(position);
+    motion.velocity_mm_s.push_back(velocity);
+    motion.tool_axis.push_back(axis);
+    rolls.push_back(roll);
+  }
+  TrajectoryPiece piece;
+  piece.t_begin_s = t_begin;
+  piece.t_end_s = t_begin + intervals * motion.period_s;
+  piece.tool_axis.begin = motion.tool_axis.front();
+  piece.tool_axis.end = motion.tool_axis.back();
+  piece.tool_axis.roll_begin = rolls.front();
+  piece.tool_axis.roll_end = rolls.back();
+  if (std::any_of(rolls.begin(), rolls.end(), [](double r) { return r != 0.0; }))
+    motion.roll_rad = std::move(rolls);
+  piece.motion = std::move(motion);
+  return piece;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -795,6 +930,56 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     t = pieces.back().t_end_s;
   };
 
+  // One print path's flown-by geometry, its grid with the joints along it, and its time law;
+  // `speed` and `both` cruise at the largest constant speed no limit slows.
+  const auto plan_print_path = [&](const PrintPath& path, const std::string& name) {
+    PlannedPath out;
+    out.geometry = print_geometry(path, settings, jerk_limited);
+    PathGrid grid = polyline_grid(fly_by_pieces(out.geometry.polyline, jerk_limited),
+                                  settings.ds_mm, path.speed_mm_s, name);
+    grid.points.front().tool_axis = path.tool_axis(0);
+    grid.points.back().tool_axis = path.tool_axis(path.points.size() - 1);
+    if (joints) attach_joints_with_headroom(grid, *joints);
+    const std::vector<MachineLimits> interval_limits = interval_tcp_limits(grid, limits, kChunkMm);
+
+    TimeLawOptions options;
+    out.bound = constant_speed || report ? speed_bound(grid, interval_limits, options)
+                                         : std::numeric_limits<double>::quiet_NaN();
+    out.line_speed = path.speed_mm_s;
+    if (constant_speed) {
+      out.line_speed = std::min(path.speed_mm_s, out.bound);
+      if (!(out.line_speed > 0.0))
+        throw InputError(name, "no constant speed keeps the joints within their limits");
+    }
+    for (int round = 0; round < 8; ++round) {
+      set_cruise_speed(grid, out.line_speed);
+      out.timed = time_law(grid, interval_limits, options);
+      if (!constant_speed) break;
+      // the accelerations the law was planned with (the sampling margin, repairs) can lower
+      // the constant speed: plan again at the speed they allow
+      TimeLawOptions planned;
+      planned.tcp_accel_scale = out.timed.tcp_accel_scale;
+      const double lowered = speed_bound(grid, interval_limits, planned);
+      if (lowered >= out.line_speed * (1 - 1e-12)) break;
+      out.line_speed = lowered;
+      options.tcp_accel_scale = out.timed.repair_scale;  // time_path adds its margins again
+    }
+
+    // decelerations the lagging flow can follow (flow_lag_s): bounds ahead of each slow-down,
+    // planned again until none is lowered (down to kLagFloorShare of the line speed)
+    if (settings.flow_lag_s > 0.0)
+      for (int round = 0;
+           round < kLagRounds && cap_decelerations(grid, out.timed.samples, settings.flow_lag_s,
+                                                   kLagFloorShare * out.line_speed);
+           ++round)
+        out.timed = time_law(grid, interval_limits, options);
+    return out;
+  };
+
+  // lead_in: the paths whose lead-in and lead-out were not taken, and why the first was not
+  int leads_dropped = 0;
+  std::string leads_dropped_first;
+
   Vec3 position = toolpath.start_mm;
   ToolOrientation orientation = toolpath.start_orientation();
   for (size_t index = 0; index < toolpath.paths.size(); ++index) {
@@ -802,19 +987,75 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     const PrintPath& path = toolpath.paths[index];
     const std::string name = path_name(path, index);
     validate_print_path(path, name, kSamePoint);
-    add_transition(position, orientation, path.front(), path.orientation(0),
-                   "transition to " + name);
+    PlannedPath planned = plan_print_path(path, name);
 
-    // the flown-by path on its grid, with the joints along it
-    const PathGeometry geometry = print_geometry(path, settings, jerk_limited);
+    // lead_in: the law's ramps from and to rest moved onto straight extensions of the end
+    // edges, planned with the path as one and cut off it with the material off, so that the
+    // path itself is printed at its cruise speed from end to end. The extensions are as long
+    // as the ramps (with a margin), measured on the path's own law, and longer if the extended
+    // law ramps farther. Not taken (a warning counts them) where the machine cannot reach the
+    // extensions, or where they would lower the cruise speed.
+    double lead_in_mm = 0.0, lead_out_mm = 0.0;
+    if (settings.lead_in && settings.zone_mm > 0.0 && !path.has_arcs()) {
+      RampLengths ramps = ramp_lengths(planned.timed.samples, planned.line_speed);
+      for (int round = 0; round < 3; ++round) {
+        const double in_mm = 1.25 * ramps.in_mm + 2.0 * settings.ds_mm;
+        const double out_mm = 1.25 * ramps.out_mm + 2.0 * settings.ds_mm;
+        PlannedPath led;
+        try {
+          led = plan_print_path(with_leads(path, in_mm, out_mm), name + " with its lead-in");
+        } catch (const InputError& error) {
+          if (leads_dropped++ == 0) leads_dropped_first = error.what();
+          break;
+        }
+        const auto stops = [](const PlannedPath& p) {
+          return p.geometry.sharp_stops.size() + p.geometry.tiny_stops.size();
+        };
+        if (led.line_speed < planned.line_speed * (1 - 1e-3) || stops(led) != stops(planned)) {
+          if (leads_dropped++ == 0)
+            leads_dropped_first = name + ": its lead-in and lead-out would slow or stop it";
+          break;
+        }
+        const RampLengths led_ramps = ramp_lengths(led.timed.samples, led.line_speed);
+        if (led_ramps.in_mm <= in_mm && led_ramps.out_mm <= out_mm) {
+          // where the law passes the path's ends (the leads are straight: planes across them)
+          const TrajectoryPiece whole = sampled_piece(led.timed.samples, 0.0);
+          const size_t n = path.points.size();
+          led.print_from_s = crossing_time(whole, path.points[0],
+                                           (path.points[1] - path.points[0]).normalized(), false);
+          led.print_to_s =
+              crossing_time(whole, path.points[n - 1],
+                            (path.points[n - 1] - path.points[n - 2]).normalized(), true);
+          if (!(led.print_to_s > led.print_from_s)) {
+            if (leads_dropped++ == 0)
+              leads_dropped_first = name + ": its ends could not be found on its extended law";
+            break;
+          }
+          planned = std::move(led);
+          lead_in_mm = in_mm;
+          lead_out_mm = out_mm;
+          break;
+        }
+        ramps = led_ramps;
+        if (round == 2 && leads_dropped++ == 0)
+          leads_dropped_first = name + ": its law kept ramping beyond its lead-in and lead-out";
+      }
+    }
+    const PathGeometry& geometry = planned.geometry;
+    const PathSamples& samples = planned.timed.samples;
+    const double line_speed = planned.line_speed;
+
+    const size_t first_point = lead_in_mm > 0.0 ? 1 : 0;  // the path's point 0 in the geometry
     for (const size_t i : geometry.sharp_stops) {
       std::ostringstream msg;
-      msg << name << ": stops at point " << i << ": the path turns by more than 170 deg";
+      msg << name << ": stops at point " << i - first_point
+          << ": the path turns by more than 170 deg";
       warn(msg.str());
     }
     for (const size_t i : geometry.tiny_stops) {
       std::ostringstream msg;
-      msg << name << ": stops at point " << i << ": the tool axis turns too sharply there to fly "
+      msg << name << ": stops at point " << i - first_point
+          << ": the tool axis turns too sharply there to fly "
           << "by within zone_ori_deg = " << settings.zone_ori_deg << " deg";
       warn(msg.str());
     }
@@ -824,48 +1065,29 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
           << " mm from a point, beyond zone_mm / 2 = " << 0.5 * settings.zone_mm << " mm";
       warn(msg.str());
     }
-    PathGrid grid = polyline_grid(fly_by_pieces(geometry.polyline, jerk_limited), settings.ds_mm,
-                                  path.speed_mm_s, name);
-    grid.points.front().tool_axis = path.tool_axis(0);
-    grid.points.back().tool_axis = path.tool_axis(path.points.size() - 1);
-    if (joints) attach_joints_with_headroom(grid, *joints);
-    const std::vector<MachineLimits> interval_limits = interval_tcp_limits(grid, limits, kChunkMm);
 
-    // the time law; `speed` and `both` cruise at the largest constant speed no limit slows
-    TimeLawOptions options;
-    const double bound = constant_speed || report ? speed_bound(grid, interval_limits, options)
-                                                  : std::numeric_limits<double>::quiet_NaN();
-    double line_speed = path.speed_mm_s;
-    if (constant_speed) {
-      line_speed = std::min(path.speed_mm_s, bound);
-      if (!(line_speed > 0.0))
-        throw InputError(name, "no constant speed keeps the joints within their limits");
-    }
-    TimedPath timed;
-    for (int round = 0; round < 8; ++round) {
-      set_cruise_speed(grid, line_speed);
-      timed = time_law(grid, interval_limits, options);
-      if (!constant_speed) break;
-      // the accelerations the law was planned with (the sampling margin, repairs) can lower
-      // the constant speed: plan again at the speed they allow
-      TimeLawOptions planned;
-      planned.tcp_accel_scale = timed.tcp_accel_scale;
-      const double lowered = speed_bound(grid, interval_limits, planned);
-      if (lowered >= line_speed * (1 - 1e-12)) break;
-      line_speed = lowered;
-      options.tcp_accel_scale = timed.repair_scale;  // time_path adds its margins again
-    }
-
-    // decelerations the lagging flow can follow (flow_lag_s): bounds ahead of each slow-down,
-    // planned again until none is lowered (down to kLagFloorShare of the line speed)
-    if (settings.flow_lag_s > 0.0)
-      for (int round = 0;
-           round < kLagRounds &&
-           cap_decelerations(grid, timed.samples, settings.flow_lag_s, kLagFloorShare * line_speed);
-           ++round)
-        timed = time_law(grid, interval_limits, options);
-
-    TrajectoryPiece piece = sampled_piece(timed.samples, t);
+    // with leads: the law's piece cut where it passes the path's ends, material off on the leads
+    const bool led = lead_in_mm > 0.0;
+    if (led)
+      add_transition(position, orientation, samples.position_mm.front(),
+                     ToolOrientation{samples.tool_axis.front(), samples.roll_rad.front()},
+                     "transition to " + name);
+    else
+      add_transition(position, orientation, path.front(), path.orientation(0),
+                     "transition to " + name);
+    const TrajectoryPiece whole = sampled_piece(samples, 0.0);
+    const double duration_s = samples.duration_s();
+    const auto add_lead = [&](double t0, double t1) {
+      TrajectoryPiece lead = resampled_piece(whole, t0, t1, t, settings.period_s);
+      lead.path_index = -1;
+      lead.depositing = false;
+      pieces.push_back(std::move(lead));
+      t = pieces.back().t_end_s;
+    };
+    if (led) add_lead(0.0, planned.print_from_s);
+    TrajectoryPiece piece =
+        led ? resampled_piece(whole, planned.print_from_s, planned.print_to_s, t, settings.period_s)
+            : sampled_piece(samples, t);
     piece.path_index = static_cast<int>(index);
     piece.depositing = true;
     piece.desired_speed_mm_s = path.speed_mm_s;
@@ -879,7 +1101,7 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
       ConformalPathReport entry;
       entry.path_index = static_cast<int>(index);
       entry.desired_speed_mm_s = path.speed_mm_s;
-      entry.constant_speed_bound_mm_s = std::min(bound, path.speed_mm_s);
+      entry.constant_speed_bound_mm_s = std::min(planned.bound, path.speed_mm_s);
       entry.line_speed_mm_s = line_speed;
       entry.flow_fraction_min =
           *std::min_element(motion.flow_fraction.begin(), motion.flow_fraction.end());
@@ -889,14 +1111,19 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
           static_cast<int>(geometry.sharp_stops.size() + geometry.tiny_stops.size()) +
           (settings.zone_mm <= 0.0 ? static_cast<int>(path.points.size()) - 2 : 0);
       entry.max_blend_deviation_mm = geometry.max_deviation_mm;
-      entry.adjusted_samples = timed.samples.adjusted_samples;
-      entry.repair_rounds = timed.repair_rounds;
+      entry.adjusted_samples = samples.adjusted_samples;
+      entry.repair_rounds = planned.timed.repair_rounds;
+      entry.lead_in_mm = lead_in_mm;
+      entry.lead_out_mm = lead_out_mm;
       report->paths.push_back(entry);
     }
     pieces.push_back(std::move(piece));
     t = pieces.back().t_end_s;
-    position = path.back();
-    orientation = path.orientation(path.points.size() - 1);
+    if (led) add_lead(planned.print_to_s, duration_s);
+    // where the next transition starts: the lead-out's end, or the path's
+    position = led ? samples.position_mm.back() : path.back();
+    orientation = led ? ToolOrientation{samples.tool_axis.back(), samples.roll_rad.back()}
+                      : path.orientation(path.points.size() - 1);
   }
   add_transition(position, orientation, toolpath.end_mm, toolpath.end_orientation(),
                  "transition to the toolpath's end");
@@ -909,6 +1136,12 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     rest.velocity_mm_s = {Vec3::Zero()};
     rest.tool_axis = {vertical_tool_axis()};
     pieces.push_back(sampled_piece(rest, 0.0));
+  }
+  if (leads_dropped > 0) {
+    std::ostringstream msg;
+    msg << leads_dropped << " path(s) printed without a lead-in and lead-out, from rest to rest "
+        << "(first: " << leads_dropped_first << ")";
+    warnings.push_back(msg.str());
   }
   if (unlifted > 0) {
     std::ostringstream msg;
@@ -967,6 +1200,17 @@ std::vector<PlannerParameter> conformal_parameters() {
        false,
        {},
        "mm"},
+      {"lead_in",
+       0.0,
+       0.0,
+       1.0,
+       "1: each path planned with straight extensions of its end edges as long as its ramps, "
+       "printed only between them (material off on them): the path at its cruise speed from "
+       "end to end; 0: from rest to rest on the path",
+       false,
+       {},
+       "",
+       /*whole_number=*/true},
       {"period_s", 0.001, 1e-5, 0.1, "sample period of the planned motion", false, {}, "s"},
       {"ds_mm",
        0.05,
@@ -998,6 +1242,10 @@ ConformalSettings conformal_settings(const PlannerSpec& spec) {
   settings.lift_mm = spec.get("lift_mm", settings.lift_mm);
   settings.period_s = spec.get("period_s", settings.period_s);
   settings.ds_mm = spec.get("ds_mm", settings.ds_mm);
+  const double lead_in = spec.get("lead_in", 0.0);
+  if (lead_in != 0.0 && lead_in != 1.0)
+    throw InputError("planners.conformal.lead_in", "must be 0 or 1");
+  settings.lead_in = lead_in == 1.0;
   return settings;
 }
 

@@ -2,8 +2,10 @@
 // arm, sec. 4 "Trajectory parameters" and 4.1 "Velocity control", on a time-optimal path
 // parametrisation under TCP and joint limits (path_parametrization.hpp, TOPP-RA).
 //
-// Each print path is printed from rest to rest. Its polyline is flown by at interior points
-// like RobotStudio's zone data (fly-by points): around point i a quadratic Bezier blend of size
+// Each print path is printed from rest to rest (lead_in: its ramps moved onto straight
+// extensions of its end edges, cut off with the material off, see ConformalSettings). Its
+// polyline is flown by at interior points like RobotStudio's zone data (fly-by points): around
+// point i a quadratic Bezier blend of size
 //   delta_i = min(zone_mm, 0.5 * the shorter adjacent edge)
 // from P_i - delta_i d_in through P_i (control point) to P_i + delta_i d_out, tangent to both
 // edges, so position is C1 and the curvature steps at the blend's ends. The blend's apex is
@@ -95,6 +97,12 @@ struct ConformalSettings {
   // surface's slight turns are flown by over their whole edges (`uniform` sets it, its
   // tolerance the bound; not a scenario parameter: the paper's zones keep their size).
   bool zone_bounds_deviation_only = false;
+  // true: each print path is planned with straight extensions of its end edges, as long as its
+  // ramps from and to rest, and printed only between them (the material off on them): the path
+  // itself at its cruise speed from end to end, as an aerosol stream that cannot be modulated
+  // needs (`uniform` sets it for aerosol; the scenario's `lead_in: 1`). Not taken, with a
+  // warning, where the machine cannot reach an extension or it would lower the cruise speed.
+  bool lead_in = false;
 };
 
 // The gap test over a toolpath: every pair of consecutive points of every path.
@@ -119,6 +127,7 @@ struct ConformalPathReport {
   double max_blend_deviation_mm = 0.0;  // the blended path from the polyline's points
   int adjusted_samples = 0;             // velocities fitted for the cubic interpolation
   int repair_rounds = 0;
+  double lead_in_mm = 0.0, lead_out_mm = 0.0;  // lead_in: the extensions taken (0: none)
 };
 struct ConformalPlanReport {
   GapReport gaps;

@@ -16,6 +16,15 @@ namespace {
 
 // arcs become chords within this share of the tolerance before their corners are blended
 constexpr double kArcChordShare = 0.1;
+
+// the toolpath with its arcs as chords within kArcChordShare of the tolerance (their corners
+// are blended like any other)
+Toolpath with_arcs_chorded(const Toolpath& toolpath, double tolerance_mm) {
+  Toolpath chorded = toolpath;
+  for (PrintPath& path : chorded.paths)
+    if (path.has_arcs()) path = path.chorded(kArcChordShare * tolerance_mm);
+  return chorded;
+}
 // fine edges are merged within this share of the tolerance (merge_fine_edges); the blends keep
 // to the rest
 constexpr double kMergeShare = 0.5;
@@ -176,22 +185,29 @@ bool turns_tool(const Toolpath& toolpath) {
 // mm/s (|v| tau = 0.03 mm at 1.4 mm/s on the fillet) the speed falls faster between its points,
 // and the prediction sees what that leaves.
 // Extrusion takes the one of less predicted line error + time_weight x time; aerosol, whose
-// stream cannot follow a speed, the constant speed. One decision per path reports it.
+// stream cannot follow a speed, the constant speed, its ramps on a lead-in and a lead-out with
+// the shutter closed (ConformalSettings::lead_in), so the path is printed at that speed from
+// end to end. One decision per path reports it.
 Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits,
                           const UniformSettings& settings, const DepositModel& model) {
   const bool aerosol = model.aerosol();
   const double tau_s = aerosol ? 0.0 : model.settings.tau_s;
+  // (the joints' law takes polylines)
+  const Toolpath chorded = with_arcs_chorded(toolpath, settings.tolerance_mm);
   // (a report only where it is read: with one, conformal also computes each path's constant
   // speed bound)
   const auto plan_with = [&](ConformalControl control, ConformalPlanReport* report) {
     ConformalSettings conformal;
     conformal.zone_mm = 2.0 * settings.tolerance_mm;
     conformal.zone_bounds_deviation_only = true;
+    // aerosol: the ramps on extensions of the end edges, the shutter closed there (the stream
+    // cannot follow a speed, so a ramp printed from rest would thicken the line's ends)
+    conformal.lead_in = aerosol;
     conformal.period_s = settings.period_s;
     conformal.control = control;
     // decelerations the led flow can follow (any, when the extruder may retract)
     conformal.flow_lag_s = model.settings.retract ? 0.0 : tau_s;
-    Trajectory timed = ConformalPlanner(conformal).plan(toolpath, jerk_limits, report);
+    Trajectory timed = ConformalPlanner(conformal).plan(chorded, jerk_limits, report);
     std::vector<TrajectoryPiece> pieces = timed.pieces();
     if (!aerosol)
       for (TrajectoryPiece& piece : pieces)
@@ -223,6 +239,10 @@ Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits
       d.figures.push_back({"print_speed_mm_s", report.desired_speed_mm_s, "mm/s"});
       d.figures.push_back({"constant_speed_mm_s", report.line_speed_mm_s, "mm/s"});
       d.figures.push_back({"deviation_mm", report.max_blend_deviation_mm, "mm"});
+      if (aerosol) {
+        d.figures.push_back({"lead_in_mm", report.lead_in_mm, "mm"});
+        d.figures.push_back({"lead_out_mm", report.lead_out_mm, "mm"});
+      }
       if (comparable && follow[k].depositing && follow[k].path_index == piece.path_index) {
         const double constant_error = predicted_line_error_mm(piece, tau_s);
         const double follow_error = predicted_line_error_mm(follow[k], tau_s);
@@ -278,10 +298,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
   options.period_s = settings_.period_s;
   options.curved_ramps = settings_.curved_ramps;
 
-  // arcs as fine chords (their corners are blended like any other)
-  Toolpath chorded = toolpath;
-  for (PrintPath& path : chorded.paths)
-    if (path.has_arcs()) path = path.chorded(kArcChordShare * settings_.tolerance_mm);
+  const Toolpath chorded = with_arcs_chorded(toolpath, settings_.tolerance_mm);
 
   std::vector<TrajectoryPiece> pieces;
   std::vector<PlanDecision> decisions;

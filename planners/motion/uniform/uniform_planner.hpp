@@ -26,7 +26,8 @@
 //    modulated, so a path's start ramp would thicken it), extrusion paths at rest.
 //  - On a machine whose joints turn the tool (an arm), in a job that turns it, each print path
 //    is timed on the joints instead, by `conformal`'s TOPP-RA law, its flow following the speed
-//    or its speed held constant by the same cost (plan_on_joints in uniform_planner.cpp).
+//    or its speed held constant by the same cost (aerosol: the constant speed, the ramps on a
+//    lead-in and a lead-out with the shutter closed; plan_on_joints in uniform_planner.cpp).
 // Joined paths (a path starting where the previous one ended) are printed in one go, their
 // joint a corner like any other. Arcs (PrintPath::arcs) are chorded within a tenth of the
 // tolerance first; then every chain's fine edges (those chords, or a slicer's) are merged within

@@ -152,6 +152,7 @@ TEST(ConformalPlanner, DeclaresItsParametersWithRanges) {
   spec.params["lift_mm"] = {0.0};
   spec.params["period_s"] = {0.002};
   spec.params["ds_mm"] = {0.02};
+  spec.params["lead_in"] = {1.0};
   EXPECT_EQ(check_planner_spec(spec), "");
   const ConformalSettings settings = conformal_settings(spec);
   EXPECT_EQ(settings.control, ConformalControl::both);
@@ -161,7 +162,14 @@ TEST(ConformalPlanner, DeclaresItsParametersWithRanges) {
   EXPECT_EQ(settings.lift_mm, 0.0);
   EXPECT_EQ(settings.period_s, 0.002);
   EXPECT_EQ(settings.ds_mm, 0.02);
+  EXPECT_TRUE(settings.lead_in);
   EXPECT_EQ(conformal_settings(PlannerSpec{"conformal", {}, 0}).control, ConformalControl::none);
+  EXPECT_FALSE(conformal_settings(PlannerSpec{"conformal", {}, 0}).lead_in);
+
+  spec.params["lead_in"] = {0.5};  // a switch: 0 or 1
+  EXPECT_NE(check_planner_spec(spec).find("'lead_in'"), std::string::npos);
+  EXPECT_THROW(conformal_settings(spec), InputError);
+  spec.params.erase("lead_in");
 
   spec.choices["control"] = "fast";
   EXPECT_NE(check_planner_spec(spec).find("not one of none | speed | flow | both"),
@@ -638,6 +646,128 @@ TEST(ConformalPlanner, FlowLagBoundsTheDecelerations) {
 // less predicted line error + time_weight x time (time_weight 0: the constant speed; a second
 // worth 1000 mm: the time-optimal law with the flow following the speed). The same path with a
 // vertical tool keeps the TCP law and its per-corner choices.
+// lead_in: the law's ramps on straight extensions of the end edges, the material off there.
+// On the faceted arc (the tool on the normal, the tilt joint, a jerk limit) the print piece runs
+// from the path's first point to its last exactly, at the constant speed throughout; without
+// it the print starts and ends at rest. The leads are the end edges' lines, begin and end at
+// rest, the tool turning on them at the arc's own rate; every limit holds across the cuts.
+TEST(ConformalPlanner, LeadInPrintsThePathAtItsCruiseSpeedFromEndToEnd) {
+  const PrintPath path = faceted_arc(10.0);
+  const MachineLimits tcp = MachineLimits::uniform(1000.0, 5000.0, 1e4);
+  const TcpLimits limits = with_tilt_joint(tcp);
+  const auto plan = [&](bool lead_in, ConformalPlanReport& report) {
+    ConformalSettings settings;
+    settings.control = ConformalControl::speed;
+    settings.zone_mm = 0.1;
+    settings.zone_bounds_deviation_only = true;
+    settings.lead_in = lead_in;
+    return ConformalPlanner(settings).plan(one_path(path), limits, &report);
+  };
+  ConformalPlanReport plain_report, led_report;
+  const Trajectory plain = plan(false, plain_report);
+  const Trajectory led = plan(true, led_report);
+  EXPECT_TRUE(led.warnings().empty());
+  ASSERT_EQ(print_pieces(plain).size(), 1u);
+  ASSERT_EQ(print_pieces(led).size(), 1u);
+  EXPECT_EQ(samples_of(*print_pieces(plain)[0]).velocity_mm_s.front().norm(), 0.0);
+  EXPECT_EQ(plain_report.paths[0].lead_in_mm, 0.0);
+
+  // transition, lead-in, print, lead-out, transition
+  const std::vector<TrajectoryPiece>& pieces = led.pieces();
+  ASSERT_EQ(pieces.size(), 5u);
+  const TrajectoryPiece& lead_in = pieces[1];
+  const TrajectoryPiece& print = pieces[2];
+  const TrajectoryPiece& lead_out = pieces[3];
+  EXPECT_FALSE(lead_in.depositing);
+  EXPECT_FALSE(lead_out.depositing);
+  EXPECT_EQ(lead_in.path_index, -1);
+  ASSERT_TRUE(print.depositing);
+
+  // the print piece: from the first point to the last, at the constant speed, 10 mm/s
+  const double speed = led_report.paths[0].line_speed_mm_s;
+  EXPECT_EQ(speed, 10.0);
+  const SampledMotion& printed = samples_of(print);
+  EXPECT_LT((printed.position_mm.front() - path.points.front()).norm(), 1e-9);
+  EXPECT_LT((printed.position_mm.back() - path.points.back()).norm(), 1e-9);
+  for (const Vec3& v : printed.velocity_mm_s) EXPECT_NEAR(v.norm(), speed, 1e-6 * speed);
+  EXPECT_LE(printed.period_s, 0.001);
+  // its duration: the polyline's length at that speed, less the blends' shortcuts (31 blends
+  // over 1.4 deg turns, about 2e-5 mm each)
+  const double printed_mm = (print.t_end_s - print.t_begin_s) * speed;
+  EXPECT_LE(printed_mm, path.length_mm());
+  EXPECT_GE(printed_mm, path.length_mm() - 31 * 3e-5);
+
+  // the leads: on the end edges' lines, as long as reported, from and to rest
+  const size_t n = path.points.size();
+  const Vec3 u_in = (path.points[1] - path.points[0]).normalized();
+  const Vec3 u_out = (path.points[n - 1] - path.points[n - 2]).normalized();
+  const auto off_line = [](const Vec3& q, const Vec3& on, const Vec3& u) {
+    return (q - on - (q - on).dot(u) * u).norm();
+  };
+  for (const Vec3& q : samples_of(lead_in).position_mm)
+    EXPECT_LT(off_line(q, path.points[0], u_in), 1e-9);
+  for (const Vec3& q : samples_of(lead_out).position_mm)
+    EXPECT_LT(off_line(q, path.points[n - 1], u_out), 1e-9);
+  EXPECT_NEAR((samples_of(lead_in).position_mm.front() - path.points[0]).norm(),
+              led_report.paths[0].lead_in_mm, 1e-9);
+  EXPECT_NEAR((samples_of(lead_out).position_mm.back() - path.points[n - 1]).norm(),
+              led_report.paths[0].lead_out_mm, 1e-9);
+  EXPECT_EQ(samples_of(lead_in).velocity_mm_s.front().norm(), 0.0);
+  EXPECT_LT(samples_of(lead_out).velocity_mm_s.back().norm(), 1e-9);
+  // the tool turns on the leads at the arc's rate (pi/4 over its length), not held still
+  const double rate = (kPi / 4) / path.length_mm();
+  const double lead_turn = axis_angle_rad(samples_of(lead_in).tool_axis.front(), path.normals[0]);
+  EXPECT_NEAR(lead_turn, rate * led_report.paths[0].lead_in_mm, 1e-3 * lead_turn);
+  // and where the print starts and ends, the path's own axis within zone_ori_deg
+  EXPECT_LT(axis_angle_rad(printed.tool_axis.front(), path.normals.front()), deg_to_rad(1.5));
+  EXPECT_LT(axis_angle_rad(printed.tool_axis.back(), path.normals.back()), deg_to_rad(1.5));
+
+  // the limits by finite differences, through the cuts
+  double velocity = 0.0, acceleration = 0.0;
+  tilt_excess(led, velocity, acceleration);
+  EXPECT_LE(velocity, 5e-3);
+  EXPECT_LE(acceleration, 5e-3);
+  testing_support::expect_finite_difference_limits(led, tcp, 0.01);
+  testing_support::expect_contract(led, one_path(path), tcp);
+}
+
+// A lead the machine cannot reach is not taken: the path is printed from rest to rest, and a
+// warning says so. The tilt machine here cannot reach x beyond the arc's end by 0.01 mm.
+TEST(ConformalPlanner, ALeadOutOfReachIsNotTakenAndSaysSo) {
+  const PrintPath path = faceted_arc(10.0);
+  const double x_reach = path.points.back().x() + 0.01;
+  auto map = tilt_joint_map();
+  const auto solve = map->solve;
+  map->solve = [solve, x_reach](const std::vector<Pose>& poses, std::vector<JointVector>& joints,
+                                std::string* why) {
+    for (size_t i = 0; i < poses.size(); ++i)
+      if (poses[i].position_mm.x() > x_reach) {
+        if (why) *why = "pose " + std::to_string(i) + " beyond x " + std::to_string(x_reach);
+        return false;
+      }
+    return solve(poses, joints, why);
+  };
+  const MachineLimits tcp = MachineLimits::uniform(1000.0, 5000.0, 1e4);
+  const TcpLimits limits(
+      tcp, [tcp](const Vec3&, const Vec3&) { return tcp; }, map);
+  ConformalSettings settings;
+  settings.control = ConformalControl::speed;
+  settings.lead_in = true;
+  ConformalPlanReport report;
+  const Trajectory plan = ConformalPlanner(settings).plan(one_path(path), limits, &report);
+  // (and the transition to the end, lifting along the tilted axis, goes straight: a second)
+  ASSERT_FALSE(plan.warnings().empty());
+  EXPECT_NE(plan.warnings()[0].find("1 path(s) printed without a lead-in and lead-out, from rest "
+                                    "to rest (first: toolpath path 0 with its lead-in: the "
+                                    "machine cannot follow the path"),
+            std::string::npos)
+      << plan.warnings()[0];
+  EXPECT_EQ(report.paths[0].lead_in_mm, 0.0);
+  ASSERT_EQ(plan.pieces().size(), 3u);
+  EXPECT_EQ(samples_of(*print_pieces(plan)[0]).velocity_mm_s.front().norm(), 0.0);
+  testing_support::expect_contract(plan, one_path(path), tcp);
+}
+
 TEST(UniformOnJoints, TimesATurningToolOnTheJointsAndChoosesTheLawPerPath) {
   DepositionSettings extrusion;
   extrusion.type = ProcessType::extrusion;
@@ -692,8 +822,16 @@ TEST(UniformOnJoints, TimesATurningToolOnTheJointsAndChoosesTheLawPerPath) {
         EXPECT_LE(figure.value, 0.05);
         ++figures;
       }
+      // with a lead-in and a lead-out: the stream prints the path at that speed throughout
+      if (figure.name == "lead_in_mm" || figure.name == "lead_out_mm") {
+        EXPECT_GT(figure.value, 0.0) << figure.name;
+        ++figures;
+      }
     }
-    EXPECT_EQ(figures, 2);
+    EXPECT_EQ(figures, 4);
+    ASSERT_EQ(print_pieces(faceted).size(), 1u);
+    for (const Vec3& v : samples_of(*print_pieces(faceted)[0]).velocity_mm_s)
+      EXPECT_NEAR(v.norm(), 10.0, 1e-5);
   }
 
   // a vertical tool throughout: nothing turns, the TCP law with its corner choices
