@@ -25,6 +25,7 @@ Toolpath with_arcs_chorded(const Toolpath& toolpath, double tolerance_mm) {
     if (path.has_arcs()) path = path.chorded(kArcChordShare * tolerance_mm);
   return chorded;
 }
+
 // fine edges are merged within this share of the tolerance (merge_fine_edges); the blends keep
 // to the rest
 constexpr double kMergeShare = 0.5;

@@ -638,14 +638,6 @@ TEST(ConformalPlanner, FlowLagBoundsTheDecelerations) {
   EXPECT_LE(acceleration, 5e-3);
 }
 
-// ---------------------------------------------------------------------------------------
-// `uniform` on a machine whose joints turn the tool (uniform_planner.cpp, plan_on_joints)
-
-// On the fillet the tool turns, so `uniform` times the path on the joints: the tilt joint within
-// its limits at every 1 ms sample, the corners within the tolerance, and per path the law of
-// less predicted line error + time_weight x time (time_weight 0: the constant speed; a second
-// worth 1000 mm: the time-optimal law with the flow following the speed). The same path with a
-// vertical tool keeps the TCP law and its per-corner choices.
 // lead_in: the law's ramps on straight extensions of the end edges, the material off there.
 // On the faceted arc (the tool on the normal, the tilt joint, a jerk limit) the print piece runs
 // from the path's first point to its last exactly, at the constant speed throughout; without
@@ -768,6 +760,14 @@ TEST(ConformalPlanner, ALeadOutOfReachIsNotTakenAndSaysSo) {
   testing_support::expect_contract(plan, one_path(path), tcp);
 }
 
+// ---------------------------------------------------------------------------------------
+// `uniform` on a machine whose joints turn the tool (uniform_planner.cpp, plan_on_joints)
+
+// On the fillet the tool turns, so `uniform` times the path on the joints: the tilt joint within
+// its limits at every 1 ms sample, the corners within the tolerance, and per path the law of
+// less predicted line error + time_weight x time (time_weight 0: the constant speed; a second
+// worth 1000 mm: the time-optimal law with the flow following the speed). The same path with a
+// vertical tool keeps the TCP law and its per-corner choices.
 TEST(UniformOnJoints, TimesATurningToolOnTheJointsAndChoosesTheLawPerPath) {
   DepositionSettings extrusion;
   extrusion.type = ProcessType::extrusion;
