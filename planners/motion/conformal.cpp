@@ -689,9 +689,9 @@ struct PlannedPath {
 
 // The orientation a lead of length_mm ahead of point `end` of the path (0 or the last) takes
 // at its far end: the path's own turn over as long a stretch from that end, continued the
-// other way (by at most kLeadTurnRad), so that the tool turns at about the same rate per mm
-// through the end point: at cruise speed a lead that held the axis still would step the
-// joints' speeds there.
+// other way (the axis and the roll by at most kLeadTurnRad each), so that the tool turns at about
+// the same rate per mm through the end point: at cruise speed a lead that held the axis still would
+// step the joints' speeds there.
 constexpr double kLeadTurnRad = 15.0 * kPi / 180.0;
 ToolOrientation lead_orientation(const PrintPath& path, size_t end, double length_mm) {
   const size_t n = path.points.size();
@@ -705,8 +705,10 @@ ToolOrientation lead_orientation(const PrintPath& path, size_t end, double lengt
   }
   const ToolOrientation at_end = path.orientation(end), there = path.orientation(k);
   const double angle = axis_angle_rad(at_end.axis, there.axis);
+  const double roll_turn = std::abs(there.roll_rad - at_end.roll_rad);
   double share = length_mm / along;  // of the stretch's turn, continued beyond the end
   if (angle * share > kLeadTurnRad) share = kLeadTurnRad / angle;
+  if (roll_turn * share > kLeadTurnRad) share = kLeadTurnRad / roll_turn;
   return ToolOrientation{slerp_axis(at_end.axis, there.axis, -share),
                          at_end.roll_rad - share * (there.roll_rad - at_end.roll_rad)};
 }
