@@ -40,6 +40,9 @@ struct PlannerSpec {
 
   // the parameter's first value, or `fallback` when absent
   double get(const std::string& key, double fallback) const;
+  // a 0/1 switch: the parameter as a bool, or `fallback` when absent; InputError
+  // ("planners.<name>.<key>") for any other number
+  bool get_switch(const std::string& key, bool fallback) const;
   // the chosen word, or `fallback` when absent
   std::string get_choice(const std::string& key, const std::string& fallback) const;
   // the run's name: its label, else the planner's name

@@ -18,6 +18,13 @@ double PlannerSpec::get(const std::string& key, double fallback) const {
   return it == params.end() || it->second.empty() ? fallback : it->second.front();
 }
 
+bool PlannerSpec::get_switch(const std::string& key, bool fallback) const {
+  const double value = get(key, fallback ? 1.0 : 0.0);
+  if (value != 0.0 && value != 1.0)
+    throw InputError("planners." + name + "." + key, "must be 0 or 1");
+  return value == 1.0;
+}
+
 std::string PlannerSpec::get_choice(const std::string& key, const std::string& fallback) const {
   auto it = choices.find(key);
   return it == choices.end() ? fallback : it->second;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -683,7 +684,9 @@ struct PlannedPath {
   double bound = 0.0;
   double line_speed = 0.0;
   TimedPath timed;
-  // lead_in: when the law passes the path's first and last point (0 and its duration: no leads)
+  // lead_in: the law as one piece (empty: no leads), and when it passes the path's first and
+  // last point
+  std::optional<TrajectoryPiece> whole;
   double print_from_s = 0.0, print_to_s = 0.0;
 };
 
@@ -786,31 +789,20 @@ double crossing_time(const TrajectoryPiece& whole, const Vec3& point, const Vec3
 TrajectoryPiece resampled_piece(const TrajectoryPiece& whole, double t0, double t1, double t_begin,
                                 double max_period_s) {
   const int intervals = std::max(1, static_cast<int>(std::ceil((t1 - t0) / max_period_s - 1e-9)));
-  SampledMotion motion;
-  motion.period_s = (t1 - t0) / intervals;
-  std::vector<double> rolls;
+  PathSamples samples;
+  samples.period_s = (t1 - t0) / intervals;
   for (int j = 0; j <= intervals; ++j) {
-    const double tau = j == intervals ? t1 : t0 + j * motion.period_s;
+    const double tau = j == intervals ? t1 : t0 + j * samples.period_s;
     Vec3 position, velocity, acceleration, axis, angular;
     double roll = 0.0;
     evaluate_motion(whole, tau, position, velocity, acceleration);
     evaluate_tool_axis(whole, tau, position, velocity, axis, angular, roll);
-    motion.position_mm.push_back(position);
-    motion.velocity_mm_s.push_back(velocity);
-    motion.tool_axis.push_back(axis);
-    rolls.push_back(roll);
+    samples.position_mm.push_back(position);
+    samples.velocity_mm_s.push_back(velocity);
+    samples.tool_axis.push_back(axis);
+    samples.roll_rad.push_back(roll);
   }
-  TrajectoryPiece piece;
-  piece.t_begin_s = t_begin;
-  piece.t_end_s = t_begin + intervals * motion.period_s;
-  piece.tool_axis.begin = motion.tool_axis.front();
-  piece.tool_axis.end = motion.tool_axis.back();
-  piece.tool_axis.roll_begin = rolls.front();
-  piece.tool_axis.roll_end = rolls.back();
-  if (std::any_of(rolls.begin(), rolls.end(), [](double r) { return r != 0.0; }))
-    motion.roll_rad = std::move(rolls);
-  piece.motion = std::move(motion);
-  return piece;
+  return sampled_piece(samples, t_begin);
 }
 
 }  // namespace
@@ -1021,12 +1013,12 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
         const RampLengths led_ramps = ramp_lengths(led.timed.samples, led.line_speed);
         if (led_ramps.in_mm <= in_mm && led_ramps.out_mm <= out_mm) {
           // where the law passes the path's ends (the leads are straight: planes across them)
-          const TrajectoryPiece whole = sampled_piece(led.timed.samples, 0.0);
+          led.whole = sampled_piece(led.timed.samples, 0.0);
           const size_t n = path.points.size();
-          led.print_from_s = crossing_time(whole, path.points[0],
+          led.print_from_s = crossing_time(*led.whole, path.points[0],
                                            (path.points[1] - path.points[0]).normalized(), false);
           led.print_to_s =
-              crossing_time(whole, path.points[n - 1],
+              crossing_time(*led.whole, path.points[n - 1],
                             (path.points[n - 1] - path.points[n - 2]).normalized(), true);
           if (!(led.print_to_s > led.print_from_s)) {
             if (leads_dropped++ == 0)
@@ -1069,7 +1061,7 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     }
 
     // with leads: the law's piece cut where it passes the path's ends, material off on the leads
-    const bool led = lead_in_mm > 0.0;
+    const bool led = planned.whole.has_value();
     if (led)
       add_transition(position, orientation, samples.position_mm.front(),
                      ToolOrientation{samples.tool_axis.front(), samples.roll_rad.front()},
@@ -1077,19 +1069,17 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     else
       add_transition(position, orientation, path.front(), path.orientation(0),
                      "transition to " + name);
-    const TrajectoryPiece whole = sampled_piece(samples, 0.0);
-    const double duration_s = samples.duration_s();
     const auto add_lead = [&](double t0, double t1) {
-      TrajectoryPiece lead = resampled_piece(whole, t0, t1, t, settings.period_s);
+      TrajectoryPiece lead = resampled_piece(*planned.whole, t0, t1, t, settings.period_s);
       lead.path_index = -1;
       lead.depositing = false;
       pieces.push_back(std::move(lead));
       t = pieces.back().t_end_s;
     };
     if (led) add_lead(0.0, planned.print_from_s);
-    TrajectoryPiece piece =
-        led ? resampled_piece(whole, planned.print_from_s, planned.print_to_s, t, settings.period_s)
-            : sampled_piece(samples, t);
+    TrajectoryPiece piece = led ? resampled_piece(*planned.whole, planned.print_from_s,
+                                                  planned.print_to_s, t, settings.period_s)
+                                : sampled_piece(samples, t);
     piece.path_index = static_cast<int>(index);
     piece.depositing = true;
     piece.desired_speed_mm_s = path.speed_mm_s;
@@ -1121,7 +1111,7 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     }
     pieces.push_back(std::move(piece));
     t = pieces.back().t_end_s;
-    if (led) add_lead(planned.print_to_s, duration_s);
+    if (led) add_lead(planned.print_to_s, samples.duration_s());
     // where the next transition starts: the lead-out's end, or the path's
     position = led ? samples.position_mm.back() : path.back();
     orientation = led ? ToolOrientation{samples.tool_axis.back(), samples.roll_rad.back()}
@@ -1244,10 +1234,7 @@ ConformalSettings conformal_settings(const PlannerSpec& spec) {
   settings.lift_mm = spec.get("lift_mm", settings.lift_mm);
   settings.period_s = spec.get("period_s", settings.period_s);
   settings.ds_mm = spec.get("ds_mm", settings.ds_mm);
-  const double lead_in = spec.get("lead_in", 0.0);
-  if (lead_in != 0.0 && lead_in != 1.0)
-    throw InputError("planners.conformal.lead_in", "must be 0 or 1");
-  settings.lead_in = lead_in == 1.0;
+  settings.lead_in = spec.get_switch("lead_in", settings.lead_in);
   return settings;
 }
 

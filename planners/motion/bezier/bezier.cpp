@@ -898,10 +898,7 @@ BezierSettings bezier_settings(const PlannerSpec& spec) {
   auto weights = spec.params.find("weight");
   if (weights != spec.params.end() && !weights->second.empty()) settings.weights = weights->second;
   settings.period_s = spec.get("period_s", settings.period_s);
-  const double lead_in = spec.get("lead_in", 0.0);
-  if (lead_in != 0.0 && lead_in != 1.0)
-    throw InputError("planners.bezier.lead_in", "must be 0 or 1");
-  settings.lead_in = lead_in == 1.0;
+  settings.lead_in = spec.get_switch("lead_in", settings.lead_in);
   return settings;
 }
 
