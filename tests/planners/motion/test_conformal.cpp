@@ -10,6 +10,7 @@
 
 #include "contract/planner_checks.hpp"
 #include "core/error.hpp"
+#include "core/segment_distance.hpp"
 #include "metrics/motion_metrics.hpp"
 #include "planners/motion/conformal.hpp"
 #include "planners/motion/path_parametrization.hpp"
@@ -693,13 +694,12 @@ TEST(ConformalPlanner, LeadInPrintsThePathAtItsCruiseSpeedFromEndToEnd) {
   const size_t n = path.points.size();
   const Vec3 u_in = (path.points[1] - path.points[0]).normalized();
   const Vec3 u_out = (path.points[n - 1] - path.points[n - 2]).normalized();
-  const auto off_line = [](const Vec3& q, const Vec3& on, const Vec3& u) {
-    return (q - on - (q - on).dot(u) * u).norm();
-  };
+  const Vec3 lead_start = path.points[0] - led_report.paths[0].lead_in_mm * u_in;
+  const Vec3 lead_end = path.points[n - 1] + led_report.paths[0].lead_out_mm * u_out;
   for (const Vec3& q : samples_of(lead_in).position_mm)
-    EXPECT_LT(off_line(q, path.points[0], u_in), 1e-9);
+    EXPECT_LT(point_segment_distance(q, lead_start, path.points[0]), 1e-9);
   for (const Vec3& q : samples_of(lead_out).position_mm)
-    EXPECT_LT(off_line(q, path.points[n - 1], u_out), 1e-9);
+    EXPECT_LT(point_segment_distance(q, path.points[n - 1], lead_end), 1e-9);
   EXPECT_NEAR((samples_of(lead_in).position_mm.front() - path.points[0]).norm(),
               led_report.paths[0].lead_in_mm, 1e-9);
   EXPECT_NEAR((samples_of(lead_out).position_mm.back() - path.points[n - 1]).norm(),
