@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <unordered_map>
@@ -420,6 +421,30 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
                                   : name(static_cast<size_t>(st.path), st.point);
     return where + " " + point_text(st.pose.position_mm);
   };
+
+  // every point above the table's top: one below it is an error of the input, named before
+  // the ladder is built (between stations too)
+  std::vector<Problem> below;
+  size_t below_count = 0;
+  const auto check_above_table = [&](const Vec3& p, const std::function<std::string()>& where) {
+    if (arm.below_table_problem(p).empty()) return;
+    if (++below_count <= kMaxNamedPoints)
+      below.push_back(Problem{"", 0, "toolpath",
+                              where() + " " + point_text(p) +
+                                  " is below the table's top (z = 0 of the work frame, where "
+                                  "the part stands): the nozzle would be inside the table"});
+  };
+  check_above_table(toolpath.start_mm, [] { return std::string("the start"); });
+  for (size_t p = 0; p < toolpath.paths.size(); ++p)
+    for (size_t i = 0; i < toolpath.paths[p].points.size(); ++i)
+      check_above_table(toolpath.paths[p].points[i], [&] { return name(p, i); });
+  check_above_table(toolpath.end_mm, [] { return std::string("the end"); });
+  if (below_count > kMaxNamedPoints)
+    below.push_back(Problem{"", 0, "toolpath",
+                            "... and " + std::to_string(below_count - kMaxNamedPoints) +
+                                " more points below the table's top (raise a part with "
+                                "toolpath.surface.offset, paths with toolpath.offset)"});
+  if (!below.empty()) throw InputError(below);
 
   // pass 1, every branch: rung validity and cost from the kinematics alone
   std::vector<double> cost(static_cast<size_t>(kBranches) * n * K, kInfinity);

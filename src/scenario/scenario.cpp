@@ -47,6 +47,8 @@ constexpr std::size_t kMaxSpeedProblems = 20;
 constexpr double kClampChordTolerance_mm = 1e-3;
 // a surface toolpath's path problems listed before the rest are counted
 constexpr std::size_t kMaxSurfacePathProblems = 5;
+// a surface's print point may lie this far (mm) below the work surface's top, z = 0 (rounding)
+constexpr double kBelowWorkSurfaceTolerance_mm = 1e-3;
 // a surface toolpath starts and ends this far above the part's highest point (and its layers)
 constexpr double kSurfaceClearance_mm = 20.0;
 // the longest `name:` or planner `label:` (each names a folder; file systems allow 255 bytes)
@@ -1237,6 +1239,22 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     problems_.add(field.key_line, field.key,
                   "the hatch found no printable surface on '" + given_file +
                       "' (seen from above; check units, offset and rotation)");
+    return;
+  }
+  // the surface printed on stands on the work surface, z = 0 (the top of the table, bed or
+  // plate: the part's own body may reach below it, into a fixture): no print point below it
+  double lowest_z = std::numeric_limits<double>::infinity();
+  for (const PrintPath& path : hatch.toolpath.paths)
+    for (const Vec3& p : path.points) lowest_z = std::min(lowest_z, p.z());
+  if (lowest_z < -kBelowWorkSurfaceTolerance_mm) {
+    const Vec3 raised = surface->offset_mm - Vec3(0, 0, lowest_z);
+    problems_.add(field.key_line, field.key,
+                  "the hatch on '" + given_file + "' reaches z = " + format_number(lowest_z) +
+                      " mm, below the work surface (z = 0, the top of the table, bed or plate "
+                      "the part stands on): the nozzle would be inside it; raise the part: "
+                      "offset: [" +
+                      format_number(raised.x()) + ", " + format_number(raised.y()) + ", " +
+                      format_number(raised.z()) + "]");
     return;
   }
 

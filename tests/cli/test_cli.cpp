@@ -470,6 +470,55 @@ TEST(Cli, ArmSingularPointIsNamed) {
   EXPECT_NE(ok.output.find("machine arm6, 4 print paths"), std::string::npos) << ok.output;
 }
 
+// A part sunk into the table: its hatch reaches below the table's top (z = 0). One problem at
+// the surface's key gives the lowest point and the offset that lifts it onto the table; that
+// offset is accepted. Paths below it on the arm are named point by point.
+TEST(Cli, APartOrAPathBelowTheTableIsRefused) {
+  const std::string dir = fresh_directory("cli_arm_below_table");
+  const std::string path = write_text(dir, "sunk.yaml", arm_beam_scenario("[0, 0, -2]"));
+  const Result r = depotwin("validate " + path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  const std::string head = path + ":7: toolpath.surface: the hatch on '";
+  ASSERT_NE(r.output.find(head), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" mm, below the work surface (z = 0, the top of the table, bed or plate "
+                          "the part stands on): the nozzle would be inside it; raise the part: "
+                          "offset: [0, 0, "),
+            std::string::npos)
+      << r.output;
+  // the lowest point: between 2 mm below (the beam's ends stand at z = 0) and 0
+  double lowest_z = 0.0, raised_z = 0.0;
+  const size_t at = r.output.find("reaches z = ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at, "reaches z = %lf", &lowest_z), 1);
+  EXPECT_GE(lowest_z, -2.0);
+  EXPECT_LT(lowest_z, 0.0);
+  const size_t fix = r.output.find("offset: [0, 0, ");
+  ASSERT_EQ(std::sscanf(r.output.c_str() + fix, "offset: [0, 0, %lf]", &raised_z), 1);
+  EXPECT_NEAR(raised_z, -2.0 - lowest_z, 1e-4);
+  const std::string lifted =
+      write_text(dir, "lifted.yaml", arm_beam_scenario("[0, 0, " + std::to_string(raised_z) + "]"));
+  const Result ok = depotwin("validate " + lifted);
+  EXPECT_EQ(ok.status, 0) << ok.output;
+  expect_bad_run("arm_below_table", arm_beam_scenario("[0, 0, -2]"), "below the work surface");
+
+  // a polyline dipping 0.5 mm into the table: its one point below is named
+  const std::string dip = write_text(
+      dir, "dip.yaml",
+      "name: dip\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
+      "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
+      "toolpath:\n  speed: 20\n  polylines:\n    - [[0, 0, 1], [10, 0, -0.5], [20, 0, 1]]\n"
+      "planners: [conformal]\n");
+  const Result d = depotwin("validate " + dip);
+  EXPECT_EQ(d.status, 2) << d.output;
+  EXPECT_NE(d.output.find(dip + ":8: toolpath.polylines[0]: point 1 (10.000, 0.000, -0.500) mm is "
+                                "below the table's top (z = 0 of the work frame, where the part "
+                                "stands): the nozzle would be inside the table"),
+            std::string::npos)
+      << d.output;
+  EXPECT_EQ(d.output.find("point 0 ("), std::string::npos) << d.output;
+  EXPECT_EQ(d.output.find("point 2 ("), std::string::npos) << d.output;
+}
+
 // `arm:` on a machine without a wrist
 TEST(Cli, ArmSettingsOnAPlanarMachineAreRefused) {
   const std::string dir = fresh_directory("cli_arm_planar");

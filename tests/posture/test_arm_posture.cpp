@@ -137,17 +137,17 @@ TEST(ArmPosture, SingularPointIsNamed) {
 }
 
 TEST(ArmPosture, CollidingPointIsNamed) {
-  // a point 15 mm inside a solid block: the nozzle (its last 3 mm excepted) is in the part at
-  // every roll
+  // a point 15 mm inside a solid block on the table: the nozzle (its last 3 mm excepted) is in
+  // the part at every roll
   const Arm6 arm;
   TriangleMesh block;
-  block.vertices = {Vec3(-20, -20, -40), Vec3(20, -20, -40), Vec3(20, 20, -40), Vec3(-20, 20, -40),
-                    Vec3(-20, -20, 0),   Vec3(20, -20, 0),   Vec3(20, 20, 0),   Vec3(-20, 20, 0)};
+  block.vertices = {Vec3(-20, -20, 0),  Vec3(20, -20, 0),  Vec3(20, 20, 0),  Vec3(-20, 20, 0),
+                    Vec3(-20, -20, 40), Vec3(20, -20, 40), Vec3(20, 20, 40), Vec3(-20, 20, 40)};
   block.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
                      {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
   const PartClearance part(block);
   const std::string text =
-      problem_text(arm, &part, single_path({Vec3(0, 0, 0), Vec3(0, 5, -15)}), {});
+      problem_text(arm, &part, single_path({Vec3(0, 0, 40), Vec3(0, 5, 25)}), {});
   EXPECT_NE(text.find("path 0, point 1"), std::string::npos) << text;
   EXPECT_NE(text.find("too close to the part"), std::string::npos) << text;
 }
