@@ -92,6 +92,16 @@ std::vector<std::string> actuator_limit_warnings(const ActuatorStats& stats) {
   return warnings;
 }
 
+std::string arm_collision_warning(const ArmStats& arm, const ContactLog& contacts) {
+  if (arm.collisions <= 0) return "";
+  std::string warning =
+      "collisions in the simulation: " + std::to_string(arm.collisions) + " contact event(s), " +
+      std::to_string(arm.table_contacts) + " with the table, " + std::to_string(arm.part_contacts) +
+      " with the part, " + std::to_string(arm.self_contacts) + " of the arm with itself";
+  if (!contacts.first.empty()) warning += " (the first MuJoCo contact at " + contacts.first + ")";
+  return warning;
+}
+
 namespace {
 
 ThicknessSummary thickness_summary(const ThicknessStats& stats) {

@@ -32,6 +32,10 @@ ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointL
 // limit 200 mm/s in the simulation"
 std::vector<std::string> actuator_limit_warnings(const ActuatorStats& stats);
 
+// An arm's collisions for metrics.json's warnings ("" without any): the contact events by kind
+// (ArmStats) and the first MuJoCo contact (its time and the two geoms) where one was recorded
+std::string arm_collision_warning(const ArmStats& arm, const ContactLog& contacts);
+
 // Adds to a planned report (plan_job's) what the simulation scored: the simulated velocity
 // error (whole and steady: outside the plan's ramps, report.speed_ramps) and path error,
 // thickness, material and waste from the deposit, and the simulation's own statistics.

@@ -204,6 +204,11 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   if (const auto* arm = dynamic_cast<const Arm6*>(job.machine.get()); arm && job.posture)
     run.report.arm =
         arm_run_stats(*arm, job.clearance.get(), run.record, *job.posture, kArmClearancePeriod_s);
+  // a collision is said in the warnings too, not only counted in metrics.json's arm
+  if (run.report.arm) {
+    std::string warning = arm_collision_warning(*run.report.arm, run.record.contacts);
+    if (!warning.empty()) run.report.warnings.push_back(std::move(warning));
+  }
   return run;
 }
 

@@ -1,5 +1,6 @@
 // A simulated joint beyond its limits is said in metrics.json's warnings, one line per joint
-// and quantity, in the report's units; a peak at its limit is not beyond it.
+// and quantity, in the report's units; a peak at its limit is not beyond it. An arm's
+// collisions too.
 #include <gtest/gtest.h>
 
 #include "metrics/metrics_report.hpp"
@@ -46,6 +47,29 @@ TEST(ActuatorWarnings, OneLinePerQuantityBeyondItsLimit) {
   stats.peak_vel[0] = 200.03;
   EXPECT_EQ(actuator_limit_warnings(stats).at(0),
             "joint y: peak speed 200 mm/s above its limit 200 mm/s (+0.015 %) in the simulation");
+}
+
+// An arm's collisions: no warning without one; else the events by kind and the first MuJoCo
+// contact (the table's, as Simulation logs it)
+TEST(ArmCollisionWarning, CountsTheEventsByKindAndNamesTheFirstContact) {
+  ArmStats arm;
+  ContactLog contacts;
+  EXPECT_EQ(arm_collision_warning(arm, contacts), "");
+  arm.table_contacts = 2;
+  arm.part_contacts = 1;
+  arm.collisions = 3;
+  contacts.other_events = 2;
+  contacts.first = "t = 0.75 s: table / tool_nozzle_tip";
+  EXPECT_EQ(arm_collision_warning(arm, contacts),
+            "collisions in the simulation: 3 contact event(s), 2 with the table, 1 with the part, "
+            "0 of the arm with itself (the first MuJoCo contact at t = 0.75 s: table / "
+            "tool_nozzle_tip)");
+  // a contact with the part alone is measured by clearance, not logged by MuJoCo
+  arm.table_contacts = 0;
+  arm.collisions = 1;
+  EXPECT_EQ(arm_collision_warning(arm, ContactLog{}),
+            "collisions in the simulation: 1 contact event(s), 0 with the table, 1 with the part, "
+            "0 of the arm with itself");
 }
 
 }  // namespace

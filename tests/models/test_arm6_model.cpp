@@ -451,5 +451,32 @@ TEST(Arm6Tracking, FollowsATiltedTurningCircle) {
   EXPECT_LT(tracking.peak_torque_fraction, 0.8);
 }
 
+// The nozzle driven down 20 mm from 10 mm above the table: the simulation records a contact
+// event with the table (none of the arm with itself), names it first, when the tip has gone
+// 3 mm into the table (the nozzle's last 3 mm are visual only), and only one: it stays
+TEST(Arm6Tracking, ANozzleDrivenIntoTheTableIsRecordedAsOneContactWithTheTable) {
+  const Arm6 arm;
+  const Vec3 start(0, 0, 10), down(0, 0, -1);
+  PathShape line;
+  line.length_mm = 20.0;
+  line.pose = [&](double s) { return Pose(start + s * down); };
+  line.tangent = [&](double) { return down; };
+  double begin_s = 0.0, end_s = 0.0;
+  const double speed_mm_s = 20.0, ramp_s = 0.1;
+  const Trajectory trajectory = sampled_print(line, speed_mm_s, ramp_s, begin_s, end_s);
+  SimSettings settings;
+  settings.settle_s = 0.2;
+  Simulation simulation(arm6_model_path(), arm, settings);
+  const RecordedRun run = simulation.run(trajectory);
+  EXPECT_EQ(run.contacts.other_events, 1) << run.contacts.first;
+  EXPECT_EQ(run.contacts.self_events, 0);
+  EXPECT_NE(run.contacts.first.find("table"), std::string::npos) << run.contacts.first;
+  EXPECT_NE(run.contacts.first.find("tool_nozzle_tip"), std::string::npos) << run.contacts.first;
+  // z = -3 mm at s = 13 mm, reached at the constant speed (s = v (t - ramp_s))
+  double first_s = -1.0;
+  ASSERT_EQ(std::sscanf(run.contacts.first.c_str(), "t = %lf s", &first_s), 1);
+  EXPECT_NEAR(first_s, ramp_s + 13.0 / speed_mm_s, 0.01) << run.contacts.first;
+}
+
 }  // namespace
 }  // namespace depotwin
