@@ -760,6 +760,47 @@ TEST(ConformalPlanner, ALeadOutOfReachIsNotTakenAndSaysSo) {
   testing_support::expect_contract(plan, one_path(path), tcp);
 }
 
+// A lead does not go into the work surface (z = 0, the table's or bed's top). The faceted arc
+// raised so that its ends are 0.1 mm above it: its end edges slope down at 22.5 deg, so leads
+// of over 0.26 mm would end below z = 0, and they are not taken. Raised 5 mm: they are. The
+// arc as it is, below z = 0 at its ends (not on a work surface), keeps its leads.
+TEST(ConformalPlanner, ALeadIntoTheWorkSurfaceIsNotTakenAndSaysSo) {
+  const MachineLimits tcp = MachineLimits::uniform(1000.0, 5000.0, 1e4);
+  const TcpLimits limits = with_tilt_joint(tcp);
+  ConformalSettings settings;
+  settings.control = ConformalControl::speed;
+  settings.lead_in = true;
+  const PrintPath arc = faceted_arc(10.0);
+  const double end_z = arc.points.front().z();  // -1.52 mm, the ends' height
+  const auto raised = [&](double dz) {
+    PrintPath path = arc;
+    for (Vec3& p : path.points) p.z() += dz;
+    return path;
+  };
+  ConformalPlanReport report;
+  const PrintPath low = raised(0.1 - end_z);
+  const Trajectory grazing = ConformalPlanner(settings).plan(one_path(low), limits, &report);
+  ASSERT_FALSE(grazing.warnings().empty());
+  EXPECT_NE(grazing.warnings()[0].find("1 path(s) printed without a lead-in and lead-out, from "
+                                       "rest to rest (first: toolpath path 0: its lead-in or "
+                                       "lead-out would go below the work surface (z = 0))"),
+            std::string::npos)
+      << grazing.warnings()[0];
+  EXPECT_EQ(report.paths[0].lead_in_mm, 0.0);
+  ASSERT_EQ(grazing.pieces().size(), 3u);
+  for (const TrajectoryPiece& piece : grazing.pieces())
+    for (const Vec3& p : samples_of(piece).position_mm) EXPECT_GE(p.z(), 0.1 - 1e-9);
+  testing_support::expect_contract(grazing, one_path(low), tcp);
+
+  for (const PrintPath& path : {raised(5.0 - end_z), arc}) {
+    ConformalPlanReport taken;
+    const Trajectory led = ConformalPlanner(settings).plan(one_path(path), limits, &taken);
+    EXPECT_EQ(led.pieces().size(), 5u) << path.points.front().z();
+    EXPECT_GT(taken.paths[0].lead_in_mm, 0.26) << path.points.front().z();
+    EXPECT_GT(taken.paths[0].lead_out_mm, 0.26) << path.points.front().z();
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // `uniform` on a machine whose joints turn the tool (uniform_planner.cpp, plan_on_joints)
 
