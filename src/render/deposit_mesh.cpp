@@ -19,6 +19,9 @@ namespace {
 constexpr double kLightTilt_deg = 30.0;
 constexpr float kLightAmbient = 0.7f;
 constexpr float kLightDiffuse = 0.3f;
+// a grid square whose surface heights differ by more than this many grid steps is a cliff (a
+// part's wall, steeper than atan(10 / sqrt(2)) = 82 deg across its diagonal): not meshed
+constexpr double kCliffRise = 10.0;
 
 // the resampled grid: block maxima over stride x stride cells
 struct BlockGrid {
@@ -194,7 +197,10 @@ DepositMesh build_deposit_mesh(const HeightMap& map, const DepositMeshOptions& o
   }
 
   // two triangles per grid square whose corners all exist and one reaches the threshold,
-  // split along the diagonal whose ends differ less (a ridge stays connected)
+  // split along the diagonal whose ends differ less (a ridge stays connected). Not across a
+  // cliff: a square whose surface heights differ by more than kCliffRise steps (a part's
+  // wall down to the table) would hang a curtain of deposit down it
+  const double cliff_mm = kCliffRise * step_mm;
   for (int by = 0; by + 1 < grid.ny; ++by)
     for (int bx = 0; bx + 1 < grid.nx; ++bx) {
       const size_t b00 = static_cast<size_t>(by) * grid.nx + bx, b10 = b00 + 1, b01 = b00 + grid.nx,
@@ -204,6 +210,9 @@ DepositMesh build_deposit_mesh(const HeightMap& map, const DepositMeshOptions& o
                   t11 = grid.value[b11];
       if (std::max({t00, t10, t01, t11}) < threshold) continue;
       const unsigned v00 = index[b00], v10 = index[b10], v01 = index[b01], v11 = index[b11];
+      const auto [low, high] =
+          std::minmax({base[v00].z(), base[v10].z(), base[v01].z(), base[v11].z()});
+      if (high - low > cliff_mm) continue;
       if (std::abs(t00 - t11) <= std::abs(t10 - t01))
         mesh.triangles.insert(mesh.triangles.end(), {v00, v10, v11, v00, v11, v01});
       else

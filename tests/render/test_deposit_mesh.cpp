@@ -122,6 +122,35 @@ TEST(DepositMesh, OnAPartTheReliefStandsAlongTheNormal) {
   }
 }
 
+// A part's wall down to the table is not hung with a curtain of deposit: no grid square is
+// meshed across a rise of more than 10 grid steps. A plateau 3 mm high (30 steps) for
+// x < 1 mm, the table beyond: no triangle joins the two. Slopes of 5 steps per step (79 deg)
+// and less keep every square.
+TEST(DepositMesh, NoCurtainDownAPartsWall) {
+  const HeightMap map = grid(20, 5, [](double, double) { return 4.0; });
+  DepositMeshOptions options;
+  options.min_relative_thickness = 0.0;
+  options.surface_height_mm = [](double x, double) -> std::optional<double> {
+    if (x > 0.95) return std::nullopt;
+    return 3.0;
+  };
+  const DepositMesh wall = build_deposit_mesh(map, options);
+  ASSERT_EQ(wall.vertex_count(), 100u);
+  // 9 x 4 squares on the plateau, 9 x 4 on the table, none across the wall
+  EXPECT_EQ(wall.triangles.size(), 6u * (9u + 9u) * 4u);
+  for (size_t t = 0; t < wall.triangles.size(); t += 3) {
+    int on_plateau = 0;
+    for (int k = 0; k < 3; ++k) on_plateau += vertex(wall, wall.triangles[t + k]).x() < 0.95;
+    EXPECT_TRUE(on_plateau == 0 || on_plateau == 3) << t;
+  }
+  for (double slope : {0.9, 5.0}) {
+    options.surface_height_mm = [slope](double x, double) -> std::optional<double> {
+      return slope * x;
+    };
+    EXPECT_EQ(build_deposit_mesh(map, options).triangles.size(), 6u * 19u * 4u) << slope;
+  }
+}
+
 // cells far from the deposit carry no vertex, and nothing thinner than the threshold is drawn
 TEST(DepositMesh, OnlyTheDepositAndItsRimAreMeshed) {
   // one 3 x 3 patch of 5 um in a 20 x 20 grid of zeros
