@@ -423,11 +423,13 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   };
 
   // every point above the table's top: one below it is an error of the input, named before
-  // the ladder is built (between stations too)
+  // the ladder is built (between stations too), then how far to raise them
   std::vector<Problem> below;
   size_t below_count = 0;
+  double lowest_z = 0.0;
   const auto check_above_table = [&](const Vec3& p, const std::function<std::string()>& where) {
     if (arm.below_table_problem(p).empty()) return;
+    lowest_z = std::min(lowest_z, p.z());
     if (++below_count <= kMaxNamedPoints)
       below.push_back(Problem{"", 0, "toolpath",
                               where() + " " + point_text(p) +
@@ -439,11 +441,13 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     for (size_t i = 0; i < toolpath.paths[p].points.size(); ++i)
       check_above_table(toolpath.paths[p].points[i], [&] { return name(p, i); });
   check_above_table(toolpath.end_mm, [] { return std::string("the end"); });
-  if (below_count > kMaxNamedPoints)
-    below.push_back(Problem{"", 0, "toolpath",
-                            "... and " + std::to_string(below_count - kMaxNamedPoints) +
-                                " more points below the table's top (raise a part with "
-                                "toolpath.surface.offset, paths with toolpath.offset)"});
+  if (below_count > 0)
+    below.push_back(Problem{
+        "", 0, "toolpath",
+        std::to_string(below_count) +
+            " point(s) below the table's top, the lowest at z = " + format("%.3f", lowest_z) +
+            " mm: raise the toolpath by at least " + format("%.3f", -lowest_z) +
+            " mm (toolpath.offset's z; a part: toolpath.surface.offset's)"});
   if (!below.empty()) throw InputError(below);
 
   // pass 1, every branch: rung validity and cost from the kinematics alone

@@ -517,6 +517,10 @@ TEST(Cli, APartOrAPathBelowTheTableIsRefused) {
       << d.output;
   EXPECT_EQ(d.output.find("point 0 ("), std::string::npos) << d.output;
   EXPECT_EQ(d.output.find("point 2 ("), std::string::npos) << d.output;
+  EXPECT_NE(d.output.find(dip + ":5: toolpath: 1 point(s) below the table's top, the lowest at "
+                                "z = -0.500 mm: raise the toolpath by at least 0.500 mm"),
+            std::string::npos)
+      << d.output;
 }
 
 // `arm:` on a machine without a wrist
