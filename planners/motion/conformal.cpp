@@ -30,8 +30,7 @@ constexpr int kLineMinIntervals = 3;                      // per line (4-point d
 constexpr int kRestGrading = 12;     // grid steps halve this many times towards a rest
 constexpr double kMinLineMm = 1e-4;  // the shortest line left between two blends
 constexpr double kTurnInPlaceLiftMm = 1.0;
-constexpr double kSamePoint = 1e-9;            // mm
-constexpr double kLeadBelowSurface_mm = 1e-3;  // a lead may end this far below z = 0 (rounding)
+constexpr double kSamePoint = 1e-9;  // mm
 // flow_lag_s: the rounds of lowered speed bounds, and the speed they stop at (below it the law
 // brakes to rest as the limits allow: the flow left is at most this share of the nominal)
 constexpr int kLagRounds = 4;
@@ -993,17 +992,17 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
     double lead_in_mm = 0.0, lead_out_mm = 0.0;
     if (settings.lead_in && settings.zone_mm > 0.0 && !path.has_arcs()) {
       RampLengths ramps = ramp_lengths(planned.timed.samples, planned.line_speed);
+      // a path on or above the work surface, z = 0 (a table's or bed's top), does not lead
+      // into it (a path below it, a CAM pass on a machine without a table, is not judged)
+      double lowest_z = kInf;
+      for (const Vec3& p : path.points) lowest_z = std::min(lowest_z, p.z());
+      const bool on_work_surface = lowest_z >= -kWorkSurfaceTolerance_mm;
       for (int round = 0; round < 3; ++round) {
         const double in_mm = 1.25 * ramps.in_mm + 2.0 * settings.ds_mm;
         const double out_mm = 1.25 * ramps.out_mm + 2.0 * settings.ds_mm;
-        // a path on or above the work surface, z = 0 (a table's or bed's top), does not lead
-        // into it (a path below it, a CAM pass on a machine without a table, is not judged)
         const PrintPath extended = with_leads(path, in_mm, out_mm);
-        double lowest_z = kInf;
-        for (const Vec3& p : path.points) lowest_z = std::min(lowest_z, p.z());
-        if (lowest_z >= -kLeadBelowSurface_mm &&
-            std::min(extended.points.front().z(), extended.points.back().z()) <
-                -kLeadBelowSurface_mm) {
+        if (on_work_surface && std::min(extended.points.front().z(), extended.points.back().z()) <
+                                   -kWorkSurfaceTolerance_mm) {
           if (leads_dropped++ == 0)
             leads_dropped_first =
                 name + ": its lead-in or lead-out would go below the work surface (z = 0)";

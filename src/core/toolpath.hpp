@@ -110,6 +110,10 @@ void grow_arc_bounds(const Vec3& start, const Vec3& end, const EdgeArc& arc, Vec
 // Two path ends closer than this (mm) are one point: printing continues through them.
 constexpr double kJoinTolerance_mm = 1e-6;
 
+// The work frame's z = 0 is the top of the table, bed or plate the part stands on; a print
+// point this far (mm) below it still counts as on it (rounding in a part's file)
+constexpr double kWorkSurfaceTolerance_mm = 1e-3;
+
 // The toolpath with each run of consecutive paths that join end to start (printing goes on
 // through the joint) merged into one polyline: what is printed in one go. The merged path
 // keeps the first path's speed and source index. Used where "a path's ends" matter (the

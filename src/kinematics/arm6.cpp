@@ -7,6 +7,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/toolpath.hpp"
+
 namespace depotwin {
 
 namespace {
@@ -20,8 +22,6 @@ constexpr double kWristSingular = 1e-12;
 constexpr double kShoulderSingular_mm = 1e-9;
 // a wrist centre this far (mm) outside the arm's annulus still counts as reached (rounding)
 constexpr double kReachTolerance_mm = 1e-9;
-// a nozzle tip this far below the table's top (z = 0) is refused (rounding in a part's file)
-constexpr double kBelowTableTolerance_mm = 1e-3;
 
 // IRB 120 datasheet: ranges (deg), speeds (deg/s); accelerations 4 x v_max per second
 struct JointSpec {
@@ -425,11 +425,9 @@ std::string Arm6::pose_problem(const Pose& pose) const {
   return "";
 }
 
-std::string Arm6::below_table_problem(const Vec3& tip_mm) const {
+bool Arm6::below_table(const Vec3& tip_mm) const {
   // the work frame's z = 0 is the table's top: a nozzle tip below it is inside the table
-  if (!(tip_mm.z() < -kBelowTableTolerance_mm)) return "";
-  return "below the table: the nozzle tip would be at z = " + format("%.3f", tip_mm.z()) +
-         " mm, under the table's top (z = 0 of the work frame, where the part stands)";
+  return tip_mm.z() < -kWorkSurfaceTolerance_mm;
 }
 
 std::string Arm6::reach_problem(double distance_mm) const {

@@ -164,11 +164,11 @@ class Arm6 final : public Machine {
   // the eight branch solutions (joint 6 nearest 0, ranges not checked); false when the pose is
   // out of reach or not finite. No allocation: the benchmarked hot path.
   bool branch_solutions(const Pose& pose, Arm6Branches& out) const;
-  // "" when a nozzle tip at this work-frame point is above the table's top (z = 0, where the
-  // part stands; 0.001 mm of rounding allowed), else why not. The kinematics do not refuse
+  // whether a nozzle tip at this work-frame point is below the table's top (z = 0, where the
+  // part stands; kWorkSurfaceTolerance_mm of rounding allowed). The kinematics do not refuse
   // such a pose (a plan's transition may graze the table: the simulation counts contacts);
   // the toolpath's points are checked with it (posture/arm_posture.cpp)
-  std::string below_table_problem(const Vec3& tip_mm) const;
+  bool below_table(const Vec3& tip_mm) const;
   // the branch (bits above) of a joint position
   int branch_of(const JointVector& joints) const;
   int branch_of(const Arm6Joints& q) const;

@@ -428,7 +428,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   size_t below_count = 0;
   double lowest_z = 0.0;
   const auto check_above_table = [&](const Vec3& p, const std::function<std::string()>& where) {
-    if (arm.below_table_problem(p).empty()) return;
+    if (!arm.below_table(p)) return;
     lowest_z = std::min(lowest_z, p.z());
     if (++below_count <= kMaxNamedPoints)
       below.push_back(Problem{"", 0, "toolpath",

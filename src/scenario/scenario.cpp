@@ -47,8 +47,6 @@ constexpr std::size_t kMaxSpeedProblems = 20;
 constexpr double kClampChordTolerance_mm = 1e-3;
 // a surface toolpath's path problems listed before the rest are counted
 constexpr std::size_t kMaxSurfacePathProblems = 5;
-// a surface's print point may lie this far (mm) below the work surface's top, z = 0 (rounding)
-constexpr double kBelowWorkSurfaceTolerance_mm = 1e-3;
 // a surface toolpath starts and ends this far above the part's highest point (and its layers)
 constexpr double kSurfaceClearance_mm = 20.0;
 // the longest `name:` or planner `label:` (each names a folder; file systems allow 255 bytes)
@@ -1246,7 +1244,7 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
   double lowest_z = std::numeric_limits<double>::infinity();
   for (const PrintPath& path : hatch.toolpath.paths)
     for (const Vec3& p : path.points) lowest_z = std::min(lowest_z, p.z());
-  if (lowest_z < -kBelowWorkSurfaceTolerance_mm) {
+  if (lowest_z < -kWorkSurfaceTolerance_mm) {
     const Vec3 raised = surface->offset_mm - Vec3(0, 0, lowest_z);
     problems_.add(field.key_line, field.key,
                   "the hatch on '" + given_file + "' reaches z = " + format_number(lowest_z) +
