@@ -6,6 +6,15 @@
 
 namespace depotwin {
 
+namespace {
+
+// a mesh whose facets' signed projected areas cancel to within this share of their absolute
+// sum is judged closed (a solid; one with a few holes too), by its signed volume. An open
+// surface that is a height field has the ratio 1
+constexpr double kClosedAreaRatio = 0.1;
+
+}  // namespace
+
 Vec3 TriangleMesh::facet_normal(size_t t) const {
   const std::array<int, 3>& f = triangles[t];
   const Vec3 n = (vertices[f[1]] - vertices[f[0]]).cross(vertices[f[2]] - vertices[f[0]]);
@@ -94,6 +103,30 @@ std::vector<std::array<Vec3, 3>> TriangleMesh::corner_normals(double crease_angl
 
 void TriangleMesh::transform(const Eigen::Matrix3d& rotation, const Vec3& offset) {
   for (Vec3& v : vertices) v = rotation * v + offset;
+}
+
+bool TriangleMesh::face_outward_and_up() {
+  // the signed area projected on xy (n_z A per facet) and its absolute sum; the signed volume
+  // (divergence theorem: the sum of v0 . (v1 x v2) / 6), taken about the mesh's centre so that
+  // a part far from the origin loses no digits
+  Vec3 lo, hi;
+  bounds(lo, hi);
+  const Vec3 centre = 0.5 * (lo + hi);
+  double signed_area = 0.0, absolute_area = 0.0, volume = 0.0;
+  for (const auto& t : triangles) {
+    const Vec3 a = vertices[t[0]] - centre, b = vertices[t[1]] - centre,
+               c = vertices[t[2]] - centre;
+    const double projected = 0.5 * ((b - a).cross(c - a)).z();
+    signed_area += projected;
+    absolute_area += std::abs(projected);
+    volume += a.dot(b.cross(c)) / 6.0;
+  }
+  // a closed solid's projected areas cancel (up to rounding): judge it by its volume
+  const bool closed = std::abs(signed_area) <= kClosedAreaRatio * absolute_area;
+  const bool reversed = closed ? volume < 0.0 : signed_area < 0.0;
+  if (!reversed) return false;
+  for (auto& t : triangles) std::swap(t[1], t[2]);
+  return true;
 }
 
 }  // namespace depotwin

@@ -36,6 +36,13 @@ struct TriangleMesh {
   std::vector<std::array<Vec3, 3>> corner_normals(double crease_angle_rad) const;
   // x -> rotation x + offset on every vertex (triangle orientation is kept: rotations only)
   void transform(const Eigen::Matrix3d& rotation, const Vec3& offset);
+  // Turns every triangle over (reverses its winding) where the whole mesh faces the wrong way:
+  // a closed solid wound inside out (negative signed volume), or an open surface facing down
+  // on the whole (its facets' signed areas projected on the xy plane sum below 0), as an STL
+  // of a surface patch exported with its winding reversed is. A mesh that faces up, a closed
+  // solid wound outward, or a closed one whose signed volume is 0 is left as it is. Returns
+  // whether it turned the triangles over.
+  bool face_outward_and_up();
 };
 
 }  // namespace depotwin

@@ -1195,6 +1195,12 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
          Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.x()), Vec3::UnitX()))
             .toRotationMatrix();
     part.transform(rotation, surface->offset_mm);
+    // an STL wound the wrong way (a surface patch facing down, a solid inside out) is turned
+    // over, and every run says so: the hatch looks for the faces seen from above
+    if (part.face_outward_and_up())
+      scenario_.notes.push_back("toolpath.surface: '" + given_file +
+                                "' faced down or inside out (its triangles wound clockwise "
+                                "seen from outside); its triangles were turned over");
     // the grid's size before it is built: every layer's points over the part's (x, y) bounds
     Vec3 lo, hi;
     part.bounds(lo, hi);

@@ -269,6 +269,52 @@ TEST_F(ScenarioLoad, GcodeToolpathRelativeToTheScenarioFile) {
   EXPECT_DOUBLE_EQ(s.toolpath.print_length_mm(), 20.0 + 10.0 + 15.0);
 }
 
+// A surface STL wound clockwise seen from above (a patch exported facing down) is turned
+// over: the same hatch as the same patch wound counter-clockwise, tool axes up, and a note
+// that every run reports. The patch: the plane z = 1 + 0.1 x over 10 x 10 mm, two facets.
+TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
+  const auto patch = [](bool facing_up) {
+    const char* corners[2][3] = {{"0 0 1", "10 0 2", "10 10 2"}, {"0 0 1", "10 10 2", "0 10 1"}};
+    std::string text = "solid patch\n";
+    for (const auto& facet : corners) {
+      text += " facet normal 0 0 0\n  outer loop\n";
+      for (int k : {0, 1, 2})
+        text += std::string("   vertex ") + facet[facing_up ? k : (3 - k) % 3] + "\n";
+      text += "  endloop\n endfacet\n";
+    }
+    return text + "endsolid patch\n";
+  };
+  write("up.stl", patch(true));
+  write("down.stl", patch(false));
+  const auto scenario = [&](const std::string& stl) {
+    return load_scenario(
+        write(stl + ".yaml",
+              "machine: arm6\nlimits: {v_max: 200, a_max: 2000}\nprocess: {type: aerosol}\n"
+              "toolpath:\n  speed: 10\n  surface: {file: " +
+                  stl + ", hatch_mm: 2, alpha: 1}\n"));
+  };
+  const Scenario up = scenario("up.stl");
+  const Scenario down = scenario("down.stl");
+  EXPECT_TRUE(up.notes.empty());
+  ASSERT_EQ(down.notes.size(), 1u);
+  EXPECT_EQ(down.notes[0],
+            "toolpath.surface: 'down.stl' faced down or inside out (its triangles wound "
+            "clockwise seen from outside); its triangles were turned over");
+  ASSERT_GT(up.toolpath.paths.size(), 3u);
+  ASSERT_EQ(down.toolpath.paths.size(), up.toolpath.paths.size());
+  const Vec3 normal = Vec3(-0.1, 0, 1).normalized();
+  for (size_t p = 0; p < up.toolpath.paths.size(); ++p) {
+    const PrintPath& a = up.toolpath.paths[p];
+    const PrintPath& b = down.toolpath.paths[p];
+    ASSERT_EQ(a.points.size(), b.points.size());
+    for (size_t i = 0; i < a.points.size(); ++i) {
+      EXPECT_EQ(a.points[i], b.points[i]);
+      EXPECT_LT((a.tool_axis(i) - normal).norm(), 1e-9);
+      EXPECT_LT((b.tool_axis(i) - normal).norm(), 1e-9);
+    }
+  }
+}
+
 // A planner parameter from the registry: its default loads, a value past its range does
 // not. Skipped while no registered planner declares parameters.
 TEST_F(ScenarioLoad, PlannerParametersFromTheRegistry) {
