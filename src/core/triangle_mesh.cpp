@@ -105,25 +105,30 @@ void TriangleMesh::transform(const Eigen::Matrix3d& rotation, const Vec3& offset
   for (Vec3& v : vertices) v = rotation * v + offset;
 }
 
-bool TriangleMesh::face_outward_and_up() {
-  // the signed area projected on xy (n_z A per facet) and its absolute sum; the signed volume
-  // (divergence theorem: the sum of v0 . (v1 x v2) / 6), taken about the mesh's centre so that
-  // a part far from the origin loses no digits
+double TriangleMesh::signed_volume_mm3() const {
+  // the sum of v0 . (v1 x v2) / 6 over the triangles
   Vec3 lo, hi;
   bounds(lo, hi);
   const Vec3 centre = 0.5 * (lo + hi);
-  double signed_area = 0.0, absolute_area = 0.0, volume = 0.0;
+  double volume = 0.0;
+  for (const auto& t : triangles)
+    volume +=
+        (vertices[t[0]] - centre).dot((vertices[t[1]] - centre).cross(vertices[t[2]] - centre));
+  return volume / 6.0;
+}
+
+bool TriangleMesh::face_outward_and_up() {
+  // the signed area projected on xy (n_z A per facet) and its absolute sum
+  double signed_area = 0.0, absolute_area = 0.0;
   for (const auto& t : triangles) {
-    const Vec3 a = vertices[t[0]] - centre, b = vertices[t[1]] - centre,
-               c = vertices[t[2]] - centre;
-    const double projected = 0.5 * ((b - a).cross(c - a)).z();
+    const Vec3& a = vertices[t[0]];
+    const double projected = 0.5 * (vertices[t[1]] - a).cross(vertices[t[2]] - a).z();
     signed_area += projected;
     absolute_area += std::abs(projected);
-    volume += a.dot(b.cross(c)) / 6.0;
   }
   // a closed solid's projected areas cancel (up to rounding): judge it by its volume
   const bool closed = std::abs(signed_area) <= kClosedAreaRatio * absolute_area;
-  const bool reversed = closed ? volume < 0.0 : signed_area < 0.0;
+  const bool reversed = closed ? signed_volume_mm3() < 0.0 : signed_area < 0.0;
   if (!reversed) return false;
   for (auto& t : triangles) std::swap(t[1], t[2]);
   return true;

@@ -34,6 +34,9 @@ struct TriangleMesh {
   // meets a side wall) each side keeps its own normal instead of a 45-degree average. The
   // facet normal for a corner of a degenerate triangle (zero: degenerate triangles only).
   std::vector<std::array<Vec3, 3>> corner_normals(double crease_angle_rad) const;
+  // the enclosed volume by the divergence theorem (mm^3): positive when the triangles are wound
+  // outward; taken about the bounds' centre so that a part far from the origin loses no digits
+  double signed_volume_mm3() const;
   // x -> rotation x + offset on every vertex (triangle orientation is kept: rotations only)
   void transform(const Eigen::Matrix3d& rotation, const Vec3& offset);
   // Turns every triangle over (reverses its winding) where the whole mesh faces the wrong way:

@@ -78,14 +78,6 @@ TriangleMesh prism(const std::vector<Eigen::Vector2d>& profile,
   return m;
 }
 
-// the enclosed volume by the divergence theorem: positive when the normals point outwards
-double signed_volume(const TriangleMesh& m) {
-  double v = 0;
-  for (const auto& t : m.triangles)
-    v += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6;
-  return v;
-}
-
 // a U channel along y: floor z in [0, floor], walls x in [-outer, -groove] and [groove, outer] up
 // to z = height; the groove x in (-groove, groove), z > floor is open at the top
 struct Channel {
@@ -115,7 +107,7 @@ void expect_consistent(const PartClearance::Result& r) {
 TEST(PartClearance, SphereInAConcaveChannelIsClearWhereTheHullSaysItIsInside) {
   const Channel ch;
   const TriangleMesh mesh = ch.mesh();
-  ASSERT_GT(signed_volume(mesh), 0);
+  ASSERT_GT(mesh.signed_volume_mm3(), 0);
   const PartClearance part(mesh);
   EXPECT_TRUE(part.closed());
   EXPECT_EQ(part.triangle_count(), mesh.triangle_count());
@@ -262,7 +254,7 @@ TEST(PartClearance, SeveralShapesOnSeveralLinksGiveTheMinimumAndItsIndex) {
 
 TEST(PartClearance, InsideAClosedPartIsNegativeOutsideAnOpenOneIsNot) {
   const TriangleMesh box_mesh = cube(10);
-  ASSERT_GT(signed_volume(box_mesh), 0);
+  ASSERT_GT(box_mesh.signed_volume_mm3(), 0);
   const PartClearance solid(box_mesh);
   ASSERT_TRUE(solid.closed());
   const auto sphere = make_shape(Type::sphere, Vec3(3, 0, 0));
