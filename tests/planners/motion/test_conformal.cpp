@@ -723,6 +723,24 @@ TEST(ConformalPlanner, LeadInPrintsThePathAtItsCruiseSpeedFromEndToEnd) {
   testing_support::expect_contract(led, one_path(path), tcp);
 }
 
+// A plan of one path whose lead-in and lead-out were not taken: the warning naming the first
+// reason (`first`), no lead reported, three pieces (the print from rest between transitions)
+// and the planner contract
+void expect_leads_not_taken(const Trajectory& plan, const ConformalPlanReport& report,
+                            const PrintPath& path, const MachineLimits& tcp,
+                            const std::string& first) {
+  ASSERT_FALSE(plan.warnings().empty());
+  EXPECT_NE(plan.warnings()[0].find("1 path(s) printed without a lead-in and lead-out, from rest "
+                                    "to rest (first: " +
+                                    first),
+            std::string::npos)
+      << plan.warnings()[0];
+  EXPECT_EQ(report.paths[0].lead_in_mm, 0.0);
+  ASSERT_EQ(plan.pieces().size(), 3u);
+  EXPECT_EQ(samples_of(*print_pieces(plan)[0]).velocity_mm_s.front().norm(), 0.0);
+  testing_support::expect_contract(plan, one_path(path), tcp);
+}
+
 // A lead the machine cannot reach is not taken: the path is printed from rest to rest, and a
 // warning says so. The tilt machine here cannot reach x beyond the arc's end by 0.01 mm.
 TEST(ConformalPlanner, ALeadOutOfReachIsNotTakenAndSaysSo) {
@@ -748,16 +766,8 @@ TEST(ConformalPlanner, ALeadOutOfReachIsNotTakenAndSaysSo) {
   ConformalPlanReport report;
   const Trajectory plan = ConformalPlanner(settings).plan(one_path(path), limits, &report);
   // (and the transition to the end, lifting along the tilted axis, goes straight: a second)
-  ASSERT_FALSE(plan.warnings().empty());
-  EXPECT_NE(plan.warnings()[0].find("1 path(s) printed without a lead-in and lead-out, from rest "
-                                    "to rest (first: toolpath path 0 with its lead-in: the "
-                                    "machine cannot follow the path"),
-            std::string::npos)
-      << plan.warnings()[0];
-  EXPECT_EQ(report.paths[0].lead_in_mm, 0.0);
-  ASSERT_EQ(plan.pieces().size(), 3u);
-  EXPECT_EQ(samples_of(*print_pieces(plan)[0]).velocity_mm_s.front().norm(), 0.0);
-  testing_support::expect_contract(plan, one_path(path), tcp);
+  expect_leads_not_taken(plan, report, path, tcp,
+                         "toolpath path 0 with its lead-in: the machine cannot follow the path");
 }
 
 // A lead does not go into the work surface (z = 0, the table's or bed's top). The faceted arc
@@ -780,17 +790,11 @@ TEST(ConformalPlanner, ALeadIntoTheWorkSurfaceIsNotTakenAndSaysSo) {
   ConformalPlanReport report;
   const PrintPath low = raised(0.1 - end_z);
   const Trajectory grazing = ConformalPlanner(settings).plan(one_path(low), limits, &report);
-  ASSERT_FALSE(grazing.warnings().empty());
-  EXPECT_NE(grazing.warnings()[0].find("1 path(s) printed without a lead-in and lead-out, from "
-                                       "rest to rest (first: toolpath path 0: its lead-in or "
-                                       "lead-out would go below the work surface (z = 0))"),
-            std::string::npos)
-      << grazing.warnings()[0];
-  EXPECT_EQ(report.paths[0].lead_in_mm, 0.0);
-  ASSERT_EQ(grazing.pieces().size(), 3u);
+  expect_leads_not_taken(grazing, report, low, tcp,
+                         "toolpath path 0: its lead-in or lead-out would go below the work "
+                         "surface (z = 0))");
   for (const TrajectoryPiece& piece : grazing.pieces())
     for (const Vec3& p : samples_of(piece).position_mm) EXPECT_GE(p.z(), 0.1 - 1e-9);
-  testing_support::expect_contract(grazing, one_path(low), tcp);
 
   for (const PrintPath& path : {raised(5.0 - end_z), arc}) {
     ConformalPlanReport taken;
