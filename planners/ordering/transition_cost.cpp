@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/number_text.hpp"
 #include "motion/mtt.hpp"
 #include "motion/sync.hpp"
 #include "planners/motion/transition.hpp"
@@ -52,6 +53,11 @@ TransitionCost::TransitionCost(const Toolpath& toolpath, const TcpLimits& tcp_li
   exit_velocity_.assign(2 * path_count + 2, Vec3::Zero());
   speed_mm_s_.assign(2 * path_count + 2, 0.0);
   std::vector<Problem> problems;
+  // paths too fast for the machine at their ends: the first kListedTooFast named, the rest
+  // counted with the lowest speed any of them allows
+  constexpr int kListedTooFast = 10;
+  int too_fast_count = 0;
+  double lowest_allowed_mm_s = 0.0;
   for (int i = 0; i < path_count; ++i) {
     const PrintPath& path = toolpath.paths[i];
     const std::string key = "toolpath.paths[" + std::to_string(path.source_index) + "]";
@@ -80,13 +86,28 @@ TransitionCost::TransitionCost(const Toolpath& toolpath, const TcpLimits& tcp_li
     path.bounds(lo, hi);
     const MachineLimits limits = tcp_limits.over(lo, hi);
     const int too_fast_axis = clamp_exit_velocities(2 * i, limits, model);
-    if (too_fast_axis >= 0)
-      problems.push_back(
-          {"", 0, key + ".speed",
-           "print speed " + std::to_string(path.speed_mm_s) +
-               " mm/s exceeds v_max = " + std::to_string(limits.axes[too_fast_axis].v_max_mm_s) +
-               " mm/s of axis " + kAxisNames[too_fast_axis] + " at its ends"});
+    if (too_fast_axis < 0) continue;
+    const double allowed_mm_s = limits.axes[too_fast_axis].v_max_mm_s;
+    lowest_allowed_mm_s =
+        too_fast_count == 0 ? allowed_mm_s : std::min(lowest_allowed_mm_s, allowed_mm_s);
+    if (++too_fast_count > kListedTooFast) continue;
+    // a machine whose joints set the TCP's limits where the path is (an arm, a delta) says so
+    const bool from_joints = allowed_mm_s < requested.axes[too_fast_axis].v_max_mm_s;
+    problems.push_back(
+        {"", 0, key + ".speed",
+         "print speed " + message_number(path.speed_mm_s) +
+             " mm/s exceeds v_max = " + message_number(allowed_mm_s) + " mm/s of axis " +
+             kAxisNames[too_fast_axis] + " at its ends" +
+             (from_joints ? " (the machine's joint limits mapped over this path; limits v_max is " +
+                                message_number(requested.axes[too_fast_axis].v_max_mm_s) + ")"
+                          : "")});
   }
+  if (too_fast_count > kListedTooFast)
+    problems.push_back({"", 0, "toolpath",
+                        "... and " + std::to_string(too_fast_count - kListedTooFast) +
+                            " more print paths too fast at their ends (" +
+                            std::to_string(too_fast_count) + " in all): print them at " +
+                            message_number(lowest_allowed_mm_s) + " mm/s or less"});
   if (!problems.empty()) throw InputError(std::move(problems));
   positions_[start_node()] = toolpath.start_mm;
   positions_[end_node()] = toolpath.end_mm;

@@ -1728,6 +1728,45 @@ Problem path_point_problem(const Scenario& scenario, int source_index, std::size
       "path " + std::to_string(source_index) + ", point " + std::to_string(point) + " " + message};
 }
 
+Problem path_problem(const Scenario& scenario, int source_index, const std::string& detail,
+                     const std::string& message) {
+  const std::string below = detail.empty() ? "" : "." + detail;
+  // a hatched surface: its layer and hatch line, at the toolpath's key for the detail (its
+  // `speed:`) when given, else at the `surface:` key
+  if (scenario.surface) {
+    const auto& origins = scenario.surface->origins;
+    std::string where = "path " + std::to_string(source_index);
+    if (source_index >= 0 && static_cast<std::size_t>(source_index) < origins.size()) {
+      const SurfaceToolpath::PathOrigin& origin = origins[static_cast<std::size_t>(source_index)];
+      where = "layer " + std::to_string(origin.layer) + ", line " + std::to_string(origin.line);
+    }
+    const auto shared =
+        detail.empty() ? scenario.key_lines.end() : scenario.key_lines.find("toolpath" + below);
+    if (shared != scenario.key_lines.end())
+      return Problem{scenario.file, shared->second, shared->first, where + ": " + message};
+    return Problem{scenario.file, scenario.surface->line, "toolpath.surface",
+                   where + ": " + message};
+  }
+  if (source_index >= 0 && static_cast<std::size_t>(source_index) < scenario.path_sources.size()) {
+    const PathSource& source = scenario.path_sources[static_cast<std::size_t>(source_index)];
+    const int first_line = source.point_lines.empty() ? 0 : source.point_lines.front();
+    // a path of a G-code file: the line of its first move, at the file's key
+    if (!source.key.empty() && source.file != scenario.file)
+      return Problem{source.file, first_line, source.key,
+                     "the print path from this line: " + message};
+    // a path of the scenario file: its own key for the detail when given, else its entry
+    if (!source.key.empty()) {
+      const auto own = scenario.key_lines.find(source.key + below);
+      const int line = own != scenario.key_lines.end() ? own->second
+                       : first_line > 0                ? first_line
+                                                       : scenario.line_of(source.key);
+      return Problem{scenario.file, line, source.key + below, message};
+    }
+  }
+  return Problem{scenario.file, scenario.toolpath_line, "toolpath",
+                 "path " + std::to_string(source_index) + ": " + message};
+}
+
 std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine& machine,
                                         std::size_t max_listed) {
   std::vector<Problem> problems;
@@ -1789,8 +1828,24 @@ Problem Scenario::problem_at(const std::string& key, const std::string& message)
 }
 
 std::vector<Problem> Scenario::located(std::vector<Problem> problems) const {
+  static const std::string kPathKey = "toolpath.paths[";
   for (Problem& p : problems) {
     if (!p.file.empty()) continue;
+    // "toolpath.paths[N]" or "toolpath.paths[N].detail": path N's own source
+    if (p.key.compare(0, kPathKey.size(), kPathKey) == 0) {
+      const std::size_t close = p.key.find(']', kPathKey.size());
+      const std::string index = close == std::string::npos
+                                    ? std::string()
+                                    : p.key.substr(kPathKey.size(), close - kPathKey.size());
+      if (!index.empty() && index.size() < 10 &&
+          std::all_of(index.begin(), index.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+        const std::string detail = close + 2 <= p.key.size() && p.key[close + 1] == '.'
+                                       ? p.key.substr(close + 2)
+                                       : std::string();
+        p = path_problem(*this, std::stoi(index), detail, p.message);
+        continue;
+      }
+    }
     p.file = file;
     p.line = line_of(p.key);
   }

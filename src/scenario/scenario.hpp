@@ -172,7 +172,9 @@ struct Scenario {
   // a problem found after loading, placed in this file at its key's line
   Problem problem_at(const std::string& key, const std::string& message) const;
   // problems without a file (e.g. thrown by a downstream check that names only a key) placed
-  // in this file at their key's line
+  // in this file at their key's line; one that names a print path by its source index
+  // ("toolpath.paths[7].speed", as the ordering does) at that path's own source: its YAML
+  // entry, its G-code line or its hatch line (path_problem)
   std::vector<Problem> located(std::vector<Problem> problems) const;
 };
 
@@ -182,6 +184,13 @@ struct Scenario {
 // toolpath's points are named by layer, line and point.
 Problem path_point_problem(const Scenario& scenario, int source_index, std::size_t point,
                            const std::string& message);
+
+// The problem `message` about the whole print path with this source index, `detail` the key
+// below it the message is about ("speed", or ""): at the path's YAML entry ("toolpath.paths[2]"
+// or "toolpath.segments[5]"), at its first move's line in a G-code file, or at the `surface:`
+// key with its layer and hatch line ("layer 0, line 12: ...").
+Problem path_problem(const Scenario& scenario, int source_index, const std::string& detail,
+                     const std::string& message);
 
 // Every toolpath pose (start, end, each point) a machine that holds the nozzle as the paths
 // say cannot reach, as problems at the point's file, line and key; at most `max_listed`

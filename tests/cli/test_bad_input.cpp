@@ -294,6 +294,23 @@ std::vector<Row> rows() {
       replace_line(probe_with("machine:", "machine: arm6"), "  start:", "  start: [0, 0, 2000]"),
       "{s}:7: toolpath\\.start: the start \\(0\\.000, 0\\.000, 2000\\.000\\) mm "
       "is out of the arm's reach"));
+  // near the arm's base its joints allow the TCP less than limits.v_max: the path is named at
+  // its own line (not the ordering's "toolpath.paths[0]"), a G-code path at its first move
+  r.push_back(scenario(
+      "ArmPathTooFastNearItsBase",
+      replace_line(replace_line(replace_line(probe_with("machine:", "machine: arm6"),
+                                             "limits:", "limits: {v_max: 200, a_max: 2000}"),
+                                "  speed:", "  speed: 30"),
+                   "    - [[2, 2], [8, 2]]", "    - [[-300, 2], [-290, 2]]"),
+      "{s}:9: toolpath\\.segments\\[0\\]\\.speed: print speed 30 mm/s exceeds "
+      "v_max = [0-9.]+ mm/s of axis x at its ends \\(the machine's joint limits "
+      "mapped over this path; limits v_max is 200\\)"));
+  r.push_back(scenario("ArmGcodeTooFastNearItsBase",
+                       "machine: arm6\nlimits: {v_max: 200, a_max: 2000}\ntoolpath:\n"
+                       "  gcode: part.gcode\nplanners: [lspb_mtt]\n",
+                       "part\\.gcode:3: toolpath\\.gcode: the print path from this line: print "
+                       "speed 50 mm/s exceeds v_max = [0-9.]+ mm/s of axis x at its ends",
+                       {{"part.gcode", "G21\nG1 X-300 Y0 Z5 F3000\nG1 X-290 E1\nG1 Y10 E2\n"}}));
   r.push_back(scenario("ArmPointAKilometreAway",
                        probe_with("    - [[8, 2], [5, 7]]", "    - [[8, 2], [1e300, 7]]"),
                        "{s}:10: toolpath\\.segments\\[1\\]\\[1\\]\\[0\\]: must be in "

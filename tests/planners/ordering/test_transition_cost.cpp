@@ -112,6 +112,36 @@ TEST(TransitionCost, OrderCostAddsPrintTimeAndTransitions) {
   EXPECT_NEAR(cost.transition_length_mm(order), 20.0 + gap + 20.0, 1e-12);
 }
 
+// paths too fast where the machine's joints slow the TCP (limits that fall with x, as an arm's
+// near its base): the first ten named with the joints' limit, the rest counted with the lowest
+TEST(TransitionCost, PathsTooFastForTheJointsAreNamedThenCounted) {
+  const TcpLimits falling(kPaperLimits, [](const Vec3&, const Vec3& hi) {
+    return MachineLimits::uniform(4.0 - 0.1 * hi.x(), 30.0);
+  });
+  Toolpath toolpath;
+  toolpath.start_mm = toolpath.end_mm = Vec3(0, -10, 0);
+  for (int i = 0; i < 12; ++i)  // path i from x = i to i + 1 (v_max 3.9 - 0.1 i) at 3.85 mm/s
+    toolpath.paths.push_back(segment(Vec3(i, 3.0 * i, 0), Vec3(i + 1, 3.0 * i, 0), 3.85));
+  for (int i = 0; i < 12; ++i) toolpath.paths[i].source_index = i;
+  std::vector<Problem> problems;
+  try {
+    TransitionCost cost(toolpath, falling, CostModel::machine);
+  } catch (const InputError& e) {
+    problems = e.problems();
+  }
+  // path 0 (v_max 3.9) is fine; paths 1 to 11 are too fast: 1 to 10 named, 11 counted
+  ASSERT_EQ(problems.size(), 11u);
+  EXPECT_EQ(problems[0].key, "toolpath.paths[1].speed");
+  EXPECT_EQ(problems[0].message,
+            "print speed 3.85 mm/s exceeds v_max = 3.8 mm/s of axis x at its ends (the machine's "
+            "joint limits mapped over this path; limits v_max is 4)");
+  EXPECT_EQ(problems[9].key, "toolpath.paths[10].speed");
+  EXPECT_EQ(problems[10].key, "toolpath");
+  EXPECT_EQ(problems[10].message,
+            "... and 1 more print paths too fast at their ends (11 in all): print them at 2.8 "
+            "mm/s or less");
+}
+
 TEST(TransitionCost, UnprintablePathsAreInputErrors) {
   Toolpath toolpath = two_on_a_line(5.0);
   toolpath.paths[1].speed_mm_s = 5.0;  // above v_max on x
