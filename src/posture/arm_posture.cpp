@@ -1,6 +1,7 @@
 #include "posture/arm_posture.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -469,6 +470,10 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
 
   // stations no branch and no roll can take: the job cannot be printed; say where and why
   std::vector<Problem> problems;
+  // every such station counted by its reason, and the box they span, for the summary
+  std::array<size_t, 5> failed_by_reason{};
+  size_t failed = 0;
+  Vec3 failed_lo = Vec3::Constant(kInfinity), failed_hi = Vec3::Constant(-kInfinity);
   for (size_t s = 0; s < n; ++s) {
     Reason best = Reason::unreachable;
     bool any = false;
@@ -482,12 +487,37 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
         best = std::max(best, reason[i]);
       }
     if (any) continue;
+    ++failed;
+    ++failed_by_reason[static_cast<size_t>(best)];
+    failed_lo = failed_lo.cwiseMin(stations[s].pose.position_mm);
+    failed_hi = failed_hi.cwiseMax(stations[s].pose.position_mm);
     if (problems.size() < kMaxNamedPoints)
       problems.push_back(Problem{"", 0, "toolpath",
                                  station_name(s) + " is " + reason_text(best) +
                                      " for every roll and branch of " + arm.name()});
   }
-  if (!problems.empty()) throw InputError(problems);
+  if (failed > 0) {
+    // how many, why, where they are, and where the arm works best
+    std::string reasons;
+    for (const Reason r :
+         {Reason::unreachable, Reason::joint_limit, Reason::singular, Reason::collides}) {
+      const size_t count = failed_by_reason[static_cast<size_t>(r)];
+      if (count == 0) continue;
+      reasons += (reasons.empty() ? "" : ", ") + std::to_string(count) + " " + reason_text(r);
+    }
+    const auto span = [&](int axis) {
+      return format("%.1f", failed_lo[axis]) + " to " + format("%.1f", failed_hi[axis]);
+    };
+    problems.push_back(Problem{
+        "", 0, "toolpath",
+        std::to_string(failed) + " of " + std::to_string(n) +
+            " points checked along the toolpath cannot be posed (" + reasons + "), spanning x " +
+            span(0) + ", y " + span(1) + ", z " + span(2) + " mm; " + arm.name() +
+            " works best on a part centred at the work frame's origin, " +
+            "within about 150 x 130 mm and 40 mm high (move the toolpath with toolpath.offset; a " +
+            "part: toolpath.surface.offset)"});
+    throw InputError(problems);
+  }
 
   ArmPosture result;
   result.stations = n;

@@ -124,6 +124,12 @@ TEST(ArmPosture, UnreachablePointIsNamed) {
   EXPECT_NE(text.find("out of the arm's reach for every roll and branch"), std::string::npos)
       << text;
   EXPECT_EQ(text.find("point 1"), std::string::npos) << text;  // only the bad point
+  // then how many, why and where, and where the arm works
+  EXPECT_NE(text.find("1 of 5 points checked along the toolpath cannot be posed (1 out of the "
+                      "arm's reach), spanning x 600.0 to 600.0, y 0.0 to 0.0, z 0.0 to 0.0 mm; "
+                      "arm6 works best on a part centred at the work frame's origin"),
+            std::string::npos)
+      << text;
 }
 
 TEST(ArmPosture, SingularPointIsNamed) {
