@@ -1231,7 +1231,10 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     // the reader's and the hatch's problems name this file and line
     for (Problem p : e.problems()) {
       if (p.file.empty() || p.file == surface->file) {
-        p.message = (p.file.empty() ? std::string() : "'" + given_file + "': ") + p.message;
+        // "'part.stl' line 12: ..." where the STL reader names its line
+        const std::string stl_line = p.line > 0 ? " line " + std::to_string(p.line) : "";
+        p.message =
+            (p.file.empty() ? std::string() : "'" + given_file + "'" + stl_line + ": ") + p.message;
         p.file = problems_.file();
         p.line = field.key_line;
       }

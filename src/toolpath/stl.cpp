@@ -11,12 +11,15 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <locale>
 #include <sstream>
+#include <string_view>
 #include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/number_text.hpp"
 
 namespace depotwin {
 
@@ -83,6 +86,167 @@ std::string format_count(std::size_t n) {
   return std::to_string(n);
 }
 
+// A strict reader of ASCII STL, the grammar every exporter writes:
+//   solid [name]
+//     facet normal ni nj nk / outer loop / vertex x y z (three) / endloop / endfacet  (any number)
+//   endsolid [name]
+// one solid or several in a row; keywords in any case, words separated by any white space.
+// Every departure from it (a facet of two or four vertices, a coordinate that is not a number
+// such as a decimal comma, a fourth coordinate, no `endsolid`) is an InputError naming the
+// line: a general reader's guess would be a silently different part. Coordinates are 32-bit
+// floats, as in a binary STL, and identical ones are joined across the solids.
+class AsciiStlReader {
+ public:
+  AsciiStlReader(const std::string& text, const std::string& path, double mm_per_unit,
+                 const std::string& key)
+      : text_(text), path_(path), key_(key), mm_per_unit_(mm_per_unit) {}
+
+  TriangleMesh read() {
+    std::string_view word;
+    while (next(word)) {
+      // "solid", or "solid" and the name with no space between (as begins_with_solid allows)
+      if (!is(word.substr(0, 5), "solid"))
+        fail("expected 'solid' (or the end of the file), got " + shown(word));
+      skip_line();  // the solid's name, if any
+      ++solids_;
+      read_facets();
+    }
+    if (mesh_.triangles.empty()) fail_at(0, "ASCII STL without triangles");
+    return std::move(mesh_);
+  }
+
+ private:
+  // the facets of one solid, through its `endsolid`
+  void read_facets() {
+    std::string_view word;
+    for (;;) {
+      if (!next(word))
+        fail_at(line_, "the file ends without 'endsolid' (solid " + std::to_string(solids_) +
+                           " is not closed: a truncated file?)");
+      if (is(word, "endsolid")) {
+        skip_line();
+        return;
+      }
+      if (!is(word, "facet")) fail("expected 'facet' or 'endsolid', got " + shown(word));
+      const int facet_line = word_line_;
+      ++facets_;
+      expect("normal", "after 'facet'");
+      // the normal is read, not used: the winding decides which way the facet faces
+      for (int i = 0; i < 3; ++i) number("the facet's normal");
+      expect("outer", "after the facet's normal");
+      expect("loop", "after 'outer'");
+      std::array<int, 3> corners{};
+      int vertices = 0;
+      for (;;) {
+        if (!next(word)) ends_inside_facet();
+        if (is(word, "endloop")) break;
+        if (!is(word, "vertex"))
+          fail("expected 'vertex' or 'endloop', got " + shown(word) +
+               (parse_double(std::string(word)) ? " (a vertex has three coordinates)" : ""));
+        const int index = vertex();
+        if (vertices < 3) corners[static_cast<std::size_t>(vertices)] = index;
+        ++vertices;
+      }
+      if (vertices != 3)
+        fail_at(facet_line, "facet " + std::to_string(facets_) + " has " +
+                                std::to_string(vertices) +
+                                " vertices: an STL facet is a triangle, with 3");
+      expect("endfacet", "after 'endloop'");
+      mesh_.triangles.push_back(corners);
+    }
+  }
+
+  // `vertex x y z`: the joined vertex's index
+  int vertex() {
+    std::array<uint32_t, 3> bits{};
+    Vec3 mm;
+    for (int i = 0; i < 3; ++i) {
+      const double value = number("a vertex");
+      if (!std::isfinite(value)) fail("non-finite coordinate in facet " + std::to_string(facets_));
+      if (std::abs(value) > std::numeric_limits<float>::max())
+        fail("coordinate " + message_number(value) + " in facet " + std::to_string(facets_) +
+             " is beyond STL's 32-bit floats");
+      const float f = static_cast<float>(value) + 0.0f;  // -0 as +0
+      std::memcpy(&bits[static_cast<std::size_t>(i)], &f, 4);
+      mm[i] = mm_per_unit_ * static_cast<double>(f);
+    }
+    const auto [it, inserted] = index_of_.emplace(bits, static_cast<int>(mesh_.vertices.size()));
+    if (inserted) mesh_.vertices.push_back(mm);
+    return it->second;
+  }
+
+  // the next word as a number (nan and inf included: the caller decides); a problem at the
+  // line of the word the numbers follow (`vertex`, `normal`)
+  double number(const std::string& what) {
+    const int statement_line = word_line_;
+    std::string_view word;
+    if (!next(word)) ends_inside_facet();
+    const std::optional<double> value = parse_double(std::string(word));
+    if (!value)
+      fail_at(statement_line, what + " needs three numbers, got " + shown(word) +
+                                  (word.find(',') != std::string_view::npos
+                                       ? " (STL writes '.' for the decimal point)"
+                                       : ""));
+    return *value;
+  }
+
+  void expect(const char* keyword, const std::string& where) {
+    std::string_view word;
+    if (!next(word)) ends_inside_facet();
+    if (!is(word, keyword))
+      fail(std::string("expected '") + keyword + "' " + where + ", got " + shown(word));
+  }
+
+  // the next white-space separated word, and its line in word_line_; false at the end
+  bool next(std::string_view& word) {
+    while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) {
+      if (text_[pos_] == '\n') ++line_;
+      ++pos_;
+    }
+    if (pos_ == text_.size()) return false;
+    const std::size_t start = pos_;
+    while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+    word = std::string_view(text_).substr(start, pos_ - start);
+    word_line_ = line_;
+    return true;
+  }
+
+  void skip_line() {
+    while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+  }
+
+  static bool is(std::string_view word, const char* keyword) {
+    const std::size_t n = std::strlen(keyword);
+    if (word.size() != n) return false;
+    for (std::size_t i = 0; i < n; ++i)
+      if (std::tolower(static_cast<unsigned char>(word[i])) != keyword[i]) return false;
+    return true;
+  }
+
+  static std::string shown(std::string_view word) {
+    return "'" + printable_text(std::string(word)) + "'";
+  }
+
+  [[noreturn]] void ends_inside_facet() const {
+    fail_at(line_,
+            "the file ends inside facet " + std::to_string(facets_) + " (a truncated file?)");
+  }
+  [[noreturn]] void fail(const std::string& message) const { fail_at(word_line_, message); }
+  [[noreturn]] void fail_at(int line, const std::string& message) const {
+    throw InputError(path_, line, key_, message);
+  }
+
+  const std::string& text_;
+  const std::string& path_;
+  const std::string& key_;
+  double mm_per_unit_;
+  std::size_t pos_ = 0;
+  int line_ = 1, word_line_ = 1;
+  int solids_ = 0, facets_ = 0;
+  TriangleMesh mesh_;
+  std::unordered_map<std::array<uint32_t, 3>, int, FloatTripleHash> index_of_;
+};
+
 }  // namespace
 
 TriangleMesh read_stl(const std::string& path, double mm_per_unit, const std::string& key) {
@@ -126,7 +290,15 @@ TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& path, d
                          " bytes) does not match a binary STL's triangle count (truncated?)");
   }
 
-  // assimp decides binary vs ASCII by the same size rule, so the hint is unambiguous here
+  if (!binary) {
+    TriangleMesh mesh = AsciiStlReader(bytes, path, mm_per_unit, key).read();
+    for (const Vec3& v : mesh.vertices)
+      if (!v.allFinite())  // finite floats times a finite scale may still overflow
+        throw InputError(path, 0, key, "coordinates overflow when scaled to mm");
+    return mesh;
+  }
+
+  // a binary file through assimp, which decides binary vs ASCII by the same size rule
   Assimp::Importer importer;
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS);
   const aiScene* scene =

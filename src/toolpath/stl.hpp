@@ -1,13 +1,15 @@
 // STL import and export for the part a conformal toolpath is printed on.
 //
-// Reading goes through assimp (5.2), for ASCII and binary files alike, but the storage
-// format is decided here first: a file is binary when its size is exactly 84 + 50 n bytes
-// with n the little-endian uint32 at offset 80, whatever its first bytes say (CAD exporters
-// write binary files whose 80-byte header begins with "solid"), and ASCII when it is not
-// and begins with "solid". Assimp then gets the bytes with the "stl" hint and decides the
-// same way (it checks the binary size first). Identical vertices are joined (after the
-// facet normals are dropped: assimp would otherwise keep one vertex per facet), so vertex
-// normals are smooth over the surface.
+// The storage format is decided here first: a file is binary when its size is exactly
+// 84 + 50 n bytes with n the little-endian uint32 at offset 80, whatever its first bytes say
+// (CAD exporters write binary files whose 80-byte header begins with "solid"), and ASCII when
+// it is not and begins with "solid". A binary file goes through assimp (5.2), with the "stl"
+// hint (it checks the binary size first too). An ASCII file is read here, strictly: its
+// grammar (solid, facet normal, outer loop, three vertices, endloop, endfacet, endsolid) and
+// nothing else, every departure an error naming its line (assimp reads "10,5" as 10 and a
+// facet of four vertices without a word). Identical vertices are joined (after the facet
+// normals are dropped: assimp would otherwise keep one vertex per facet), so vertex normals
+// are smooth over the surface.
 #pragma once
 
 #include <string>
@@ -20,7 +22,9 @@ namespace depotwin {
 // in mm, 25.4 for inches). Bad input is an InputError naming the file and `key`: a missing
 // or unreadable file, an empty or truncated file, a binary header whose triangle count does
 // not match the file's size, a file that is not STL, non-finite coordinates, no triangles, a
-// non-positive or non-finite mm_per_unit.
+// non-positive or non-finite mm_per_unit; in an ASCII file also its line (Problem::line) and
+// what it found there: a word out of the grammar, a facet of other than 3 vertices, a
+// coordinate that is not a number or beyond 32-bit floats, a solid without `endsolid`.
 TriangleMesh read_stl(const std::string& path, double mm_per_unit,
                       const std::string& key = "toolpath.surface.file");
 // The same for a file's bytes already in memory; `label` names the file in messages.

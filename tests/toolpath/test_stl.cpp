@@ -1,6 +1,7 @@
-// STL import and export: ASCII and binary through assimp, a binary file whose header begins
-// with "solid" (decided by its size), identical vertices joined (across solids too), units,
-// round trips, and every kind of broken file an InputError naming the file.
+// STL import and export: binary through assimp, ASCII by its own strict reader, a binary file
+// whose header begins with "solid" (decided by its size), identical vertices joined (across
+// solids too), units, round trips, and every kind of broken file an InputError naming the file
+// (an ASCII one also its line).
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -208,7 +209,7 @@ TEST(Stl, BrokenFilesNameTheFile) {
   const std::string ascii = stl_ascii_text(tetrahedron(), "tetra");
   const std::string ascii_cut = scratch("ascii_cut.stl");
   write_bytes(ascii_cut, ascii.substr(0, 200));  // in the middle of the second facet
-  expect_problem(ascii_cut, "ASCII STL that cannot be read");
+  expect_problem(ascii_cut, "the file ends inside facet 2");
 
   const std::string zero = scratch("zero_triangles.stl");
   write_bytes(zero, stl_binary_bytes(TriangleMesh{}, "nothing"));
@@ -227,6 +228,72 @@ TEST(Stl, BrokenFilesNameTheFile) {
   expect_problem(noise, "not an STL file");
 
   EXPECT_THROW(read_stl(kTorus, 0.0), InputError);
+}
+
+// an ASCII STL of two facets (a 10 mm square at z = 1), its first facet's third vertex line
+// (line 6) as given
+std::string square_with_third_vertex(const std::string& third_vertex) {
+  return "solid x\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 1\n  vertex 10 0 1\n" +
+         third_vertex +
+         "\n endloop\nendfacet\nfacet normal 0 0 1\n outer loop\n  vertex 10 0 1\n"
+         "  vertex 10 10 1\n  vertex 0 10 1\n endloop\nendfacet\nendsolid x\n";
+}
+
+// the problem of reading these ASCII bytes (fails the test if they read)
+Problem ascii_problem(const std::string& text) {
+  try {
+    read_stl_bytes(text, "part.stl", 1.0);
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problems().size(), 1u);
+    return e.problems().front();
+  }
+  ADD_FAILURE() << "expected an InputError for:\n" << text;
+  return {};
+}
+
+TEST(Stl, AsciiDeparturesFromTheGrammarNameTheirLine) {
+  const auto expect_at = [](const std::string& text, int line, const std::string& message) {
+    const Problem p = ascii_problem(text);
+    EXPECT_EQ(p.file, "part.stl");
+    EXPECT_EQ(p.line, line) << p.message;
+    EXPECT_EQ(p.message, message);
+  };
+  // a decimal comma (what a German locale's exporter writes): not read as 10
+  expect_at(square_with_third_vertex("  vertex 0 10,5 1"), 6,
+            "a vertex needs three numbers, got '10,5' (STL writes '.' for the decimal point)");
+  expect_at(square_with_third_vertex("  vertex 0 10"), 6,
+            "a vertex needs three numbers, got 'endloop'");
+  expect_at(square_with_third_vertex("  vertex 0 10 1 7"), 6,
+            "expected 'vertex' or 'endloop', got '7' (a vertex has three coordinates)");
+  expect_at(square_with_third_vertex("  vertex 0 10 1\n  vertex 5 5 1"), 2,
+            "facet 1 has 4 vertices: an STL facet is a triangle, with 3");
+  expect_at(square_with_third_vertex("  vertex 0 1e50 1"), 6,
+            "coordinate 1e+50 in facet 1 is beyond STL's 32-bit floats");
+  expect_at(square_with_third_vertex("  vertex 0 nan 1"), 6, "non-finite coordinate in facet 1");
+  expect_at(square_with_third_vertex("  vertex 0 10 1\n  endlop"), 7,
+            "expected 'vertex' or 'endloop', got 'endlop'");
+  // a file cut after a whole facet: no `endsolid`, not a smaller part
+  const std::string whole = square_with_third_vertex("  vertex 0 10 1");
+  expect_at(whole.substr(0, whole.find("endsolid")), 16,
+            "the file ends without 'endsolid' (solid 1 is not closed: a truncated file?)");
+  expect_at(whole + "garbage\n", 17, "expected 'solid' (or the end of the file), got 'garbage'");
+}
+
+TEST(Stl, AsciiAsExportersWriteItReads) {
+  // the grammar in capitals, CRLF line ends, tabs, a degenerate facet's NaN normal (some
+  // exporters write one) and no name: the same two triangles as the plain file
+  const TriangleMesh plain =
+      read_stl_bytes(square_with_third_vertex("  vertex 0 10 1"), "plain.stl", 1.0);
+  const std::string shouted =
+      "SOLID\r\nFACET NORMAL nan nan nan\r\n\tOUTER LOOP\r\n\t\tVERTEX 0 0 1\r\n"
+      "\t\tVERTEX 1e1 0 1\r\n\t\tVERTEX 0 10 +1\r\n\tENDLOOP\r\nENDFACET\r\n"
+      "FACET NORMAL 0 0 1 OUTER LOOP VERTEX 10 0 1 VERTEX 10 10 1 VERTEX 0 10 1 ENDLOOP "
+      "ENDFACET\r\nENDSOLID\r\n";
+  const TriangleMesh read = read_stl_bytes(shouted, "shouted.stl", 1.0);
+  ASSERT_EQ(read.triangle_count(), 2u);
+  ASSERT_EQ(read.vertices.size(), 4u);  // the diagonal's two vertices shared
+  EXPECT_EQ(read.vertices, plain.vertices);
+  EXPECT_EQ(read.triangles, plain.triangles);
 }
 
 }  // namespace
