@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/number_text.hpp"
 
 namespace depotwin {
 
@@ -512,6 +513,17 @@ void GcodeParser::extrude(double delta) {
 }
 
 void GcodeParser::move(int motion, int line_number) {
+  // a multi-axis file's other axes (rotary A B C, or U V W) moved: their tool orientation or
+  // second carriage cannot be followed by reading X Y Z alone (0, or no move in G91, is fine)
+  for (const char letter : {'A', 'B', 'C', 'U', 'V', 'W'}) {
+    if (!words_.has(letter) || words_.get(letter) == 0.0) continue;
+    problem(line_number, std::string("axis word ") + letter + " (" +
+                             message_number(words_.get(letter)) +
+                             ") on a move: only X, Y, Z and E are read, so a multi-axis "
+                             "file's rotary or extra axes would be dropped silently; "
+                             "convert it to 3-axis G-code first");
+    return;
+  }
   // target position and extrusion of this move
   Vec3 target_mm = position_mm_;
   for (int axis = 0; axis < 3; ++axis) {

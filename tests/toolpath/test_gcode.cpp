@@ -222,10 +222,11 @@ TEST(Gcode, EveryMalformedLineIsReported) {
       "G1 X5 E5 #\n"        // 9 stray character
       "G1 X\x01\x02\n"      // 10 control bytes
       "G81 X1 Y1 Z-1 R1\n"  // 11 canned cycle
+      "G1 X7 Y0 A30 B0\n"   // 12 a rotary axis that turns
       "M117 anything: goes here\n"
       "PRINT_START BED=60\n"
       "G1 X6 E6\n");
-  ASSERT_EQ(problems.size(), 10u) << dump(problems);
+  ASSERT_EQ(problems.size(), 11u) << dump(problems);
   for (std::size_t i = 0; i < problems.size(); ++i) {
     EXPECT_EQ(problems[i].file, "test.gcode");
     EXPECT_EQ(problems[i].line, static_cast<int>(i) + 2) << problems[i].str();
@@ -244,6 +245,19 @@ TEST(Gcode, EveryMalformedLineIsReported) {
   EXPECT_EQ(problems[8].message,
             "binary or control byte \\x01 at column 5 (is this a G-code text file?)");
   EXPECT_NE(problems[9].message.find("G81 is not supported"), std::string::npos);
+  EXPECT_EQ(problems[10].message,
+            "axis word A (30) on a move: only X, Y, Z and E are read, so a multi-axis file's "
+            "rotary or extra axes would be dropped silently; convert it to 3-axis G-code first");
+}
+
+TEST(Gcode, RotaryAxesAtZeroAreNoMove) {
+  // a 5-axis post's output with its rotary axes at 0 (absolute) or not moved (relative): the
+  // same path as without them
+  const GcodeImport plain = parse("G1 X1 E1 F600\nG1 X2 Y1 E2\n");
+  const GcodeImport zero = parse("G1 X1 A0 B0 C0 E1 F600\nG91\nG1 X1 Y1 A0 U0 E1\n");
+  ASSERT_EQ(zero.toolpath.paths.size(), 1u);
+  ASSERT_EQ(plain.toolpath.paths.size(), 1u);
+  EXPECT_EQ(zero.toolpath.paths[0].points, plain.toolpath.paths[0].points);
 }
 
 TEST(Gcode, ManyBadLinesAreSummarised) {
