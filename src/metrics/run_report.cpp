@@ -6,6 +6,18 @@
 
 namespace depotwin {
 
+namespace {
+
+// a simulated peak above a joint's limit by more than rounding: a servo that tracks a speed
+// planned at the limit reads it back a few ulp above (15 mm/s "above" 15 mm/s by 1e-10)
+constexpr double kLimitRoundoff = 1e-9;
+
+bool exceeds(double peak, double limit) {
+  return limit > 0.0 && peak > limit * (1.0 + kLimitRoundoff);
+}
+
+}  // namespace
+
 MotionSamples recorded_motion(const RecordedRun& record) {
   MotionSamples samples;
   samples.reserve(record.size());
@@ -45,9 +57,9 @@ ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointL
                               ? record.reference_peak_acceleration[j]
                               : 0.0;
     // the limits are counted in the record's units; a hinge is reported in degrees
-    if (v_lim > 0 && v > v_lim) ++stats.limit_violations;
-    if (a_lim > 0 && a > a_lim) ++stats.limit_violations;
-    if (f_lim > 0 && f > f_lim) ++stats.limit_violations;
+    if (exceeds(v, v_lim)) ++stats.limit_violations;
+    if (exceeds(a, a_lim)) ++stats.limit_violations;
+    if (exceeds(f, f_lim)) ++stats.limit_violations;
     const double scale = known && limits[j].revolute ? 180.0 / kPi : 1.0;
     stats.joint_names.push_back(record.joint_names[j]);
     stats.revolute.push_back(known && limits[j].revolute);
@@ -83,7 +95,7 @@ std::vector<std::string> actuator_limit_warnings(const ActuatorStats& stats) {
         {"actuator force", stats.peak_force[j], stats.limit_force[j], hinge ? "N m" : "N"},
     };
     for (const auto& q : quantities)
-      if (q.limit > 0.0 && q.peak > q.limit)
+      if (exceeds(q.peak, q.limit))
         warnings.push_back("joint " + stats.joint_names[j] + ": peak " + q.what + " " +
                            number(q.peak) + " " + q.unit + " above its limit " + number(q.limit) +
                            " " + q.unit + " (+" + number(100.0 * (q.peak / q.limit - 1.0)) +
