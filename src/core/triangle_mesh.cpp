@@ -1,7 +1,9 @@
 #include "core/triangle_mesh.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 
 namespace depotwin {
@@ -132,6 +134,69 @@ bool TriangleMesh::face_outward_and_up() {
   if (!reversed) return false;
   for (auto& t : triangles) std::swap(t[1], t[2]);
   return true;
+}
+
+size_t TriangleMesh::orient_consistently() {
+  // every directed edge of every triangle with two distinct corners: (undirected key, triangle,
+  // whether it runs from the lower vertex index to the higher)
+  struct EdgeUse {
+    uint64_t key;
+    uint32_t triangle;
+    bool ascending;
+  };
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const int a = triangles[t][c], b = triangles[t][(c + 1) % 3];
+      if (a == b) continue;
+      const uint64_t low = static_cast<uint32_t>(std::min(a, b));
+      const uint64_t high = static_cast<uint32_t>(std::max(a, b));
+      uses.push_back({(low << 32) | high, static_cast<uint32_t>(t), a < b});
+    }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return x.key != y.key ? x.key < y.key : x.triangle < y.triangle;
+  });
+
+  // the neighbours across manifold edges, and whether each pair must differ in winding from
+  // the other's current one (they run the edge the same way) or not
+  std::vector<std::vector<std::pair<uint32_t, bool>>> neighbours(triangles.size());
+  for (size_t i = 0; i < uses.size();) {
+    size_t j = i;
+    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    if (j - i == 2 && uses[i].triangle != uses[i + 1].triangle) {
+      const bool same_way = uses[i].ascending == uses[i + 1].ascending;
+      neighbours[uses[i].triangle].push_back({uses[i + 1].triangle, same_way});
+      neighbours[uses[i + 1].triangle].push_back({uses[i].triangle, same_way});
+    }
+    i = j;
+  }
+
+  // each piece by breadth-first search: a triangle's turn relative to the piece's first, then
+  // the turn of the smaller area applied
+  std::vector<int8_t> relative(triangles.size(), -1);
+  std::vector<uint32_t> piece;
+  size_t turned = 0;
+  for (size_t seed = 0; seed < triangles.size(); ++seed) {
+    if (relative[seed] >= 0) continue;
+    piece.assign(1, static_cast<uint32_t>(seed));
+    relative[seed] = 0;
+    for (size_t k = 0; k < piece.size(); ++k)
+      for (const auto& [other, same_way] : neighbours[piece[k]]) {
+        if (relative[other] >= 0) continue;  // reached already (a conflict keeps the first)
+        relative[other] = static_cast<int8_t>(relative[piece[k]] ^ (same_way ? 1 : 0));
+        piece.push_back(other);
+      }
+    double area[2] = {0.0, 0.0};
+    for (const uint32_t t : piece) area[relative[t]] += facet_area_mm2(t);
+    const int8_t turn = area[1] > area[0] ? 0 : 1;
+    for (const uint32_t t : piece)
+      if (relative[t] == turn) {
+        std::swap(triangles[t][1], triangles[t][2]);
+        ++turned;
+      }
+  }
+  return turned;
 }
 
 }  // namespace depotwin

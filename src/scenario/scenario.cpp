@@ -1195,8 +1195,15 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
          Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.x()), Vec3::UnitX()))
             .toRotationMatrix();
     part.transform(rotation, surface->offset_mm);
-    // an STL wound the wrong way (a surface patch facing down, a solid inside out) is turned
-    // over, and every run says so: the hatch looks for the faces seen from above
+    // facets wound against their neighbours turned to match them, then an STL wound the wrong
+    // way (a surface patch facing down, a solid inside out) turned over; every run says so:
+    // the hatch looks for the faces seen from above
+    if (const size_t turned = part.orient_consistently(); turned > 0)
+      scenario_.notes.push_back("toolpath.surface: " + std::to_string(turned) + " of " +
+                                std::to_string(part.triangle_count()) + " triangles of '" +
+                                given_file +
+                                "' were wound against their neighbours; they were turned over "
+                                "to match them");
     if (part.face_outward_and_up())
       scenario_.notes.push_back("toolpath.surface: '" + given_file +
                                 "' faced down or inside out (its triangles wound clockwise "

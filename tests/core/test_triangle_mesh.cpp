@@ -1,9 +1,11 @@
 // TriangleMesh::face_outward_and_up: a mesh wound the wrong way (a closed solid inside out, an
 // open surface facing down) is turned over, and one wound right is left alone, judged by the
-// closed form of its signed volume and its signed projected area.
+// closed form of its signed volume and its signed projected area. orient_consistently: facets
+// wound against their neighbours are turned to match the larger area around them.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <utility>
 
 #include "core/triangle_mesh.hpp"
@@ -66,6 +68,77 @@ TEST(TriangleMesh, AnOpenSurfaceFacingDownIsTurnedUp) {
   // an empty mesh has nothing to turn
   TriangleMesh empty;
   EXPECT_FALSE(empty.face_outward_and_up());
+}
+
+// an n x n grid of squares on z = sin(x / 3) cos(y / 4), counter-clockwise from above
+TriangleMesh wavy_grid(int n) {
+  TriangleMesh mesh;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      mesh.vertices.emplace_back(i, j, std::sin(i / 3.0) * std::cos(j / 4.0));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = (n + 1) * j + i;
+      mesh.triangles.push_back({a, a + 1, a + n + 2});
+      mesh.triangles.push_back({a, a + n + 2, a + n + 1});
+    }
+  return mesh;
+}
+
+TEST(TriangleMesh, TrianglesWoundAgainstTheirNeighboursAreTurnedToMatch) {
+  // a surface with every 7th facet reversed (and the first two, at a corner): those are turned
+  // back, whichever way the rest runs, and a consistent mesh is left alone
+  const TriangleMesh right = wavy_grid(12);
+  TriangleMesh consistent = right;
+  EXPECT_EQ(consistent.orient_consistently(), 0u);
+  EXPECT_EQ(consistent.triangles, right.triangles);
+  TriangleMesh mixed = right;
+  size_t reversed = 0;
+  for (size_t t = 0; t < mixed.triangle_count(); ++t)
+    if (t < 2 || t % 7 == 3) {
+      std::swap(mixed.triangles[t][1], mixed.triangles[t][2]);
+      ++reversed;
+    }
+  TriangleMesh mixed_down = turned_over(mixed);
+  EXPECT_EQ(mixed.orient_consistently(), reversed);
+  EXPECT_EQ(mixed.triangles, right.triangles);
+  EXPECT_EQ(mixed_down.orient_consistently(), reversed);
+  EXPECT_EQ(mixed_down.triangles, turned_over(right).triangles);
+  EXPECT_TRUE(mixed_down.face_outward_and_up());  // then the whole is turned up
+  EXPECT_EQ(mixed_down.triangles, right.triangles);
+
+  // a closed cube with one face (two triangles) reversed: its volume back to 8
+  TriangleMesh box = cube(Vec3::Zero());
+  std::swap(box.triangles[4][1], box.triangles[4][2]);
+  std::swap(box.triangles[5][1], box.triangles[5][2]);
+  EXPECT_EQ(box.orient_consistently(), 2u);
+  EXPECT_EQ(box.triangles, cube(Vec3::Zero()).triangles);
+  EXPECT_NEAR(box.signed_volume_mm3(), 8.0, 1e-12);
+
+  // an edge of three triangles (non-manifold) joins nothing: such a fan is left as it is; a
+  // Moebius strip cannot be wound consistently and settles after one pass
+  TriangleMesh fan;
+  fan.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(0, -1, 0)};
+  fan.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};  // edge 0-1 used three times
+  const TriangleMesh fan_before = fan;
+  EXPECT_EQ(fan.orient_consistently(), 0u);
+  EXPECT_EQ(fan.triangles, fan_before.triangles);
+  TriangleMesh strip;
+  for (int k = 0; k < 8; ++k) {
+    const double a = 2.0 * 3.141592653589793 * k / 8.0, w = 0.3 * std::cos(a / 2.0);
+    strip.vertices.emplace_back(std::cos(a) * (1 + w), std::sin(a) * (1 + w),
+                                0.3 * std::sin(a / 2));
+    strip.vertices.emplace_back(std::cos(a) * (1 - w), std::sin(a) * (1 - w),
+                                -0.3 * std::sin(a / 2));
+  }
+  for (int k = 0; k < 8; ++k) {
+    const int a = 2 * k, b = 2 * k + 1;
+    const int c = k < 7 ? 2 * k + 2 : 1, d = k < 7 ? 2 * k + 3 : 0;  // the half twist
+    strip.triangles.push_back({a, b, c});
+    strip.triangles.push_back({b, d, c});
+  }
+  strip.orient_consistently();
+  EXPECT_EQ(strip.orient_consistently(), 0u);  // settled: a second pass turns nothing
 }
 
 }  // namespace

@@ -270,22 +270,29 @@ TEST_F(ScenarioLoad, GcodeToolpathRelativeToTheScenarioFile) {
 }
 
 // A surface STL wound clockwise seen from above (a patch exported facing down) is turned
-// over: the same hatch as the same patch wound counter-clockwise, tool axes up, and a note
-// that every run reports. The patch: the plane z = 1 + 0.1 x over 10 x 10 mm, two facets.
+// over, and one facet wound against its neighbour turned to match it: the same hatch as the
+// same patch wound counter-clockwise, tool axes up, and a note that every run reports. The
+// patch: the plane z = 1 + 0.1 x over 10 x 10 mm, two facets.
 TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
-  const auto patch = [](bool facing_up) {
+  // each facet up or down
+  const auto patch = [](bool first_up, bool second_up) {
     const char* corners[2][3] = {{"0 0 1", "10 0 2", "10 10 2"}, {"0 0 1", "10 10 2", "0 10 1"}};
     std::string text = "solid patch\n";
-    for (const auto& facet : corners) {
+    for (int f : {0, 1}) {
+      const bool facing_up = f == 0 ? first_up : second_up;
       text += " facet normal 0 0 0\n  outer loop\n";
       for (int k : {0, 1, 2})
-        text += std::string("   vertex ") + facet[facing_up ? k : (3 - k) % 3] + "\n";
+        text += std::string("   vertex ") + corners[f][facing_up ? k : (3 - k) % 3] + "\n";
       text += "  endloop\n endfacet\n";
     }
     return text + "endsolid patch\n";
   };
-  write("up.stl", patch(true));
-  write("down.stl", patch(false));
+  write("up.stl", patch(true, true));
+  write("down.stl", patch(false, false));
+  // one facet each way: turned to match its neighbour (of equal area: the first's winding
+  // kept), then the whole up
+  write("mixed_up.stl", patch(true, false));
+  write("mixed_down.stl", patch(false, true));
   const auto scenario = [&](const std::string& stl) {
     return load_scenario(
         write(stl + ".yaml",
@@ -295,22 +302,32 @@ TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
   };
   const Scenario up = scenario("up.stl");
   const Scenario down = scenario("down.stl");
+  const Scenario mixed_up = scenario("mixed_up.stl");
+  const Scenario mixed_down = scenario("mixed_down.stl");
   EXPECT_TRUE(up.notes.empty());
   ASSERT_EQ(down.notes.size(), 1u);
   EXPECT_EQ(down.notes[0],
             "toolpath.surface: 'down.stl' faced down or inside out (its triangles wound "
             "clockwise seen from outside); its triangles were turned over");
+  const std::string against =
+      "' were wound against their neighbours; they were turned over to match them";
+  ASSERT_EQ(mixed_up.notes.size(), 1u);
+  EXPECT_EQ(mixed_up.notes[0], "toolpath.surface: 1 of 2 triangles of 'mixed_up.stl" + against);
+  ASSERT_EQ(mixed_down.notes.size(), 2u);
+  EXPECT_EQ(mixed_down.notes[0], "toolpath.surface: 1 of 2 triangles of 'mixed_down.stl" + against);
   ASSERT_GT(up.toolpath.paths.size(), 3u);
-  ASSERT_EQ(down.toolpath.paths.size(), up.toolpath.paths.size());
   const Vec3 normal = Vec3(-0.1, 0, 1).normalized();
-  for (size_t p = 0; p < up.toolpath.paths.size(); ++p) {
-    const PrintPath& a = up.toolpath.paths[p];
-    const PrintPath& b = down.toolpath.paths[p];
-    ASSERT_EQ(a.points.size(), b.points.size());
-    for (size_t i = 0; i < a.points.size(); ++i) {
-      EXPECT_EQ(a.points[i], b.points[i]);
-      EXPECT_LT((a.tool_axis(i) - normal).norm(), 1e-9);
-      EXPECT_LT((b.tool_axis(i) - normal).norm(), 1e-9);
+  for (const Scenario* other : {&down, &mixed_up, &mixed_down}) {
+    ASSERT_EQ(other->toolpath.paths.size(), up.toolpath.paths.size());
+    for (size_t p = 0; p < up.toolpath.paths.size(); ++p) {
+      const PrintPath& a = up.toolpath.paths[p];
+      const PrintPath& b = other->toolpath.paths[p];
+      ASSERT_EQ(a.points.size(), b.points.size());
+      for (size_t i = 0; i < a.points.size(); ++i) {
+        EXPECT_EQ(a.points[i], b.points[i]);
+        EXPECT_LT((a.tool_axis(i) - normal).norm(), 1e-9);
+        EXPECT_LT((b.tool_axis(i) - normal).norm(), 1e-9);
+      }
     }
   }
 }
