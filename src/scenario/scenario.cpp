@@ -149,6 +149,7 @@ class Loader {
   bool read_document(YAML::Node& root);
   void read_name(const Field& field);
   void read_machine(const Field& field);
+  void read_machine_value(const Field& field);  // (read_machine less its bookkeeping)
   void read_limits(const Field& field);
   // false when v_max was given but unusable (speed checks on that axis are skipped)
   bool read_axis_limits(const MapView& view, const std::string& section, AxisLimits& axis);
@@ -204,6 +205,9 @@ class Loader {
   // per TCP axis: its v_max is usable, so print speeds are checked against it
   std::array<bool, 3> axis_v_max_known_{true, true, true};
   bool joint_limits_bad_ = false;  // `limits.joint` given but unusable
+  // `machine:` given without a known kinematics family: no machine's checks then (the
+  // default machine's reach would only add errors about a machine the file does not name)
+  bool machine_bad_ = false;
   // the machine named (when known) and its TCP limits per move, for the speed and reach checks
   std::unique_ptr<Machine> machine_;
   // a long segments list read without yaml-cpp (scenario/lifted_list.hpp)
@@ -243,7 +247,7 @@ ScenarioReading Loader::read() {
     check_settings();
   }
   // `arm:` belongs to an arm
-  if (scenario_.arm && scenario_.machine != "arm6")
+  if (scenario_.arm && !machine_bad_ && scenario_.machine != "arm6")
     problems_.add(scenario_.arm_line, "arm",
                   "applies to machine arm6 (a 6-DOF arm), not to " + scenario_.machine);
   if (speed_problems_ > kMaxSpeedProblems)
@@ -310,6 +314,12 @@ void Loader::read_name(const Field& field) {
 
 void Loader::read_machine(const Field& field) {
   scenario_.machine_line = field.line;
+  // (its kinematics family is what the checks need: a missing MJCF file still names one)
+  machine_bad_ = true;
+  read_machine_value(field);
+}
+
+void Loader::read_machine_value(const Field& field) {
   const std::string families = join(machine_names());
   // a registered machine by name
   if (field.node.IsScalar()) {
@@ -317,6 +327,7 @@ void Loader::read_machine(const Field& field) {
     if (!machine) return;
     if (contains(machine_names(), *machine)) {
       scenario_.machine = *machine;
+      machine_bad_ = false;
       return;
     }
     const bool mjcf = fs::path(*machine).extension() == ".xml";
@@ -342,7 +353,7 @@ void Loader::read_machine(const Field& field) {
       problems_.add(f->line, f->key,
                     "unknown kinematics family '" + *family + "' (expected " + families + ")");
     else if (family)
-      scenario_.machine = *family;
+      scenario_.machine = *family, machine_bad_ = false;
   }
   if (const Field* f = view.find("model")) {
     const std::optional<std::string> model = read_string(*f, problems_);
@@ -439,6 +450,7 @@ void Loader::read_limits(const Field& field) {
 }
 
 void Loader::prepare_machine() {
+  if (machine_bad_) return;
   machine_ = make_machine(scenario_.machine);
   if (!machine_) return;
   // joint limits the machine cannot honour (e.g. a jerk limit on the delta's carriages)

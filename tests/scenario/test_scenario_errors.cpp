@@ -532,12 +532,27 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
   expect_problem(
       unknown, scenario_path(), "machine", 1,
       "unknown machine 'scara' (expected xy_stage, linear_delta, arm6, cartesian, or {model:");
+  // a point the default machine (xy_stage) could not reach: no error about that machine
+  const auto unknown_with_z = problems_of(R"(
+machine: delta
+toolpath: {speed: 3, segments: [[[0, 0, 5], [1, 0, 5]]]}
+)");
+  ASSERT_EQ(unknown_with_z.size(), 1u) << dump(unknown_with_z);
+  expect_problem(unknown_with_z, scenario_path(), "machine", 1, "unknown machine 'delta'");
+  // a missing model still names its family, whose reach is checked
   const auto missing = problems_of(R"(
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
 machine: {model: models/none.xml, kinematics: xy_stage}
 )");
   ASSERT_EQ(missing.size(), 1u) << dump(missing);
   expect_problem(missing, scenario_path(), "machine.model", 2,
+                 "MJCF file 'models/none.xml' not found");
+  const auto missing_off_stage = problems_of(R"(
+toolpath: {speed: 3, segments: [[[0, 0, 5], [1, 0, 5]]]}
+machine: {model: models/none.xml, kinematics: xy_stage}
+)");
+  ASSERT_EQ(missing_off_stage.size(), 3u) << dump(missing_off_stage);
+  expect_problem(missing_off_stage, scenario_path(), "machine.model", 2,
                  "MJCF file 'models/none.xml' not found");
 }
 
