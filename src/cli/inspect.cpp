@@ -215,6 +215,10 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
 void inspect_gcode_file(const std::string& path, const GcodeOptions& options,
                         const InspectBaseline& baseline) {
   const GcodeProgram program = read_gcode_program(path, options);
+  // no facts of a file that holds no code: zeros would read as an empty print
+  if (const std::string problem = no_code_problem(program.n_lines, program.n_code_lines);
+      !problem.empty())
+    throw InputError(path, 0, "", problem);
   std::cout << gcode_facts_json(gcode_facts(program, options.rule, baseline)).dump(2) << '\n';
 }
 

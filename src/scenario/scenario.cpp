@@ -863,6 +863,11 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   settings->layer_z_mm = imported.layer_z_mm;
   if (settings->rule == "auto")
     scenario_.notes.push_back("toolpath.gcode: " + imported.rule_reason);
+  if (const std::string no_code = no_code_problem(imported.n_lines, imported.n_code_lines);
+      !no_code.empty()) {
+    problems_.add(field.line, field.key, "G-code file '" + *given + "' " + no_code);
+    return;
+  }
   if (imported.toolpath.paths.empty()) {
     problems_.add(
         field.line, field.key,

@@ -238,6 +238,7 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   if (*p == '$') return;
   // Klipper's extended commands (a name, not a letter and a number): not motion
   if (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_')) return;
+  ++program_.n_code_lines;
   // the first code after an optional line number: Marlin's text commands end here
   const char* q = p;
   if (upper(*q) == 'N') {
@@ -846,8 +847,18 @@ std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule re
   return distinct;
 }
 
+std::string no_code_problem(int n_lines, int n_code_lines) {
+  if (n_code_lines > 0) return "";
+  if (n_lines == 0) return "is empty (no G-code)";
+  return "holds no G-code: " +
+         (n_lines == 1 ? std::string("its one line has no")
+                       : "none of its " + std::to_string(n_lines) + " lines has a") +
+         " G or M code (only comments, blank lines or named commands): is it a G-code file?";
+}
+
 GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions& options) {
   GcodeImport result;
+  result.n_lines = program.n_lines, result.n_code_lines = program.n_code_lines;
   result.rule = resolve_print_rule(program, options.rule, &result.rule_reason);
   result.layer_z_mm = print_layer_levels(program, result.rule);
   const int n_layers = static_cast<int>(result.layer_z_mm.size());

@@ -80,7 +80,14 @@ struct GcodeProgram {
   double dwell_s = 0.0;            // sum of G4 dwells
   std::vector<GcodePause> pauses;  // dwells and E-only moves, in file order
   int n_lines = 0;
+  // lines that hold code (a letter and a number), not only comments, grbl's $ commands or
+  // Klipper's named commands: none in a file that is no G-code (a README, a YAML file)
+  int n_code_lines = 0;
 };
+
+// "holds no G-code: none of its N lines has a G or M code (...)" ("is empty ..." when it has
+// no line), or "" when the file has a line of code (GcodeProgram's n_lines, n_code_lines)
+std::string no_code_problem(int n_lines, int n_code_lines);
 
 // Parse G-code text; `file_label` names the source in messages. Throws InputError listing
 // the first 20 malformed lines ("file:line: toolpath.gcode: ...") and then how many more.
@@ -108,6 +115,7 @@ struct GcodeImport {
   std::vector<double> layer_z_mm;      // z of every layer of the file, ascending
   int first_layer = 0;                 // file layer of toolpath layer 0
   std::optional<Vec3> first_point_mm;  // the first imported print point
+  int n_lines = 0, n_code_lines = 0;   // the program's
 };
 
 // Print paths of a parsed program under the options' rule and layer selection.

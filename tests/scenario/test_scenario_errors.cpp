@@ -391,6 +391,13 @@ TEST_F(ScenarioErrors, GcodeWithoutPrintMoves) {
   const auto problems = problems_of("toolpath: {speed: 3, gcode: {file: travel.gcode, rule: e}}\n");
   ASSERT_EQ(problems.size(), 1u) << dump(problems);
   expect_problem(problems, scenario_path(), "toolpath.gcode", 1, "has no print moves");
+  // a file that is no G-code at all says so
+  write("notes.gcode", "Print these at 30 mm/s.\n; (comment)\n");
+  const auto not_code = problems_of("toolpath: {speed: 3, gcode: {file: notes.gcode}}\n");
+  ASSERT_EQ(not_code.size(), 1u) << dump(not_code);
+  expect_problem(not_code, scenario_path(), "toolpath.gcode", 1,
+                 "G-code file 'notes.gcode' holds no G-code: none of its 2 lines has a G or M "
+                 "code");
 }
 
 TEST_F(ScenarioErrors, BadOutputs) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 
 #include "cli/inspect.hpp"
 #include "core/error.hpp"
@@ -240,6 +241,36 @@ TEST(GcodeFiles, InspectJsonKeys) {
     EXPECT_TRUE(json.contains(key)) << key;
   EXPECT_EQ(json["n_layers"], 1);
   EXPECT_EQ(json["print_bbox"]["min"][0], -10.0);
+}
+
+// a file that holds no code (a README, a YAML file, comments only) gives no facts: inspect
+// refuses it rather than print zeros that read as an empty print
+TEST(GcodeFiles, InspectRefusesAFileWithoutCode) {
+  const auto code_lines = [](const std::string& text) {
+    return parse_gcode_program(text, "x.gcode", GcodeOptions{}).n_code_lines;
+  };
+  EXPECT_EQ(code_lines("name: part\nmachine: cartesian\n"), 0);
+  EXPECT_EQ(code_lines("; comment\n(comment)\n$H\nPRINT_START\n\n"), 0);
+  EXPECT_EQ(code_lines("; comment\nM104 S200\nN10 G1 X1*3\n"), 2);
+  EXPECT_EQ(no_code_problem(3, 0),
+            "holds no G-code: none of its 3 lines has a G or M code (only comments, blank lines "
+            "or named commands): is it a G-code file?");
+  EXPECT_EQ(no_code_problem(1, 0).rfind("holds no G-code: its one line has no G or M code", 0), 0u);
+  EXPECT_EQ(no_code_problem(0, 0), "is empty (no G-code)");
+  EXPECT_EQ(no_code_problem(3, 1), "");
+
+  const std::string path = ::testing::TempDir() + "readme.gcode";
+  std::ofstream(path) << "This folder holds the parts.\nSee the README.\n";
+  try {
+    inspect_gcode_file(path, GcodeOptions{}, InspectBaseline{});
+    FAIL() << "inspect printed facts of a file without code";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.problems().size(), 1u);
+    EXPECT_EQ(e.problems()[0].file, path);
+    EXPECT_NE(e.problems()[0].message.find("none of its 2 lines has a G or M code"),
+              std::string::npos)
+        << e.problems()[0].message;
+  }
 }
 
 }  // namespace
