@@ -26,6 +26,15 @@ const char* const kMaxMemoryHelp =
     "refuse a job estimated to need more memory than this, before any work: bytes or K, M, G, T "
     "(powers of 1024), e.g. 16G (default 8G)";
 
+// a list option given with nothing in it (`--planners ''`): refused, not read as not given
+const CLI::Validator kNamesGiven(
+    [](std::string& value) {
+      return value.find_first_not_of(" \t,") == std::string::npos
+                 ? std::string("is empty: name at least one, or leave the option out")
+                 : std::string();
+    },
+    "NAMES");
+
 void print_problems(const InputError& error) {
   for (const Problem& problem : error.problems()) std::cerr << "error: " << problem.str() << '\n';
 }
@@ -75,7 +84,8 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "plan, simulate, deposit and score a scenario");
   run->add_option("scenario", run_options.scenario, "scenario YAML file")->required();
   run->add_option("--planner", run_options.planners,
-                  "planner(s) to run, comma-separated (default: all of the scenario's)");
+                  "planner(s) to run, comma-separated (default: all of the scenario's)")
+      ->check(kNamesGiven);
   run->add_option("--out", run_options.out, "output directory (default: results/<scenario name>)");
   run->add_flag("--no-render", run_options.no_render, "write no images or plots");
   run->add_flag("--quiet", run_options.quiet, "no progress line");
@@ -94,11 +104,15 @@ int main(int argc, char** argv) {
   CLI::App* compare =
       app.add_subcommand("compare", "run several planners on the same toolpath and compare them");
   compare->add_option("scenario", compare_options.run.scenario, "scenario YAML file")->required();
-  compare->add_option("--planners", compare_options.run.planners,
-                      "planners to compare, comma-separated (default: all of the scenario's)");
-  compare->add_option("--orders", compare_options.orders,
-                      "print orders to compare instead, comma-separated, e.g. "
-                      "as_given,nearest_neighbor,christofides+three_opt");
+  compare
+      ->add_option("--planners", compare_options.run.planners,
+                   "planners to compare, comma-separated (default: all of the scenario's)")
+      ->check(kNamesGiven);
+  compare
+      ->add_option("--orders", compare_options.orders,
+                   "print orders to compare instead, comma-separated, e.g. "
+                   "as_given,nearest_neighbor,christofides+three_opt")
+      ->check(kNamesGiven);
   compare->add_option("--out", compare_options.run.out,
                       "output directory (default: results/<scenario name>)");
   compare->add_flag("--no-render", compare_options.run.no_render, "write no images or plots");
@@ -119,7 +133,8 @@ int main(int argc, char** argv) {
       app.add_subcommand("plan", "plan only (no simulation): trajectory and planned metrics");
   plan->add_option("scenario", plan_options.scenario, "scenario YAML file")->required();
   plan->add_option("--planner", plan_options.planners,
-                   "planner(s), comma-separated (default: all of the scenario's)");
+                   "planner(s), comma-separated (default: all of the scenario's)")
+      ->check(kNamesGiven);
   plan->add_option("--out", plan_options.out,
                    "output directory (default: results/<scenario name>)");
   plan->add_flag("--no-wait", plan_options.no_wait,
@@ -166,8 +181,10 @@ int main(int argc, char** argv) {
   CLI::App* export_gcode = app.add_subcommand(
       "export", "plan a scenario with one planner and write its motion as G-code");
   export_gcode->add_option("scenario", export_options.scenario, "scenario YAML file")->required();
-  export_gcode->add_option("--planner", export_options.planner,
-                           "the planner (run label) to export (default: the scenario's only one)");
+  export_gcode
+      ->add_option("--planner", export_options.planner,
+                   "the planner (run label) to export (default: the scenario's only one)")
+      ->check(kNamesGiven);
   export_gcode->add_option("--out", export_options.out, "the G-code file to write")->required();
   export_gcode
       ->add_option("--tolerance", export_options.settings.chord_tolerance_mm,

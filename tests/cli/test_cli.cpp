@@ -60,6 +60,21 @@ TEST(Cli, UnknownVerbIsNamedWithTheVerbs) {
   EXPECT_EQ(line_after(none.output, "error: a verb is required; verbs are "), verbs);
 }
 
+// a list option given empty is refused (exit 2), never read as "not given" (every planner)
+TEST(Cli, EmptyNameListsAreRefused) {
+  const std::string scenario = scenario_path("thompson_fig7.yaml");
+  for (const std::string& args :
+       {"compare " + scenario + " --planners ''", "compare " + scenario + " --orders ' , '",
+        "run " + scenario + " --planner ''", "plan " + scenario + " --planner ','",
+        "export " + scenario + " --planner '' --out x.gcode"}) {
+    const Result r = depotwin(args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.output;
+    EXPECT_NE(r.output.find("is empty: name at least one, or leave the option out"),
+              std::string::npos)
+        << args << ": " << r.output;
+  }
+}
+
 TEST(Cli, MoveOvershootCase) {
   // v0 = 4 towards a target 0.1 mm ahead: overshoot and come back, 0.282405 s
   const Result r = depotwin("move --q0 0 --q1 0.1 --v0 4 --v1 0 --vmax 4 --amax 30");
