@@ -282,9 +282,10 @@ void BM_RenderRunPlots(benchmark::State& state) {
   input.simulated = &run.simulated;
   input.transitions = plots::transition_intervals(run.plan.trajectory);
   if (!finished.map.thickness_um.empty()) input.thickness = &finished.map;
-  input.profiles = centreline_profiles(run.deposit->normal_field(), finished.job.toolpath);
+  input.profiles = centreline_profiles(*run.deposit, finished.job.toolpath);
   input.target_thickness_um = target_thickness_um(run.deposit->front(), finished.job.toolpath);
   if (run.report.thickness) input.mean_thickness_um = run.report.thickness->mean_um;
+  input.layer_count = run.deposit->layer_count();
   ScratchDirectory scratch;
   size_t images = 0;
   double wall_s = 0.0;

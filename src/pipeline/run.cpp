@@ -49,11 +49,14 @@ DepositionSettings deposition_settings(const Scenario& scenario) {
   return s;
 }
 
-std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
+std::vector<plots::LineProfile> centreline_profiles(const LayeredDeposit& deposit,
                                                     const Toolpath& toolpath) {
   std::vector<plots::LineProfile> profiles;
-  const double step_mm = field.cell_mm();
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
+    // (its layer as the run deposited it: clamped to the deposit's layers)
+    const int layer = std::clamp(toolpath.paths[i].layer, 0, deposit.layer_count() - 1);
+    const ThicknessField& field = deposit.layer_normal_field(layer);
+    const double step_mm = field.cell_mm();
     plots::LineProfile profile;
     profile.path_index = static_cast<int>(i);
     const auto& points = toolpath.paths[i].points;
@@ -251,7 +254,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
       input.simulated = &run.simulated;
       input.transitions = plots::transition_intervals(run.plan.trajectory);
       if (!map.thickness_um.empty()) input.thickness = &map;
-      input.profiles = centreline_profiles(field, job.toolpath);
+      input.profiles = centreline_profiles(*run.deposit, job.toolpath);
       input.target_thickness_um = target_thickness_um(run.deposit->front(), job.toolpath);
       // where that target comes from, said under thickness_profile.png
       const DepositionSettings& process = run.deposit->front().settings();
@@ -262,6 +265,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
           process.type == ProcessType::aerosol ? process.aerosol_flow_mm3_s() : process.flow_mm3_s,
           process.bead_width_mm, process.layer_height_mm);
       if (run.report.thickness) input.mean_thickness_um = run.report.thickness->mean_um;
+      input.layer_count = run.deposit->layer_count();
       // every machine's joints against their limits
       std::vector<bool> revolute;
       for (const JointLimit& limit : job.machine->joint_limits())

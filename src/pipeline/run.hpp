@@ -46,8 +46,10 @@ struct SimulatedRun {
   std::shared_ptr<StateSamples> states;
 };
 
-// thickness along each print path's centreline, sampled every cell length
-std::vector<plots::LineProfile> centreline_profiles(const ThicknessField& field,
+// thickness along each print path's centreline, sampled every cell length, on the deposit of
+// the path's own layer (the layers above and below would add theirs: with several layers,
+// the stack read at a path is no line's profile)
+std::vector<plots::LineProfile> centreline_profiles(const LayeredDeposit& deposit,
                                                     const Toolpath& toolpath);
 // the scenario's deposition settings
 DepositionSettings deposition_settings(const Scenario& scenario);

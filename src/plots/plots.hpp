@@ -64,6 +64,9 @@ struct RunPlotInput {
   // named in a note under thickness_profile.png (<= 0: none); the plot's mean line is the
   // centreline mean, computed from the profiles
   double mean_thickness_um = 0.0;
+  // the job's layers: with several, each profile is its own layer's deposit and
+  // mean_thickness_um is the stack's (both said on the plot)
+  int layer_count = 1;
   double feature_size_mm = 0.0;  // <= 0: feature_size_mm(*toolpath)
   // joints.png (optional): the joints against time, with their ranges
   const JointSeries* joints = nullptr;
@@ -79,7 +82,7 @@ struct RunPlotInput {
 // thickness_profile.png's note on the target: the centreline peak of a straight line at
 // its print speed, with the numbers of the process (aerosol: Q / (v sigma sqrt(2 pi));
 // extrusion: the bead's w x h cross-section as a Gaussian, w h / (sigma sqrt(2 pi)), sigma =
-// w / 4: 1.60 h)
+// w / 4: 1.60 h); short enough for one line under the plot
 std::string target_thickness_note(bool extrusion, double target_um, double speed_mm_s,
                                   double sigma_mm, double flow_mm3_s, double bead_width_mm,
                                   double layer_height_mm);

@@ -34,9 +34,9 @@ std::string target_thickness_note(bool extrusion, double target_um, double speed
                                   double layer_height_mm) {
   if (extrusion && !(flow_mm3_s > 0.0))
     return format(
-        "target %.3g µm: the bead's w × h = %.3g × %.3g mm cross-section as a Gaussian of "
-        "σ = w/4 = %.3g mm: w h / (σ √(2π)) = 1.60 h",
-        target_um, bead_width_mm, layer_height_mm, sigma_mm);
+        "target %.3g µm = w h / (σ √(2π)) = 1.60 h: a w × h = %.3g × %.3g mm bead as a "
+        "Gaussian, σ = w/4",
+        target_um, bead_width_mm, layer_height_mm);
   return format(
       "target %.3g µm: a straight line's centreline peak Q / (v σ √(2π)), Q = %.3g mm³/s, "
       "v = %.3g mm/s, σ = %.3g mm",
@@ -370,7 +370,12 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
   s += "set title " + style::quoted(input.title + ": thickness along the print lines") +
        " font \"" + style::title_font() + "\"\n";
   s += "set xlabel " + style::quoted(style::axis_label("arc length along the line", "mm")) + "\n";
-  s += "set ylabel " + style::quoted(style::axis_label("centreline thickness", "µm")) + "\n";
+  // (several layers: each line on its own layer's deposit, centreline_profiles)
+  s += "set ylabel " +
+       style::quoted(style::axis_label(
+           input.layer_count > 1 ? "centreline thickness, own layer" : "centreline thickness",
+           "µm")) +
+       "\n";
   s += "set lmargin at screen 0.095\nset rmargin at screen 0.97\n";
   s += "set tmargin at screen 0.90\nset bmargin at screen 0.36\n";
   s += "set key at screen 0.5,0.235 center top horizontal maxrows 3 width 1 samplen 3\n";
@@ -389,10 +394,13 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
                         : "target: the centreline peak of a straight line at its print speed "
                           "(Gaussian cross-section)");
   if (input.mean_thickness_um > 0.0)
-    notes.push_back(
-        format("metrics.json thickness.mean_um = %.3g µm is the mean over the lines' "
-               "whole width, not the centreline",
-               input.mean_thickness_um));
+    notes.push_back(input.layer_count > 1
+                        ? format("metrics.json thickness.mean_um = %.3g µm: all %d layers "
+                                 "stacked, over the lines' whole width",
+                                 input.mean_thickness_um, input.layer_count)
+                        : format("metrics.json thickness.mean_um = %.3g µm is the mean over "
+                                 "the lines' whole width, not the centreline",
+                                 input.mean_thickness_um));
   for (size_t i = 0; i < notes.size(); ++i)
     s += format("set label %zu %s at screen 0.5,%.4f center font \",10\" tc rgb \"#404040\"\n",
                 950 + i, style::quoted(notes[i]).c_str(), 0.075 - 0.04 * i);

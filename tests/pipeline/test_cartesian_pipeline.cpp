@@ -102,6 +102,22 @@ TEST_F(CartesianPipeline, LayersStackToTheExtrudedVolume) {
   EXPECT_NEAR(stacked_mm, 3 * 0.309, 0.03);
 }
 
+// thickness_profile.png's lines: each path read on its own layer's deposit, one bead high
+// (0.309 mm at the nearest cell centre, as above), never the stack of three under it
+TEST_F(CartesianPipeline, EachLineProfileIsItsOwnLayersBead) {
+  const std::vector<plots::LineProfile> profiles =
+      centreline_profiles(*run_->deposit, job_->toolpath);
+  ASSERT_EQ(profiles.size(), 3u);
+  for (size_t i = 0; i < profiles.size(); ++i) {
+    const plots::LineProfile& profile = profiles[i];
+    ASSERT_GT(profile.thickness_um.size(), 100u);
+    // an eighth of the 40 mm: the first edge's middle, 5 mm from either corner
+    const double mid_um = profile.thickness_um[profile.thickness_um.size() / 8];
+    EXPECT_GT(mid_um, 0.8 * 309.0) << "path " << i;
+    EXPECT_LT(mid_um, 1.2 * 319.0) << "path " << i;
+  }
+}
+
 // metrics per layer and overall; the gantry follows the plan: its path error is the plan's own
 // (lspb_mtt rounds each 90 degree corner by 0.05 mm at 20 mm/s) plus at most 5 um of tracking
 TEST_F(CartesianPipeline, ScoresEachLayerAndTracksThePath) {

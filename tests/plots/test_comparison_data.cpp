@@ -119,8 +119,8 @@ TEST(ThicknessProfile, TargetNoteSaysWhereTheTargetComesFrom) {
   const std::string extrusion =
       plots::target_thickness_note(true, 319.15, 10.0, 0.1125, 0.0, 0.45, 0.2);
   EXPECT_EQ(extrusion,
-            "target 319 µm: the bead's w × h = 0.45 × 0.2 mm cross-section as a Gaussian of "
-            "σ = w/4 = 0.113 mm: w h / (σ √(2π)) = 1.60 h");
+            "target 319 µm = w h / (σ √(2π)) = 1.60 h: a w × h = 0.45 × 0.2 mm bead as a "
+            "Gaussian, σ = w/4");
   const std::string aerosol = plots::target_thickness_note(false, 2.0, 3.0, 0.1, 1.504, 0, 0);
   EXPECT_EQ(aerosol,
             "target 2 µm: a straight line's centreline peak Q / (v σ √(2π)), Q = 1.5 mm³/s, "
