@@ -205,6 +205,12 @@ class GcodeParser {
   GcodeProgram program_;
 };
 
+// "G41", "G51.1": a G code as written, from its number in tenths
+std::string g_code_name(int tenths) {
+  return "G" + std::to_string(tenths / 10) +
+         (tenths % 10 != 0 ? "." + std::to_string(tenths % 10) : "");
+}
+
 void GcodeParser::problem(int line_number, const std::string& message) {
   ++problem_count_;
   if (problems_.size() < kMaxListedProblems)
@@ -469,10 +475,27 @@ void GcodeParser::execute(int line_number) {
       case 890:
       case 930:
       case 950:
-        problem(line_number, "G" + std::to_string(code.tenths / 10) +
-                                 (code.tenths % 10 ? "." + std::to_string(code.tenths % 10) : "") +
+        problem(line_number, g_code_name(code.tenths) +
                                  " is not supported (splines, canned cycles, threading and "
                                  "inverse-time or per-revolution feed change the path)");
+        return;
+      case 410:
+      case 411:
+      case 420:
+      case 421:
+        problem(line_number, g_code_name(code.tenths) +
+                                 " is not supported: cutter radius compensation offsets the "
+                                 "path by a tool radius the file does not give (export the "
+                                 "toolpath without it, G40)");
+        return;
+      case 160:
+      case 510:
+      case 511:
+      case 680:
+        problem(line_number, g_code_name(code.tenths) +
+                                 " is not supported: polar coordinates, scaling, mirroring and "
+                                 "rotation change every point that follows (export the "
+                                 "toolpath with them applied)");
         return;
       default:
         break;  // other G codes (G29, G54, G64, G94, ...) change no geometry here

@@ -250,6 +250,28 @@ TEST(Gcode, EveryMalformedLineIsReported) {
             "rotary or extra axes would be dropped silently; convert it to 3-axis G-code first");
 }
 
+// codes that move every later point by what the file does not give, or by a transform the
+// reader does not apply, are refused at their line; their cancels (G40, G15, G50.1, G69) pass
+TEST(Gcode, CompensationAndCoordinateTransformsAreRefused) {
+  const auto problems = problems_of(
+      "G21 G90\nG1 X0 Y0 F600\n"
+      "G41 D1\nG42.1 D2\nG16\nG51 X0 Y0 P2\nG51.1 X0\nG68 X0 Y0 R45\n"
+      "G1 X10 E1\n");
+  ASSERT_EQ(problems.size(), 6u) << dump(problems);
+  const char* codes[6] = {"G41", "G42.1", "G16", "G51", "G51.1", "G68"};
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    EXPECT_EQ(problems[i].line, static_cast<int>(i) + 3);
+    EXPECT_EQ(problems[i].message.rfind(std::string(codes[i]) + " is not supported: ", 0), 0u)
+        << problems[i].str();
+  }
+  EXPECT_NE(problems[0].message.find("cutter radius compensation"), std::string::npos);
+  EXPECT_NE(problems[5].message.find("rotation"), std::string::npos);
+  // the cancels change nothing: one 10 mm print move
+  const GcodeImport cancels = parse("G21 G90\nG40\nG15\nG50.1\nG69\nG1 X0 Y0 F600\nG1 X10 E1\n");
+  ASSERT_EQ(cancels.toolpath.paths.size(), 1u);
+  expect_points(cancels.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+}
+
 TEST(Gcode, RotaryAxesAtZeroAreNoMove) {
   // a 5-axis post's output with its rotary axes at 0 (absolute) or not moved (relative): the
   // same path as without them
