@@ -156,6 +156,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   facts.n_retractions = program.n_retractions;
   facts.extrusion_e_total = program.extrusion_e_total;
   facts.feed_rate_time_s = program.dwell_s;
+  facts.ignored_axis_codes = program.ignored_axis_codes;
   bool previous_printed = false;
   Vec3 previous_end = Vec3::Zero();
   // every move: print or travel, its length, boxes and time
@@ -209,6 +210,11 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
       {"planner", "firmware"}, {"mode", facts.baseline_mode}, {"machine", facts.baseline_machine}};
   out["feed_rate_time_s"] = facts.feed_rate_time_s;
   out["n_moves_without_feed"] = facts.n_moves_without_feed;
+  out["ignored_axis_words"] = nlohmann::json::array();
+  for (const IgnoredAxisCode& code : facts.ignored_axis_codes)
+    out["ignored_axis_words"].push_back({{"code", g_code_name(code.tenths)},
+                                         {"n_lines", code.n_lines},
+                                         {"first_line", code.first_line}});
   return out;
 }
 

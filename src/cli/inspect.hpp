@@ -46,6 +46,8 @@ struct GcodeFacts {
   // and counted
   double feed_rate_time_s = 0.0;
   int n_moves_without_feed = 0;
+  // G codes the reader does not know whose axis words it left alone (no move made there)
+  std::vector<IgnoredAxisCode> ignored_axis_codes;
   std::string baseline_machine;  // the machine and firmware mode estimated_time_s assumes
   std::string baseline_mode;
 };

@@ -90,15 +90,61 @@ struct LineWords {
   double get(char letter) const { return value[letter - 'A']; }
 };
 
-// whether text (up to a comment) holds a G word: G, spaces, a digit, after a space or the start
+// whether text (up to a comment) holds a G word: G, spaces, a digit, after a space or the start,
+// in a token of words only (letters, digits, points and signs: `G1X5` is one, Bambu's flag name
+// `g29_before_print_flag` is none)
 bool has_g_word(const char* p, const char* end) {
   for (const char* c = p; c < end && *c != ';' && *c != '(' && *c != '"'; ++c) {
     if (upper(*c) != 'G' || (c > p && !is_space(c[-1]))) continue;
     const char* d = c + 1;
     while (d < end && is_space(*d)) ++d;
-    if (d < end && is_digit(*d)) return true;
+    if (d == end || !is_digit(*d)) continue;
+    const char* token_end = d;
+    while (token_end < end && (is_letter(*token_end) || is_digit(*token_end) || *token_end == '.' ||
+                               *token_end == '+' || *token_end == '-'))
+      ++token_end;
+    if (token_end == end || is_space(*token_end) || *token_end == ';' || *token_end == '(' ||
+        *token_end == '*')
+      return true;
   }
   return false;
+}
+
+// G codes the reader knows as modes that change no geometry here and take no axis words: a
+// line's axis words beside them are a move in the modal motion (RS274/NGC), `G90 X5`
+bool is_modal_setting(int tenths) {
+  switch (tenths) {
+    case 70:  // G7, G8: lathe diameter or radius mode
+    case 80:
+    case 150:  // G15 polar coordinates off
+    case 400:  // G40 cutter compensation off
+    case 430:  // G43 tool length offset (H), G49 off
+    case 490:
+    case 500:  // G50, G50.1: scaling and mirroring off
+    case 501:
+    case 540:  // G54..G59.3 work coordinate systems (read as identity)
+    case 541:
+    case 550:
+    case 560:
+    case 570:
+    case 580:
+    case 590:
+    case 591:
+    case 592:
+    case 593:
+    case 610:  // G61, G61.1, G64: path control
+    case 611:
+    case 640:
+    case 690:  // G69 rotation off
+    case 940:  // G94 feed per minute
+    case 960:  // G96, G97 spindle speed modes
+    case 970:
+    case 980:  // G98, G99 canned-cycle return levels
+    case 990:
+      return true;
+    default:
+      return false;
+  }
 }
 
 // whether the code number at p (after its letter, spaces allowed) is `number`, whole
@@ -189,26 +235,62 @@ class GcodeParser {
   LineWords words_;
 
   // modal state
-  Vec3 position_mm_ = Vec3::Zero();   // machine frame
-  Vec3 offset_mm_ = Vec3::Zero();     // machine = programmed + offset (G92)
-  double extruder_ = 0.0;             // programmed E
-  bool axes_relative_ = false;        // G91
-  bool arc_centre_absolute_ = false;  // G90.1
-  bool extruder_relative_ = false;    // M83
-  double unit_mm_ = 1.0;              // G20: 25.4
-  double feed_mm_s_ = 0.0;            // 0: no F given yet
-  int motion_mode_ = -1;              // last G0..G3, -1: none
-  int plane_ = 17;                    // G17, G18, G19
-  bool open_ = false;                 // the shutter's open code is active
-  bool retracting_ = false;           // the last E change was a decrease
+  Vec3 position_mm_ = Vec3::Zero();      // machine frame
+  Vec3 offset_mm_ = Vec3::Zero();        // machine = programmed + offset (G92)
+  Vec3 saved_offset_mm_ = Vec3::Zero();  // G92.2 suspended these, G92.3 restores them
+  double extruder_ = 0.0;                // programmed E
+  bool axes_relative_ = false;           // G91
+  bool arc_centre_absolute_ = false;     // G90.1
+  bool extruder_relative_ = false;       // M83
+  double unit_mm_ = 1.0;                 // G20: 25.4
+  double feed_mm_s_ = 0.0;               // 0: no F given yet
+  int motion_mode_ = -1;                 // last G0..G3, -1: none
+  int plane_ = 17;                       // G17, G18, G19
+  bool open_ = false;                    // the shutter's open code is active
+  bool retracting_ = false;              // the last E change was a decrease
 
   GcodeProgram program_;
 };
 
-// "G41", "G51.1": a G code as written, from its number in tenths
-std::string g_code_name(int tenths) {
-  return "G" + std::to_string(tenths / 10) +
-         (tenths % 10 != 0 ? "." + std::to_string(tenths % 10) : "");
+// Why a G code the reader refuses would move the path in a way it cannot follow; nullptr for
+// the codes it reads or may ignore
+const char* unsupported_g_code_reason(int tenths) {
+  switch (tenths) {
+    case 50:   // G5 cubic spline
+    case 51:   // G5.1 quadratic spline
+    case 52:   // G5.2 NURBS
+    case 330:  // G33 spindle-synchronised motion
+    case 331:  // G33.1 rigid tapping
+    case 730:  // G73 and G76..G89: canned cycles
+    case 760:
+    case 810:
+    case 820:
+    case 830:
+    case 840:
+    case 850:
+    case 860:
+    case 870:
+    case 880:
+    case 890:
+    case 930:  // G93 inverse-time feed
+    case 950:  // G95 feed per revolution
+      return " is not supported (splines, canned cycles, threading and inverse-time or "
+             "per-revolution feed change the path)";
+    case 410:  // G41, G41.1, G42, G42.1: cutter radius compensation
+    case 411:
+    case 420:
+    case 421:
+      return " is not supported: cutter radius compensation offsets the path by a tool radius "
+             "the file does not give (export the toolpath without it, G40)";
+    case 160:  // G16 polar coordinates
+    case 510:  // G51 scaling
+    case 511:  // G51.1 mirroring
+    case 680:  // G68 rotation
+      return " is not supported: polar coordinates, scaling, mirroring and rotation change "
+             "every point that follows (export the toolpath with them applied)";
+    default:
+      return nullptr;
+  }
 }
 
 void GcodeParser::problem(int line_number, const std::string& message) {
@@ -341,8 +423,16 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
     const bool clean = digits > 0 && (p == end || !(is_digit(*p) || *p == '.'));
     if (!clean ||
         (p < end && !is_space(*p) && !is_letter(*p) && *p != ';' && *p != '(' && *p != '*')) {
+      // a slicer's placeholder left in (`Z{+0.0}`, `S[bed_temperature]`): a template
+      const bool placeholder = std::any_of(word_start, word_end, [](char ch) {
+        return ch == '{' || ch == '[' || ch == '}' || ch == ']';
+      });
       problem(line_number, "malformed word '" + printable(word_start, word_end) + "' (expected " +
-                               std::string(1, letter) + " followed by a number)");
+                               std::string(1, letter) + " followed by a number" +
+                               (placeholder ? "; a slicer's placeholder not filled in: this "
+                                              "looks like a start G-code template, not an "
+                                              "exported print)"
+                                            : ")"));
       return false;
     }
     double value = 0.0;
@@ -394,6 +484,7 @@ void GcodeParser::execute(int line_number) {
   int motion = -1;
   bool uses_axes = false;  // G92, G28, G10, G4, M codes: the axis words belong to the command
   bool dwell = false, set_position = false, home = false;
+  int foreign_code = -1;  // a G code the reader does not know: the axis words are its own
   for (int i = 0; i < words_.n_codes; ++i) {
     const Code code = words_.codes[i];
     const auto is_code = [&](const std::optional<Code>& c) {
@@ -412,6 +503,10 @@ void GcodeParser::execute(int line_number) {
       // M205, M906, ...), never a modal move
       uses_axes = true;
       continue;
+    }
+    if (const char* reason = unsupported_g_code_reason(code.tenths)) {
+      problem(line_number, g_code_name(code.tenths) + reason);
+      return;
     }
     switch (code.tenths) {
       case 0:
@@ -453,52 +548,28 @@ void GcodeParser::execute(int line_number) {
       case 920:
         set_position = uses_axes = true;
         break;
+      case 921:  // G92.1: the G92 offsets cleared
+        offset_mm_ = saved_offset_mm_ = Vec3::Zero();
+        break;
+      case 922:  // G92.2: suspended (G92.3 restores them)
+        saved_offset_mm_ = offset_mm_;
+        offset_mm_ = Vec3::Zero();
+        break;
+      case 923:
+        offset_mm_ = saved_offset_mm_;
+        break;
       case 100:
       case 530:
         uses_axes = true;
         break;  // G10, G53: not moves here
-      case 50:
-      case 51:
-      case 52:
-      case 330:
-      case 331:
-      case 730:
-      case 760:
-      case 810:
-      case 820:
-      case 830:
-      case 840:
-      case 850:
-      case 860:
-      case 870:
-      case 880:
-      case 890:
-      case 930:
-      case 950:
-        problem(line_number, g_code_name(code.tenths) +
-                                 " is not supported (splines, canned cycles, threading and "
-                                 "inverse-time or per-revolution feed change the path)");
-        return;
-      case 410:
-      case 411:
-      case 420:
-      case 421:
-        problem(line_number, g_code_name(code.tenths) +
-                                 " is not supported: cutter radius compensation offsets the "
-                                 "path by a tool radius the file does not give (export the "
-                                 "toolpath without it, G40)");
-        return;
-      case 160:
-      case 510:
-      case 511:
-      case 680:
-        problem(line_number, g_code_name(code.tenths) +
-                                 " is not supported: polar coordinates, scaling, mirroring and "
-                                 "rotation change every point that follows (export the "
-                                 "toolpath with them applied)");
-        return;
       default:
-        break;  // other G codes (G29, G54, G64, G94, ...) change no geometry here
+        // a firmware's own code (Bambu's G380 probe, G29.1 z trim, G38.2 probing, G30, ...):
+        // what its axis words do is unknown here, so they are its parameters, never a move
+        if (!is_modal_setting(code.tenths)) {
+          uses_axes = true;
+          foreign_code = code.tenths;
+        }
+        break;
     }
   }
   if (words_.has('F')) {
@@ -516,6 +587,16 @@ void GcodeParser::execute(int line_number) {
   const bool axis_words = words_.has('X') || words_.has('Y') || words_.has('Z') ||
                           words_.has('E') || words_.has('I') || words_.has('J') ||
                           words_.has('K') || words_.has('R');
+  if (foreign_code >= 0 && motion < 0 && axis_words) {
+    // reported (inspect's ignored_axis_words): the position did not change at this line
+    auto& ignored = program_.ignored_axis_codes;
+    auto it = std::find_if(ignored.begin(), ignored.end(),
+                           [&](const IgnoredAxisCode& c) { return c.tenths == foreign_code; });
+    if (it == ignored.end())
+      ignored.push_back(IgnoredAxisCode{foreign_code, 1, line_number});
+    else
+      ++it->n_lines;
+  }
   if (motion < 0 && !uses_axes && axis_words) {
     if (motion_mode_ < 0) {
       problem(line_number, "axis words without a motion command (G0, G1, G2 or G3)");
@@ -606,6 +687,16 @@ bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, 
     problem(line_number, std::string("an arc needs either R or the centre offsets ") +
                              offset_letters[a0] + "/" + offset_letters[a1] + " (plane " +
                              plane_name + "), not " + (has_offset ? "both" : "neither"));
+    return false;
+  }
+  // P counts the turns in RS274/NGC (LinuxCNC; Bambu's spiral lifts write P1) but the extra
+  // circles in Marlin: one turn is read, more would be a guess
+  if (words_.has('P') && words_.get('P') != 1.0) {
+    problem(line_number, std::string(motion == 3 ? "G3" : "G2") + " P" +
+                             message_number(words_.get('P')) +
+                             ": arcs of more than one turn are not supported (P counts the "
+                             "turns in LinuxCNC, the extra circles in Marlin); write one arc "
+                             "per turn");
     return false;
   }
   // G3 turns positively about the plane's normal, G2 negatively (seen from its + end)
@@ -758,6 +849,11 @@ double print_run_level(const GcodeProgram& program, std::size_t first, std::size
 }
 
 }  // namespace
+
+std::string g_code_name(int tenths) {
+  return "G" + std::to_string(tenths / 10) +
+         (tenths % 10 != 0 ? "." + std::to_string(tenths % 10) : "");
+}
 
 const char* print_rule_name(PrintRule rule) {
   switch (rule) {

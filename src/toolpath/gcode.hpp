@@ -69,6 +69,15 @@ struct GcodePause {
   int line = 0;  // 1-based
 };
 
+// A G code the reader does not know (a firmware's own: Bambu's G380 probe and G29.1 z trim,
+// G38.2 probing, G30) on lines with axis words: those words are the command's parameters, so
+// the position did not change there. `tenths`: G38.2 is 382.
+struct IgnoredAxisCode {
+  int tenths = 0;
+  int n_lines = 0;
+  int first_line = 0;  // 1-based
+};
+
 // Everything a file does, before a print rule is applied.
 struct GcodeProgram {
   std::string file_label;
@@ -83,7 +92,11 @@ struct GcodeProgram {
   // lines that hold code (a letter and a number), not only comments, grbl's $ commands or
   // Klipper's named commands: none in a file that is no G-code (a README, a YAML file)
   int n_code_lines = 0;
+  std::vector<IgnoredAxisCode> ignored_axis_codes;  // in order of first occurrence
 };
+
+// "G41", "G51.1": a G code as written, from its number in tenths (IgnoredAxisCode::tenths)
+std::string g_code_name(int tenths);
 
 // "holds no G-code: none of its N lines has a G or M code (...)" ("is empty ..." when it has
 // no line), or "" when the file has a line of code (GcodeProgram's n_lines, n_code_lines)

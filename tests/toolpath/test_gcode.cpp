@@ -2,6 +2,7 @@
 // modal state (G90/G91, M82/M83, G92, G20/G21, F) is followed, bad lines are reported.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -270,6 +271,73 @@ TEST(Gcode, CompensationAndCoordinateTransformsAreRefused) {
   const GcodeImport cancels = parse("G21 G90\nG40\nG15\nG50.1\nG69\nG1 X0 Y0 F600\nG1 X10 E1\n");
   ASSERT_EQ(cancels.toolpath.paths.size(), 1u);
   expect_points(cancels.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+}
+
+TEST(Gcode, UnknownCodesKeepTheirAxisWords) {
+  // a Bambu Lab print's start: G380 probes (relative), G29.1 sets a z trim, G38.2 probes; none
+  // is a move, so the first print move starts where the last real move ended
+  const std::string text =
+      "G90\nM83\nG1 X5 Y5 Z5 F600\nG91\nG380 S2 Z30 F300\nG380 S2 Z-25 F300\nG90\n"
+      "G29.1 Z0\nG38.2 Z-10 F50\nG1 X10 E1\nG90 X15 E1\n";
+  const GcodeProgram program = parse_gcode_program(text, "bambu.gcode", GcodeOptions{});
+  ASSERT_EQ(program.moves.size(), 3u);
+  EXPECT_EQ(program.moves[1].from_mm, Vec3(5, 5, 5));
+  EXPECT_EQ(program.moves[1].to_mm, Vec3(10, 5, 5));
+  // G90 is a mode: its line's axis words are a move in the modal G1
+  EXPECT_EQ(program.moves[2].to_mm, Vec3(15, 5, 5));
+  ASSERT_EQ(program.ignored_axis_codes.size(), 3u);
+  EXPECT_EQ(g_code_name(program.ignored_axis_codes[0].tenths), "G380");
+  EXPECT_EQ(program.ignored_axis_codes[0].n_lines, 2);
+  EXPECT_EQ(program.ignored_axis_codes[0].first_line, 5);
+  EXPECT_EQ(g_code_name(program.ignored_axis_codes[1].tenths), "G29.1");
+  EXPECT_EQ(program.ignored_axis_codes[1].first_line, 8);
+  EXPECT_EQ(g_code_name(program.ignored_axis_codes[2].tenths), "G38.2");
+  // Bambu's flag names hold "g29" and "g39": text, not G words
+  const GcodeImport flags = parse(
+      "M83\nM1002 judge_flag g29_before_print_flag\nM622 J1\nM1002 judge_flag "
+      "g39_3rd_layer_detect_flag\nG39 S1\nM623\nG1 X0 Y0 F600\nG1 X10 E1\n");
+  ASSERT_EQ(flags.toolpath.paths.size(), 1u);
+  expect_points(flags.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+}
+
+TEST(Gcode, OffsetsAreClearedSuspendedAndRestored) {
+  // G92 X0 at x 10 puts the program's 0 at 10; G92.2 suspends it, G92.3 restores, G92.1 clears
+  const GcodeProgram program =
+      parse_gcode_program("G1 X10 F600\nG92 X0\nG1 X5\nG92.2\nG1 X5\nG92.3\nG1 X1\nG92.1\nG1 X2\n",
+                          "o.nc", GcodeOptions{});
+  ASSERT_EQ(program.moves.size(), 5u);
+  EXPECT_EQ(program.moves[1].to_mm.x(), 15.0);
+  EXPECT_EQ(program.moves[2].to_mm.x(), 5.0);
+  EXPECT_EQ(program.moves[3].to_mm.x(), 11.0);
+  EXPECT_EQ(program.moves[4].to_mm.x(), 2.0);
+  EXPECT_TRUE(program.ignored_axis_codes.empty());
+}
+
+TEST(Gcode, ArcTurnsBeyondOneAreRefused) {
+  // Bambu's spiral lift: a full helical turn, P1 (one turn), the same as without P
+  const GcodeProgram lift = parse_gcode_program(
+      "G1 X0 Y0 Z0 F600\nG17\nG2 Z1 I0.86 J0.86 P1 F20000\n", "b.gcode", GcodeOptions{});
+  const GcodeProgram plain = parse_gcode_program(
+      "G1 X0 Y0 Z0 F600\nG17\nG2 Z1 I0.86 J0.86 F20000\n", "b.gcode", GcodeOptions{});
+  // (the G1 from the origin to it is no move)
+  ASSERT_EQ(lift.moves.size(), 1u);
+  EXPECT_DOUBLE_EQ(lift.moves[0].arc.sweep_rad, 2.0 * kPi);
+  EXPECT_DOUBLE_EQ(lift.moves[0].length_mm, plain.moves[0].length_mm);
+  EXPECT_NEAR(lift.moves[0].length_mm, std::hypot(2.0 * kPi * 0.86 * std::sqrt(2.0), 1.0), 1e-12);
+  // more turns mean different things in LinuxCNC and Marlin: refused at the line
+  const auto problems = problems_of("G1 X0 Y0 F600\nG3 X0 Y0 I5 P2 E1\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 2);
+  EXPECT_EQ(problems[0].message.rfind("G3 P2: arcs of more than one turn", 0), 0u)
+      << problems[0].str();
+}
+
+TEST(Gcode, PlaceholdersAreNamedAsATemplate) {
+  const auto problems = problems_of("G90\nG29.1 Z{+0.0}\nM190 S[bed_temperature]\nG1 X1\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 2);
+  EXPECT_NE(problems[0].message.find("placeholder not filled in"), std::string::npos)
+      << problems[0].str();
 }
 
 TEST(Gcode, RotaryAxesAtZeroAreNoMove) {

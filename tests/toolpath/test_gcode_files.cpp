@@ -41,6 +41,29 @@ TEST(GcodeFiles, SpacesInsideWords) {
   EXPECT_EQ(facts.n_moves_without_feed, 2);
 }
 
+TEST(GcodeFiles, InspectListsIgnoredAxisWords) {
+  // a Bambu Lab start: two G380 probes and a G29.1 z trim whose axis words were not moves,
+  // then a 10 mm line (M83) and a helical lift (G2 P1, a travel)
+  const std::string text =
+      "G90\nM83\nG91\nG380 S2 Z30 F300\nG380 S2 Z-25 F300\nG90\nG29.1 Z0\n"
+      "G1 X0 Y0 Z0.2 F600\nG1 X10 E0.5\nG2 Z1 I0.5 J0 P1\n";
+  const GcodeFacts facts =
+      gcode_facts(parse_gcode_program(text, "bambu.gcode", GcodeOptions{}), PrintRule::automatic);
+  EXPECT_EQ(facts.n_print_moves, 1);
+  EXPECT_DOUBLE_EQ(facts.print_length_mm, 10.0);
+  EXPECT_EQ(facts.n_travel_moves, 2);
+  // the travel from the origin at z 0 (the probes moved nothing) to z 0.2, then the helix
+  EXPECT_NEAR(facts.travel_length_mm, 0.2 + std::hypot(kPi, 0.8), 1e-12);
+  const nlohmann::json json = gcode_facts_json(facts);
+  const nlohmann::json expected = nlohmann::json::parse(
+      R"([{"code": "G380", "n_lines": 2, "first_line": 4},
+          {"code": "G29.1", "n_lines": 1, "first_line": 7}])");
+  EXPECT_EQ(json["ignored_axis_words"], expected) << json["ignored_axis_words"].dump();
+  // a file without such codes lists none
+  EXPECT_EQ(gcode_facts_json(facts_of("arcs.gcode"))["ignored_axis_words"],
+            nlohmann::json::array());
+}
+
 TEST(GcodeFiles, RArcFullCircleAndLongArc) {
   // a quarter of radius 10 (5 pi), a full circle of radius 5 (10 pi), 270 degrees of radius 10
   // (15 pi): one path of 30 pi mm
