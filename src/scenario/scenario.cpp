@@ -257,10 +257,11 @@ ScenarioReading Loader::read() {
                       std::to_string(kMaxSpeedProblems) + " are listed)");
   // what the machine makes of the paths that were read: every pose within its travel or
   // workspace (the arm's reach depends on the roll its posture chooses: prepare_job)
+  // (the keys' lines first: the reach check names them)
+  scenario_.key_lines = problems_.key_lines();
   if (machine_ && scenario_.machine != "arm6")
     for (Problem& problem : unreachable_points(scenario_, *machine_))
       problems_.add_problem(std::move(problem));
-  scenario_.key_lines = problems_.key_lines();
   reading.problems = std::move(problems_.problems());
   // problems under an overridden key belong to the sweep file's override
   if (overrides_ != nullptr) attribute_to_overrides(reading.problems, *overrides_);
@@ -1794,6 +1795,54 @@ Problem path_problem(const Scenario& scenario, int source_index, const std::stri
                  "path " + std::to_string(source_index) + ": " + message};
 }
 
+namespace {
+
+// Where the paths lie against the machine's reach, and the move that brings every path point
+// within it, if centring them on the workspace does: in x and y first (the layers stay on the
+// bed), else in z too. A slicer's file lies in its bed's frame, from 0; the machines here
+// centre on 0 (the middle of every joint's travel).
+std::string reach_summary(const Toolpath& toolpath, const Machine& machine, bool from_gcode) {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const PrintPath& path : toolpath.paths)
+    for (const Vec3& p : path.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  JointVector middle(machine.joint_count());
+  for (int j = 0; j < machine.joint_count(); ++j) {
+    const JointLimit& limit = machine.joint_limits()[static_cast<std::size_t>(j)];
+    middle[j] = 0.5 * (limit.min + limit.max);
+  }
+  const Vec3 centre = machine.forward(middle).position_mm;
+  const auto rounded = [](const Vec3& v) -> Vec3 {
+    return Vec3((v.array() * 10.0).round() / 10.0) + Vec3::Zero();  // (+0: no -0 in messages)
+  };
+  const auto all_reachable = [&](const Vec3& shift) {
+    JointVector joints;
+    for (const PrintPath& path : toolpath.paths)
+      for (std::size_t i = 0; i < path.points.size(); ++i)
+        if (!machine.inverse(Pose(path.points[i] + shift, path.tool_axis(i)), joints)) return false;
+    return true;
+  };
+  const Vec3 to_centre = centre - 0.5 * (lo + hi);
+  const Vec3 in_plane = rounded(Vec3(to_centre.x(), to_centre.y(), 0.0));
+  const Vec3 in_space = rounded(to_centre);
+  const auto range = [](double from, double to) {
+    return from == to ? format_number(from) : format_number(from) + " to " + format_number(to);
+  };
+  const std::string message = "the print paths span x " + range(lo.x(), hi.x()) + ", y " +
+                              range(lo.y(), hi.y()) + ", z " + range(lo.z(), hi.z()) + " mm; ";
+  const Vec3 shifts[2] = {in_plane, in_space};
+  for (const Vec3& shift : shifts)
+    if (all_reachable(shift))
+      return message + "moved by " + format_point(shift) + " mm every point is within " +
+             machine.name() + "'s reach: add that to toolpath.offset (" +
+             (from_gcode ? "a slicer's file lies in its bed's frame, from 0; " : "") +
+             machine.name() + " centres on " + format_point(rounded(centre)) + ")";
+  return message + "even centred on " + machine.name() + "'s workspace (moved by " +
+         format_point(in_space) + " mm) some are out of its reach: the print is larger than " +
+         "the machine, or its shape does not fit the workspace";
+}
+
+}  // namespace
+
 std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine& machine,
                                         std::size_t max_listed) {
   std::vector<Problem> problems;
@@ -1825,16 +1874,26 @@ std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine&
     add(Problem{scenario.file, end_line(scenario.end_line), "toolpath.end",
                 (scenario.end_line > 0 ? "" : "(the default) ") + *why});
   // every point of every path, where it was given
+  bool path_out_of_reach = false;
   for (const PrintPath& path : toolpath.paths)
     for (std::size_t i = 0; i < path.points.size(); ++i)
-      if (const auto why = unreachable(Pose(path.points[i], path.tool_axis(i))))
+      if (const auto why = unreachable(Pose(path.points[i], path.tool_axis(i)))) {
         add(path_point_problem(scenario, path.source_index, i, *why));
+        path_out_of_reach = true;
+      }
   if (unlisted > 0)
     problems.push_back(
         Problem{scenario.file, surface_line > 0 ? surface_line : scenario.toolpath_line,
                 scenario.surface ? "toolpath.surface" : "toolpath",
                 "... and " + std::to_string(unlisted) + " more unreachable points (the first " +
                     std::to_string(max_listed) + " are listed)"});
+  if (path_out_of_reach) {
+    // (at the offset when given, else at the toolpath)
+    const auto offset = scenario.key_lines.find("toolpath.offset");
+    problems.push_back(Problem{
+        scenario.file, offset != scenario.key_lines.end() ? offset->second : scenario.toolpath_line,
+        "toolpath.offset", reach_summary(toolpath, machine, scenario.gcode != nullptr)});
+  }
   return problems;
 }
 

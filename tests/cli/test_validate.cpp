@@ -27,6 +27,10 @@ toolpath:
   EXPECT_EQ(r.status, 2) << r.output;
   const std::string expected =
       "error: " + path + ":1: limits.a_max: expected a number, got 'abc'\n" + "error: " + path +
+      ":2: toolpath.offset: the print paths span x 0 to 70, y 0 to 4, z 0 mm; moved by (-35, -2, "
+      "0) mm every point is within xy_stage's reach: add that to toolpath.offset (xy_stage "
+      "centres on (0, 0, 0))\n" +
+      "error: " + path +
       ":6: toolpath.polylines[0]: segment 0 (points 0 and 1): print speed 5 mm/s needs 5 mm/s "
       "on x, above limits v_max 4 (lower the speed or raise the limit)\n" +
       "error: " + path +

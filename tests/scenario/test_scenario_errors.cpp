@@ -354,6 +354,45 @@ toolpath:
                  "malformed word 'Xabc'");
 }
 
+TEST_F(ScenarioErrors, GcodeInTheBedsFrameIsToldTheOffset) {
+  // a slicer's square in its bed's frame (x 120 to 180, y 100 to 160 mm) on the cartesian
+  // printer, which centres on (0, 0) with x and y in [-100, 100]: the summary names the move
+  // that centres it, and with that offset the scenario is clean
+  write("bed.gcode",
+        "G90\nM83\nG1 X120 Y100 Z0.2 F3000\nG1 X180 Y100 E1 F1800\nG1 X180 Y160 E1\n"
+        "G1 X120 Y160 E1\n");
+  const auto problems = problems_of(R"(
+machine: cartesian
+limits: {v_max: 100, a_max: 1000}
+toolpath:
+  gcode: bed.gcode
+)");
+  ASSERT_FALSE(problems.empty());
+  expect_problem(problems, scenario_path(), "toolpath.offset", 3,
+                 "the print paths span x 120 to 180, y 100 to 160, z 0.2 mm; moved by (-150, "
+                 "-130, 0) mm every point is within cartesian's reach: add that to "
+                 "toolpath.offset (a slicer's file lies in its bed's frame, from 0;");
+  const auto moved = problems_of(R"(
+machine: cartesian
+limits: {v_max: 100, a_max: 1000}
+toolpath:
+  gcode: bed.gcode
+  offset: [-150, -130]
+)");
+  EXPECT_TRUE(moved.empty()) << dump(moved);
+  // given an offset that is not enough, the summary is at its line and counts from it
+  const auto short_move = problems_of(R"(
+machine: cartesian
+limits: {v_max: 100, a_max: 1000}
+toolpath:
+  gcode: bed.gcode
+  offset: [-50, -50]
+)");
+  expect_problem(short_move, scenario_path(), "toolpath.offset", 5,
+                 "the print paths span x 70 to 130, y 50 to 110, z 0.2 mm; moved by (-100, -80, "
+                 "0) mm");
+}
+
 TEST_F(ScenarioErrors, GcodePrintSpeedAboveLimits) {
   // F600 = 10 mm/s along x on line 2, above v_max 4 (feed: error; clamp slows it instead)
   write("fast.gcode", "G1 X1 Y0 E1 F120\nG1 X11 Y0 E2 F600\n");
@@ -558,9 +597,12 @@ machine: {model: models/none.xml, kinematics: xy_stage}
 toolpath: {speed: 3, segments: [[[0, 0, 5], [1, 0, 5]]]}
 machine: {model: models/none.xml, kinematics: xy_stage}
 )");
-  ASSERT_EQ(missing_off_stage.size(), 3u) << dump(missing_off_stage);
+  ASSERT_EQ(missing_off_stage.size(), 4u) << dump(missing_off_stage);
   expect_problem(missing_off_stage, scenario_path(), "machine.model", 2,
                  "MJCF file 'models/none.xml' not found");
+  // the stage has no z: 5 mm down (and 0.5 mm in -x, centred) brings the line onto it
+  expect_problem(missing_off_stage, scenario_path(), "toolpath.offset", 1,
+                 "moved by (-0.5, 0, -5) mm every point is within xy_stage's reach");
 }
 
 // an MJCF model names its kinematics family; it is never guessed from the file

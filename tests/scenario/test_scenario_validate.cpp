@@ -83,7 +83,7 @@ toolpath:
        [60, 0]]
 )");
   const std::string file = scenario_path();
-  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  ASSERT_EQ(problems.size(), 4u) << dump(problems);
   expect_problem(problems, file, "toolpath.start", 4,
                  "(0, 60, 0) mm is not reachable by xy_stage: joint y at -60 mm is outside its "
                  "travel [-50, 50] mm");
@@ -91,6 +91,11 @@ toolpath:
                  "point 1 (60, 0, 0) mm is not reachable by xy_stage");
   // the end defaults to the start: named as the default, at the toolpath's line
   expect_problem(problems, file, "toolpath.end", 2, "(the default) (0, 60, 0) mm");
+  // and where the paths lie: moved 30 mm in -x (their centre onto the stage's), every path
+  // point is within the stage's travel [-50, 50]
+  expect_problem(problems, file, "toolpath.offset", 2,
+                 "the print paths span x 0 to 60, y 0, z 0 mm; moved by (-30, 0, 0) mm every "
+                 "point is within xy_stage's reach: add that to toolpath.offset");
 }
 
 // the loader's problems and the machine's in one list, in line order
@@ -105,13 +110,17 @@ toolpath:
     - [[0, 0], [500, 0]]
 )");
   const std::string file = scenario_path();
-  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  ASSERT_EQ(problems.size(), 4u) << dump(problems);
   expect_problem(problems, file, "limits.joint", 2, "a carriage j_max is not supported");
   expect_problem(problems, file, "sim.kp_scale", 3, "must be in [0.1, 10], got 0");
   expect_problem(problems, file, "toolpath.polylines[0]", 7,
                  "point 1 (500, 0, 0) mm is not reachable by linear_delta");
-  EXPECT_LT(problems[0].line, problems[1].line);
-  EXPECT_LT(problems[1].line, problems[2].line);
+  // 500 mm long: no move brings it within the delta's reach
+  expect_problem(problems, file, "toolpath.offset", 4,
+                 "the print paths span x 0 to 500, y 0, z 0 mm; even centred on linear_delta's "
+                 "workspace (moved by (-250, 0, 37.5) mm) some are out of its reach");
+  for (std::size_t i = 1; i < problems.size(); ++i)
+    EXPECT_LE(problems[i - 1].line, problems[i].line);
 }
 
 // a print speed within the user's limits but above what the delta's carriages allow over the
