@@ -484,7 +484,7 @@ void GcodeParser::execute(int line_number) {
   int motion = -1;
   bool uses_axes = false;  // G92, G28, G10, G4, M codes: the axis words belong to the command
   bool dwell = false, set_position = false, home = false;
-  int foreign_code = -1;  // a G code the reader does not know: the axis words are its own
+  int foreign_code = -1;  // a G code whose axis words are its own (unknown here, Prusa G80)
   for (int i = 0; i < words_.n_codes; ++i) {
     const Code code = words_.codes[i];
     const auto is_code = [&](const std::optional<Code>& c) {
@@ -535,7 +535,11 @@ void GcodeParser::execute(int line_number) {
         home = uses_axes = true;
         break;
       case 800:
+        // the canned cycle cancelled (RS274/NGC), or Prusa's mesh bed levelling, whose axis
+        // words name its area (`G80 X32.5 Y40.2 W150 H120`): never a move
         motion_mode_ = -1;
+        uses_axes = true;
+        foreign_code = code.tenths;
         break;
       case 900:
       case 910:

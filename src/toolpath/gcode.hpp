@@ -70,8 +70,9 @@ struct GcodePause {
 };
 
 // A G code the reader does not know (a firmware's own: Bambu's G380 probe and G29.1 z trim,
-// G38.2 probing, G30) on lines with axis words: those words are the command's parameters, so
-// the position did not change there. `tenths`: G38.2 is 382.
+// G38.2 probing, G30), or Prusa's G80 mesh levelling with its area, on lines with axis words:
+// those words are the command's parameters, so the position did not change there. `tenths`:
+// G38.2 is 382.
 struct IgnoredAxisCode {
   int tenths = 0;
   int n_lines = 0;

@@ -292,6 +292,17 @@ TEST(Gcode, UnknownCodesKeepTheirAxisWords) {
   EXPECT_EQ(g_code_name(program.ignored_axis_codes[1].tenths), "G29.1");
   EXPECT_EQ(program.ignored_axis_codes[1].first_line, 8);
   EXPECT_EQ(g_code_name(program.ignored_axis_codes[2].tenths), "G38.2");
+  // PrusaSlicer's MK3S start: G80 levels the mesh over the first layer's area, never a move
+  const GcodeProgram prusa = parse_gcode_program(
+      "M83\nG28 W\nG80 X32.5 Y40.2 W150 H120 ; mesh bed levelling\nG1 Y-3.0 F1000.0\n"
+      "G92 E0.0\nG1 X60.0 E9.0 F1000.0\n",
+      "mk3s.gcode", GcodeOptions{});
+  ASSERT_EQ(prusa.moves.size(), 2u);
+  EXPECT_EQ(prusa.moves[0].from_mm, Vec3(0, 0, 0));
+  EXPECT_EQ(prusa.moves[1].to_mm, Vec3(60, -3, 0));
+  ASSERT_EQ(prusa.ignored_axis_codes.size(), 1u);
+  EXPECT_EQ(g_code_name(prusa.ignored_axis_codes[0].tenths), "G80");
+  EXPECT_EQ(prusa.ignored_axis_codes[0].first_line, 3);
   // Bambu's flag names hold "g29" and "g39": text, not G words
   const GcodeImport flags = parse(
       "M83\nM1002 judge_flag g29_before_print_flag\nM622 J1\nM1002 judge_flag "
