@@ -122,16 +122,7 @@ bool is_modal_setting(int tenths) {
     case 490:
     case 500:  // G50, G50.1: scaling and mirroring off
     case 501:
-    case 540:  // G54..G59.3 work coordinate systems (read as identity)
-    case 541:
-    case 550:
-    case 560:
-    case 570:
-    case 580:
-    case 590:
-    case 591:
-    case 592:
-    case 593:
+    case 541:  // G54.1 P: Fanuc's extended work systems (offsets not in the file)
     case 610:  // G61, G61.1, G64: path control
     case 611:
     case 640:
@@ -207,6 +198,7 @@ class GcodeParser {
   GcodeParser(std::string file_label, const GcodeOptions& options)
       : open_code_(code_of(options.open_code)), close_code_(code_of(options.close_code)) {
     program_.file_label = std::move(file_label);
+    work_offset_mm_.fill(Vec3::Zero());
   }
 
   void line(const char* begin, const char* end, int line_number);
@@ -225,7 +217,11 @@ class GcodeParser {
   void move(int motion, int line_number);
   bool arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc);
   void set_position();
+  // G10 L2 / L20: a work system's offsets; false (and a problem) when malformed
+  bool set_work_offsets(int line_number);
   void home();
+  // machine = programmed + this (the active work system's offsets and G92's)
+  Vec3 frame_offset() const { return work_offset_mm_[work_system_] + offset_mm_; }
   void extrude(double delta);
 
   std::optional<Code> open_code_;
@@ -235,8 +231,12 @@ class GcodeParser {
   LineWords words_;
 
   // modal state
-  Vec3 position_mm_ = Vec3::Zero();      // machine frame
-  Vec3 offset_mm_ = Vec3::Zero();        // machine = programmed + offset (G92)
+  Vec3 position_mm_ = Vec3::Zero();  // machine frame
+  Vec3 offset_mm_ = Vec3::Zero();    // machine = programmed + work offset + offset (G92)
+  // work coordinate systems 1-9 (G54..G59.3), as G10 L2/L20 set them; the controller's own,
+  // which the file does not give, are read as 0 (index 0 unused)
+  std::array<Vec3, 10> work_offset_mm_{};
+  int work_system_ = 1;                  // G54
   Vec3 saved_offset_mm_ = Vec3::Zero();  // G92.2 suspended these, G92.3 restores them
   double extruder_ = 0.0;                // programmed E
   bool axes_relative_ = false;           // G91
@@ -247,6 +247,7 @@ class GcodeParser {
   int motion_mode_ = -1;                 // last G0..G3, -1: none
   int plane_ = 17;                       // G17, G18, G19
   bool open_ = false;                    // the shutter's open code is active
+  bool machine_frame_ = false;           // this line's G53
   bool retracting_ = false;              // the last E change was a decrease
 
   GcodeProgram program_;
@@ -389,7 +390,10 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
     const char* word_start = p;
     ++p;
     while (p < end && is_space(*p)) ++p;  // spaces inside a word: `Z  15.000`
-    // the number: sign, digits and one point, a lowercase exponent glued to it
+    // the number: sign, digits and one point, a lowercase exponent glued to it (`X1e-05`,
+    // from a script's floats); after a lowercase letter an `e` is the next word (`y0e1`: a
+    // file written in lowercase, Y 0 and E 1)
+    const bool lowercase_word = c >= 'a' && c <= 'z';
     const char* number_start = p;
     if (p < end && (*p == '+' || *p == '-')) ++p;
     const char* mantissa = p;
@@ -400,7 +404,7 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
       digits += is_digit(*p) ? 1 : 0;
       ++p;
     }
-    if (digits > 0 && p + 1 < end && *p == 'e' &&
+    if (digits > 0 && !lowercase_word && p + 1 < end && *p == 'e' &&
         (is_digit(p[1]) || ((p[1] == '+' || p[1] == '-') && p + 2 < end && is_digit(p[2])))) {
       p += 2;
       while (p < end && is_digit(*p)) ++p;
@@ -482,8 +486,9 @@ void GcodeParser::execute(int line_number) {
   }
   // G/M codes: check, then modes before motion
   int motion = -1;
+  machine_frame_ = false;
   bool uses_axes = false;  // G92, G28, G10, G4, M codes: the axis words belong to the command
-  bool dwell = false, set_position = false, home = false;
+  bool dwell = false, set_position = false, home = false, work_offsets = false;
   int foreign_code = -1;  // a G code whose axis words are its own (unknown here, Prusa G80)
   for (int i = 0; i < words_.n_codes; ++i) {
     const Code code = words_.codes[i];
@@ -562,10 +567,32 @@ void GcodeParser::execute(int line_number) {
       case 923:
         offset_mm_ = saved_offset_mm_;
         break;
-      case 100:
-      case 530:
+      case 100: {
+        // G10 L2 / L20 set a work system's offsets (RS274/NGC, grbl, RepRapFirmware); other
+        // G10s' axis words are tool offsets or tool-table entries (RepRapFirmware's G10 P0
+        // X..): listed as ignored, never a move (Marlin's bare G10 retracts)
         uses_axes = true;
-        break;  // G10, G53: not moves here
+        const double l_word = words_.has('L') ? words_.get('L') : -1.0;
+        if (l_word == 2.0 || l_word == 20.0)
+          work_offsets = true;
+        else
+          foreign_code = code.tenths;
+        break;
+      }
+      case 530:  // G53: this line's axis words in the machine frame
+        machine_frame_ = true;
+        break;
+      case 540:  // G54..G59, G59.1..G59.3: work systems 1-9
+      case 550:
+      case 560:
+      case 570:
+      case 580:
+      case 590:
+      case 591:
+      case 592:
+      case 593:
+        work_system_ = code.tenths < 590 ? (code.tenths - 540) / 10 + 1 : code.tenths - 584;
+        break;
       default:
         // a firmware's own code (Bambu's G380 probe, G29.1 z trim, G38.2 probing, G30, ...):
         // what its axis words do is unknown here, so they are its parameters, never a move
@@ -587,6 +614,7 @@ void GcodeParser::execute(int line_number) {
     program_.pauses.push_back(GcodePause{program_.moves.size(), dwell_s, line_number});
   }
   if (set_position) this->set_position();
+  if (work_offsets && !set_work_offsets(line_number)) return;
   if (home) this->home();
   const bool axis_words = words_.has('X') || words_.has('Y') || words_.has('Z') ||
                           words_.has('E') || words_.has('I') || words_.has('J') ||
@@ -633,13 +661,21 @@ void GcodeParser::move(int motion, int line_number) {
                              "convert it to 3-axis G-code first");
     return;
   }
+  if (machine_frame_ && motion >= 2) {
+    problem(line_number, "G53 (the machine frame) with an arc: only G0 and G1 move there");
+    return;
+  }
   // target position and extrusion of this move
   Vec3 target_mm = position_mm_;
   for (int axis = 0; axis < 3; ++axis) {
     const char letter = static_cast<char>('X' + axis);
     if (!words_.has(letter)) continue;
     const double value = words_.get(letter) * unit_mm_;
-    target_mm[axis] = axes_relative_ ? target_mm[axis] + value : value + offset_mm_[axis];
+    // G53: the machine frame, absolute (RS274/NGC, grbl)
+    if (machine_frame_)
+      target_mm[axis] = value;
+    else
+      target_mm[axis] = axes_relative_ ? target_mm[axis] + value : value + frame_offset()[axis];
   }
   double e_delta = 0.0;
   if (words_.has('E')) {
@@ -717,8 +753,8 @@ bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, 
         words_.has(offset_letters[a0]) ? words_.get(offset_letters[a0]) * unit_mm_ : 0.0;
     const double i1 =
         words_.has(offset_letters[a1]) ? words_.get(offset_letters[a1]) * unit_mm_ : 0.0;
-    c0 = arc_centre_absolute_ ? i0 + offset_mm_[a0] : s0 + i0;
-    c1 = arc_centre_absolute_ ? i1 + offset_mm_[a1] : s1 + i1;
+    c0 = arc_centre_absolute_ ? i0 + frame_offset()[a0] : s0 + i0;
+    c1 = arc_centre_absolute_ ? i1 + frame_offset()[a1] : s1 + i1;
     const double r_start = std::hypot(s0 - c0, s1 - c1);
     const double r_end = std::hypot(e0 - c0, e1 - c1);
     if (r_start <= kMinMove_mm) {
@@ -785,12 +821,43 @@ void GcodeParser::set_position() {
   for (int axis = 0; axis < 3; ++axis) {
     const char letter = static_cast<char>('X' + axis);
     if (words_.has(letter))
-      offset_mm_[axis] = position_mm_[axis] - words_.get(letter) * unit_mm_;
+      offset_mm_[axis] =
+          position_mm_[axis] - work_offset_mm_[work_system_][axis] - words_.get(letter) * unit_mm_;
     else if (!any)
-      offset_mm_[axis] = position_mm_[axis];
+      offset_mm_[axis] = position_mm_[axis] - work_offset_mm_[work_system_][axis];
   }
   if (words_.has('E')) extruder_ = words_.get('E') * unit_mm_;
   if (!any) extruder_ = 0.0;
+}
+
+bool GcodeParser::set_work_offsets(int line_number) {
+  // P names the system: 1-9 for G54..G59.3, 0 the active one
+  const bool l20 = words_.get('L') == 20.0;
+  const std::string command = l20 ? "G10 L20" : "G10 L2";
+  const double p_word = words_.has('P') ? words_.get('P') : -1.0;
+  if (!(p_word >= 0.0 && p_word <= 9.0 && p_word == std::floor(p_word))) {
+    problem(line_number, command +
+                             " needs P0-P9 (the work system: 1-9 for G54..G59.3, 0 the "
+                             "active one)" +
+                             (words_.has('P') ? ", not P" + message_number(p_word) : ""));
+    return false;
+  }
+  if (words_.has('R') && words_.get('R') != 0.0) {
+    problem(line_number, command + " R" + message_number(words_.get('R')) +
+                             " is not supported: a rotated work system changes every point "
+                             "that follows (export the toolpath with it applied)");
+    return false;
+  }
+  const int system = p_word == 0.0 ? work_system_ : static_cast<int>(p_word);
+  for (int axis = 0; axis < 3; ++axis) {
+    const char letter = static_cast<char>('X' + axis);
+    if (!words_.has(letter)) continue;
+    const double value = words_.get(letter) * unit_mm_;
+    // L2: the offset itself; L20: the one that makes the present position read `value`
+    // (G92's offsets on top, as before). G91 changes neither.
+    work_offset_mm_[system][axis] = l20 ? position_mm_[axis] - offset_mm_[axis] - value : value;
+  }
+  return true;
 }
 
 void GcodeParser::home() {

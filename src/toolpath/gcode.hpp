@@ -3,11 +3,13 @@
 // Read: G0/G1, G2/G3 arcs (I/J/K offsets or R, R < 0 the long way; a full circle when an
 // I/J/K arc ends where it starts; helical: the third axis moves linearly) in the G17/G18/G19
 // planes, G90/G91 (and G90.1/G91.1 for arc centres), M82/M83, G92, G20/G21, G28, G4 dwell
-// (P milliseconds, S seconds, as Marlin and Klipper), F (modal, per minute), E. Several G/M
+// (P milliseconds, S seconds, as Marlin and Klipper), F (modal, per minute), E, work systems
+// (G54..G59.3 select, G10 L2/L20 set, G53 one line in the machine frame). Several G/M
 // words may share a line (G17 G21 G90) and run in RS274/NGC order (F, M, modes, motion);
 // axis words without a G word use the last motion mode. Spaces inside words are allowed
-// (`G0 Z  15.000`), numbers as `Z.2` or `E-.8`, a lowercase exponent (`1e3`; `1E3` is X1
-// then E3, as firmware reads compact lines). Comments `;...` and `(...)`, N words and
+// (`G0 Z  15.000`), numbers as `Z.2` or `E-.8`, a lowercase exponent after a capital letter
+// (`X1e3`; `X1E3` is X1 then E3, as firmware reads compact lines, and so is `x1e3` in a
+// lowercase file). Comments `;...` and `(...)`, N words and
 // `*checksums` are skipped, as are Klipper's extended commands (`PRINT_START ...`), the text
 // commands (M117, M118, M23, ...) and every other G or M code, except the ones that would
 // change the geometry and are not supported (G5 splines, canned cycles G73/G76/G81-G89,

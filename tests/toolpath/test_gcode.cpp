@@ -324,6 +324,53 @@ TEST(Gcode, OffsetsAreClearedSuspendedAndRestored) {
   EXPECT_TRUE(program.ignored_axis_codes.empty());
 }
 
+TEST(Gcode, WorkSystemsAreSetSelectedAndBypassed) {
+  // G10 L2 sets G54's offset to (100, 50); L20 at machine (120, 50) makes it read (0, 0);
+  // G55 (system 2, offset -7 in x), G53 the machine frame for one line, G59.3 is system 9
+  const GcodeProgram program = parse_gcode_program(
+      "G10 L2 P1 X100 Y50\nG54 G1 X0 Y0 F600\nG1 X20\nG10 L20 P0 X0 Y0\nG1 X5 Y5\n"
+      "G10 L2 P2 X-7\nG55 G0 X0 Y0\nG53 X3 Y4\nG1 X1\nG91 G10 L2 P9 Z2\nG59.3 G90 Z1\n"
+      "G92 Z0\nG1 Z1\n",
+      "w.ngc", GcodeOptions{});
+  // the moves' ends in the machine frame; the last: G92 Z0 at machine z 3 in system 9
+  // (offset 2) puts G92's offset at 1, so Z1 is 1 + 2 + 1
+  const std::vector<Vec3> expected = {{100, 50, 0}, {120, 50, 0}, {125, 55, 0}, {-7, 0, 0},
+                                      {3, 4, 0},    {-6, 4, 0},   {-6, 4, 3},   {-6, 4, 4}};
+  ASSERT_EQ(program.moves.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    EXPECT_EQ(program.moves[i].to_mm, expected[i])
+        << i << ": " << program.moves[i].to_mm.transpose();
+  EXPECT_TRUE(program.ignored_axis_codes.empty());
+}
+
+TEST(Gcode, ToolOffsetsAndBadWorkSystemsAreNamed) {
+  // RepRapFirmware's G10 P1 X3 (a tool's offsets): listed, never a move
+  const GcodeProgram tool =
+      parse_gcode_program("G1 X1 F600\nG10 P1 X3 Y4\nG1 X2\n", "t.gcode", GcodeOptions{});
+  ASSERT_EQ(tool.ignored_axis_codes.size(), 1u);
+  EXPECT_EQ(g_code_name(tool.ignored_axis_codes[0].tenths), "G10");
+  EXPECT_EQ(tool.moves.back().to_mm, Vec3(2, 0, 0));
+  const auto problems =
+      problems_of("G10 L2 X1\nG10 L20 P12 X1\nG10 L2 P1 R30 X1\nG1 X1 F60\nG53 G2 X2 R1\n");
+  ASSERT_EQ(problems.size(), 4u) << dump(problems);
+  EXPECT_EQ(problems[0].message.rfind("G10 L2 needs P0-P9", 0), 0u) << problems[0].str();
+  EXPECT_NE(problems[1].message.find("not P12"), std::string::npos) << problems[1].str();
+  EXPECT_EQ(problems[2].message.rfind("G10 L2 R30 is not supported", 0), 0u) << problems[2].str();
+  EXPECT_EQ(problems[3].line, 5);
+}
+
+TEST(Gcode, LowercaseFilesReadEAsAWord) {
+  // `y0e1`: Y 0 then E 1 in a file written in lowercase; `X1e-05` keeps its exponent
+  const GcodeProgram lower =
+      parse_gcode_program("g90\nm83\ng1x10y0e1f1200\n", "l.gcode", GcodeOptions{});
+  ASSERT_EQ(lower.moves.size(), 1u);
+  EXPECT_EQ(lower.moves[0].e_delta, 1.0);
+  EXPECT_EQ(lower.moves[0].to_mm, Vec3(10, 0, 0));
+  const GcodeProgram script = parse_gcode_program("G1 X1e-05 Y2 F60\n", "s.gcode", GcodeOptions{});
+  ASSERT_EQ(script.moves.size(), 1u);
+  EXPECT_EQ(script.moves[0].to_mm.x(), 1e-05);
+}
+
 TEST(Gcode, ArcTurnsBeyondOneAreRefused) {
   // Bambu's spiral lift: a full helical turn, P1 (one turn), the same as without P
   const GcodeProgram lift = parse_gcode_program(
