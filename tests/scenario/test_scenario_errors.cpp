@@ -361,33 +361,23 @@ TEST_F(ScenarioErrors, GcodeInTheBedsFrameIsToldTheOffset) {
   write("bed.gcode",
         "G90\nM83\nG1 X120 Y100 Z0.2 F3000\nG1 X180 Y100 E1 F1800\nG1 X180 Y160 E1\n"
         "G1 X120 Y160 E1\n");
-  const auto problems = problems_of(R"(
-machine: cartesian
-limits: {v_max: 100, a_max: 1000}
-toolpath:
-  gcode: bed.gcode
-)");
+  // the scenario with a toolpath line after `gcode:` (an offset, or nothing)
+  const auto problems_with = [&](const std::string& offset_line) {
+    return problems_of(
+        "machine: cartesian\nlimits: {v_max: 100, a_max: 1000}\ntoolpath:\n"
+        "  gcode: bed.gcode\n" +
+        offset_line);
+  };
+  const auto problems = problems_with("");
   ASSERT_FALSE(problems.empty());
   expect_problem(problems, scenario_path(), "toolpath.offset", 3,
                  "the print paths span x 120 to 180, y 100 to 160, z 0.2 mm; moved by (-150, "
                  "-130, 0) mm every point is within cartesian's reach: add that to "
                  "toolpath.offset (a slicer's file lies in its bed's frame, from 0;");
-  const auto moved = problems_of(R"(
-machine: cartesian
-limits: {v_max: 100, a_max: 1000}
-toolpath:
-  gcode: bed.gcode
-  offset: [-150, -130]
-)");
+  const auto moved = problems_with("  offset: [-150, -130]\n");
   EXPECT_TRUE(moved.empty()) << dump(moved);
   // given an offset that is not enough, the summary is at its line and counts from it
-  const auto short_move = problems_of(R"(
-machine: cartesian
-limits: {v_max: 100, a_max: 1000}
-toolpath:
-  gcode: bed.gcode
-  offset: [-50, -50]
-)");
+  const auto short_move = problems_with("  offset: [-50, -50]\n");
   expect_problem(short_move, scenario_path(), "toolpath.offset", 5,
                  "the print paths span x 70 to 130, y 50 to 110, z 0.2 mm; moved by (-100, -80, "
                  "0) mm");
