@@ -654,11 +654,17 @@ void GcodeParser::move(int motion, int line_number) {
   // second carriage cannot be followed by reading X Y Z alone (0, or no move in G91, is fine)
   for (const char letter : {'A', 'B', 'C', 'U', 'V', 'W'}) {
     if (!words_.has(letter) || words_.get(letter) == 0.0) continue;
-    problem(line_number, std::string("axis word ") + letter + " (" +
-                             message_number(words_.get(letter)) +
-                             ") on a move: only X, Y, Z and E are read, so a multi-axis "
-                             "file's rotary or extra axes would be dropped silently; "
-                             "convert it to 3-axis G-code first");
+    problem(
+        line_number,
+        std::string("axis word ") + letter + " (" + message_number(words_.get(letter)) +
+            ") on a move: only X, Y, Z and E are read, so a multi-axis "
+            "file's rotary or extra axes would be dropped silently; "
+            "convert it to 3-axis G-code first" +
+            // MakerBot/Sailfish files name their extruders A and B
+            (letter == 'A' || letter == 'B' ? std::string(" (or, if ") + letter +
+                                                  " is a MakerBot-flavour extruder, export with "
+                                                  "RepRap/Marlin flavour: E)"
+                                            : std::string()));
     return;
   }
   if (machine_frame_ && motion >= 2) {

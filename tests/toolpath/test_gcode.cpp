@@ -248,7 +248,8 @@ TEST(Gcode, EveryMalformedLineIsReported) {
   EXPECT_NE(problems[9].message.find("G81 is not supported"), std::string::npos);
   EXPECT_EQ(problems[10].message,
             "axis word A (30) on a move: only X, Y, Z and E are read, so a multi-axis file's "
-            "rotary or extra axes would be dropped silently; convert it to 3-axis G-code first");
+            "rotary or extra axes would be dropped silently; convert it to 3-axis G-code first "
+            "(or, if A is a MakerBot-flavour extruder, export with RepRap/Marlin flavour: E)");
 }
 
 // codes that move every later point by what the file does not give, or by a transform the
