@@ -285,7 +285,8 @@ std::vector<SchemaSection> make_schema() {
          "a G-code file (RS274/NGC, RepRap/Marlin/Klipper) and how its moves print",
          {other("file", "text", "", "required", "the G-code file, relative to the scenario"),
           word("rule", {"auto", "e", "shutter", "feed"}, gcode.rule,
-               "what prints: e (E increases), shutter (G1-G3 while `open` is active), feed "
+               "what prints: e (E increases), shutter (G1-G3 while `open` is active and the "
+               "modal S, a laser's power, is not 0), feed "
                "(G1-G3 print, G0 travels); auto: e if the file has E, else shutter if it has "
                "the codes, else feed (metrics.json's warnings say which)"),
           other("open", "text", "", gcode.open_code, "the shutter rule's open code (e.g. M106)"),

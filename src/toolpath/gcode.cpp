@@ -247,6 +247,7 @@ class GcodeParser {
   int motion_mode_ = -1;                 // last G0..G3, -1: none
   int plane_ = 17;                       // G17, G18, G19
   bool open_ = false;                    // the shutter's open code is active
+  bool power_off_ = false;               // the modal S is 0 (a laser's or spindle's power)
   bool machine_frame_ = false;           // this line's G53
   bool retracting_ = false;              // the last E change was a decrease
 
@@ -490,13 +491,14 @@ void GcodeParser::execute(int line_number) {
   bool uses_axes = false;  // G92, G28, G10, G4, M codes: the axis words belong to the command
   bool dwell = false, set_position = false, home = false, work_offsets = false;
   int foreign_code = -1;  // a G code whose axis words are its own (unknown here, Prusa G80)
+  bool opens = false;     // the line holds the open code
   for (int i = 0; i < words_.n_codes; ++i) {
     const Code code = words_.codes[i];
     const auto is_code = [&](const std::optional<Code>& c) {
       return c && c->letter == code.letter && c->tenths == code.tenths;
     };
     if (is_code(open_code_)) {
-      open_ = true;
+      open_ = opens = true;
       program_.has_shutter_codes = true;
     } else if (is_code(close_code_)) {
       open_ = false;
@@ -636,6 +638,10 @@ void GcodeParser::execute(int line_number) {
     }
     motion = motion_mode_;
   }
+  // S on a move, on the open code or alone: the power, modal (grbl's laser `G1 X5 S0`, `M4
+  // S0`: open and off); S elsewhere is a temperature, a dwell or a setting
+  if (words_.has('S') && (opens || motion >= 0 || words_.n_codes == 0))
+    power_off_ = words_.get('S') <= 0.0;
   if (motion >= 0) {
     motion_mode_ = motion;
     move(motion, line_number);
@@ -711,7 +717,7 @@ void GcodeParser::move(int motion, int line_number) {
   record.e_delta = e_delta;
   record.feed_mm_s = feed_mm_s_;
   record.has_e = words_.has('E');
-  record.open = open_;
+  record.open = open_ && !power_off_;
   position_mm_ = target_mm;
   if (record.length_mm > kMinMove_mm)
     program_.moves.push_back(record);

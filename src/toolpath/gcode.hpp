@@ -16,8 +16,9 @@
 // G93/G95 feed modes, G33 threading), which are errors.
 //
 // Print rules decide which moves deposit: `e` (E increases), `shutter` (G1/G2/G3 while the
-// open code is active), `feed` (G1/G2/G3 print, G0 travels) and `auto` (E values: e; else the
-// open or close code present: shutter; else feed). Consecutive print moves at one feed rate
+// open code is active and the modal S, a laser's or spindle's power, is not 0), `feed`
+// (G1/G2/G3 print, G0 travels) and `auto` (E values: e; else the open or close code present:
+// shutter; else feed). Consecutive print moves at one feed rate
 // form one print path; arcs stay exact (PrintPath::arcs) until a planner chords them.
 // A path's layer is the z of the first point of its uninterrupted print run; layers are
 // numbered 0, 1, ... by increasing z (levels within 1e-6 mm are one).
@@ -59,7 +60,7 @@ struct GcodeMove {
   double e_delta = 0.0;    // extruder change during the move (mm of filament)
   double feed_mm_s = 0.0;  // modal feed rate (0: none given yet)
   bool has_e = false;      // an E word on the line
-  bool open = false;       // the shutter's open code was the last of open/close
+  bool open = false;       // the open code was the last of open/close, and the modal S not 0
 };
 
 // Where the machine stands still between moves: a G4 dwell, or an E-only move (a retraction

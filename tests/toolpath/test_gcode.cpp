@@ -156,6 +156,25 @@ TEST(Gcode, HugeCodeNumbersAreRefused) {
   }
 }
 
+TEST(Gcode, PowerZeroClosesTheShutter) {
+  // a grbl laser file (LightBurn's M4 S0, then power per move): S0 on a move, or alone, prints
+  // nothing though the open code is active; M104 S0 and G4 S0 are no power
+  GcodeOptions laser;
+  laser.open_code = "M4";
+  laser.close_code = "M5";
+  const GcodeProgram program = parse_gcode_program(
+      "G21 G90\nM4 S0\nG0 X0 Y0\nG1 X10 F600 S1000\nG1 Y10 S0\nG1 X0 S500\nM104 S0\n"
+      "G4 S0\nG1 Y5\nS0\nG1 Y0\nM4\nG1 X5\nM4 S300\nG1 X0\n",
+      "laser.gcode", laser);
+  const GcodeImport imported = import_gcode_program(program, laser);
+  EXPECT_EQ(imported.rule, PrintRule::shutter);
+  // printed: X10 (S1000), then X0 and Y5 (S500), then X0 (S300); not Y10, Y0 or X5 (S0)
+  ASSERT_EQ(imported.toolpath.paths.size(), 3u);
+  expect_points(imported.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+  expect_points(imported.toolpath.paths[1], {Vec3(10, 10, 0), Vec3(0, 10, 0), Vec3(0, 5, 0)});
+  expect_points(imported.toolpath.paths[2], {Vec3(5, 0, 0), Vec3(0, 0, 0)});
+}
+
 TEST(Gcode, InchesAndSetPosition) {
   // G20: 1 inch = 25.4 mm; F60 in/min = 25.4 mm/s
   const GcodeImport inches = parse("G20\nG1 X1 Y0 E0.1 F60\n");
