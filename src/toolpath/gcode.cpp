@@ -414,12 +414,16 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
     const char* word_end = p;
     while (word_end < end && !is_space(*word_end) && *word_end != ';' && *word_end != '(')
       ++word_end;
-    // G28's axes may be named without a number (Marlin's G28 X Y, Prusa's G28 W): flags
+    // homing's axes may be named without a number (Marlin's G28 X Y, Prusa's G28 W, G161 and
+    // G162 homing to the axes' minimum or maximum in MakerBot's and Repetier's files): flags
     if (digits == 0 && p == number_start &&
         (p == end || is_space(*p) || *p == ';' || is_letter(*p)) && letter != 'G' &&
         letter != 'M' && !words_.has(letter) &&
         std::any_of(words_.codes.begin(), words_.codes.begin() + words_.n_codes,
-                    [](const Code& code) { return code.letter == 'G' && code.tenths == 280; })) {
+                    [](const Code& code) {
+                      return code.letter == 'G' &&
+                             (code.tenths == 280 || code.tenths == 1610 || code.tenths == 1620);
+                    })) {
       words_.present |= 1u << (letter - 'A');
       words_.value[letter - 'A'] = 0.0;
       words_.text[letter - 'A'] = word_start;

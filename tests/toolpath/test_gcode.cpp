@@ -329,6 +329,14 @@ TEST(Gcode, UnknownCodesKeepTheirAxisWords) {
       "g39_3rd_layer_detect_flag\nG39 S1\nM623\nG1 X0 Y0 F600\nG1 X10 E1\n");
   ASSERT_EQ(flags.toolpath.paths.size(), 1u);
   expect_points(flags.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+  // MakerBot's and Repetier's G161/G162 home to the axes' ends, named by letter alone
+  const GcodeProgram homing = parse_gcode_program(
+      "G162 X Y F2000\nG161 Z F900\nG92 X0 Y0 Z0\nG1 X10 F600\n", "mb.gcode", GcodeOptions{});
+  ASSERT_EQ(homing.ignored_axis_codes.size(), 2u);
+  EXPECT_EQ(g_code_name(homing.ignored_axis_codes[0].tenths), "G162");
+  EXPECT_EQ(g_code_name(homing.ignored_axis_codes[1].tenths), "G161");
+  ASSERT_EQ(homing.moves.size(), 1u);
+  EXPECT_EQ(homing.moves[0].to_mm, Vec3(10, 0, 0));
 }
 
 TEST(Gcode, OffsetsAreClearedSuspendedAndRestored) {
