@@ -90,6 +90,48 @@ struct LineWords {
   double get(char letter) const { return value[letter - 'A']; }
 };
 
+// Why a line that does not split into words uses RS274/NGC's programming (LinuxCNC): O-word
+// subroutines and control flow, # parameters, [ ] expressions; nullptr when it does not. A
+// slicer's placeholder (`[bed_temperature]`, `{...}`) is not an expression.
+const char* ngc_programming_reason(const char* p, const char* end) {
+  const char* first = p;
+  while (first < end && is_space(*first)) ++first;
+  if (first < end && upper(*first) == 'O') {
+    // `O100 sub`, `o<probe> call`, `O101 while [...]`: a keyword after the O word's number
+    const char* q = first + 1;
+    if (q < end && *q == '<') q = std::find(q, end, '>');
+    while (q < end && (is_digit(*q) || *q == '>')) ++q;
+    while (q < end && is_space(*q)) ++q;
+    const char* word_end = q;
+    while (word_end < end && is_letter(*word_end)) ++word_end;
+    std::string keyword(q, word_end);
+    for (char& ch : keyword) ch = static_cast<char>(ch | 0x20);
+    for (const char* name : {"sub", "endsub", "call", "return", "if", "elseif", "else", "endif",
+                             "while", "endwhile", "do", "repeat", "endrepeat", "break", "continue"})
+      if (keyword == name)
+        return "O-word subroutines and control flow (`O100 sub`, `call`, `if`, `while`) are "
+               "not supported: export the program expanded, every move written out";
+  }
+  for (const char* q = p; q < end; ++q) {
+    if (*q == ';') break;
+    if (*q == '(') {
+      q = std::find(q, end, ')');
+      if (q == end) break;
+      continue;
+    }
+    if (*q == '#' && q + 1 < end && (is_digit(q[1]) || q[1] == '<'))
+      return "RS274/NGC parameters (`#1`, `#<depth>`) are not supported: export the program "
+             "with their values written in";
+    if (*q == '[') {
+      const char* close = std::find(q, end, ']');
+      if (std::any_of(q + 1, close, [](char ch) { return !is_letter(ch) && ch != '_'; }))
+        return "RS274/NGC expressions (`X[2*3]`) are not supported: export the program with "
+               "their values written in";
+    }
+  }
+  return nullptr;
+}
+
 // whether text (up to a comment) holds a G word: G, spaces, a digit, after a space or the start,
 // in a token of words only (letters, digits, points and signs: `G1X5` is one, Bambu's flag name
 // `g29_before_print_flag` is none)
@@ -350,6 +392,25 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
         (open_code_ && open_code_->letter == 'M' && open_code_->tenths == tenths) ||
         (close_code_ && close_code_->letter == 'M' && close_code_->tenths == tenths);
     if (tenths >= 0 && !shutter_code && tenths % 10 == 0 && is_text_command(number)) return;
+    // Fanuc's M98 P1000 runs subprogram O1000, whose moves would be skipped (RepRapFirmware's
+    // M98 P"macro.g" runs a macro: the firmware's, not the print's)
+    if (tenths == 980 && !shutter_code) {
+      const char* word = stop;
+      while (word < end && (is_space(*word) || upper(*word) != 'P') && *word != ';' && *word != '(')
+        ++word;
+      if (word < end && upper(*word) == 'P') {
+        ++word;
+        while (word < end && is_space(*word)) ++word;
+        if (word < end && is_digit(*word)) {
+          const char* digits_end = std::find_if(word, end, [](char ch) { return !is_digit(ch); });
+          problem(line_number, "M98 P" + std::string(word, digits_end) +
+                                   ": subprogram calls are not supported (the subprogram's "
+                                   "moves would be skipped): export the program expanded, "
+                                   "every move written out");
+          return;
+        }
+      }
+    }
     // any other M code but M82, M83 and the shutter's: the firmware's settings, whose
     // parameters need not be numbers (M862.3 P "MK3S", M115 U3.13.2); no geometry, unless the
     // line also holds a G code (checked below, as a whole line)
@@ -366,6 +427,7 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
 bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
   words_.present = 0;
   words_.n_codes = 0;
+  const char* const line_begin = p;
   while (p < end) {
     const char c = *p;
     if (is_space(c)) {
@@ -383,8 +445,10 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
       continue;
     }
     if (!is_letter(c)) {
-      problem(line_number,
-              "unexpected '" + printable(p, p + 1) + "' (expected a letter followed by a number)");
+      const char* reason = ngc_programming_reason(line_begin, end);
+      problem(line_number, reason ? std::string(reason)
+                                  : "unexpected '" + printable(p, p + 1) +
+                                        "' (expected a letter followed by a number)");
       return false;
     }
     const char letter = upper(c);
@@ -436,6 +500,10 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
       const bool placeholder = std::any_of(word_start, word_end, [](char ch) {
         return ch == '{' || ch == '[' || ch == '}' || ch == ']';
       });
+      if (const char* reason = ngc_programming_reason(line_begin, end)) {
+        problem(line_number, reason);
+        return false;
+      }
       problem(line_number, "malformed word '" + printable(word_start, word_end) + "' (expected " +
                                std::string(1, letter) + " followed by a number" +
                                (placeholder ? "; a slicer's placeholder not filled in: this "
@@ -979,11 +1047,15 @@ GcodeProgram parse_gcode_program(const std::string& text, const std::string& fil
   if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) p += 3;
   // at most one move per line: one reservation instead of a copy at every doubling (capped:
   // beyond 2^23 moves the vector grows as usual)
-  const auto n_lines = static_cast<std::size_t>(std::count(p, end, '\n')) + 1;
+  const auto n_newlines = static_cast<std::size_t>(std::count(p, end, '\n'));
+  // a file of classic Mac line ends (CR alone) has no LF at all
+  const char separator = n_newlines == 0 && std::memchr(p, '\r', end - p) ? '\r' : '\n';
+  const auto n_lines =
+      (separator == '\n' ? n_newlines : static_cast<std::size_t>(std::count(p, end, '\r'))) + 1;
   parser.reserve_moves(std::min<std::size_t>(n_lines, std::size_t{1} << 23));
   int line_number = 0;
   while (p < end) {
-    const char* line_end = static_cast<const char*>(std::memchr(p, '\n', end - p));
+    const char* line_end = static_cast<const char*>(std::memchr(p, separator, end - p));
     if (!line_end) line_end = end;
     parser.line(p, line_end, ++line_number);
     p = line_end + 1;

@@ -13,7 +13,9 @@
 // `*checksums` are skipped, as are Klipper's extended commands (`PRINT_START ...`), the text
 // commands (M117, M118, M23, ...) and every other G or M code, except the ones that would
 // change the geometry and are not supported (G5 splines, canned cycles G73/G76/G81-G89,
-// G93/G95 feed modes, G33 threading), which are errors.
+// G93/G95 feed modes, G33 threading) and RS274/NGC programming (O-word subroutines and
+// control flow, # parameters, [ ] expressions; Fanuc's M98 P subprogram calls), which are
+// errors. Lines end at LF, CR LF, or CR alone in a file without LF.
 //
 // Print rules decide which moves deposit: `e` (E increases), `shutter` (G1/G2/G3 while the
 // open code is active and the modal S, a laser's or spindle's power, is not 0), `feed`

@@ -175,6 +175,37 @@ TEST(Gcode, PowerZeroClosesTheShutter) {
   expect_points(imported.toolpath.paths[2], {Vec3(5, 0, 0), Vec3(0, 0, 0)});
 }
 
+TEST(Gcode, ProgrammingAndSubprogramsAreNamed) {
+  // LinuxCNC's O-word subroutines, # parameters and [ ] expressions, and Fanuc's M98 call: a
+  // program, not a list of moves (RepRapFirmware's M98 P"macro.g" passes; a slicer's
+  // placeholder is named as one)
+  const auto problems = problems_of(
+      "G21\n#1 = 5\nG1 X#1 F60\nO100 sub\no<probe> call\nG1 X[2*3]\nM98 P1000 L2\n"
+      "M98 P\"0:/macros/start.g\"\nG1 Z{+0.0}\nO1000\nG1 X1\n");
+  ASSERT_EQ(problems.size(), 7u) << dump(problems);
+  const std::vector<int> lines = {2, 3, 4, 5, 6, 7, 9};
+  const std::vector<std::string> starts = {"RS274/NGC parameters",    "RS274/NGC parameters",
+                                           "O-word subroutines",      "O-word subroutines",
+                                           "RS274/NGC expressions",   "M98 P1000: subprogram calls",
+                                           "malformed word 'Z{+0.0}'"};
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    EXPECT_EQ(problems[i].line, lines[i]) << problems[i].str();
+    EXPECT_EQ(problems[i].message.rfind(starts[i], 0), 0u) << problems[i].str();
+  }
+}
+
+TEST(Gcode, ClassicMacLineEndsAreLines) {
+  // CR alone ends a line in a file without LF (and CR LF is one line end, as before)
+  for (const std::string end : {"\r", "\r\n", "\n"}) {
+    const GcodeProgram program =
+        parse_gcode_program("G90" + end + "M83" + end + "G1 X10 E1 F600" + end + "G1 Y10 E1" + end,
+                            "mac.gcode", GcodeOptions{});
+    EXPECT_EQ(program.n_lines, 4) << end.size();
+    ASSERT_EQ(program.moves.size(), 2u);
+    EXPECT_EQ(program.moves[1].to_mm, Vec3(10, 10, 0));
+  }
+}
+
 TEST(Gcode, InchesAndSetPosition) {
   // G20: 1 inch = 25.4 mm; F60 in/min = 25.4 mm/s
   const GcodeImport inches = parse("G20\nG1 X1 Y0 E0.1 F60\n");
