@@ -1,0 +1,1 @@
+G21#1 = 5G1 X#1 F60O100 subo<probe> callO101 while [#1 LT 3]G1 X[2*3]M98 P1000 L2M98 P"0:/macros/start.g"M99
