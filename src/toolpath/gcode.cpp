@@ -1090,7 +1090,7 @@ PrintRule resolve_print_rule(const GcodeProgram& program, PrintRule rule, std::s
     if (reason)
       *reason =
           "auto chose shutter: no E values, and the file opens or closes the shutter "
-          "(G1/G2/G3 print while it is open)";
+          "(G1/G2/G3 print while it is open and the power S is not 0)";
     return PrintRule::shutter;
   }
   if (reason)
