@@ -277,7 +277,7 @@ class GcodeParser {
   Vec3 offset_mm_ = Vec3::Zero();    // machine = programmed + work offset + offset (G92)
   // work coordinate systems 1-9 (G54..G59.3), as G10 L2/L20 set them; the controller's own,
   // which the file does not give, are read as 0 (index 0 unused)
-  std::array<Vec3, 10> work_offset_mm_{};
+  std::array<Vec3, 10> work_offset_mm_;  // zeroed in the constructor
   int work_system_ = 1;                  // G54
   Vec3 saved_offset_mm_ = Vec3::Zero();  // G92.2 suspended these, G92.3 restores them
   double extruder_ = 0.0;                // programmed E
@@ -396,8 +396,7 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     // M98 P"macro.g" runs a macro: the firmware's, not the print's)
     if (tenths == 980 && !shutter_code) {
       const char* word = stop;
-      while (word < end && (is_space(*word) || upper(*word) != 'P') && *word != ';' && *word != '(')
-        ++word;
+      while (word < end && upper(*word) != 'P' && *word != ';' && *word != '(') ++word;
       if (word < end && upper(*word) == 'P') {
         ++word;
         while (word < end && is_space(*word)) ++word;
@@ -751,6 +750,7 @@ void GcodeParser::move(int motion, int line_number) {
   }
   // target position and extrusion of this move
   Vec3 target_mm = position_mm_;
+  const Vec3 frame_mm = frame_offset();
   for (int axis = 0; axis < 3; ++axis) {
     const char letter = static_cast<char>('X' + axis);
     if (!words_.has(letter)) continue;
@@ -759,7 +759,7 @@ void GcodeParser::move(int motion, int line_number) {
     if (machine_frame_)
       target_mm[axis] = value;
     else
-      target_mm[axis] = axes_relative_ ? target_mm[axis] + value : value + frame_offset()[axis];
+      target_mm[axis] = axes_relative_ ? target_mm[axis] + value : value + frame_mm[axis];
   }
   double e_delta = 0.0;
   if (words_.has('E')) {
