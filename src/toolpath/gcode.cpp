@@ -40,6 +40,8 @@ constexpr double kLayerTolerance_mm = 1e-6;
 // an arc's end may miss its centre's radius by this much (absolute mm, relative)
 constexpr double kArcRadiusTolerance_mm = 0.005;
 constexpr double kArcRadiusTolerance_rel = 1e-3;
+// G60 S: save slots read (Marlin's SAVED_POSITIONS, RepRapFirmware's restore points)
+constexpr int kSavedPositionSlots = 10;
 
 // text for a message: printable ASCII kept, other bytes as \xNN, at most 32 characters
 std::string printable(const char* begin, const char* end) {
@@ -165,8 +167,7 @@ bool is_modal_setting(int tenths) {
     case 500:  // G50, G50.1: scaling and mirroring off
     case 501:
     case 541:  // G54.1 P: Fanuc's extended work systems (offsets not in the file)
-    case 610:  // G61, G61.1, G64: path control
-    case 611:
+    case 611:  // G61.1, G64: path control (G61 is read where it is executed)
     case 640:
     case 690:  // G69 rotation off
     case 940:  // G94 feed per minute
@@ -257,6 +258,14 @@ class GcodeParser {
   bool split_words(const char* p, const char* end, int line_number);
   void execute(int line_number);
   void move(int motion, int line_number);
+  // a move's record from the present position to target (and there the position)
+  void append_move(int motion, const Vec3& target_mm, double e_delta, const EdgeArc& arc,
+                   int line_number);
+  // G60 S / G61 S / G1 R: a save slot's number from `letter` (0 if absent); -1 and a problem
+  // when it is not one
+  int save_slot(char letter, const std::string& command, int line_number);
+  // Marlin's G61: a travel back to the position G60 saved
+  void return_to_saved(int line_number);
   bool arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc);
   void set_position();
   // G10 L2 / L20: a work system's offsets; false (and a problem) when malformed
@@ -292,6 +301,12 @@ class GcodeParser {
   bool power_off_ = false;               // the modal S is 0 (a laser's or spindle's power)
   bool machine_frame_ = false;           // this line's G53
   bool retracting_ = false;              // the last E change was a decrease
+  // positions G60 saved (machine frame) with the programmed E, per slot
+  struct SavedPosition {
+    Vec3 machine_mm;
+    double extruder = 0.0;
+  };
+  std::array<std::optional<SavedPosition>, kSavedPositionSlots> saved_positions_;
 
   GcodeProgram program_;
 };
@@ -478,14 +493,15 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
     while (word_end < end && !is_space(*word_end) && *word_end != ';' && *word_end != '(')
       ++word_end;
     // homing's axes may be named without a number (Marlin's G28 X Y, Prusa's G28 W, G161 and
-    // G162 homing to the axes' minimum or maximum in MakerBot's and Repetier's files): flags
+    // G162 homing to the axes' minimum or maximum in MakerBot's and Repetier's files), and so
+    // may the axes Marlin's G61 returns to a saved position (`G61 S0 X Y`): flags
     if (digits == 0 && p == number_start &&
         (p == end || is_space(*p) || *p == ';' || is_letter(*p)) && letter != 'G' &&
         letter != 'M' && !words_.has(letter) &&
         std::any_of(words_.codes.begin(), words_.codes.begin() + words_.n_codes,
                     [](const Code& code) {
-                      return code.letter == 'G' &&
-                             (code.tenths == 280 || code.tenths == 1610 || code.tenths == 1620);
+                      return code.letter == 'G' && (code.tenths == 280 || code.tenths == 610 ||
+                                                    code.tenths == 1610 || code.tenths == 1620);
                     })) {
       words_.present |= 1u << (letter - 'A');
       words_.value[letter - 'A'] = 0.0;
@@ -561,6 +577,7 @@ void GcodeParser::execute(int line_number) {
   machine_frame_ = false;
   bool uses_axes = false;  // G92, G28, G10, G4, M codes: the axis words belong to the command
   bool dwell = false, set_position = false, home = false, work_offsets = false;
+  bool save_position = false, g61 = false;
   int foreign_code = -1;  // a G code whose axis words are its own (unknown here, Prusa G80)
   bool opens = false;     // the line holds the open code
   for (int i = 0; i < words_.n_codes; ++i) {
@@ -652,6 +669,12 @@ void GcodeParser::execute(int line_number) {
           foreign_code = code.tenths;
         break;
       }
+      case 600:  // G60: Marlin's and RepRapFirmware's save of the position (S the slot)
+        save_position = uses_axes = true;
+        break;
+      case 610:  // G61: exact-path mode (RS274/NGC), or Marlin's return to a saved position
+        g61 = true;
+        break;
       case 530:  // G53: this line's axis words in the machine frame
         machine_frame_ = true;
         break;
@@ -676,6 +699,13 @@ void GcodeParser::execute(int line_number) {
         break;
     }
   }
+  // a G61 without a motion, with its axes, slot or E named or after a G60 S0: Marlin's
+  // return, whose F holds for that move alone (a bare G61 with slot 0 empty: a path mode)
+  const bool returns = g61 && motion < 0 &&
+                       (saved_positions_[0] || words_.has('X') || words_.has('Y') ||
+                        words_.has('Z') || words_.has('E') || words_.has('S'));
+  uses_axes = uses_axes || returns;
+  const double feed_before = feed_mm_s_;
   if (words_.has('F')) {
     feed_mm_s_ = words_.get('F') * unit_mm_ / kSecondsPerMinute;
   }
@@ -689,6 +719,22 @@ void GcodeParser::execute(int line_number) {
   if (set_position) this->set_position();
   if (work_offsets && !set_work_offsets(line_number)) return;
   if (home) this->home();
+  if (save_position) {
+    if (words_.has('X') || words_.has('Y') || words_.has('Z')) {
+      problem(line_number,
+              "G60 with axis words (a one-direction positioning move) is not supported; G60 "
+              "saves the position in Marlin and RepRapFirmware (S the slot)");
+      return;
+    }
+    const int slot = save_slot('S', "G60 S", line_number);
+    if (slot < 0) return;
+    saved_positions_[slot] = SavedPosition{position_mm_, extruder_};
+  }
+  if (returns) {
+    return_to_saved(line_number);
+    feed_mm_s_ = feed_before;
+    return;
+  }
   const bool axis_words = words_.has('X') || words_.has('Y') || words_.has('Z') ||
                           words_.has('E') || words_.has('I') || words_.has('J') ||
                           words_.has('K') || words_.has('R');
@@ -748,6 +794,23 @@ void GcodeParser::move(int motion, int line_number) {
     problem(line_number, "G53 (the machine frame) with an arc: only G0 and G1 move there");
     return;
   }
+  // RepRapFirmware's `G1 R1 X0 Y0 Z2`: back to restore point 1, the named axes offset by
+  // their values (the others stay)
+  const SavedPosition* restore_point = nullptr;
+  if (motion <= 1 && words_.has('R')) {
+    const std::string command = "G" + std::to_string(motion) + " R";
+    const int slot = save_slot('R', command, line_number);
+    if (slot < 0) return;
+    if (!saved_positions_[slot]) {
+      problem(line_number, command + std::to_string(slot) + " returns to restore point " +
+                               std::to_string(slot) + ", which no earlier G60 S" +
+                               std::to_string(slot) +
+                               " in this file saved (the firmware's own, from a pause or a tool "
+                               "change, are not in the file)");
+      return;
+    }
+    restore_point = &*saved_positions_[slot];
+  }
   // target position and extrusion of this move
   Vec3 target_mm = position_mm_;
   const Vec3 frame_mm = frame_offset();
@@ -755,8 +818,9 @@ void GcodeParser::move(int motion, int line_number) {
     const char letter = static_cast<char>('X' + axis);
     if (!words_.has(letter)) continue;
     const double value = words_.get(letter) * unit_mm_;
+    if (restore_point) target_mm[axis] = restore_point->machine_mm[axis] + value;
     // G53: the machine frame, absolute (RS274/NGC, grbl)
-    if (machine_frame_)
+    else if (machine_frame_)
       target_mm[axis] = value;
     else
       target_mm[axis] = axes_relative_ ? target_mm[axis] + value : value + frame_mm[axis];
@@ -772,6 +836,11 @@ void GcodeParser::move(int motion, int line_number) {
   }
   EdgeArc arc;
   if (motion >= 2 && !arc_geometry(motion, target_mm, line_number, arc)) return;
+  append_move(motion, target_mm, e_delta, arc, line_number);
+}
+
+void GcodeParser::append_move(int motion, const Vec3& target_mm, double e_delta, const EdgeArc& arc,
+                              int line_number) {
   GcodeMove record;
   record.line = line_number;
   record.motion = motion;
@@ -942,6 +1011,44 @@ bool GcodeParser::set_work_offsets(int line_number) {
     work_offset_mm_[system][axis] = l20 ? position_mm_[axis] - offset_mm_[axis] - value : value;
   }
   return true;
+}
+
+int GcodeParser::save_slot(char letter, const std::string& command, int line_number) {
+  const double slot = words_.has(letter) ? words_.get(letter) : 0.0;
+  if (slot >= 0.0 && slot < kSavedPositionSlots && slot == std::floor(slot))
+    return static_cast<int>(slot);
+  problem(line_number, command + message_number(slot) +
+                           ": the save slot must be a whole number 0-" +
+                           std::to_string(kSavedPositionSlots - 1));
+  return -1;
+}
+
+void GcodeParser::return_to_saved(int line_number) {
+  const int slot = save_slot('S', "G61 S", line_number);
+  if (slot < 0) return;
+  if (!saved_positions_[slot]) {
+    problem(line_number, "G61 with axis words or a slot is Marlin's return to the position G60 S" +
+                             std::to_string(slot) + " saved, and no G60 S" + std::to_string(slot) +
+                             " came before it (RS274/NGC's G61, exact-path mode, takes none)");
+    return;
+  }
+  // no axis named: X, Y, Z and E as saved; else the named ones, their values offsets from it
+  const SavedPosition& saved = *saved_positions_[slot];
+  const bool any_axis = words_.has('X') || words_.has('Y') || words_.has('Z') || words_.has('E');
+  Vec3 target_mm = position_mm_;
+  for (int axis = 0; axis < 3; ++axis) {
+    const char letter = static_cast<char>('X' + axis);
+    if (words_.has(letter))
+      target_mm[axis] = saved.machine_mm[axis] + words_.get(letter) * unit_mm_;
+    else if (!any_axis)
+      target_mm[axis] = saved.machine_mm[axis];
+  }
+  // E is set, not moved: the return is a travel
+  if (words_.has('E'))
+    extruder_ = saved.extruder + words_.get('E') * unit_mm_;
+  else if (!any_axis)
+    extruder_ = saved.extruder;
+  append_move(0, target_mm, 0.0, EdgeArc{}, line_number);
 }
 
 void GcodeParser::home() {

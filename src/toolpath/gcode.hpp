@@ -4,7 +4,8 @@
 // I/J/K arc ends where it starts; helical: the third axis moves linearly) in the G17/G18/G19
 // planes, G90/G91 (and G90.1/G91.1 for arc centres), M82/M83, G92, G20/G21, G28, G4 dwell
 // (P milliseconds, S seconds, as Marlin and Klipper), F (modal, per minute), E, work systems
-// (G54..G59.3 select, G10 L2/L20 set, G53 one line in the machine frame). Several G/M
+// (G54..G59.3 select, G10 L2/L20 set, G53 one line in the machine frame), saved positions
+// (G60 S saves one; Marlin's G61 and RepRapFirmware's G0/G1 R return to it). Several G/M
 // words may share a line (G17 G21 G90) and run in RS274/NGC order (F, M, modes, motion);
 // axis words without a G word use the last motion mode. Spaces inside words are allowed
 // (`G0 Z  15.000`), numbers as `Z.2` or `E-.8`, a lowercase exponent after a capital letter

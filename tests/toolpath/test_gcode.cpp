@@ -418,6 +418,54 @@ TEST(Gcode, ToolOffsetsAndBadWorkSystemsAreNamed) {
   EXPECT_EQ(problems[3].line, 5);
 }
 
+TEST(Gcode, SavedPositionsAreReturnedTo) {
+  // Marlin's park-and-return: G60 saves (20, 10, 0); G61 S0 X Y goes back over it at the
+  // lifted z with F1200 for that move alone, G61 S0 Z comes down; a G61 beside a motion is
+  // RS274/NGC's path mode
+  const GcodeProgram marlin = parse_gcode_program(
+      "M83\nG1 X10 Y10 F600\nG1 X20 E1\nG60 S0\nG91\nG1 Z5\nG90\nG0 X0 Y0 F3000\n"
+      "G61 S0 X Y F1200\nG61 S0 Z\nG1 X30 E1\nG61 G1 X31 E0.1\n",
+      "m.gcode", GcodeOptions{});
+  const std::vector<Vec3> ends = {{10, 10, 0}, {20, 10, 0}, {20, 10, 5}, {0, 0, 5},
+                                  {20, 10, 5}, {20, 10, 0}, {30, 10, 0}, {31, 10, 0}};
+  ASSERT_EQ(marlin.moves.size(), ends.size());
+  for (std::size_t i = 0; i < ends.size(); ++i)
+    EXPECT_EQ(marlin.moves[i].to_mm, ends[i]) << i << ": " << marlin.moves[i].to_mm.transpose();
+  // the returns travel (G0) at their own F; the print after them keeps the modal 3000/min
+  EXPECT_EQ(marlin.moves[4].motion, 0);
+  EXPECT_DOUBLE_EQ(marlin.moves[4].feed_mm_s, 20.0);
+  EXPECT_DOUBLE_EQ(marlin.moves[5].feed_mm_s, 50.0);
+  EXPECT_DOUBLE_EQ(marlin.moves[6].feed_mm_s, 50.0);
+  EXPECT_EQ(marlin.moves[6].e_delta, 1.0);
+  // G61 E restores the saved E (absolute, M82) without moving: the next E counts from it
+  const GcodeProgram e_restore = parse_gcode_program(
+      "M82\nG1 X10 E5 F600\nG60 S2\nG1 X20 E8\nG61 S2 E\nG1 X30 E6\n", "e.gcode", GcodeOptions{});
+  ASSERT_EQ(e_restore.moves.size(), 3u);
+  EXPECT_EQ(e_restore.moves[2].e_delta, 1.0);
+  // RepRapFirmware's restore point: G1 R1 offsets the named axes from it, keeps the others
+  const GcodeProgram reprap =
+      parse_gcode_program("G1 X10 Y10 Z1 F600\nG60 S1\nG1 X20 Y30 Z3\nG1 R1 X0 Z2\nG0 R1 Y-1\n",
+                          "r.gcode", GcodeOptions{});
+  ASSERT_EQ(reprap.moves.size(), 4u);
+  EXPECT_EQ(reprap.moves[2].to_mm, Vec3(10, 30, 3));
+  EXPECT_EQ(reprap.moves[3].to_mm, Vec3(10, 9, 3));
+  // without a G60 before: G61 alone is a path mode, G61 with axes and G1 R are refused
+  const GcodeProgram path_mode = parse_gcode_program("G61\nG1 X5 F60\n", "p.ngc", GcodeOptions{});
+  ASSERT_EQ(path_mode.moves.size(), 1u);
+  EXPECT_EQ(path_mode.moves[0].to_mm, Vec3(5, 0, 0));
+  const auto problems =
+      problems_of("G1 X1 F60\nG61 X Y\nG1 R1 X0\nG60 S12\nG60 X5\nG60 S3\nG61 S4\n");
+  ASSERT_EQ(problems.size(), 5u) << dump(problems);
+  EXPECT_EQ(problems[0].message.rfind("G61 with axis words or a slot is Marlin's return", 0), 0u)
+      << problems[0].str();
+  EXPECT_EQ(problems[1].message.rfind("G1 R1 returns to restore point 1", 0), 0u)
+      << problems[1].str();
+  EXPECT_EQ(problems[2].message.rfind("G60 S12: the save slot must be", 0), 0u)
+      << problems[2].str();
+  EXPECT_EQ(problems[3].line, 5);
+  EXPECT_NE(problems[4].message.find("G60 S4 saved"), std::string::npos) << problems[4].str();
+}
+
 TEST(Gcode, LowercaseFilesReadEAsAWord) {
   // `y0e1`: Y 0 then E 1 in a file written in lowercase; `X1e-05` keeps its exponent
   const GcodeProgram lower =
