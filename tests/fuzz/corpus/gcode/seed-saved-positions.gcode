@@ -1,0 +1,20 @@
+; a Marlin park-and-return and a RepRapFirmware restore point
+G21
+G90
+M83
+G1 X10 Y10 F600
+G1 X20 E1
+G60 S0
+G91
+G1 Z5
+G90
+G0 X0 Y0 F3000
+G61 S0 X Y F1200
+G61 S0 Z
+G1 X30 E1
+G60 S1
+G1 X40 Y30 E1
+G1 R1 X0 Y0 Z2
+G0 R1 Z0
+G61 S1 E
+G1 X45 E0.5
