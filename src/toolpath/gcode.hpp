@@ -10,13 +10,14 @@
 // axis words without a G word use the last motion mode. Spaces inside words are allowed
 // (`G0 Z  15.000`), numbers as `Z.2` or `E-.8`, a lowercase exponent after a capital letter
 // (`X1e3`; `X1E3` is X1 then E3, as firmware reads compact lines, and so is `x1e3` in a
-// lowercase file). Comments `;...` and `(...)`, N words and
-// `*checksums` are skipped, as are Klipper's extended commands (`PRINT_START ...`), the text
-// commands (M117, M118, M23, ...) and every other G or M code, except the ones that would
-// change the geometry and are not supported (G5 splines, canned cycles G73/G76/G81-G89,
-// G93/G95 feed modes, G33 threading) and RS274/NGC programming (O-word subroutines and
-// control flow, # parameters, [ ] expressions; Fanuc's M98 P subprogram calls), which are
-// errors. Lines end at LF, CR LF, or CR alone in a file without LF.
+// lowercase file). Comments `;...` and `(...)`, N words, `*checksums` and a line's leading
+// `/` (block delete: the line runs, as with the switch off) are skipped, as are Klipper's
+// extended commands (`PRINT_START ...`), the text commands (M117, M118, M23, ...) and every
+// other G or M code, except the ones that would change the geometry and are not supported
+// (G5 splines, canned cycles G73/G76/G81-G89, G93/G95 feed modes, G33 threading) and
+// RS274/NGC programming (O-word subroutines and control flow, # parameters, [ ]
+// expressions; Fanuc's M98 P subprogram calls), which are errors. Lines end at LF, CR LF,
+// or CR alone in a file without LF.
 //
 // Print rules decide which moves deposit: `e` (E increases), `shutter` (G1/G2/G3 while the
 // open code is active and the modal S, a laser's or spindle's power, is not 0), `feed`
