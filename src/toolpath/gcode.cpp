@@ -134,6 +134,21 @@ const char* ngc_programming_reason(const char* p, const char* end) {
   return nullptr;
 }
 
+// What a file that begins with a container's signature is and how to get its G-code out;
+// nullptr for any other file
+const char* packed_gcode_reason(const std::string& text) {
+  // PrusaSlicer's binary G-code: "GCDE" and a 32-bit little-endian version (1 so far)
+  if (text.size() >= 8 && text.compare(0, 4, "GCDE") == 0 && text.compare(5, 3, "\0\0\0", 3) == 0)
+    return "a binary G-code file (PrusaSlicer's .bgcode, signature GCDE): export text G-code "
+           "instead (Printer Settings > General > Firmware: binary G-code off)";
+  if (text.compare(0, 4, "PK\x03\x04") == 0)
+    return "a zip archive, not G-code (Bambu Studio's and OrcaSlicer's .gcode.3mf, or a 3MF "
+           "project): unzip it; the G-code is Metadata/plate_1.gcode";
+  if (text.compare(0, 2, "\x1f\x8b") == 0)
+    return "a gzip-compressed file: decompress it first (gunzip)";
+  return nullptr;
+}
+
 // whether text (up to a comment) holds a G word: G, spaces, a digit, after a space or the start,
 // in a token of words only (letters, digits, points and signs: `G1X5` is one, Bambu's flag name
 // `g29_before_print_flag` is none)
@@ -1152,6 +1167,9 @@ GcodeProgram parse_gcode_program(const std::string& text, const std::string& fil
   const char* end = p + text.size();
   // a UTF-8 byte order mark is not part of the first command
   if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) p += 3;
+  // containers a slicer may write instead of text: named, rather than a byte at a column
+  if (const char* container = packed_gcode_reason(text))
+    throw InputError(file_label, 1, kKey, container);
   // at most one move per line: one reservation instead of a copy at every doubling (capped:
   // beyond 2^23 moves the vector grows as usual)
   const auto n_newlines = static_cast<std::size_t>(std::count(p, end, '\n'));

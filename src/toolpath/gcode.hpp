@@ -16,8 +16,9 @@
 // other G or M code, except the ones that would change the geometry and are not supported
 // (G5 splines, canned cycles G73/G76/G81-G89, G93/G95 feed modes, G33 threading) and
 // RS274/NGC programming (O-word subroutines and control flow, # parameters, [ ]
-// expressions; Fanuc's M98 P subprogram calls), which are errors. Lines end at LF, CR LF,
-// or CR alone in a file without LF.
+// expressions; Fanuc's M98 P subprogram calls), which are errors, as are binary files (a
+// container, PrusaSlicer's .bgcode, a zip or gzip, is named). Lines end at LF, CR LF, or CR
+// alone in a file without LF.
 //
 // Print rules decide which moves deposit: `e` (E increases), `shutter` (G1/G2/G3 while the
 // open code is active and the modal S, a laser's or spindle's power, is not 0), `feed`

@@ -302,6 +302,26 @@ TEST(Gcode, EveryMalformedLineIsReported) {
             "(or, if A is a MakerBot-flavour extruder, export with RepRap/Marlin flavour: E)");
 }
 
+TEST(Gcode, PackedFilesAreNamedWithTheWayOut) {
+  // PrusaSlicer's binary G-code, a Bambu .gcode.3mf (zip) and a gzip file: one problem at
+  // line 1 naming the container, instead of a control byte at a column
+  const std::vector<std::pair<std::string, std::string>> packed = {
+      {std::string("GCDE\x01\x00\x00\x00", 8), "binary G-code file (PrusaSlicer's .bgcode"},
+      {std::string("PK\x03\x04\x14\x00", 6), "Metadata/plate_1.gcode"},
+      {std::string("\x1f\x8b\x08\x00", 4), "gzip-compressed"}};
+  for (const auto& [bytes, named] : packed) {
+    const auto problems = problems_of(bytes);
+    ASSERT_EQ(problems.size(), 1u) << dump(problems);
+    EXPECT_EQ(problems[0].line, 1);
+    EXPECT_NE(problems[0].message.find(named), std::string::npos) << problems[0].str();
+  }
+  // a text file whose first line merely begins with the letters is read as text (a named
+  // command, as Klipper's)
+  const GcodeProgram text = parse_gcode_program("GCDE\nG1 X1 F60\n", "t.gcode", GcodeOptions{});
+  ASSERT_EQ(text.moves.size(), 1u);
+  EXPECT_EQ(text.moves[0].to_mm, Vec3(1, 0, 0));
+}
+
 // codes that move every later point by what the file does not give, or by a transform the
 // reader does not apply, are refused at their line; their cancels (G40, G15, G50.1, G69) pass
 TEST(Gcode, CompensationAndCoordinateTransformsAreRefused) {
