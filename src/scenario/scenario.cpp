@@ -47,6 +47,9 @@ constexpr std::size_t kMaxSpeedProblems = 20;
 constexpr double kClampChordTolerance_mm = 1e-3;
 // a surface toolpath's path problems listed before the rest are counted
 constexpr std::size_t kMaxSurfacePathProblems = 5;
+// a surface whose up-facing area is hidden under another part of it by more than this
+// fraction is noted: the hatch leaves that area bare
+constexpr double kHiddenAreaNoted = 0.01;
 // a surface toolpath starts and ends this far above the part's highest point (and its layers)
 constexpr double kSurfaceClearance_mm = 20.0;
 // the longest `name:` or planner `label:` (each names a folder; file systems allow 255 bytes)
@@ -1252,6 +1255,26 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     spec.speed_mm_s = *speed;
     projector = std::make_shared<const SurfaceProjector>(std::move(part));
     hatch = hatch_surface(*projector, spec);
+    // the hatch prints what is seen from above: an up-facing area under another part of the
+    // surface (a shelf under an overhang) gets nothing, and every run says so
+    const HiddenSurface hidden = hidden_top_surface(*projector, spec.min_normal_z);
+    if (hidden.hidden_area_mm2 > kHiddenAreaNoted * hidden.up_area_mm2) {
+      // "x -10 to 10", or "z 5" where the hidden area is flat
+      auto span = [&](int axis, const char* name) {
+        const double lo = hidden.lower_mm[axis], hi = hidden.upper_mm[axis];
+        return std::string(name) + " " + format_number(lo) +
+               (hi > lo ? " to " + format_number(hi) : std::string());
+      };
+      scenario_.notes.push_back(
+          "toolpath.surface: " +
+          format_number(std::round(1000.0 * hidden.hidden_area_mm2 / hidden.up_area_mm2) / 10.0) +
+          " % of the up-facing area of '" + given_file + "' (" +
+          format_number(std::round(hidden.hidden_area_mm2)) + " of " +
+          format_number(std::round(hidden.up_area_mm2)) + " mm², within " + span(0, "x") + ", " +
+          span(1, "y") + ", " + span(2, "z") +
+          " mm) lies under another part of the surface: the hatch is projected from above "
+          "onto the top surface only, so that area gets no deposit");
+    }
   } catch (const InputError& e) {
     // the reader's and the hatch's problems name this file and line
     for (Problem p : e.problems()) {

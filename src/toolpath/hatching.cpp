@@ -191,4 +191,61 @@ SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatch
   return result;
 }
 
+HiddenSurface hidden_top_surface(const SurfaceProjector& projector, double min_normal_z) {
+  HiddenSurface result;
+  const TriangleMesh& mesh = projector.mesh();
+  if (mesh.empty()) return result;
+  const double size_mm = (projector.upper_bound() - projector.lower_bound()).norm();
+  const double tolerance_mm = std::max(1e-3, 1e-6 * size_mm);
+  Vec3 lower = Vec3::Constant(INFINITY), upper = Vec3::Constant(-INFINITY);
+
+  // samples in batches (a mesh of millions of triangles keeps its memory to one batch)
+  constexpr std::size_t kBatch = 4096;
+  std::vector<Vec3> samples;
+  std::vector<int> owner;
+  std::vector<double> weight;
+  std::vector<Vec2> xy;
+  std::vector<std::optional<SurfaceHit>> hits;
+  auto flush = [&] {
+    xy.resize(samples.size());
+    for (std::size_t k = 0; k < samples.size(); ++k) xy[k] = samples[k].head<2>();
+    projector.project_down(xy, hits);
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      const std::optional<SurfaceHit>& hit = hits[k];
+      if (!hit || hit->triangle == owner[k] || hit->point_mm.z() <= samples[k].z() + tolerance_mm)
+        continue;
+      result.hidden_area_mm2 += weight[k];
+      for (int corner : mesh.triangles[static_cast<std::size_t>(owner[k])]) {
+        lower = lower.cwiseMin(mesh.vertices[static_cast<std::size_t>(corner)]);
+        upper = upper.cwiseMax(mesh.vertices[static_cast<std::size_t>(corner)]);
+      }
+    }
+    samples.clear();
+    owner.clear();
+    weight.clear();
+  };
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    if (mesh.facet_normal(t).z() <= min_normal_z) continue;  // a wall or an underside
+    const double area = mesh.facet_area_mm2(t);
+    result.up_area_mm2 += area;
+    const Vec3& a = mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][0])];
+    const Vec3& b = mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][1])];
+    const Vec3& c = mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][2])];
+    // the centroids of the four triangles of the midpoint subdivision
+    for (const Vec3& sample : {Vec3((4.0 * a + b + c) / 6.0), Vec3((a + 4.0 * b + c) / 6.0),
+                               Vec3((a + b + 4.0 * c) / 6.0), Vec3((a + b + c) / 3.0)}) {
+      samples.push_back(sample);
+      owner.push_back(static_cast<int>(t));
+      weight.push_back(0.25 * area);
+    }
+    if (samples.size() >= kBatch) flush();
+  }
+  if (!samples.empty()) flush();
+  if (result.hidden_area_mm2 > 0.0) {
+    result.lower_mm = lower;
+    result.upper_mm = upper;
+  }
+  return result;
+}
+
 }  // namespace depotwin

@@ -82,4 +82,18 @@ SurfaceHatch hatch_surface(const TriangleMesh& placed_part_mm, const SurfaceHatc
 // the same with a projector built once (several hatches of one part)
 SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatchSpec& spec);
 
+// The up-facing area the hatch cannot reach: every grid point is projected straight down, so
+// only the top surface is printed; an up-facing triangle (facet n_z > min_normal_z) with
+// another part of the surface above it (a shelf under an overhang, a cavity's floor) gets no
+// deposit. Each triangle is sampled at the four centroids of its midpoint subdivision, a
+// quarter of its area each; a sample is hidden when the first surface above it is more than
+// 1e-3 mm (or 1e-6 of the part's size) higher.
+struct HiddenSurface {
+  double up_area_mm2 = 0.0;      // the up-facing area
+  double hidden_area_mm2 = 0.0;  // the part of it under another part of the surface
+  Vec3 lower_mm = Vec3::Zero();  // the bounds of the triangles with a hidden sample, if any
+  Vec3 upper_mm = Vec3::Zero();
+};
+HiddenSurface hidden_top_surface(const SurfaceProjector& projector, double min_normal_z = 0.1);
+
 }  // namespace depotwin

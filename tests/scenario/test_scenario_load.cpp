@@ -332,6 +332,47 @@ TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
   }
 }
 
+// An up-facing area under another part of the surface gets no deposit, and every run says
+// how much and where: a shelf at z 20 over half of a plate at z 1 hides 3000 of 9000 mm²
+TEST_F(ScenarioLoad, ASurfaceUnderAnOverhangIsNoted) {
+  // counter-clockwise quads seen from above: (x0, x1, z)
+  const auto quads = [](const std::vector<std::array<double, 3>>& rectangles) {
+    std::string text = "solid shelf\n";
+    for (const auto& r : rectangles) {
+      const std::string z = " " + std::to_string(r[2]) + "\n";
+      const std::string x0 = std::to_string(r[0]), x1 = std::to_string(r[1]);
+      for (const std::array<std::string, 3>& corners :
+           {std::array<std::string, 3>{x0 + " -30", x1 + " -30", x1 + " 30"},
+            std::array<std::string, 3>{x0 + " -30", x1 + " 30", x0 + " 30"}}) {
+        text += " facet normal 0 0 1\n  outer loop\n";
+        for (const std::string& xy : corners) text += "   vertex " + xy + z;
+        text += "  endloop\n endfacet\n";
+      }
+    }
+    return text + "endsolid shelf\n";
+  };
+  write("shelf.stl", quads({{-50, 0, 20}, {-50, 0, 1}, {0, 50, 1}}));
+  write("plate.stl", quads({{-50, 0, 1}, {0, 50, 1}}));
+  const auto scenario = [&](const std::string& stl) {
+    return load_scenario(
+        write(stl + ".yaml",
+              "machine: arm6\nlimits: {v_max: 200, a_max: 2000}\nprocess: {type: aerosol}\n"
+              "toolpath:\n  speed: 10\n  surface: {file: " +
+                  stl + ", hatch_mm: 2}\n"));
+  };
+  const Scenario shelf = scenario("shelf.stl");
+  ASSERT_EQ(shelf.notes.size(), 1u);
+  EXPECT_EQ(shelf.notes[0],
+            "toolpath.surface: 33.3 % of the up-facing area of 'shelf.stl' (3000 of 9000 mm², "
+            "within x -50 to 0, y -30 to 30, z 1 mm) lies under another part of the surface: "
+            "the hatch is projected from above onto the top surface only, so that area gets no "
+            "deposit");
+  // the hatch itself: nothing printed at z 1 where the shelf is above
+  for (const PrintPath& path : shelf.toolpath.paths)
+    for (const Vec3& p : path.points) EXPECT_TRUE(p.x() >= -1e-9 || p.z() == 20.0) << p.transpose();
+  EXPECT_TRUE(scenario("plate.stl").notes.empty());
+}
+
 // A planner parameter from the registry: its default loads, a value past its range does
 // not. Skipped while no registered planner declares parameters.
 TEST_F(ScenarioLoad, PlannerParametersFromTheRegistry) {

@@ -356,6 +356,85 @@ TEST(Hatching, GapRatio) {
   }
 }
 
+// a rectangle at height z over [x0, x1] x [y0, y1], in nx x ny cells of two triangles each,
+// added to `mesh`; facing up, or down (wound clockwise seen from above)
+void add_rectangle(TriangleMesh& mesh, double x0, double x1, double y0, double y1, double z, int nx,
+                   int ny, bool up = true) {
+  const int first = static_cast<int>(mesh.vertices.size());
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i)
+      mesh.vertices.push_back(Vec3(x0 + (x1 - x0) * i / nx, y0 + (y1 - y0) * j / ny, z));
+  auto at = [&](int i, int j) { return first + j * (nx + 1) + i; };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+      mesh.triangles.push_back(up ? std::array<int, 3>{a, b, c} : std::array<int, 3>{a, c, b});
+      mesh.triangles.push_back(up ? std::array<int, 3>{a, c, d} : std::array<int, 3>{a, d, c});
+    }
+}
+
+// the closed box [x0, x1] x [y0, y1] x [z0, z1], its faces outward (or inward: a cavity)
+void add_box(TriangleMesh& mesh, const Vec3& lo, const Vec3& hi, bool outward = true) {
+  const int first = static_cast<int>(mesh.vertices.size());
+  for (int k = 0; k < 8; ++k)
+    mesh.vertices.push_back(
+        Vec3(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z()));
+  // each face counter-clockwise seen from outside
+  const int faces[6][4] = {{4, 5, 7, 6}, {0, 2, 3, 1}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) {
+    const std::array<int, 4> q{first + f[0], first + f[1], first + f[2], first + f[3]};
+    if (outward) {
+      mesh.triangles.push_back({q[0], q[1], q[2]});
+      mesh.triangles.push_back({q[0], q[2], q[3]});
+    } else {
+      mesh.triangles.push_back({q[0], q[2], q[1]});
+      mesh.triangles.push_back({q[0], q[3], q[2]});
+    }
+  }
+}
+
+// What the hatch cannot reach from above: a shelf over half of a lower plate hides that
+// half (3000 of the 9000 mm² facing up), a cavity's floor inside a closed box is hidden
+// (400 of 2400 + 400 mm²); a solid's own walls, bottom and a cavity's ceiling do not face up
+TEST(Hatching, HiddenTopSurfaceIsTheUpFacingAreaUnderAnother) {
+  TriangleMesh shelf;
+  add_rectangle(shelf, -50, 0, -30, 30, 20, 5, 6);   // 3000 mm² at z 20
+  add_rectangle(shelf, -50, 50, -30, 30, 1, 10, 6);  // 6000 mm² at z 1, half under the shelf
+  const HiddenSurface under_shelf = hidden_top_surface(SurfaceProjector(shelf));
+  EXPECT_NEAR(under_shelf.up_area_mm2, 9000.0, 1e-9);
+  EXPECT_NEAR(under_shelf.hidden_area_mm2, 3000.0, 1e-9);
+  EXPECT_EQ(under_shelf.lower_mm, Vec3(-50, -30, 1));
+  EXPECT_EQ(under_shelf.upper_mm, Vec3(0, 30, 1));
+
+  TriangleMesh cavity;
+  add_box(cavity, Vec3(-30, -20, 0), Vec3(30, 20, 20));
+  add_box(cavity, Vec3(-10, -10, 5), Vec3(10, 10, 10), false);
+  const HiddenSurface inside = hidden_top_surface(SurfaceProjector(cavity));
+  EXPECT_NEAR(inside.up_area_mm2, 2400.0 + 400.0, 1e-9);
+  EXPECT_NEAR(inside.hidden_area_mm2, 400.0, 1e-9);
+  EXPECT_EQ(inside.lower_mm, Vec3(-10, -10, 5));
+  EXPECT_EQ(inside.upper_mm, Vec3(10, 10, 5));
+}
+
+// Nothing is hidden on a height field: a solid bonnet (walls and bottom), a plate whose top is
+// written twice (coplanar duplicates), a patch facing down (nothing faces up)
+TEST(Hatching, HiddenTopSurfaceIsNoneOnAHeightField) {
+  const HiddenSurface bonnet = hidden_top_surface(SurfaceProjector(car_bonnet(CarBonnetParams{})));
+  EXPECT_GT(bonnet.up_area_mm2, 150.0 * 130.0);
+  EXPECT_EQ(bonnet.hidden_area_mm2, 0.0);
+  TriangleMesh twice;
+  add_rectangle(twice, 0, 40, 0, 20, 3, 4, 2);
+  add_rectangle(twice, 0, 40, 0, 20, 3, 4, 2);
+  const HiddenSurface doubled = hidden_top_surface(SurfaceProjector(twice));
+  EXPECT_NEAR(doubled.up_area_mm2, 1600.0, 1e-9);
+  EXPECT_EQ(doubled.hidden_area_mm2, 0.0);
+  TriangleMesh down;
+  add_rectangle(down, 0, 40, 0, 20, 3, 4, 2, false);
+  add_rectangle(down, 0, 40, 0, 20, 1, 4, 2, false);
+  EXPECT_EQ(hidden_top_surface(SurfaceProjector(down)).up_area_mm2, 0.0);
+}
+
 TEST(Hatching, BadSpecsAreInputErrors) {
   const TriangleMesh mesh = plate(5.0, 5.0, 0.0);
   auto problem_key = [&](const SurfaceHatchSpec& spec) -> std::string {
