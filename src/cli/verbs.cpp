@@ -86,6 +86,8 @@ int validate_verb(const std::string& path, const std::string& max_memory) {
               << message_number(static_cast<double>(scenario.sim.max_steps)) << "); about "
               << format_bytes(memory_bytes) << " for the runs' data (--max-memory "
               << format_bytes(budget.max_memory_bytes) << ")\n";
+  // what loading found and every run will repeat (a surface turned over, a G-code rule chosen)
+  for (const std::string& note : scenario.notes) std::cout << "warning: " << note << '\n';
   return kExitOk;
 }
 

@@ -65,5 +65,19 @@ planners: [conformal]
   EXPECT_EQ(r.output.find("toolpath path"), std::string::npos) << r.output;
 }
 
+// what loading notes, which every run repeats as a warning, validate prints too (here the
+// rule a G-code file is read by)
+TEST(ValidateVerb, PrintsTheNotesEveryRunWouldWarnOf) {
+  const std::string dir = fresh_directory("validate_notes");
+  write_text(dir, "square.gcode", "G21\nG90\nM83\nG1 X10 Y0 E1 F600\nG1 X10 Y10 E1\n");
+  const std::string path = write_text(dir, "notes.yaml", R"(process: {type: extrusion}
+toolpath: {gcode: square.gcode}
+)");
+  const auto r = depotwin("validate " + path);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(path + ": ok"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\nwarning: toolpath.gcode: "), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace depotwin
