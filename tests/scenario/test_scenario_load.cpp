@@ -1,6 +1,7 @@
 // Scenario files that must load, and the values they load into.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -269,6 +270,25 @@ TEST_F(ScenarioLoad, GcodeToolpathRelativeToTheScenarioFile) {
   EXPECT_DOUBLE_EQ(s.toolpath.print_length_mm(), 20.0 + 10.0 + 15.0);
 }
 
+// an ASCII STL of the given facets, each three "x y z" vertices in the order written
+std::string ascii_stl(const std::string& name,
+                      const std::vector<std::array<std::string, 3>>& facets) {
+  std::string text = "solid " + name + "\n";
+  for (const std::array<std::string, 3>& facet : facets) {
+    text += " facet normal 0 0 0\n  outer loop\n";
+    for (const std::string& vertex : facet) text += "   vertex " + vertex + "\n";
+    text += "  endloop\n endfacet\n";
+  }
+  return text + "endsolid " + name + "\n";
+}
+
+// an aerosol scenario on the arm hatching `stl` at 2 mm, with more surface keys after it
+std::string surface_scenario(const std::string& stl, const std::string& more_keys = "") {
+  return "machine: arm6\nlimits: {v_max: 200, a_max: 2000}\nprocess: {type: aerosol}\n"
+         "toolpath:\n  speed: 10\n  surface: {file: " +
+         stl + ", hatch_mm: 2" + more_keys + "}\n";
+}
+
 // A surface STL wound clockwise seen from above (a patch exported facing down) is turned
 // over, and one facet wound against its neighbour turned to match it: the same hatch as the
 // same patch wound counter-clockwise, tool axes up, and a note that every run reports. The
@@ -276,16 +296,14 @@ TEST_F(ScenarioLoad, GcodeToolpathRelativeToTheScenarioFile) {
 TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
   // each facet up or down
   const auto patch = [](bool first_up, bool second_up) {
-    const char* corners[2][3] = {{"0 0 1", "10 0 2", "10 10 2"}, {"0 0 1", "10 10 2", "0 10 1"}};
-    std::string text = "solid patch\n";
-    for (int f : {0, 1}) {
-      const bool facing_up = f == 0 ? first_up : second_up;
-      text += " facet normal 0 0 0\n  outer loop\n";
-      for (int k : {0, 1, 2})
-        text += std::string("   vertex ") + corners[f][facing_up ? k : (3 - k) % 3] + "\n";
-      text += "  endloop\n endfacet\n";
-    }
-    return text + "endsolid patch\n";
+    const std::array<std::string, 3> first{"0 0 1", "10 0 2", "10 10 2"};
+    const std::array<std::string, 3> second{"0 0 1", "10 10 2", "0 10 1"};
+    // a facet facing down: its corners in the opposite order (the first kept first)
+    const auto turned = [](const std::array<std::string, 3>& c) {
+      return std::array<std::string, 3>{c[0], c[2], c[1]};
+    };
+    return ascii_stl("patch",
+                     {first_up ? first : turned(first), second_up ? second : turned(second)});
   };
   write("up.stl", patch(true, true));
   write("down.stl", patch(false, false));
@@ -294,11 +312,7 @@ TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
   write("mixed_up.stl", patch(true, false));
   write("mixed_down.stl", patch(false, true));
   const auto scenario = [&](const std::string& stl) {
-    return load_scenario(
-        write(stl + ".yaml",
-              "machine: arm6\nlimits: {v_max: 200, a_max: 2000}\nprocess: {type: aerosol}\n"
-              "toolpath:\n  speed: 10\n  surface: {file: " +
-                  stl + ", hatch_mm: 2, alpha: 1}\n"));
+    return load_scenario(write(stl + ".yaml", surface_scenario(stl, ", alpha: 1")));
   };
   const Scenario up = scenario("up.stl");
   const Scenario down = scenario("down.stl");
@@ -337,28 +351,19 @@ TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
 TEST_F(ScenarioLoad, ASurfaceUnderAnOverhangIsNoted) {
   // counter-clockwise quads seen from above: (x0, x1, z)
   const auto quads = [](const std::vector<std::array<double, 3>>& rectangles) {
-    std::string text = "solid shelf\n";
+    std::vector<std::array<std::string, 3>> facets;
     for (const auto& r : rectangles) {
-      const std::string z = " " + std::to_string(r[2]) + "\n";
+      const std::string z = " " + std::to_string(r[2]);
       const std::string x0 = std::to_string(r[0]), x1 = std::to_string(r[1]);
-      for (const std::array<std::string, 3>& corners :
-           {std::array<std::string, 3>{x0 + " -30", x1 + " -30", x1 + " 30"},
-            std::array<std::string, 3>{x0 + " -30", x1 + " 30", x0 + " 30"}}) {
-        text += " facet normal 0 0 1\n  outer loop\n";
-        for (const std::string& xy : corners) text += "   vertex " + xy + z;
-        text += "  endloop\n endfacet\n";
-      }
+      facets.push_back({x0 + " -30" + z, x1 + " -30" + z, x1 + " 30" + z});
+      facets.push_back({x0 + " -30" + z, x1 + " 30" + z, x0 + " 30" + z});
     }
-    return text + "endsolid shelf\n";
+    return ascii_stl("shelf", facets);
   };
   write("shelf.stl", quads({{-50, 0, 20}, {-50, 0, 1}, {0, 50, 1}}));
   write("plate.stl", quads({{-50, 0, 1}, {0, 50, 1}}));
   const auto scenario = [&](const std::string& stl) {
-    return load_scenario(
-        write(stl + ".yaml",
-              "machine: arm6\nlimits: {v_max: 200, a_max: 2000}\nprocess: {type: aerosol}\n"
-              "toolpath:\n  speed: 10\n  surface: {file: " +
-                  stl + ", hatch_mm: 2}\n"));
+    return load_scenario(write(stl + ".yaml", surface_scenario(stl)));
   };
   const Scenario shelf = scenario("shelf.stl");
   ASSERT_EQ(shelf.notes.size(), 1u);
