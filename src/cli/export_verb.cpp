@@ -433,7 +433,10 @@ int export_verb(const ExportOptions& options) {
       labels += (labels.empty() ? "" : ", ") + spec.run_label();
     throw InputError("--planner", "export writes one planner's motion; choose one of " + labels);
   }
-  const PreparedJob job = prepare_checked_job(scenario, planners, JobBudget{}, false, false);
+  // (every pose of the plan solved, as validate does: G-code the machine cannot follow is
+  // refused, not written)
+  const PreparedJob job =
+      prepare_checked_job(scenario, planners, JobBudget{}, false, false, nullptr, true);
   const PlannedRun planned = plan_job(job, planners.front());
 
   GcodeExportJob export_job;

@@ -159,6 +159,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   facts.ignored_axis_codes = program.ignored_axis_codes;
   bool previous_printed = false;
   Vec3 previous_end = Vec3::Zero();
+  double previous_feed = 0.0;
   // every move: print or travel, its length, boxes and time
   for (const GcodeMove& move : program.moves) {
     const bool prints = move_prints(move, resolved);
@@ -168,8 +169,9 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
       facts.print_length_mm += move.length_mm;
       facts.n_print_arcs += move.arc.is_arc() ? 1 : 0;
       grow(facts.print_bbox, move);
-      const bool continues =
-          previous_printed && (move.from_mm - previous_end).norm() <= kJoinTolerance_mm;
+      // a print path as the import makes them: connected print moves at one feed rate
+      const bool continues = previous_printed && move.feed_mm_s == previous_feed &&
+                             (move.from_mm - previous_end).norm() <= kJoinTolerance_mm;
       facts.n_print_paths += continues ? 0 : 1;
     } else {
       ++facts.n_travel_moves;
@@ -177,6 +179,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
     }
     previous_printed = prints;
     previous_end = move.to_mm;
+    previous_feed = move.feed_mm_s;
     if (move.feed_mm_s > 0.0)
       facts.feed_rate_time_s += move.length_mm / move.feed_mm_s;
     else
@@ -220,6 +223,15 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
 
 void inspect_gcode_file(const std::string& path, const GcodeOptions& options,
                         const InspectBaseline& baseline) {
+  // the shutter codes, named by their options
+  for (const auto& [option, code] :
+       {std::pair<const char*, const std::string*>{"--open", &options.open_code},
+        {"--close", &options.close_code}})
+    if (const std::string problem = shutter_code_problem(*code); !problem.empty())
+      throw InputError(option, problem);
+  if (const std::string clash = shutter_codes_clash(options.open_code, options.close_code);
+      !clash.empty())
+    throw InputError("--close", clash);
   const GcodeProgram program = read_gcode_program(path, options);
   // no facts of a file that holds no code: zeros would read as an empty print
   if (const std::string problem = no_code_problem(program.n_lines, program.n_code_lines);

@@ -27,7 +27,7 @@ struct GcodeFacts {
   int n_lines = 0;
   int n_print_moves = 0;
   int n_travel_moves = 0;
-  int n_print_paths = 0;  // uninterrupted print runs
+  int n_print_paths = 0;  // connected print moves at one feed rate (as the import splits them)
   int n_print_arcs = 0;   // print moves that are G2/G3
   double print_length_mm = 0.0;
   double travel_length_mm = 0.0;

@@ -46,7 +46,10 @@ int plan_verb(const RunOptions& options) {
   OutputFolder out(output_directory(scenario, options.out), "plan", scenario.file,
                    !options.no_wait);
   const std::string& directory = out.final_path();
-  const PreparedJob job = prepare_checked_job(scenario, planners, budget, false, true);
+  // (every pose of each plan solved, as validate does: a plan the machine cannot follow is
+  // refused, not written)
+  const PreparedJob job =
+      prepare_checked_job(scenario, planners, budget, false, true, nullptr, true);
   const std::vector<MetricsReport> reports = write_plans(job, planners, out.path());
   out.commit();
   std::cout << "scenario " << scenario.name << " (" << scenario.file << "), machine "

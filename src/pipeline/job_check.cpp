@@ -367,10 +367,12 @@ std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerS
             {spec, std::make_shared<const Trajectory>(plan_trajectory(job, spec))});
       const Trajectory& plan = *job.checked_plan(spec);
       const RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
-      // validate: its every pose solved now, as the simulation will (a planner's move may
-      // leave the travel or the reach between the toolpath's points); a run too long for
-      // sim.max_steps is refused for that instead (size_problems), before any such work
-      if (solve_poses && simulate && run.steps <= static_cast<double>(job.scenario.sim.max_steps))
+      // validate, plan and export: its every pose solved now, as the simulation will (a
+      // planner's move may leave the travel or the reach between the toolpath's points); a run
+      // too long for sim.max_steps is refused for that instead (size_problems), before any
+      // such work
+      if (solve_poses &&
+          (!simulate || run.steps <= static_cast<double>(job.scenario.sim.max_steps)))
         check_plan_poses(job, spec, plan);
       runs.push_back(run);
     } catch (const InputError& e) {

@@ -68,8 +68,9 @@ Scenario check_scenario(const std::string& path, const JobBudget& budget, std::s
 
 // Stage 2 (above): each planner's plan on the prepared job, measured; problems (a plan the
 // planner refuses, a run too large) appended to `problems`, the estimates returned. With
-// solve_poses (validate), each run's plan is also solved pose by pose as the simulation will
-// solve it (check_plan_poses: a plan leaving the travel or the reach); run and compare leave
+// solve_poses (validate, plan, export: the verbs that simulate nothing), each run's plan is
+// also solved pose by pose as the simulation will solve it (check_plan_poses: a plan leaving
+// the travel or the reach); run and compare leave
 // that to the simulation itself, which says the same word for word (on an arm the inverse
 // kinematics of every step is most of a run's cost, and would be paid twice). Each plan is
 // kept in job.checked_plans, where plan_job takes it.

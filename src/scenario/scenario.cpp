@@ -801,6 +801,7 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   settings->file = resolved.string();
   GcodeOptions options;
   options.default_speed_mm_s = default_speed.value_or(0.0);
+  bool bad_code = false;  // a shutter code that is none, or open and close that clash
   if (view) {
     const auto read_word = [&](const char* key, std::string& target) {
       const Field* f = view->find(key);
@@ -817,6 +818,21 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
     read_word("rule", settings->rule);
     read_word("open", settings->open_code);
     read_word("close", settings->close_code);
+    // each a G or M code, and two different switches (else nothing can be read under them)
+    for (const auto& [key, code] :
+         {std::pair<const char*, const std::string*>{"open", &settings->open_code},
+          {"close", &settings->close_code}})
+      if (const std::string problem = shutter_code_problem(*code); !problem.empty()) {
+        const Field* f = view->find(key);
+        problems_.add(f->line, f->key, problem);
+        bad_code = true;
+      }
+    if (const std::string clash = shutter_codes_clash(settings->open_code, settings->close_code);
+        !bad_code && !clash.empty()) {
+      const Field* f = view->find("close") ? view->find("close") : view->find("open");
+      problems_.add(f->line, f->key, clash);
+      bad_code = true;
+    }
     read_word("feed", settings->feed);
     if (const Field* f = view->find("chord_tolerance_mm"))
       settings->chord_tolerance_mm =
@@ -849,6 +865,7 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   options.first_layer = settings->first_layer;
   options.last_layer = settings->last_layer;
   scenario_.gcode = settings;
+  if (bad_code) return;
 
   if (const std::string problem = missing_file_problem("G-code", *given, resolved.string());
       !problem.empty()) {
@@ -859,7 +876,14 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   try {
     imported = read_gcode(resolved.string(), options);
   } catch (const InputError& e) {
-    for (const Problem& p : e.problems()) problems_.add_problem(p);
+    for (const Problem& p : e.problems()) {
+      // a layer range the file does not have belongs to the scenario's `layers:`
+      const Field* layers = view ? view->find("layers") : nullptr;
+      if (layers && p.key == "toolpath.gcode.layers")
+        problems_.add(layers->line, layers->key, p.message + " of '" + *given + "'");
+      else
+        problems_.add_problem(p);
+    }
     return;
   }
   settings->rule_applied = print_rule_name(imported.rule);
@@ -1890,10 +1914,15 @@ std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine&
   const auto end_line = [&](int given) {
     return given > 0 ? given : surface_line > 0 ? surface_line : scenario.toolpath_line;
   };
-  if (const auto why = unreachable(Pose(toolpath.start_mm)))
+  // (a default is the toolpath's first point: unknown while no path could be read)
+  const bool defaults_known = !toolpath.paths.empty();
+  if (const auto why = scenario.start_line > 0 || defaults_known
+                           ? unreachable(Pose(toolpath.start_mm))
+                           : std::nullopt)
     add(Problem{scenario.file, end_line(scenario.start_line), "toolpath.start",
                 (scenario.start_line > 0 ? "" : "(the default) ") + *why});
-  if (const auto why = unreachable(Pose(toolpath.end_mm)))
+  if (const auto why = scenario.end_line > 0 || defaults_known ? unreachable(Pose(toolpath.end_mm))
+                                                               : std::nullopt)
     add(Problem{scenario.file, end_line(scenario.end_line), "toolpath.end",
                 (scenario.end_line > 0 ? "" : "(the default) ") + *why});
   // every point of every path, where it was given

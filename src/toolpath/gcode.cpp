@@ -235,6 +235,18 @@ std::optional<Code> code_of(const std::string& text) {
   return Code{upper(text[0]), static_cast<int>(std::lround(number * 10.0))};
 }
 
+// whether `code` in a file is the shutter code `given`: the same code, or M3 and M4, which both
+// switch a spindle or a laser on (clockwise and counter-clockwise in RS274/NGC, constant and
+// dynamic power in grbl), so an open code of either opens with both
+bool is_shutter_code(const std::optional<Code>& given, const Code& code) {
+  if (!given) return false;
+  if (given->letter == code.letter && given->tenths == code.tenths) return true;
+  const auto spindle_on = [](const Code& c) {
+    return c.letter == 'M' && (c.tenths == 30 || c.tenths == 40);
+  };
+  return spindle_on(*given) && spindle_on(code);
+}
+
 // Ask for 2 MB pages over a large buffer not yet written (Linux transparent huge pages in
 // `madvise` mode): a 10^6-line file's moves take ~140 MB, and first touching them 4 kB at a
 // time costs more than parsing them. Only advice: nothing changes where it is not honoured.
@@ -418,9 +430,8 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
       tenths = number * 10;
       if (stop + 1 < end && *stop == '.' && is_digit(stop[1])) tenths += stop[1] - '0';
     }
-    const bool shutter_code =
-        (open_code_ && open_code_->letter == 'M' && open_code_->tenths == tenths) ||
-        (close_code_ && close_code_->letter == 'M' && close_code_->tenths == tenths);
+    const bool shutter_code = tenths >= 0 && (is_shutter_code(open_code_, Code{'M', tenths}) ||
+                                              is_shutter_code(close_code_, Code{'M', tenths}));
     if (tenths >= 0 && !shutter_code && tenths % 10 == 0 && is_text_command(number)) return;
     // Fanuc's M98 P1000 runs subprogram O1000, whose moves would be skipped (RepRapFirmware's
     // M98 P"macro.g" runs a macro: the firmware's, not the print's)
@@ -597,13 +608,10 @@ void GcodeParser::execute(int line_number) {
   bool opens = false;     // the line holds the open code
   for (int i = 0; i < words_.n_codes; ++i) {
     const Code code = words_.codes[i];
-    const auto is_code = [&](const std::optional<Code>& c) {
-      return c && c->letter == code.letter && c->tenths == code.tenths;
-    };
-    if (is_code(open_code_)) {
+    if (is_shutter_code(open_code_, code)) {
       open_ = opens = true;
       program_.has_shutter_codes = true;
-    } else if (is_code(close_code_)) {
+    } else if (is_shutter_code(close_code_, code)) {
       open_ = false;
       program_.has_shutter_codes = true;
     }
@@ -1152,16 +1160,33 @@ std::optional<PrintRule> print_rule_from_name(const std::string& name) {
   return std::nullopt;
 }
 
+std::string shutter_code_problem(const std::string& code) {
+  if (code_of(code)) return "";
+  return "'" + printable(code.data(), code.data() + code.size()) +
+         "' is not a G or M code (e.g. M3, M5, M106, M107)";
+}
+
+std::string shutter_codes_clash(const std::string& open, const std::string& close) {
+  const std::optional<Code> open_code = code_of(open), close_code = code_of(close);
+  if (!open_code || !close_code || !is_shutter_code(open_code, *close_code)) return "";
+  return "'" + close + "' would close what '" + open + "' opens" +
+         (open_code->tenths == close_code->tenths
+              ? std::string(": the open and close codes must differ")
+              : std::string(": M3 and M4 both switch a spindle or laser on, so either opens")) +
+         " (e.g. open M3, close M5)";
+}
+
 GcodeProgram parse_gcode_program(const std::string& text, const std::string& file_label,
                                  const GcodeOptions& options) {
-  // the shutter codes must be G or M codes (M3, M106, ...)
+  // the shutter codes must be G or M codes (M3, M106, ...), and two different switches
   for (const auto& [key, code] :
        {std::pair<const char*, const std::string*>{"open", &options.open_code},
         {"close", &options.close_code}})
-    if (!code_of(*code))
-      throw InputError(std::string(kKey) + "." + key,
-                       "'" + printable(code->data(), code->data() + code->size()) +
-                           "' is not a G or M code (e.g. M3, M5, M106, M107)");
+    if (const std::string problem = shutter_code_problem(*code); !problem.empty())
+      throw InputError(std::string(kKey) + "." + key, problem);
+  if (const std::string clash = shutter_codes_clash(options.open_code, options.close_code);
+      !clash.empty())
+    throw InputError(std::string(kKey) + ".close", clash);
   GcodeParser parser(file_label, options);
   const char* p = text.data();
   const char* end = p + text.size();
@@ -1268,7 +1293,7 @@ GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions
   const int last_layer = options.last_layer < 0 ? n_layers - 1 : options.last_layer;
   if (n_layers > 0 &&
       (options.first_layer < 0 || options.first_layer > last_layer || last_layer >= n_layers))
-    throw InputError(program.file_label, 0, kKey,
+    throw InputError(program.file_label, 0, std::string(kKey) + ".layers",
                      "layers [" + std::to_string(options.first_layer) + ", " +
                          std::to_string(options.last_layer) + "] not in the file's " +
                          std::to_string(n_layers) + " layers (0 to " +

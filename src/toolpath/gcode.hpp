@@ -21,12 +21,12 @@
 // alone in a file without LF.
 //
 // Print rules decide which moves deposit: `e` (E increases), `shutter` (G1/G2/G3 while the
-// open code is active and the modal S, a laser's or spindle's power, is not 0), `feed`
-// (G1/G2/G3 print, G0 travels) and `auto` (E values: e; else the open or close code present:
-// shutter; else feed). Consecutive print moves at one feed rate
-// form one print path; arcs stay exact (PrintPath::arcs) until a planner chords them.
-// A path's layer is the z of the first point of its uninterrupted print run; layers are
-// numbered 0, 1, ... by increasing z (levels within 1e-6 mm are one).
+// open code is active (M3 and M4 both, where either is the open code) and the modal S, a laser's or
+// spindle's power, is not 0), `feed` (G1/G2/G3 print, G0 travels) and `auto` (E values: e; else the
+// open or close code present: shutter; else feed). Consecutive print moves at one feed rate form
+// one print path; arcs stay exact (PrintPath::arcs) until a planner chords them. A path's layer is
+// the z of the first point of its uninterrupted print run; layers are numbered 0, 1, ... by
+// increasing z (levels within 1e-6 mm are one).
 #pragma once
 
 #include <istream>
@@ -47,7 +47,9 @@ std::optional<PrintRule> print_rule_from_name(const std::string& name);
 
 struct GcodeOptions {
   PrintRule rule = PrintRule::automatic;
-  std::string open_code = "M3";     // shutter rule: the code that opens (e.g. M106)
+  // shutter rule: the code that opens (e.g. M106); M3 and M4 both open where either is given
+  // (a spindle or laser switched on: clockwise or counter-clockwise, constant or dynamic power)
+  std::string open_code = "M3";
   std::string close_code = "M5";    // and the one that closes (e.g. M107)
   double default_speed_mm_s = 0.0;  // <= 0: none (then a print move before any F is an error)
   int first_layer = 0;              // layers [first, last] are imported (0-based)
@@ -110,6 +112,12 @@ std::string g_code_name(int tenths);
 // "holds no G-code: none of its N lines has a G or M code (...)" ("is empty ..." when it has
 // no line), or "" when the file has a line of code (GcodeProgram's n_lines, n_code_lines)
 std::string no_code_problem(int n_lines, int n_code_lines);
+
+// what is wrong with a shutter rule's code as given ("" when nothing: a G or M code such as
+// M3, M106), and with an open and close code together ("" unless they are one switch: the
+// same code, or M3 and M4)
+std::string shutter_code_problem(const std::string& code);
+std::string shutter_codes_clash(const std::string& open, const std::string& close);
 
 // Parse G-code text; `file_label` names the source in messages. Throws InputError listing
 // the first 20 malformed lines ("file:line: toolpath.gcode: ...") and then how many more.

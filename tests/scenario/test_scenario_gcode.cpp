@@ -136,6 +136,42 @@ toolpath:
                  "must be in [0.0001, 1], got 0");
 }
 
+// the shutter codes and a layer range the file lacks are named at their scenario keys, and a
+// file that did not load adds no problem of the default start and end (its first print point,
+// unknown): one problem each
+TEST_F(ScenarioGcode, CodesAndLayersAreNamedAtTheirKeys) {
+  write("layers.gcode", kThreeLayers);
+  const auto bad_code = problems_of(R"(
+machine: cartesian
+toolpath:
+  offset: [500, 0, 0]
+  gcode: {file: layers.gcode, open: M4 S1000}
+)");
+  ASSERT_EQ(bad_code.size(), 1u) << dump(bad_code);
+  expect_problem(bad_code, scenario_path(), "toolpath.gcode.open", 4,
+                 "'M4 S1000' is not a G or M code (e.g. M3, M5, M106, M107)");
+  const auto clash = problems_of(R"(
+machine: cartesian
+toolpath:
+  gcode: {file: layers.gcode, open: M4, close: M3}
+)");
+  ASSERT_EQ(clash.size(), 1u) << dump(clash);
+  expect_problem(clash, scenario_path(), "toolpath.gcode.close", 3,
+                 "'M3' would close what 'M4' opens: M3 and M4 both switch a spindle or laser on");
+  const auto layers = problems_of(R"(
+machine: cartesian
+limits: {v_max: 20, a_max: 300}
+toolpath:
+  offset: [500, 0, 0]
+  gcode:
+    file: layers.gcode
+    layers: [0, 7]
+)");
+  ASSERT_EQ(layers.size(), 1u) << dump(layers);
+  expect_problem(layers, scenario_path(), "toolpath.gcode.layers", 7,
+                 "layers [0, 7] not in the file's 3 layers (0 to 2) of 'layers.gcode'");
+}
+
 // a G3 quarter circle of radius 10 becomes chords within the tolerance, on the circle
 TEST_F(ScenarioGcode, ArcsAreChordedWithinTheTolerance) {
   write("arc.gcode", "G1 X10 Y0 F600\nG3 X0 Y10 I-10 J0 E1\n");

@@ -175,6 +175,40 @@ TEST(Gcode, PowerZeroClosesTheShutter) {
   expect_points(imported.toolpath.paths[2], {Vec3(5, 0, 0), Vec3(0, 0, 0)});
 }
 
+TEST(Gcode, M3AndM4BothOpenTheShutter) {
+  // a grbl laser file switches the laser on with M4 (dynamic power), a mill's spindle may turn
+  // either way: under the default open code M3 (and under M4), both open, M5 closes
+  for (const std::string open : {"M3", "M4"}) {
+    GcodeOptions options;
+    options.open_code = open;
+    const GcodeProgram program = parse_gcode_program(
+        "G21 G90\nM4 S0\nG0 X10 Y10\nG1 X30 Y10 S800 F600\nM5\nG1 X40\nM3 S100\nG1 Y20\nM5\n",
+        "laser.gcode", options);
+    const GcodeImport imported = import_gcode_program(program, options);
+    EXPECT_EQ(imported.rule, PrintRule::shutter) << open;
+    ASSERT_EQ(imported.toolpath.paths.size(), 2u) << open;
+    expect_points(imported.toolpath.paths[0], {Vec3(10, 10, 0), Vec3(30, 10, 0)});
+    expect_points(imported.toolpath.paths[1], {Vec3(40, 10, 0), Vec3(40, 20, 0)});
+  }
+  // open and close must be two switches: the same code, or M3 and M4, are refused
+  for (const auto& [open, close] : std::vector<std::pair<std::string, std::string>>{
+           {"M3", "M3"}, {"M3", "M4"}, {"M106", "M106"}}) {
+    GcodeOptions options;
+    options.open_code = open, options.close_code = close;
+    try {
+      parse_gcode_program("G1 X1\n", "test.gcode", options);
+      ADD_FAILURE() << "expected an InputError for open " << open << ", close " << close;
+    } catch (const InputError& e) {
+      ASSERT_EQ(e.problems().size(), 1u);
+      EXPECT_EQ(e.problems()[0].key, "toolpath.gcode.close");
+      EXPECT_EQ(
+          e.problems()[0].message.rfind("'" + close + "' would close what '" + open + "' opens", 0),
+          0u)
+          << e.problems()[0].message;
+    }
+  }
+}
+
 TEST(Gcode, ProgrammingAndSubprogramsAreNamed) {
   // LinuxCNC's O-word subroutines, # parameters and [ ] expressions, and Fanuc's M98 call: a
   // program, not a list of moves (RepRapFirmware's M98 P"macro.g" passes; a slicer's

@@ -148,6 +148,20 @@ TEST(GcodeFiles, M83RelativeExtrusionAndShortNumbers) {
   EXPECT_EQ(facts.layer_z_values, std::vector<double>{0.2});
 }
 
+TEST(GcodeFiles, PrintPathsSplitAtFeedChangesAsTheImportSplitsThem) {
+  // a CAM contour whose plunge, cut and lead-out run at three feeds is one connected run but
+  // three print paths, as a scenario imports it (a path has one speed)
+  const std::string text =
+      "G21 G90\nG0 X0 Y0 Z5\nM3 S1000\nG1 Z0 F300\nG1 X20 F1200\nG1 Y10\nG1 X0 F600\n"
+      "M5\nG0 Z5\n";
+  const GcodeProgram program = parse_gcode_program(text, "contour.nc", GcodeOptions{});
+  const GcodeFacts facts = gcode_facts(program, PrintRule::automatic);
+  EXPECT_EQ(facts.n_print_moves, 4);
+  EXPECT_EQ(facts.n_print_paths, 3);
+  EXPECT_EQ(import_gcode_program(program, GcodeOptions{}).toolpath.paths.size(),
+            static_cast<std::size_t>(facts.n_print_paths));
+}
+
 TEST(GcodeFiles, AerosolShutterCodes) {
   // auto: no E, M3/M5 present -> shutter: 25 + 20 mm printed, the G1 with M5 is a travel
   const GcodeFacts facts = facts_of("aerosol_m3_m5.ngc");
