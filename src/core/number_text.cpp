@@ -78,6 +78,21 @@ std::size_t printable_utf8_length(const std::string& text, std::size_t at) {
 
 }  // namespace
 
+std::size_t first_non_text_byte(const std::string& text) {
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const auto byte = static_cast<unsigned char>(text[at]);
+    if ((byte >= 0x20 && byte < 0x7F) || byte == '\t' || byte == '\n' || byte == '\r') {
+      ++at;
+    } else if (const std::size_t length = printable_utf8_length(text, at); length > 0) {
+      at += length;
+    } else {
+      return at;
+    }
+  }
+  return std::string::npos;
+}
+
 std::string printable_text(const std::string& text, std::size_t max_chars) {
   static const char* kHex = "0123456789ABCDEF";
   std::string out;

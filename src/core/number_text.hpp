@@ -30,4 +30,9 @@ void append_fixed(std::string& out, double value, int decimals);
 // \xNN, cut after max_chars characters with "..."
 std::string printable_text(const std::string& text, std::size_t max_chars = 40);
 
+// the offset of the first byte of `text` that is not text (not printable ASCII, a tab, LF or
+// CR, or well-formed UTF-8 of a printable code point: a NUL, another control byte, broken or
+// Latin-1 bytes), or std::string::npos when there is none
+std::size_t first_non_text_byte(const std::string& text);
+
 }  // namespace depotwin

@@ -2,9 +2,12 @@
 // (scenario/overrides.hpp).
 #include "scenario/overrides.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <filesystem>
 
+#include "core/number_text.hpp"
 #include "scenario/override_tree.hpp"
 
 namespace depotwin {
@@ -12,6 +15,23 @@ namespace depotwin {
 namespace scenario_detail {
 
 std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemList& problems) {
+  // text only: a NUL, a control byte or bytes that are not UTF-8 (a Latin-1 name) would reach
+  // names, folders and JSON otherwise, or be misread by the YAML parser
+  if (const std::size_t at = first_non_text_byte(text); at != std::string::npos) {
+    const std::size_t newline = at == 0 ? std::string::npos : text.rfind('\n', at - 1);
+    const std::size_t column = newline == std::string::npos ? at + 1 : at - newline;
+    const auto byte = static_cast<unsigned char>(text[at]);
+    char shown[8];
+    std::snprintf(shown, sizeof shown, "0x%02X", byte);
+    const bool control = byte < 0x20 || byte == 0x7F;
+    problems.add(
+        static_cast<int>(std::count(text.begin(), text.begin() + at, '\n')) + 1, "",
+        std::string(control ? "control byte " : "byte ") + shown + (byte == 0 ? " (NUL)" : "") +
+            " at column " + std::to_string(column) +
+            (control ? ": a scenario is text (YAML)"
+                     : " is not UTF-8: a scenario is UTF-8 text (YAML); save it as UTF-8"));
+    return std::nullopt;
+  }
   // exactly one YAML document (load_documents: not YAML::LoadAll, which never returns on some
   // malformed text)
   YamlDocuments documents;

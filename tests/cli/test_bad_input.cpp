@@ -368,6 +368,12 @@ std::vector<Row> rows() {
   r.push_back(scenario("LabelWithEscape",
                        probe_with("planners:", "planners: [{name: lspb_mtt, label: \"x\\e[31m\"}]"),
                        "{s}:11: planners\\[0\\]\\.label: 'x\\\\x1B\\[31m' holds a control"));
+  // raw bytes that are not text: a Latin-1 name, a NUL inside a key (before any YAML parsing)
+  r.push_back(scenario("NameNotUtf8", replace_line(probe(), "name:", "name: \xff\xfe bad"),
+                       "{s}:1: byte 0xFF at column 7 is not UTF-8: a scenario is UTF-8 text"));
+  r.push_back(scenario("NulInsideAKey",
+                       replace_line(probe(), "  segments:", std::string("  segme\0nts:", 12)),
+                       "{s}:8: control byte 0x00 \\(NUL\\) at column 8: a scenario is text"));
   // ---- bad --out (checked before any work) ----
   r.push_back(command("OutIsAFile", "run {dir}/scenario.yaml --out {dir}/afile --no-render --quiet",
                       "error: --out: .*afile: is a file, not a folder",
