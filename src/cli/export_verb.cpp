@@ -414,6 +414,19 @@ int export_verb(const ExportOptions& options) {
   check_out_path(options.out);
   // every check before any work (pipeline/job_check.hpp): one run, planned and sampled only
   const Scenario scenario = check_scenario(options.scenario, JobBudget{}, 1, false);
+  // never over a file the job reads (its G-code, the scenario itself)
+  {
+    namespace fs = std::filesystem;
+    std::error_code error;
+    std::vector<std::string> inputs = scenario_input_files(scenario);
+    inputs.insert(inputs.begin(), scenario.file);
+    for (const std::string& input : inputs)
+      if (fs::equivalent(options.out, input, error))
+        throw InputError("--out", "'" + options.out + "' is " +
+                                      (input == scenario.file ? "the scenario file"
+                                                              : "a file the scenario reads") +
+                                      "; name another file to write");
+  }
   // one writer of the file at a time (report/output_dir.hpp); what writers killed outright
   // left beside it goes
   const std::string target = std::filesystem::absolute(options.out).lexically_normal().string();

@@ -261,6 +261,15 @@ int main(int argc, char** argv) {
       app.exit(e);
       return kExitBadInput;
     }
+    // an option given an empty value (`--task ""`, `--out ""`: an unset shell variable) is
+    // bad input, never its default: `sweep --task ""` would run every task
+    for (const CLI::App* verb : app.get_subcommands())
+      for (const CLI::Option* option : verb->get_options())
+        if (option->get_type_size() != 0 && option->count() > 0)
+          for (const std::string& value : option->results())
+            if (value.empty())
+              throw InputError(option->get_name(),
+                               "an empty value (give one, or leave the option out)");
     // the verbs that write: SIGINT and SIGTERM stop them with their staging folder removed,
     // their children ended, the output as it was, exit 130 or 143 (core/interrupt.hpp); set
     // before any thread starts. The others (validate, view, ...) write nothing and keep the

@@ -43,8 +43,8 @@ int plan_verb(const RunOptions& options) {
   const Scenario scenario = check_scenario(options.scenario, budget, 0, false);
   const std::vector<PlannerSpec> planners = selected_planners(scenario, options.planners);
   // the output folder is checked before any planning, and replaced whole at the end
-  OutputFolder out(output_directory(scenario, options.out), "plan", scenario.file,
-                   !options.no_wait);
+  OutputFolder out(output_directory(scenario, options.out), "plan", scenario.file, !options.no_wait,
+                   scenario_input_files(scenario));
   const std::string& directory = out.final_path();
   // (every pose of each plan solved, as validate does: a plan the machine cannot follow is
   // refused, not written)
@@ -121,7 +121,8 @@ int run_verb(const RunOptions& options) {
   const std::vector<PlannerSpec> planners = selected_planners(scenario, options.planners);
   // the output folder is checked before any planning, and replaced whole at the end; it
   // outlives the writer below, which writes into it
-  OutputFolder out(output_directory(scenario, options.out), "run", scenario.file, !options.no_wait);
+  OutputFolder out(output_directory(scenario, options.out), "run", scenario.file, !options.no_wait,
+                   scenario_input_files(scenario));
   const std::string& directory = out.final_path();
   const PreparedJob job = prepare_checked_job(scenario, planners, budget, true, true);
   const RunSettings settings = run_settings(scenario, options);
@@ -162,7 +163,7 @@ int compare_verb(const CompareOptions& options) {
   comparison_cases(scenario, planners, orders);  // refuses runs sharing a label, before any work
   // the output folder is checked before any planning, and replaced whole at the end
   OutputFolder out(output_directory(scenario, options.run.out), "compare", scenario.file,
-                   !options.run.no_wait);
+                   !options.run.no_wait, scenario_input_files(scenario));
   const std::string& directory = out.final_path();
   const RunSettings settings = run_settings(scenario, options.run);
   const std::vector<ComparisonRow> rows =

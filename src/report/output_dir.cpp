@@ -79,6 +79,18 @@ bool is_depotwin_output(const fs::path& folder) {
   return !error;
 }
 
+// what the marker of `folder` says it is when that is not a run, compare or plan output
+// folder ("a depotwin sweep folder (NAME)"), else ""
+std::string marker_kind(const fs::path& folder) {
+  std::ifstream marker(folder / kOutputMarker);
+  std::string first_line;
+  if (!marker || !std::getline(marker, first_line)) return "";
+  const std::string sweep = "depotwin sweep folder";
+  if (first_line.rfind(sweep, 0) != 0) return "";
+  const std::size_t colon = first_line.find("):");
+  return "a " + (colon == std::string::npos ? sweep : first_line.substr(0, colon + 1));
+}
+
 // "the nearest existing ancestor of `path`"
 fs::path nearest_existing(fs::path path) {
   std::error_code error;
@@ -224,7 +236,8 @@ void StagedDirectory::commit() {
 }
 
 OutputFolder::OutputFolder(const std::string& final_path, const std::string& verb,
-                           const std::string& scenario_file, bool wait)
+                           const std::string& scenario_file, bool wait,
+                           const std::vector<std::string>& input_files)
     : final_path_(final_path) {
   auto refuse = [&](const std::string& why) {
     throw InputError("--out", final_path_ + ": " + why);
@@ -257,6 +270,12 @@ OutputFolder::OutputFolder(const std::string& final_path, const std::string& ver
     if (!scenario_file.empty() && is_within(scenario, canonical))
       refuse("holds the scenario file " + scenario_file +
              "; choose a folder of its own for the results");
+    for (const std::string& input : input_files)
+      if (!input.empty() && is_within(fs::weakly_canonical(input, error), canonical))
+        refuse("holds " + input +
+               ", which the scenario reads; choose a folder of its own for the results");
+    if (const std::string kind = marker_kind(target); !kind.empty())
+      refuse("is " + kind + ", not a run's; choose a folder of its own for the results");
     if (!is_depotwin_output(target))
       refuse("exists and is not a depotwin output folder (it has files but no " +
              std::string(kOutputMarker) +

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/file_io.hpp"
 
@@ -76,7 +77,8 @@ void remove_stale_staging(const std::string& target_path);
 //
 // The constructor checks DIR before any planning or simulation and throws InputError (key
 // "--out") when DIR is a file or lies under one, cannot be written in, holds the current
-// directory or the scenario file, or exists with files but is not a depotwin output (no
+// directory, the scenario file or a file it reads, is a sweep's folder (its marker says so),
+// or exists with files but is not a depotwin output (no
 // marker, and not shaped like an older depotwin result: only comparison.* files and folders
 // holding a metrics.json). A folder that is not ours is never deleted. It then takes the lock
 // (waiting for another writer, or with wait false refusing), checks DIR again, and removes
@@ -84,10 +86,12 @@ void remove_stale_staging(const std::string& target_path);
 // interrupt), the staging folder is removed with everything in it.
 class OutputFolder {
  public:
-  // verb: names the writer in the marker and lock files; scenario_file: refused as part of
-  // DIR; wait: for another writer of DIR (false: InputError while one writes)
+  // verb: names the writer in the marker and lock files; scenario_file and input_files (the
+  // files the scenario reads: G-code, STL, MJCF): refused as part of DIR, which is replaced
+  // whole; wait: for another writer of DIR (false: InputError while one writes)
   OutputFolder(const std::string& final_path, const std::string& verb,
-               const std::string& scenario_file, bool wait = true);
+               const std::string& scenario_file, bool wait = true,
+               const std::vector<std::string>& input_files = {});
   ~OutputFolder();
   OutputFolder(const OutputFolder&) = delete;
   OutputFolder& operator=(const OutputFolder&) = delete;

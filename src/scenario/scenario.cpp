@@ -1232,6 +1232,8 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
   // read and place the part; hatch it
   std::shared_ptr<const SurfaceProjector> projector;
   SurfaceHatch hatch;
+  Vec3 part_size = Vec3::Zero();  // the placed part's extent, for messages
+  const Field* file_field = view.find("file");
   try {
     TriangleMesh part = read_stl(surface->file, surface->mm_per_unit, field.key + ".file");
     const Eigen::Matrix3d rotation =
@@ -1256,6 +1258,7 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     // the grid's size before it is built: every layer's points over the part's (x, y) bounds
     Vec3 lo, hi;
     part.bounds(lo, hi);
+    part_size = hi - lo;
     const double grid_points = ((hi.x() - lo.x()) / surface->hatch_mm + 2.0) *
                                ((hi.y() - lo.y()) / surface->hatch_mm + 2.0) * surface->layers;
     if (grid_points > kMaxSurfaceGridPoints) {
@@ -1308,7 +1311,8 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
         p.message =
             (p.file.empty() ? std::string() : "'" + given_file + "'" + stl_line + ": ") + p.message;
         p.file = problems_.file();
-        p.line = field.key_line;
+        // (the file's own problems at its `file:` line)
+        p.line = p.key == field.key + ".file" && file_field ? file_field->line : field.key_line;
       }
       problems_.add_problem(p);
     }
@@ -1317,7 +1321,10 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
   if (hatch.toolpath.paths.empty()) {
     problems_.add(field.key_line, field.key,
                   "the hatch found no printable surface on '" + given_file +
-                      "' (seen from above; check units, offset and rotation)");
+                      "' (seen from above, no hatch line crosses it in two points: hatch_mm " +
+                      format_number(surface->hatch_mm) + " mm over the part's " +
+                      format_number(part_size.x()) + " x " + format_number(part_size.y()) +
+                      " mm; check hatch_mm, units, offset and rotation)");
     return;
   }
   // the surface printed on stands on the work surface, z = 0 (the top of the table, bed or
@@ -1889,6 +1896,14 @@ std::string reach_summary(const Toolpath& toolpath, const Machine& machine, bool
 }
 
 }  // namespace
+
+std::vector<std::string> scenario_input_files(const Scenario& scenario) {
+  std::vector<std::string> files;
+  if (scenario.gcode) files.push_back(scenario.gcode->file);
+  if (scenario.surface) files.push_back(scenario.surface->file);
+  if (!scenario.model_path.empty()) files.push_back(scenario.model_path);
+  return files;
+}
 
 std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine& machine,
                                         std::size_t max_listed) {

@@ -192,6 +192,10 @@ Problem path_point_problem(const Scenario& scenario, int source_index, std::size
 Problem path_problem(const Scenario& scenario, int source_index, const std::string& detail,
                      const std::string& message);
 
+// The files a scenario reads besides itself (its G-code or STL file, its MJCF model), as
+// resolved: an output folder must not hold them (report/output_dir.hpp)
+std::vector<std::string> scenario_input_files(const Scenario& scenario);
+
 // Every toolpath pose (start, end, each point) a machine that holds the nozzle as the paths
 // say cannot reach, as problems at the point's file, line and key; at most `max_listed`
 // listed, then one counting the rest. Not for the arm, whose reach depends on the roll its

@@ -252,6 +252,18 @@ class SweepReader {
                     "given twice (a key is set, swept in grid: or zipped, once)");
       return false;
     }
+    // a key inside another (`limits` and `limits.a_max`): one would silently win
+    const auto inside = [](const std::string& inner, const std::string& outer) {
+      return inner.size() > outer.size() && inner.compare(0, outer.size(), outer) == 0 &&
+             (inner[outer.size()] == '.' || inner[outer.size()] == '[');
+    };
+    for (const std::string& other : claimed_)
+      if (inside(key, other) || inside(other, key)) {
+        problems_.add(line, section + "." + key,
+                      "overlaps " + other + " (one holds the other, so one value would " +
+                          "silently replace the other): set, sweep or zip one of them");
+        return false;
+      }
     return true;
   }
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -14,6 +15,7 @@
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/number_text.hpp"
 #include "pipeline/progress_line.hpp"
 #include "report/output_dir.hpp"
 #include "scenario/overrides.hpp"
@@ -293,6 +295,20 @@ void Sweep::prepare_out_directory() const {
   if (fs::is_directory(status) && !is_sweep_folder(target))
     refuse("exists and is not a depotwin sweep folder (it has files but no " +
            std::string(kOutputMarker) + " marker); choose an empty or new folder");
+  // a run's, compare's or plan's folder (their marker) is not a sweep's: the two would mix
+  if (std::ifstream marker(target / kOutputMarker); marker) {
+    std::string first_line;
+    std::getline(marker, first_line);
+    // ("depotwin output folder, written by `depotwin run`; ...": who wrote it)
+    const std::string run_marker = "depotwin output folder";
+    if (first_line.rfind(run_marker, 0) == 0) {
+      const std::size_t by = first_line.find("written by");
+      const std::string writer =
+          by == std::string::npos ? "" : " " + first_line.substr(by, first_line.find(';', by) - by);
+      refuse("is a depotwin output folder" + writer +
+             ", not a sweep's; choose an empty or new folder");
+    }
+  }
   for (const char* folder : {"tasks", "logs"}) {
     fs::create_directories(target / folder, error);
     if (error) refuse("cannot create " + (target / folder).string() + ": " + error.message());
@@ -319,11 +335,13 @@ std::uint64_t task_index_from(const std::string& text, std::uint64_t count) {
     if (slurm != nullptr && *slurm != '\0') {
       given = slurm;
       if (const char* chunk = std::getenv("DEPOTWIN_SWEEP_TASK_OFFSET"); chunk && *chunk) {
-        char* end = nullptr;
-        offset = std::strtoull(chunk, &end, 10);
-        if (*end != '\0')
-          throw InputError("--task", std::string("DEPOTWIN_SWEEP_TASK_OFFSET is '") + chunk +
-                                         "', not a whole number");
+        // (digits only: strtoull would take "-1" as 2^64 - 1, and wrap beyond it)
+        const std::string text = chunk;
+        if (text.size() > 18 ||
+            !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
+          throw InputError("--task", "DEPOTWIN_SWEEP_TASK_OFFSET is '" + printable_text(text) +
+                                         "', not a whole number from 0");
+        offset = std::stoull(text);
       }
     } else if (k8s != nullptr && *k8s != '\0') {
       given = k8s;

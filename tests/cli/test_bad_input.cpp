@@ -378,6 +378,39 @@ std::vector<Row> rows() {
   r.push_back(command("OutIsAFile", "run {dir}/scenario.yaml --out {dir}/afile --no-render --quiet",
                       "error: --out: .*afile: is a file, not a folder",
                       {{"scenario.yaml", probe()}, {"afile", "keep me\n"}}));
+  // a folder replaced whole must not hold a file the scenario reads, nor be a sweep's; a sweep
+  // is not written into a run's folder; export never writes over its input
+  const std::string gcode_job =
+      "machine: cartesian\nlimits: {v_max: 100, a_max: 1000}\n"
+      "process: {type: extrusion, bead_width_mm: 0.4, layer_height_mm: 0.2}\n"
+      "toolpath: {gcode: out/part.gcode}\nplanners: [lspb_mtt]\n";
+  const std::string part = "G1 X0 Y0 Z0.2 F600\nG1 X10 E1\n";
+  r.push_back(command("OutHoldsTheGcodeItReads",
+                      "run {dir}/scenario.yaml --out {out} --no-render --quiet",
+                      "error: --out: .*out: holds .*part\\.gcode, which the scenario reads",
+                      {{"scenario.yaml", gcode_job}, {"out/part.gcode", part}}));
+  r.push_back(command("ExportOverTheGcodeItReads",
+                      "export {dir}/scenario.yaml --planner lspb_mtt --out {out}/part.gcode",
+                      "error: --out: '.*part\\.gcode' is a file the scenario reads",
+                      {{"scenario.yaml", gcode_job}, {"out/part.gcode", part}}));
+  r.push_back(command("RunIntoASweepFolder",
+                      "run {dir}/scenario.yaml --out {dir}/study --no-render --quiet",
+                      "error: --out: .*study: is a depotwin sweep folder \\(s\\), not a run's",
+                      {{"scenario.yaml", probe()},
+                       {"study/.depotwin", "depotwin sweep folder (s): tasks/<i> per task\n"},
+                       {"study/results.csv", "task\n0\n"}}));
+  const std::string sweep_of_probe = "base: scenario.yaml\ngrid: {limits.a_max: [20, 30]}\n";
+  r.push_back(command("SweepIntoARunFolder", "sweep {dir}/sweep.yaml --out {out}",
+                      "error: --out: .*out: is a depotwin output folder, not a sweep's",
+                      {{"scenario.yaml", probe()}, {"sweep.yaml", sweep_of_probe}}));
+  r.push_back(command("SweepKeyInsideAnother", "sweep {dir}/sweep.yaml --list --out {dir}/study",
+                      "sweep\\.yaml:[23]: (set\\.limits: overlaps "
+                      "limits\\.a_max|grid\\.limits\\.a_max: overlaps limits)",
+                      {{"scenario.yaml", probe()},
+                       {"sweep.yaml", sweep_of_probe + "set: {limits: {v_max: 4, a_max: 50}}\n"}}));
+  r.push_back(command("SweepTaskEmpty", "sweep {dir}/sweep.yaml --task '' --out {dir}/study",
+                      "error: --task: an empty value",
+                      {{"scenario.yaml", probe()}, {"sweep.yaml", sweep_of_probe}}));
   r.push_back(command("OutUnderAFile",
                       "run {dir}/scenario.yaml --out {dir}/afile/results --no-render --quiet",
                       "error: --out: .*afile/results: lies under .*afile, which is a file",
