@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -247,6 +248,25 @@ class AsciiStlReader {
   std::unordered_map<std::array<uint32_t, 3>, int, FloatTripleHash> index_of_;
 };
 
+// the largest coordinate a part may have, mm (a scenario's coordinates are within it)
+constexpr double kMaxCoordinate_mm = 1e6;
+
+// every vertex finite and within the coordinate range once scaled to mm: a stray triangle far
+// away (a CAD export's leftover) would otherwise stretch the part's bounds and hide it
+void check_coordinates(const TriangleMesh& mesh, const std::string& path, const std::string& key) {
+  for (const Vec3& v : mesh.vertices) {
+    if (!v.allFinite())  // finite floats times a finite scale may still overflow
+      throw InputError(path, 0, key, "coordinates overflow when scaled to mm");
+    if (v.cwiseAbs().maxCoeff() > kMaxCoordinate_mm) {
+      char text[160];
+      std::snprintf(text, sizeof text, "a vertex at (%.6g, %.6g, %.6g) mm lies beyond ±%g mm",
+                    v.x(), v.y(), v.z(), kMaxCoordinate_mm);
+      throw InputError(path, 0, key,
+                       std::string(text) + ": check units, or remove the stray triangles");
+    }
+  }
+}
+
 }  // namespace
 
 TriangleMesh read_stl(const std::string& path, double mm_per_unit, const std::string& key) {
@@ -260,6 +280,9 @@ TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& path, d
   if (!std::isfinite(mm_per_unit) || mm_per_unit <= 0.0)
     throw InputError(path, 0, key, "the unit scale (mm per unit) must be positive and finite");
   if (bytes.empty()) throw InputError(path, 0, key, "the STL file is empty");
+  // an ASCII STL saved with a UTF-8 byte order mark is ASCII STL
+  if (bytes.compare(0, 3, "\xEF\xBB\xBF") == 0 && begins_with_solid(bytes.substr(3)))
+    return read_stl_bytes(bytes.substr(3), path, mm_per_unit, key);
 
   // binary by its size, whatever the header says
   bool binary = false;
@@ -269,11 +292,15 @@ TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& path, d
     if (binary && count == 0)
       throw InputError(path, 0, key, "binary STL without triangles (its header counts 0)");
     if (!binary && !begins_with_solid(bytes)) {
+      const uint64_t expected = kBinaryPreambleBytes + kBinaryFacetBytes * count;
       throw InputError(path, 0, key,
-                       "not an STL file, or a truncated binary one: the binary header counts " +
-                           format_count(count) + " triangles (" +
-                           format_count(kBinaryPreambleBytes + kBinaryFacetBytes * count) +
-                           " bytes) but the file has " + format_count(bytes.size()) +
+                       std::string(bytes.size() < expected
+                                       ? "not an STL file, or a truncated binary one"
+                                       : "not an STL file, or a binary one with bytes beyond its "
+                                         "triangles (a wrong count, or data appended)") +
+                           ": the binary header counts " + format_count(count) + " triangles (" +
+                           format_count(expected) + " bytes) but the file has " +
+                           format_count(bytes.size()) +
                            " bytes, and it does not begin with \"solid\" as ASCII STL does");
     }
   } else if (!begins_with_solid(bytes)) {
@@ -292,9 +319,7 @@ TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& path, d
 
   if (!binary) {
     TriangleMesh mesh = AsciiStlReader(bytes, path, mm_per_unit, key).read();
-    for (const Vec3& v : mesh.vertices)
-      if (!v.allFinite())  // finite floats times a finite scale may still overflow
-        throw InputError(path, 0, key, "coordinates overflow when scaled to mm");
+    check_coordinates(mesh, path, key);
     return mesh;
   }
 
@@ -351,9 +376,7 @@ TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& path, d
   if (result.triangles.empty())
     throw InputError(path, 0, key,
                      std::string(binary ? "binary" : "ASCII") + " STL without triangles");
-  for (const Vec3& v : result.vertices)
-    if (!v.allFinite())  // finite floats times a finite scale may still overflow
-      throw InputError(path, 0, key, "coordinates overflow when scaled to mm");
+  check_coordinates(result, path, key);
   return result;
 }
 

@@ -700,6 +700,36 @@ toolpath:
                  "STL file 'nowhere.stl' not found");
 }
 
+// a file that is no STL is named at its `file:` line; a hatch too coarse for the part says so
+TEST_F(ScenarioErrors, SurfaceFileProblemsAtTheFileLine) {
+  write("notes.stl", "hello, world\n");
+  const auto problems = problems_of(R"(
+machine: arm6
+toolpath:
+  speed: 3
+  surface:
+    units: mm
+    file: notes.stl
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "toolpath.surface.file", 6,
+                 "'notes.stl': not an STL file");
+  // a 1 mm square under a 2 mm hatch: no line crosses it in two points
+  write("tiny.stl",
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 5\nvertex 1 0 5\nvertex 1 1 5\n"
+        "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 5\nvertex 1 1 5\n"
+        "vertex 0 1 5\nendloop\nendfacet\nendsolid t\n");
+  const auto coarse = problems_of(R"(
+machine: arm6
+toolpath:
+  speed: 3
+  surface: {file: tiny.stl, hatch_mm: 2, offset: [400, 0, 0]}
+)");
+  ASSERT_EQ(coarse.size(), 1u) << dump(coarse);
+  expect_problem(coarse, scenario_path(), "toolpath.surface", 4,
+                 "no hatch line crosses it in two points: hatch_mm 2 mm over the part's 1 x 1 mm");
+}
+
 // `arm:` belongs to the arm
 TEST_F(ScenarioErrors, ArmSettingsNeedTheArm) {
   const auto problems = problems_of(R"(

@@ -228,6 +228,36 @@ TEST(Stl, BrokenFilesNameTheFile) {
   expect_problem(noise, "not an STL file");
 
   EXPECT_THROW(read_stl(kTorus, 0.0), InputError);
+
+  // bytes beyond the counted triangles: named as such, not as a truncation
+  const std::string appended = scratch("appended.stl");
+  write_bytes(appended, good + "tail!!!");
+  expect_problem(appended, "a binary one with bytes beyond its triangles");
+  expect_problem(appended, "counts 4 triangles (284 bytes) but the file has 291 bytes");
+
+  // a stray vertex far beyond any machine (a CAD leftover, or metres read as mm): refused
+  // rather than stretching the part's bounds; at 1e6 mm still read
+  for (const double z : {1e20, 2e6}) {
+    TriangleMesh stray = tetrahedron();
+    stray.vertices[3].z() = z;
+    const std::string far = scratch("stray.stl");
+    write_bytes(far, stl_binary_bytes(stray, "stray"));
+    expect_problem(far, "lies beyond ±1e+06 mm: check units, or remove the stray triangles");
+  }
+  TriangleMesh at_limit = tetrahedron();
+  at_limit.vertices[3].z() = 1e6;
+  EXPECT_EQ(read_stl_bytes(stl_binary_bytes(at_limit, "t"), "t.stl", 1.0).triangle_count(), 4u);
+}
+
+// an ASCII STL saved with a UTF-8 byte order mark reads as the same ASCII STL
+TEST(Stl, AsciiWithAByteOrderMarkReads) {
+  const std::string ascii = stl_ascii_text(tetrahedron(), "tetra");
+  const TriangleMesh plain = read_stl_bytes(ascii, "plain.stl", 1.0);
+  const TriangleMesh marked = read_stl_bytes("\xEF\xBB\xBF" + ascii, "marked.stl", 1.0);
+  ASSERT_EQ(marked.triangle_count(), plain.triangle_count());
+  ASSERT_EQ(marked.vertices.size(), plain.vertices.size());
+  for (std::size_t i = 0; i < plain.vertices.size(); ++i)
+    EXPECT_EQ(marked.vertices[i], plain.vertices[i]);
 }
 
 // an ASCII STL of two facets (a 10 mm square at z = 1), its first facet's third vertex line
