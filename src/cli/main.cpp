@@ -6,6 +6,7 @@
 #include <iostream>
 #include <string>
 
+#include "cli/cli_checks.hpp"
 #include "cli/describe.hpp"
 #include "cli/export_verb.hpp"  // export
 #include "cli/inspect.hpp"      // inspect
@@ -97,7 +98,7 @@ int main(int argc, char** argv) {
                 "also write run.mp4 in each run folder: the scene over time, the deposit growing");
   run->add_option("--video-length", run_options.video_length_s,
                   "longest video, seconds: a longer run is sped up to fit (default 30)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   // ---- end moving pictures ----
 
   CompareOptions compare_options;
@@ -125,7 +126,7 @@ int main(int argc, char** argv) {
   compare
       ->add_option("--video-length", compare_options.run.video_length_s,
                    "longest video, seconds: a longer run is sped up to fit (default 30)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   // ---- end moving pictures ----
 
   RunOptions plan_options;
@@ -189,11 +190,11 @@ int main(int argc, char** argv) {
   export_gcode
       ->add_option("--tolerance", export_options.settings.chord_tolerance_mm,
                    "every planned point within this of the written lines, mm (default 0.005)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   export_gcode
       ->add_option("--filament-diameter", export_options.settings.filament_diameter_mm,
                    "extrusion: E is filament length of this diameter, mm (default 1.75)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   export_gcode->add_option("--open", export_options.settings.open_code,
                            "aerosol: the shutter-open code (default M3)");
   export_gcode->add_option("--close", export_options.settings.close_code,

@@ -5,6 +5,7 @@
 #include <iostream>
 #include <thread>
 
+#include "cli/cli_checks.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "sweep/emit.hpp"
@@ -40,7 +41,7 @@ CLI::App* add_sweep_verb(CLI::App& app, SweepOptions& options) {
       ->add_option("-j,--jobs", options.jobs,
                    "local worker processes (default: one per core); with --emit, the most tasks "
                    "running at once")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   CLI::Option* merge = sweep->add_flag(
       "--merge", options.merge,
       "gather every task's metrics into results.sqlite, results.csv and summary.png");

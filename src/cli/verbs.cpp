@@ -20,7 +20,16 @@ namespace {
 // select_planners, each run once: its label names its results folder
 std::vector<PlannerSpec> selected_planners(const Scenario& scenario, const std::string& names,
                                            const std::string& option = "--planner") {
-  const std::vector<PlannerSpec> planners = select_planners(scenario, names);
+  std::vector<PlannerSpec> planners;
+  try {
+    planners = select_planners(scenario, names);
+  } catch (const InputError& e) {
+    // (named by the verb's own option: compare's is --planners)
+    std::vector<Problem> problems = e.problems();
+    for (Problem& problem : problems)
+      if (problem.key == "--planner") problem.key = option;
+    throw InputError(std::move(problems));
+  }
   for (size_t i = 0; i < planners.size(); ++i)
     for (size_t k = 0; k < i; ++k)
       if (planners[k].run_label() == planners[i].run_label())

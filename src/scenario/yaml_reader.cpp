@@ -231,8 +231,12 @@ std::optional<std::uint64_t> read_seed(const Field& field, ProblemList& problems
     // a number is named by its value (never hundreds of digits), anything else as written
     const std::optional<double> number =
         node.IsScalar() && !is_quoted(node) ? parse_double(text) : std::nullopt;
+    // a whole number written otherwise (1.0, 1e3) is that number, as read_integer reads it,
+    // up to 2^53 (beyond it a double holds no longer every whole number)
+    if (number && *number >= 0.0 && *number <= 9007199254740992.0 && std::floor(*number) == *number)
+      return static_cast<std::uint64_t>(*number);
     const std::string got = !number                  ? describe(node)
-                            : std::isfinite(*number) ? format_number(*number)
+                            : std::isfinite(*number) ? printable_text(text)
                                                      : "a number beyond 1.8e+308";
     problems.add(field.line, field.key, "expected a whole number >= 0 (a random seed), got " + got);
     return std::nullopt;

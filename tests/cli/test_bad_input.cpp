@@ -411,6 +411,12 @@ std::vector<Row> rows() {
   r.push_back(command("SweepTaskEmpty", "sweep {dir}/sweep.yaml --task '' --out {dir}/study",
                       "error: --task: an empty value",
                       {{"scenario.yaml", probe()}, {"sweep.yaml", sweep_of_probe}}));
+  r.push_back(command("SweepJobsZero", "sweep {dir}/sweep.yaml -j 0 --out {dir}/study",
+                      "--jobs: expected a number above 0, got '0'",
+                      {{"scenario.yaml", probe()}, {"sweep.yaml", sweep_of_probe}}));
+  r.push_back(command("ComparePlannersUnknown",
+                      "compare {dir}/scenario.yaml --planners lspb_mtt,nope --out {dir}/cmp",
+                      "error: --planners: unknown planner 'nope'", {{"scenario.yaml", probe()}}));
   r.push_back(command("OutUnderAFile",
                       "run {dir}/scenario.yaml --out {dir}/afile/results --no-render --quiet",
                       "error: --out: .*afile/results: lies under .*afile, which is a file",

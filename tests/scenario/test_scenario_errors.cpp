@@ -252,6 +252,24 @@ order:
   expect_problem(problems, scenario_path(), "order.seed", 6, "whole number >= 0");
 }
 
+// a seed is a whole number however written (1.0, 1e3, as every whole-number key reads it);
+// anything else is echoed as written
+TEST_F(ScenarioErrors, SeedsAreWholeNumbersHoweverWritten) {
+  for (const auto& [text, seed] : std::vector<std::pair<std::string, std::uint64_t>>{
+           {"1.0", 1}, {"1e3", 1000}, {"18446744073709551615", 18446744073709551615u}}) {
+    const Scenario s = load_scenario(write("seed.yaml",
+                                           "toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\n"
+                                           "order: {method: random, seed: " +
+                                               text + "}\n"));
+    EXPECT_EQ(s.order.seed, seed) << text;
+  }
+  const auto problems = problems_of(
+      "toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\norder: {method: random, seed: 1.5}\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "order.seed", 2,
+                 "expected a whole number >= 0 (a random seed), got 1.5");
+}
+
 TEST_F(ScenarioErrors, RefinementTwice) {
   const auto problems = problems_of(R"(
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}

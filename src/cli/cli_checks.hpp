@@ -1,0 +1,27 @@
+// Checks of command-line values shared by the verbs' option tables.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include "core/number_text.hpp"
+
+namespace depotwin {
+
+// a finite number above 0 (CLI11's PositiveNumber would print its range as a 300-digit number,
+// and let inf through)
+inline CLI::Validator positive_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(value) || value <= 0.0)
+          return "expected a number above 0, got '" + printable_text(text) + "'";
+        return "";
+      },
+      "POSITIVE");
+}
+
+}  // namespace depotwin
