@@ -686,12 +686,22 @@ void GcodeParser::execute(int line_number) {
         // X..): listed as ignored, never a move (Marlin's bare G10 retracts)
         uses_axes = true;
         const double l_word = words_.has('L') ? words_.get('L') : -1.0;
-        if (l_word == 2.0 || l_word == 20.0)
+        if (l_word == 2.0 || l_word == 20.0) {
           work_offsets = true;
-        else
+        } else {
           foreign_code = code.tenths;
+          // a bare G10 is a firmware retraction (Marlin, Klipper; G11 recovers): one run of
+          // retractions as an E decrease counts (GcodeProgram::n_retractions)
+          if (!words_.has('L') && !words_.has('P')) {
+            if (!retracting_) ++program_.n_retractions;
+            retracting_ = true;
+          }
+        }
         break;
       }
+      case 110:  // G11: the firmware's recovery after a G10 retraction
+        retracting_ = false;
+        break;
       case 600:  // G60: Marlin's and RepRapFirmware's save of the position (S the slot)
         save_position = uses_axes = true;
         break;
@@ -761,7 +771,10 @@ void GcodeParser::execute(int line_number) {
   const bool axis_words = words_.has('X') || words_.has('Y') || words_.has('Z') ||
                           words_.has('E') || words_.has('I') || words_.has('J') ||
                           words_.has('K') || words_.has('R');
-  if (foreign_code >= 0 && motion < 0 && axis_words) {
+  // (a position's words: RepRapFirmware's `G10 P0 R150 S210` sets temperatures)
+  const bool position_words =
+      words_.has('X') || words_.has('Y') || words_.has('Z') || words_.has('E');
+  if (foreign_code >= 0 && motion < 0 && position_words) {
     // reported (inspect's ignored_axis_words): the position did not change at this line
     auto& ignored = program_.ignored_axis_codes;
     auto it = std::find_if(ignored.begin(), ignored.end(),
@@ -903,6 +916,16 @@ bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, 
     problem(line_number, std::string("an arc needs either R or the centre offsets ") +
                              offset_letters[a0] + "/" + offset_letters[a1] + " (plane " +
                              plane_name + "), not " + (has_offset ? "both" : "neither"));
+    return false;
+  }
+  // the offset along the plane's normal is none of its centre's (LinuxCNC refuses it); a
+  // non-zero one means the file was written for another plane (0, as some posts write, passes)
+  if (words_.has(offset_letters[normal]) && words_.get(offset_letters[normal]) != 0.0) {
+    problem(line_number, std::string("an arc in the ") + plane_name + " plane takes " +
+                             offset_letters[a0] + " and " + offset_letters[a1] + ", not " +
+                             offset_letters[normal] +
+                             message_number(words_.get(offset_letters[normal])) +
+                             " (is the plane G17, G18 or G19 as the file means it?)");
     return false;
   }
   // P counts the turns in RS274/NGC (LinuxCNC; Bambu's spiral lifts write P1) but the extra

@@ -95,7 +95,9 @@ struct GcodeProgram {
   std::vector<GcodeMove> moves;
   bool has_e_values = false;       // some G0-G3 carries E
   bool has_shutter_codes = false;  // the open or close code occurs
-  int n_retractions = 0;           // runs of consecutive E decreases (moving or not)
+  // runs of consecutive E decreases (moving or not) or firmware retractions (a bare G10, up to
+  // its G11)
+  int n_retractions = 0;
   double extrusion_e_total = 0.0;  // net E over the file (G92 resets excluded), mm
   double dwell_s = 0.0;            // sum of G4 dwells
   std::vector<GcodePause> pauses;  // dwells and E-only moves, in file order

@@ -209,6 +209,35 @@ TEST(Gcode, M3AndM4BothOpenTheShutter) {
   }
 }
 
+TEST(Gcode, FirmwareRetractionsCountAndTemperaturesAreNoAxisWords) {
+  // OrcaSlicer for Klipper: G10 retracts and G11 recovers (two runs, the repeated G10 one run);
+  // RepRapFirmware's G10 P0 R150 S210 sets temperatures: no axis word to list as ignored; its
+  // G10 P1 X3 tool offset is one
+  const GcodeProgram program = parse_gcode_program(
+      "G21 G90 M83\nG1 X0 Y0 F600\nG1 X10 E1\nG10\nG10\nG0 X20\nG11\nG1 X30 E1\nG10\n"
+      "G11\nG10 P0 R150 S210\nG10 P1 X3\n",
+      "orca.gcode", GcodeOptions{});
+  EXPECT_EQ(program.n_retractions, 2);
+  ASSERT_EQ(program.ignored_axis_codes.size(), 1u);
+  EXPECT_EQ(g_code_name(program.ignored_axis_codes[0].tenths), "G10");
+  EXPECT_EQ(program.ignored_axis_codes[0].n_lines, 1);
+  EXPECT_EQ(program.ignored_axis_codes[0].first_line, 12);
+}
+
+TEST(Gcode, AnArcOffsetAlongItsPlanesNormalIsRefused) {
+  // K in G17 or J in G18 belongs to another plane (LinuxCNC refuses it); 0 passes
+  const auto problems = problems_of(
+      "G1 X0 Y0 Z0 F600\nG2 X10 Y0 I5 J0 K7 E1\nG18\nG2 X20 Z0 I5 J-3 E2\nG17\n"
+      "G2 X10 Y0 I5 K0 E3\n");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 2);
+  EXPECT_EQ(problems[0].message,
+            "an arc in the G17 plane takes I and J, not K7 (is the plane G17, G18 or G19 as the "
+            "file means it?)");
+  EXPECT_EQ(problems[1].line, 4);
+  EXPECT_EQ(problems[1].message.rfind("an arc in the G18 plane takes K and I, not J-3", 0), 0u);
+}
+
 TEST(Gcode, ProgrammingAndSubprogramsAreNamed) {
   // LinuxCNC's O-word subroutines, # parameters and [ ] expressions, and Fanuc's M98 call: a
   // program, not a list of moves (RepRapFirmware's M98 P"macro.g" passes; a slicer's
