@@ -38,7 +38,25 @@ std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemLi
   try {
     documents = load_documents(text);
   } catch (const YAML::ParserException& e) {
-    problems.add(e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
+    const int line = e.mark.is_null() ? 0 : e.mark.line + 1;
+    // the two slips the parser's words do not name: a tab in the indentation, CR line ends
+    std::string hint;
+    int line_number = 1;
+    for (std::size_t at = 0; at < text.size() && hint.empty() && (line == 0 || line_number <= line);
+         at = text.find('\n', at), at = at == std::string::npos ? text.size() : at + 1) {
+      std::size_t k = at;
+      while (k < text.size() && (text[k] == ' ' || text[k] == '\t')) {
+        if (text[k] == '\t')
+          hint = " (line " + std::to_string(line_number) +
+                 " is indented with a tab: YAML indents with spaces only)";
+        ++k;
+      }
+      ++line_number;
+    }
+    if (hint.empty() && text.find('\r') != std::string::npos &&
+        text.find('\n') == std::string::npos)
+      hint = " (the file's lines end in CR alone, as old Mac files: save it with LF line ends)";
+    problems.add(line, "", "malformed YAML: " + e.msg + hint);
     return std::nullopt;
   } catch (const YAML::Exception& e) {
     problems.add(0, "", std::string("malformed YAML: ") + e.what());

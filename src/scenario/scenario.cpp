@@ -71,6 +71,8 @@ std::string folder_name_problem(const std::string& name) {
     return shown +
            " holds a control character (newline, tab, escape, ...): it names a folder, so "
            "give printable text";
+  if (name.find_first_not_of(' ') == std::string::npos)
+    return shown + " is blank: it names the results folder";
   if (name.find_first_of("/\\") != std::string::npos || name == "." || name == "..")
     return shown + " cannot name a results folder (no '/', '\\', '.' or '..')";
   return "";

@@ -363,6 +363,9 @@ std::vector<Row> rows() {
                        "{s}:1: name: 'n{40}\\.\\.\\.' is 300 bytes long"));
   r.push_back(scenario("NameWithNewlineTabBell", probe("", "\"a\\nb\\tc\\a\""),
                        "{s}:1: name: 'a\\\\x0Ab\\\\x09c\\\\x07' holds a control character"));
+  r.push_back(scenario("NameBlank", probe("", "\"   \""), "{s}:1: name: '   ' is blank"));
+  r.push_back(scenario("TabIndentation", replace_line(probe(), "  speed:", "\tspeed: 3"),
+                       "{s}:6: malformed YAML: .*line 6 is indented with a tab"));
   r.push_back(scenario("NameClimbingOut", probe("", "../x"),
                        "{s}:1: name: '\\.\\./x' cannot name a results folder"));
   r.push_back(scenario("LabelWithEscape",
