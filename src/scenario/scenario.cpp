@@ -54,6 +54,9 @@ constexpr double kHiddenAreaNoted = 0.01;
 constexpr double kSurfaceClearance_mm = 20.0;
 // the longest `name:` or planner `label:` (each names a folder; file systems allow 255 bytes)
 constexpr std::size_t kMaxFolderNameBytes = 100;
+// the share of an angle's up-facing grid points standing alone (no line prints them) above
+// which loading notes them
+constexpr double kLonePointsNoted = 0.01;
 // repeated print paths listed before the rest are counted
 constexpr std::size_t kMaxRepeatProblems = 20;
 
@@ -1284,6 +1287,24 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     spec.speed_mm_s = *speed;
     projector = std::make_shared<const SurfaceProjector>(std::move(part));
     hatch = hatch_surface(*projector, spec);
+    // grid points no line prints (a stretch narrower than two spacings: a groove's floor), at
+    // an angle where they are more than kLonePointsNoted of its grid: every run says so
+    for (const LoneGridPoints& lone : hatch.lone_points) {
+      if (lone.count <= kLonePointsNoted * lone.grid_points) continue;
+      auto span = [&](int axis, const char* name) {
+        const double lo = lone.lower_mm[axis], hi = lone.upper_mm[axis];
+        return std::string(name) + " " + format_number(lo) +
+               (hi > lo ? " to " + format_number(hi) : std::string());
+      };
+      scenario_.notes.push_back(
+          "toolpath.surface: at " + format_number(lone.angle_deg) + "°, " +
+          std::to_string(lone.count) + " of the " + std::to_string(lone.grid_points) +
+          " up-facing grid points of '" + given_file + "' (within " + span(0, "x") + ", " +
+          span(1, "y") + ", " + span(2, "z") +
+          " mm) stand alone between steps or walls (a stretch narrower than two "
+          "hatch_mm spacings, such as a groove's floor): a line needs two points, so lines at "
+          "that angle leave them bare; a smaller hatch_mm reaches them");
+    }
     // the hatch prints what is seen from above: an up-facing area under another part of the
     // surface (a shelf under an overhang) gets nothing, and every run says so
     const HiddenSurface hidden = hidden_top_surface(*projector, spec.min_normal_z);

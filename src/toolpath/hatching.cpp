@@ -49,6 +49,8 @@ struct AngleGrid {
   int lines = 0;
   int points_per_line = 0;
   std::vector<std::vector<Piece>> pieces;  // per line
+  int printed_points = 0;                  // in the pieces
+  std::vector<Vec3> lone_points;           // between printed pieces, in none (see close())
 };
 
 // n points spaced h, centred on [lo, hi]: the i-th at centre + (i - (n - 1) / 2) h
@@ -99,8 +101,17 @@ AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
     projector.project_down(xy, hits);  // one line per batch: memory stays one line
     std::vector<Piece>& line = grid.pieces[static_cast<std::size_t>(j)];
     Piece piece;
+    // a piece of one point is no line: between two printed pieces of the line (a groove's
+    // floor, a ridge's top, narrower than two spacings) it is kept aside for the report; at a
+    // line's end (the rim of a dome) the line merely stops a point short
+    std::vector<std::pair<Vec3, std::size_t>> lone;  // the point, the pieces before it
     auto close = [&] {
-      if (piece.points.size() >= 2) line.push_back(std::move(piece));
+      if (piece.points.size() >= 2) {
+        grid.printed_points += static_cast<int>(piece.points.size());
+        line.push_back(std::move(piece));
+      } else if (piece.points.size() == 1) {
+        lone.emplace_back(piece.points.front(), line.size());
+      }
       piece = Piece{};
     };
     for (int i = 0; i < along.n; ++i) {
@@ -115,6 +126,8 @@ AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
       piece.normals.push_back(hit->normal);
     }
     close();
+    for (const auto& [point, pieces_before] : lone)
+      if (pieces_before > 0 && pieces_before < line.size()) grid.lone_points.push_back(point);
   }
   return grid;
 }
@@ -147,6 +160,20 @@ SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatch
     if (found == grids.end())
       found = grids.emplace(angle, project_grid(projector, angle, spec)).first;
     const AngleGrid& grid = found->second;
+    // each angle's lone points, once
+    if (std::none_of(result.lone_points.begin(), result.lone_points.end(),
+                     [&](const LoneGridPoints& lone) { return lone.angle_deg == angle; })) {
+      LoneGridPoints lone;
+      lone.angle_deg = angle;
+      lone.count = static_cast<int>(grid.lone_points.size());
+      lone.grid_points = grid.printed_points + lone.count;
+      if (!grid.lone_points.empty()) lone.lower_mm = lone.upper_mm = grid.lone_points.front();
+      for (const Vec3& p : grid.lone_points) {
+        lone.lower_mm = lone.lower_mm.cwiseMin(p);
+        lone.upper_mm = lone.upper_mm.cwiseMax(p);
+      }
+      result.lone_points.push_back(lone);
+    }
     result.lines_per_layer.push_back(grid.lines);
     result.points_per_line.push_back(grid.points_per_line);
     const double offset = layer * spec.layer_height_mm;

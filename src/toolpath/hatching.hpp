@@ -61,6 +61,18 @@ struct HatchPathInfo {
                                         // normal; the tool axis is PrintPath::normals)
 };
 
+// The up-facing grid points of one hatch angle that no line prints although the same grid
+// line prints on both sides of them: each stands alone between steps or walls (a line needs
+// two points), as on a groove's floor or a ridge's top narrower than two spacings (a line
+// that stops one point short of a rim is not counted). lower/upper bound them (0 when none).
+struct LoneGridPoints {
+  double angle_deg = 0.0;
+  int count = 0;
+  int grid_points = 0;  // the grid points printed at this angle and the lone ones
+  Vec3 lower_mm = Vec3::Zero();
+  Vec3 upper_mm = Vec3::Zero();
+};
+
 struct SurfaceHatch {
   // print paths in print order: layer by layer, line by line; source_index = the path's
   // position, layer = its layer, normals = tool axes; start and end left at the origin
@@ -69,6 +81,8 @@ struct SurfaceHatch {
   // grid lines per layer (printed or not) and grid points per line, for reports
   std::vector<int> lines_per_layer;
   std::vector<int> points_per_line;
+  // per distinct angle, in the layers' order: the grid points no line prints
+  std::vector<LoneGridPoints> lone_points;
 
   // "layer 3, line 12, point 40" for point i of path p
   std::string describe(std::size_t path, std::size_t point) const;

@@ -347,7 +347,8 @@ TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
 }
 
 // An up-facing area under another part of the surface gets no deposit, and every run says
-// how much and where: a shelf at z 20 over half of a plate at z 1 hides 3000 of 9000 mm²
+// how much and where: a shelf at z 20 over half of a plate at z 1 hides 3000 of 9000 mm²; so
+// does a groove's floor narrower than two spacings
 TEST_F(ScenarioLoad, ASurfaceUnderAnOverhangIsNoted) {
   // counter-clockwise quads seen from above: (x0, x1, z)
   const auto quads = [](const std::vector<std::array<double, 3>>& rectangles) {
@@ -376,6 +377,16 @@ TEST_F(ScenarioLoad, ASurfaceUnderAnOverhangIsNoted) {
   for (const PrintPath& path : shelf.toolpath.paths)
     for (const Vec3& p : path.points) EXPECT_TRUE(p.x() >= -1e-9 || p.z() == 20.0) << p.transpose();
   EXPECT_TRUE(scenario("plate.stl").notes.empty());
+  // a groove 2 mm wide at a 2 mm hatch: one grid point of each line on its floor, between the
+  // line's two printed pieces, is printed by no line; every run says so
+  write("groove.stl", quads({{-50, -1, 10}, {-1, 1, 1}, {1, 50, 10}}));
+  const Scenario groove = scenario("groove.stl");
+  ASSERT_EQ(groove.notes.size(), 1u);
+  EXPECT_EQ(groove.notes[0],
+            "toolpath.surface: at 0°, 31 of the 1581 up-facing grid points of 'groove.stl' "
+            "(within x 0, y -30 to 30, z 1 mm) stand alone between steps or walls (a stretch "
+            "narrower than two hatch_mm spacings, such as a groove's floor): a line needs two "
+            "points, so lines at that angle leave them bare; a smaller hatch_mm reaches them");
 }
 
 // A planner parameter from the registry: its default loads, a value past its range does

@@ -435,6 +435,46 @@ TEST(Hatching, HiddenTopSurfaceIsNoneOnAHeightField) {
   EXPECT_EQ(hidden_top_surface(SurfaceProjector(down)).up_area_mm2, 0.0);
 }
 
+// A groove 0.6 mm wide, 10 mm deep, across a 20 x 10 mm top, at a 0.5 mm hatch: lines across
+// it (0 deg) have one grid point on its floor, between their two printed pieces, which no line
+// prints (21 of the 21 x 41 grid points); lines along it (90 deg) print its floor whole. The
+// same floor at the part's end is where a line merely stops short: not counted.
+TEST(Hatching, LoneGridPointsBetweenStepsAreReported) {
+  TriangleMesh groove;
+  add_rectangle(groove, -10, -0.3, -5, 5, 15, 4, 2);
+  add_rectangle(groove, -0.3, 0.3, -5, 5, 5, 1, 2);
+  add_rectangle(groove, 0.3, 10, -5, 5, 15, 4, 2);
+  SurfaceHatchSpec spec;
+  spec.angles_deg = {0, 90};
+  spec.layers = 2;
+  const SurfaceHatch hatch = hatch_surface(groove, spec);
+  ASSERT_EQ(hatch.lone_points.size(), 2u);
+  EXPECT_EQ(hatch.lone_points[0].angle_deg, 0.0);
+  EXPECT_EQ(hatch.lone_points[0].count, 21);
+  EXPECT_EQ(hatch.lone_points[0].grid_points, 21 * 41);
+  EXPECT_NEAR(hatch.lone_points[0].lower_mm.x(), 0.0, 1e-9);
+  EXPECT_NEAR(hatch.lone_points[0].upper_mm.x(), 0.0, 1e-9);
+  EXPECT_NEAR(hatch.lone_points[0].lower_mm.y(), -5.0, 1e-9);
+  EXPECT_NEAR(hatch.lone_points[0].upper_mm.y(), 5.0, 1e-9);
+  EXPECT_NEAR(hatch.lone_points[0].lower_mm.z(), 5.0, 1e-9);
+  EXPECT_EQ(hatch.lone_points[1].angle_deg, 90.0);
+  EXPECT_EQ(hatch.lone_points[1].count, 0);
+  // no point of the 0 deg layer lies on the floor
+  for (const PrintPath& path : hatch.toolpath.paths) {
+    if (path.layer != 0) continue;
+    for (const Vec3& p : path.points) EXPECT_GT(p.z(), 10.0);
+  }
+
+  TriangleMesh end;
+  add_rectangle(end, -10, -0.3, -5, 5, 15, 4, 2);
+  add_rectangle(end, -0.3, 0.3, -5, 5, 5, 1, 2);
+  spec.angles_deg = {0};
+  spec.layers = 1;
+  const SurfaceHatch stops_short = hatch_surface(end, spec);
+  ASSERT_EQ(stops_short.lone_points.size(), 1u);
+  EXPECT_EQ(stops_short.lone_points[0].count, 0);
+}
+
 TEST(Hatching, BadSpecsAreInputErrors) {
   const TriangleMesh mesh = plate(5.0, 5.0, 0.0);
   auto problem_key = [&](const SurfaceHatchSpec& spec) -> std::string {
