@@ -164,7 +164,15 @@ size_t TriangleMesh::orient_consistently() {
   for (size_t i = 0; i < uses.size();) {
     size_t j = i;
     while (j < uses.size() && uses[j].key == uses[i].key) ++j;
-    if (j - i == 2 && uses[i].triangle != uses[i + 1].triangle) {
+    // (a facet given twice, as in an STL holding a copy of its own surface, is no neighbour
+    // of its copy: the two run every edge the same way and neither is wound wrong)
+    const auto corners = [&](uint32_t t) {
+      std::array<int, 3> c = triangles[t];
+      std::sort(c.begin(), c.end());
+      return c;
+    };
+    if (j - i == 2 && uses[i].triangle != uses[i + 1].triangle &&
+        corners(uses[i].triangle) != corners(uses[i + 1].triangle)) {
       const bool same_way = uses[i].ascending == uses[i + 1].ascending;
       neighbours[uses[i].triangle].push_back({uses[i + 1].triangle, same_way});
       neighbours[uses[i + 1].triangle].push_back({uses[i].triangle, same_way});

@@ -50,9 +50,9 @@ struct TriangleMesh {
   // reversed has them: across every edge that exactly two triangles share, the two must run
   // it in opposite directions. In each connected piece (joined by such edges) the winding of
   // the larger area is kept and the smaller's turned; edges of one triangle or of three or
-  // more (non-manifold), and a piece that cannot be wound consistently (a Moebius strip: the
-  // first winding found is kept), are left as they are. Returns how many triangles it turned.
-  // Before face_outward_and_up, which then judges the whole mesh.
+  // more (non-manifold), a facet's duplicate, and a piece that cannot be wound consistently (a
+  // Moebius strip: the first winding found is kept), are left as they are. Returns how many
+  // triangles it turned. Before face_outward_and_up, which then judges the whole mesh.
   size_t orient_consistently();
 };
 

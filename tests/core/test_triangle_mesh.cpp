@@ -107,6 +107,14 @@ TEST(TriangleMesh, TrianglesWoundAgainstTheirNeighboursAreTurnedToMatch) {
   EXPECT_TRUE(mixed_down.face_outward_and_up());  // then the whole is turned up
   EXPECT_EQ(mixed_down.triangles, right.triangles);
 
+  // a surface given twice (an STL holding a copy of itself): the copies run every shared edge
+  // the same way, and nothing is wound wrong (10 of 32 triangles were turned before)
+  TriangleMesh doubled = right;
+  doubled.triangles.insert(doubled.triangles.end(), right.triangles.begin(), right.triangles.end());
+  const TriangleMesh doubled_before = doubled;
+  EXPECT_EQ(doubled.orient_consistently(), 0u);
+  EXPECT_EQ(doubled.triangles, doubled_before.triangles);
+
   // a closed cube with one face (two triangles) reversed: its volume back to 8
   TriangleMesh box = cube(Vec3::Zero());
   std::swap(box.triangles[4][1], box.triangles[4][2]);
