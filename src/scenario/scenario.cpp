@@ -81,6 +81,16 @@ std::string folder_name_problem(const std::string& name) {
   return "";
 }
 
+// "x -10 to 10, y -5 to 5, z 5": a box's extent per axis, one number where it is flat
+std::string box_text(const Vec3& lower, const Vec3& upper) {
+  std::string text;
+  for (int axis = 0; axis < 3; ++axis) {
+    text += std::string(axis > 0 ? ", " : "") + "xyz"[axis] + " " + format_number(lower[axis]);
+    if (upper[axis] > lower[axis]) text += " to " + format_number(upper[axis]);
+  }
+  return text;
+}
+
 std::string join(const std::vector<std::string>& names, const std::string& separator = ", ") {
   std::string text;
   for (const std::string& name : names) text += (text.empty() ? "" : separator) + name;
@@ -1291,16 +1301,11 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     // an angle where they are more than kLonePointsNoted of its grid: every run says so
     for (const LoneGridPoints& lone : hatch.lone_points) {
       if (lone.count <= kLonePointsNoted * lone.grid_points) continue;
-      auto span = [&](int axis, const char* name) {
-        const double lo = lone.lower_mm[axis], hi = lone.upper_mm[axis];
-        return std::string(name) + " " + format_number(lo) +
-               (hi > lo ? " to " + format_number(hi) : std::string());
-      };
       scenario_.notes.push_back(
           "toolpath.surface: at " + format_number(lone.angle_deg) + "°, " +
           std::to_string(lone.count) + " of the " + std::to_string(lone.grid_points) +
-          " up-facing grid points of '" + given_file + "' (within " + span(0, "x") + ", " +
-          span(1, "y") + ", " + span(2, "z") +
+          " up-facing grid points of '" + given_file + "' (within " +
+          box_text(lone.lower_mm, lone.upper_mm) +
           " mm) stand alone between steps or walls (a stretch narrower than two "
           "hatch_mm spacings, such as a groove's floor): a line needs two points, so lines at "
           "that angle leave them bare; a smaller hatch_mm reaches them");
@@ -1309,19 +1314,13 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     // surface (a shelf under an overhang) gets nothing, and every run says so
     const HiddenSurface hidden = hidden_top_surface(*projector, spec.min_normal_z);
     if (hidden.hidden_area_mm2 > kHiddenAreaNoted * hidden.up_area_mm2) {
-      // "x -10 to 10", or "z 5" where the hidden area is flat
-      auto span = [&](int axis, const char* name) {
-        const double lo = hidden.lower_mm[axis], hi = hidden.upper_mm[axis];
-        return std::string(name) + " " + format_number(lo) +
-               (hi > lo ? " to " + format_number(hi) : std::string());
-      };
       scenario_.notes.push_back(
           "toolpath.surface: " +
           format_number(std::round(1000.0 * hidden.hidden_area_mm2 / hidden.up_area_mm2) / 10.0) +
           " % of the up-facing area of '" + given_file + "' (" +
           format_number(std::round(hidden.hidden_area_mm2)) + " of " +
-          format_number(std::round(hidden.up_area_mm2)) + " mm², within " + span(0, "x") + ", " +
-          span(1, "y") + ", " + span(2, "z") +
+          format_number(std::round(hidden.up_area_mm2)) + " mm², within " +
+          box_text(hidden.lower_mm, hidden.upper_mm) +
           " mm) lies under another part of the surface: the hatch is projected from above "
           "onto the top surface only, so that area gets no deposit");
     }
