@@ -79,12 +79,21 @@ bool is_depotwin_output(const fs::path& folder) {
   return !error;
 }
 
+}  // namespace
+
+std::string output_marker_line(const std::string& folder) {
+  std::ifstream marker(fs::path(folder) / kOutputMarker);
+  std::string first_line;
+  if (!marker || !std::getline(marker, first_line)) return "";
+  return first_line;
+}
+
+namespace {
+
 // what the marker of `folder` says it is when that is not a run, compare or plan output
 // folder ("a depotwin sweep folder (NAME)"), else ""
 std::string marker_kind(const fs::path& folder) {
-  std::ifstream marker(folder / kOutputMarker);
-  std::string first_line;
-  if (!marker || !std::getline(marker, first_line)) return "";
+  const std::string first_line = output_marker_line(folder.string());
   const std::string sweep = "depotwin sweep folder";
   if (first_line.rfind(sweep, 0) != 0) return "";
   const std::size_t colon = first_line.find("):");

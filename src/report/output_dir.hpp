@@ -13,6 +13,10 @@ namespace depotwin {
 // The marker file in every verb's output folder: a folder holding it is depotwin's to replace.
 inline constexpr const char* kOutputMarker = ".depotwin";
 
+// the first line of `folder`'s marker file ("depotwin output folder, written by ...", "depotwin
+// sweep folder (NAME): ..."), "" when it has none: what kind of folder it is
+std::string output_marker_line(const std::string& folder);
+
 // A directory built under a temporary name (`<final>.partial-<pid>`) and renamed to its
 // final name by commit(), replacing an older result. Destroyed without commit(), it is
 // removed with everything in it.

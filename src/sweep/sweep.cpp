@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -296,9 +295,8 @@ void Sweep::prepare_out_directory() const {
     refuse("exists and is not a depotwin sweep folder (it has files but no " +
            std::string(kOutputMarker) + " marker); choose an empty or new folder");
   // a run's, compare's or plan's folder (their marker) is not a sweep's: the two would mix
-  if (std::ifstream marker(target / kOutputMarker); marker) {
-    std::string first_line;
-    std::getline(marker, first_line);
+  {
+    const std::string first_line = output_marker_line(target.string());
     // ("depotwin output folder, written by `depotwin run`; ...": who wrote it)
     const std::string run_marker = "depotwin output folder";
     if (first_line.rfind(run_marker, 0) == 0) {
