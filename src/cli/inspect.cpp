@@ -224,14 +224,9 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
 void inspect_gcode_file(const std::string& path, const GcodeOptions& options,
                         const InspectBaseline& baseline) {
   // the shutter codes, named by their options
-  for (const auto& [option, code] :
-       {std::pair<const char*, const std::string*>{"--open", &options.open_code},
-        {"--close", &options.close_code}})
-    if (const std::string problem = shutter_code_problem(*code); !problem.empty())
-      throw InputError(option, problem);
-  if (const std::string clash = shutter_codes_clash(options.open_code, options.close_code);
-      !clash.empty())
-    throw InputError("--close", clash);
+  for (const ShutterCodeProblem& problem :
+       shutter_code_problems(options.open_code, options.close_code))
+    throw InputError(problem.at_close ? "--close" : "--open", problem.message);
   const GcodeProgram program = read_gcode_program(path, options);
   // no facts of a file that holds no code: zeros would read as an empty print
   if (const std::string problem = no_code_problem(program.n_lines, program.n_code_lines);

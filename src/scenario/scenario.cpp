@@ -833,19 +833,13 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
     read_word("rule", settings->rule);
     read_word("open", settings->open_code);
     read_word("close", settings->close_code);
-    // each a G or M code, and two different switches (else nothing can be read under them)
-    for (const auto& [key, code] :
-         {std::pair<const char*, const std::string*>{"open", &settings->open_code},
-          {"close", &settings->close_code}})
-      if (const std::string problem = shutter_code_problem(*code); !problem.empty()) {
-        const Field* f = view->find(key);
-        problems_.add(f->line, f->key, problem);
-        bad_code = true;
-      }
-    if (const std::string clash = shutter_codes_clash(settings->open_code, settings->close_code);
-        !bad_code && !clash.empty()) {
-      const Field* f = view->find("close") ? view->find("close") : view->find("open");
-      problems_.add(f->line, f->key, clash);
+    // each a G or M code, and two different switches (else nothing can be read under them);
+    // a problem of a code left at its default is named at the other code, which was given
+    for (const ShutterCodeProblem& problem :
+         shutter_code_problems(settings->open_code, settings->close_code)) {
+      const Field* named = view->find(problem.at_close ? "close" : "open");
+      const Field* f = named ? named : view->find(problem.at_close ? "open" : "close");
+      problems_.add(f->line, f->key, problem.message);
       bad_code = true;
     }
     read_word("feed", settings->feed);

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <tuple>
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -1183,33 +1184,34 @@ std::optional<PrintRule> print_rule_from_name(const std::string& name) {
   return std::nullopt;
 }
 
-std::string shutter_code_problem(const std::string& code) {
-  if (code_of(code)) return "";
-  return "'" + printable(code.data(), code.data() + code.size()) +
-         "' is not a G or M code (e.g. M3, M5, M106, M107)";
-}
-
-std::string shutter_codes_clash(const std::string& open, const std::string& close) {
+std::vector<ShutterCodeProblem> shutter_code_problems(const std::string& open,
+                                                      const std::string& close) {
+  std::vector<ShutterCodeProblem> problems;
   const std::optional<Code> open_code = code_of(open), close_code = code_of(close);
-  if (!open_code || !close_code || !is_shutter_code(open_code, *close_code)) return "";
-  return "'" + close + "' would close what '" + open + "' opens" +
-         (open_code->tenths == close_code->tenths
-              ? std::string(": the open and close codes must differ")
-              : std::string(": M3 and M4 both switch a spindle or laser on, so either opens")) +
-         " (e.g. open M3, close M5)";
+  // each a G or M code
+  for (const auto& [at_close, given, code] :
+       {std::tuple<bool, const std::string*, const std::optional<Code>*>{false, &open, &open_code},
+        {true, &close, &close_code}})
+    if (!*code)
+      problems.push_back({at_close, "'" + printable(given->data(), given->data() + given->size()) +
+                                        "' is not a G or M code (e.g. M3, M5, M106, M107)"});
+  // two different switches, else nothing can be read under them
+  if (open_code && close_code && is_shutter_code(open_code, *close_code)) {
+    const std::string why = open_code->tenths == close_code->tenths
+                                ? "the open and close codes must differ"
+                                : "M3 and M4 both switch a spindle or laser on, so either opens";
+    problems.push_back({true, "'" + close + "' would close what '" + open + "' opens: " + why +
+                                  " (e.g. open M3, close M5)"});
+  }
+  return problems;
 }
 
 GcodeProgram parse_gcode_program(const std::string& text, const std::string& file_label,
                                  const GcodeOptions& options) {
   // the shutter codes must be G or M codes (M3, M106, ...), and two different switches
-  for (const auto& [key, code] :
-       {std::pair<const char*, const std::string*>{"open", &options.open_code},
-        {"close", &options.close_code}})
-    if (const std::string problem = shutter_code_problem(*code); !problem.empty())
-      throw InputError(std::string(kKey) + "." + key, problem);
-  if (const std::string clash = shutter_codes_clash(options.open_code, options.close_code);
-      !clash.empty())
-    throw InputError(std::string(kKey) + ".close", clash);
+  for (const ShutterCodeProblem& problem :
+       shutter_code_problems(options.open_code, options.close_code))
+    throw InputError(std::string(kKey) + (problem.at_close ? ".close" : ".open"), problem.message);
   GcodeParser parser(file_label, options);
   const char* p = text.data();
   const char* end = p + text.size();

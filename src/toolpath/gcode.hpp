@@ -115,11 +115,17 @@ std::string g_code_name(int tenths);
 // no line), or "" when the file has a line of code (GcodeProgram's n_lines, n_code_lines)
 std::string no_code_problem(int n_lines, int n_code_lines);
 
-// what is wrong with a shutter rule's code as given ("" when nothing: a G or M code such as
-// M3, M106), and with an open and close code together ("" unless they are one switch: the
-// same code, or M3 and M4)
-std::string shutter_code_problem(const std::string& code);
-std::string shutter_codes_clash(const std::string& open, const std::string& close);
+// one thing wrong with a shutter rule's codes, and which code it is named at
+struct ShutterCodeProblem {
+  bool at_close = false;  // the close code's (else the open code's)
+  std::string message;
+};
+// what is wrong with an open and close code as given, the open code's first: each that is no
+// G or M code (such as M3, M106), then, when both are codes, their being one switch (the same
+// code, or M3 and M4), named at the close code; none when both are fine. Every reader of the
+// codes (the G-code options, the scenario loader, `inspect`) names these at its own keys.
+std::vector<ShutterCodeProblem> shutter_code_problems(const std::string& open,
+                                                      const std::string& close);
 
 // Parse G-code text; `file_label` names the source in messages. Throws InputError listing
 // the first 20 malformed lines ("file:line: toolpath.gcode: ...") and then how many more.
