@@ -60,6 +60,32 @@ const std::vector<std::string>& refine_methods() {
   return names;
 }
 
+std::string parse_order_name(const std::string& name, OrderSpec& order) {
+  const std::size_t plus = name.find('+');
+  const std::string first = name.substr(0, plus);
+  const std::string second = plus == std::string::npos ? "" : name.substr(plus + 1);
+  const bool ok = plus == std::string::npos
+                      ? known(sequencer_methods(), first) || known(refine_methods(), first)
+                      : known(sequencer_methods(), first) && known(refine_methods(), second);
+  if (!ok) {
+    std::string refines;
+    for (const std::string& refine : refine_methods())
+      refines += (refines.empty() ? "" : "|") + refine;
+    return "unknown sequencer '" + name + "' (expected " + joined(sequencer_methods()) +
+           ", optionally +" + refines + ", or " + joined(refine_methods()) +
+           " alone for nearest_neighbor+it)";
+  }
+  // a refinement alone is shorthand for nearest_neighbor plus that refinement
+  if (known(refine_methods(), first)) {
+    order.method = "nearest_neighbor";
+    order.refine = first;
+  } else {
+    order.method = first;
+    order.refine = second;
+  }
+  return "";
+}
+
 const std::vector<std::string>& cost_models() {
   static const std::vector<std::string> names{"machine", "along_line"};
   return names;

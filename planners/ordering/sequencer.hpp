@@ -61,6 +61,11 @@ const std::vector<std::string>& sequencer_methods();
 const std::vector<std::string>& refine_methods();
 const std::vector<std::string>& cost_models();
 
+// An order written as a name (`order: NAME`, `compare --orders NAME,...`): a method, method+refine,
+// or a refinement alone for nearest_neighbor+it. Sets `order`'s method and refine and returns
+// ""; or returns what is wrong, naming the accepted forms, and leaves `order` as it was.
+std::string parse_order_name(const std::string& name, OrderSpec& order);
+
 // Throws InputError for unknown names (key order.method / order.refine / order.cost_model)
 // and for paths the limits cannot print at their speed.
 // (the transition costs take each move's own limits, as the planners do)

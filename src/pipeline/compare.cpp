@@ -18,17 +18,10 @@ namespace depotwin {
 namespace fs = std::filesystem;
 
 OrderSpec parse_order_label(const std::string& label, const OrderSpec& defaults) {
+  // the names a scenario's `order:` takes, a refinement alone included
   OrderSpec spec = defaults;
-  const size_t plus = label.find('+');
-  spec.method = label.substr(0, plus);
-  spec.refine = plus == std::string::npos ? "" : label.substr(plus + 1);
-  const auto& methods = sequencer_methods();
-  const auto& refines = refine_methods();
-  if (std::find(methods.begin(), methods.end(), spec.method) == methods.end())
-    throw InputError("--orders", "unknown order method '" + spec.method + "'");
-  if (!spec.refine.empty() &&
-      std::find(refines.begin(), refines.end(), spec.refine) == refines.end())
-    throw InputError("--orders", "unknown refinement '" + spec.refine + "'");
+  if (const std::string problem = parse_order_name(label, spec); !problem.empty())
+    throw InputError("--orders", problem);
   return spec;
 }
 

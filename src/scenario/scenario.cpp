@@ -1506,26 +1506,10 @@ void Loader::read_arm(const Field& field) {
 bool Loader::read_order_name(const Field& field, OrderSpec& order) {
   const std::optional<std::string> text = read_string(field, problems_);
   if (!text) return false;
-  const std::size_t plus = text->find('+');
-  const std::string first = text->substr(0, plus);
-  const std::string second = plus == std::string::npos ? "" : text->substr(plus + 1);
-  const bool ok = plus == std::string::npos
-                      ? contains(sequencer_methods(), first) || contains(refine_methods(), first)
-                      : contains(sequencer_methods(), first) && contains(refine_methods(), second);
-  if (!ok) {
-    problems_.add(field.line, field.key,
-                  "unknown sequencer '" + *text + "' (expected " + join(sequencer_methods()) +
-                      ", optionally +" + join(refine_methods(), "|") + ", or " +
-                      join(refine_methods()) + " alone for nearest_neighbor+it)");
+  const std::string problem = parse_order_name(*text, order);
+  if (!problem.empty()) {
+    problems_.add(field.line, field.key, problem);
     return false;
-  }
-  // a refinement alone is shorthand for nearest_neighbor plus that refinement
-  if (contains(refine_methods(), first)) {
-    order.method = "nearest_neighbor";
-    order.refine = first;
-  } else {
-    order.method = first;
-    order.refine = second;
   }
   return true;
 }

@@ -205,6 +205,25 @@ TEST(Sequencers, UnknownNamesAreInputErrors) {
   EXPECT_EQ(OrderSpec{}.label(), "as_given");
 }
 
+// `order: NAME` and `compare --orders NAME` read one grammar: a refinement alone is
+// nearest_neighbor plus it; anything else unknown is named with the accepted forms
+TEST(Sequencers, OrderNamesReadAsTheScenarioReadsThem) {
+  OrderSpec order;
+  EXPECT_EQ(parse_order_name("three_opt", order), "");
+  EXPECT_EQ(order.label(), "nearest_neighbor+three_opt");
+  EXPECT_EQ(parse_order_name("christofides+or_opt", order), "");
+  EXPECT_EQ(order.label(), "christofides+or_opt");
+  EXPECT_EQ(parse_order_name("random", order), "");
+  EXPECT_EQ(order.label(), "random");
+  for (const char* bad : {"greedy", "as_given+", "+two_opt", "two_opt+three_opt", ""}) {
+    OrderSpec kept = testing::spec("christofides", "two_opt");
+    const std::string problem = parse_order_name(bad, kept);
+    EXPECT_EQ(problem.rfind("unknown sequencer '" + std::string(bad) + "'", 0), 0u) << problem;
+    EXPECT_NE(problem.find("alone for nearest_neighbor+it"), std::string::npos) << problem;
+    EXPECT_EQ(kept.label(), "christofides+two_opt") << bad;
+  }
+}
+
 TEST(Sequencers, ApplyOrderReordersAndReverses) {
   const Toolpath toolpath = testing::paper_instance(3, 8);
   OrderResult result;
