@@ -157,6 +157,8 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   facts.extrusion_e_total = program.extrusion_e_total;
   facts.feed_rate_time_s = program.dwell_s;
   facts.ignored_axis_codes = program.ignored_axis_codes;
+  facts.program_end_line = program.program_end_line;
+  facts.n_lines_after_end = program.n_lines_after_end;
   bool previous_printed = false;
   Vec3 previous_end = Vec3::Zero();
   double previous_feed = 0.0;
@@ -218,6 +220,10 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
     out["ignored_axis_words"].push_back({{"code", g_code_name(code.tenths)},
                                          {"n_lines", code.n_lines},
                                          {"first_line", code.first_line}});
+  // null when nothing ended the program before the file's end
+  out["program_end_line"] =
+      facts.program_end_line > 0 ? nlohmann::json(facts.program_end_line) : nlohmann::json();
+  out["n_lines_after_end"] = facts.n_lines_after_end;
   return out;
 }
 

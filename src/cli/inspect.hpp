@@ -48,6 +48,10 @@ struct GcodeFacts {
   int n_moves_without_feed = 0;
   // G codes the reader does not know whose axis words it left alone (no move made there)
   std::vector<IgnoredAxisCode> ignored_axis_codes;
+  // the line of M2, M30 or the closing `%` that ended the program (0: none), and how many
+  // lines holding anything came after it, unread
+  int program_end_line = 0;
+  int n_lines_after_end = 0;
   std::string baseline_machine;  // the machine and firmware mode estimated_time_s assumes
   std::string baseline_mode;
 };

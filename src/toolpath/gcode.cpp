@@ -197,6 +197,40 @@ bool is_modal_setting(int tenths) {
   }
 }
 
+// M codes of RS274/NGC, grbl and Fanuc that take no axis words (program stops and ends,
+// spindle, tool change, coolant, overrides, the fan): on a line with axis words and no G code
+// those words are the modal move's (Fanuc's `X20. M8`, Haas's `G43 H01 Z0.1 M08`), which runs
+// with them; every other M code's axis words are its settings (M201 X1000, M92, M906, ...)
+bool m_code_takes_no_axis_words(int tenths) {
+  switch (tenths) {
+    case 0:  // M0, M1: pause
+    case 10:
+    case 20:  // M2, M30: program end
+    case 300:
+    case 30:  // M3, M4, M5: spindle or laser
+    case 40:
+    case 50:
+    case 60:  // M6: tool change
+    case 70:  // M7, M8, M9: coolant
+    case 80:
+    case 90:
+    case 480:  // M48, M49: overrides on and off
+    case 490:
+    case 1060:  // M106, M107: the fan
+    case 1070:
+      return true;
+    default:
+      return false;
+  }
+}
+
+// whether the rest of a line from p is empty or a comment (`M30` alone ends a program, where
+// Marlin's `M30 file.gco` deletes a file)
+bool rest_is_blank(const char* p, const char* end) {
+  while (p < end && is_space(*p)) ++p;
+  return p == end || *p == ';' || *p == '(';
+}
+
 // whether the code number at p (after its letter, spaces allowed) is `number`, whole
 bool code_number_is(const char* p, const char* end, int number) {
   while (p < end && is_space(*p)) ++p;
@@ -328,6 +362,7 @@ class GcodeParser {
   bool open_ = false;                    // the shutter's open code is active
   bool power_off_ = false;               // the modal S is 0 (a laser's or spindle's power)
   bool machine_frame_ = false;           // this line's G53
+  bool opened_by_percent_ = false;       // a `%` came before any code (RS274/NGC tape)
   bool retracting_ = false;              // the last E change was a decrease
   // positions G60 saved (machine frame) with the programmed E, per slot
   struct SavedPosition {
@@ -387,6 +422,11 @@ void GcodeParser::problem(int line_number, const std::string& message) {
 }
 
 void GcodeParser::line(const char* begin, const char* end, int line_number) {
+  // after the program's end nothing runs: what follows is counted, not read
+  if (program_.program_end_line > 0) {
+    if (std::any_of(begin, end, [](char c) { return !is_space(c); })) ++program_.n_lines_after_end;
+    return;
+  }
   // control bytes: a binary file, or a broken one (never echoed raw)
   for (const char* c = begin; c < end; ++c) {
     const auto byte = static_cast<unsigned char>(*c);
@@ -400,7 +440,15 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   while (p < end && is_space(*p)) ++p;
   if (p < end && *p == '/') ++p;  // block delete: the line runs (block delete off)
   while (p < end && is_space(*p)) ++p;
-  if (p == end || *p == '%' || *p == ';' || *p == '(') {
+  // a `%` before any code opens an RS274/NGC program; the next `%` ends it
+  if (p < end && *p == '%') {
+    if (program_.n_code_lines == 0)
+      opened_by_percent_ = true;
+    else if (opened_by_percent_)
+      program_.program_end_line = line_number;
+    return;
+  }
+  if (p == end || *p == ';' || *p == '(') {
     if (p < end && *p == '(') {
       // a line that is a comment, or a comment then words
       const char* close = std::find(p, end, ')');
@@ -433,6 +481,11 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     }
     const bool shutter_code = tenths >= 0 && (is_shutter_code(open_code_, Code{'M', tenths}) ||
                                               is_shutter_code(close_code_, Code{'M', tenths}));
+    // M2 or M30 alone: the program's end (RS274/NGC, grbl)
+    if ((tenths == 20 || tenths == 300) && !shutter_code && rest_is_blank(stop, end)) {
+      program_.program_end_line = line_number;
+      return;
+    }
     if (tenths >= 0 && !shutter_code && tenths % 10 == 0 && is_text_command(number)) return;
     // Fanuc's M98 P1000 runs subprogram O1000, whose moves would be skipped (RepRapFirmware's
     // M98 P"macro.g" runs a macro: the firmware's, not the print's)
@@ -455,7 +508,8 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     // any other M code but M82, M83 and the shutter's: the firmware's settings, whose
     // parameters need not be numbers (M862.3 P "MK3S", M115 U3.13.2); no geometry, unless the
     // line also holds a G code (checked below, as a whole line)
-    if (tenths >= 0 && !shutter_code && tenths != 820 && tenths != 830 && !has_g_word(q, end))
+    if (tenths >= 0 && !shutter_code && tenths != 820 && tenths != 830 &&
+        !m_code_takes_no_axis_words(tenths) && !has_g_word(q, end))
       return;
   }
   // G29 (bed levelling, probing) takes flags without numbers (Prusa's G29 A, G29 G): no
@@ -463,6 +517,13 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   if (q < end && upper(*q) == 'G' && code_number_is(q + 1, end, 29)) return;
   if (!split_words(p, end, line_number)) return;
   execute(line_number);
+  // M2 or M30 with other words: the program ends after the line (its move made)
+  for (int i = 0; i < words_.n_codes; ++i)
+    if (words_.codes[i].letter == 'M' &&
+        (words_.codes[i].tenths == 20 || words_.codes[i].tenths == 300) &&
+        !is_shutter_code(open_code_, words_.codes[i]) &&
+        !is_shutter_code(close_code_, words_.codes[i]))
+      program_.program_end_line = line_number;
 }
 
 bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
@@ -619,8 +680,10 @@ void GcodeParser::execute(int line_number) {
     if (code.letter == 'M') {
       if (code.tenths == 820 || code.tenths == 830) extruder_relative_ = code.tenths == 830;
       // an M code's axis words are its parameters (M201 X1000: the x acceleration, M92, M203,
-      // M205, M906, ...), never a modal move
-      uses_axes = true;
+      // M205, M906, ...), never a modal move, but for the codes that take none (M8, M3, ...)
+      if (!m_code_takes_no_axis_words(code.tenths) && !is_shutter_code(open_code_, code) &&
+          !is_shutter_code(close_code_, code))
+        uses_axes = true;
       continue;
     }
     if (const char* reason = unsupported_g_code_reason(code.tenths)) {
@@ -744,9 +807,15 @@ void GcodeParser::execute(int line_number) {
     feed_mm_s_ = words_.get('F') * unit_mm_ / kSecondsPerMinute;
   }
   if (dwell) {
+    // S in seconds over P in milliseconds (Marlin, Klipper, RepRapFirmware: S wins when both
+    // are given); Fanuc's X in seconds. grbl's and LinuxCNC's P, in seconds, reads as ms here
     double dwell_s = 0.0;
-    if (words_.has('S')) dwell_s += std::max(0.0, words_.get('S'));
-    if (words_.has('P')) dwell_s += std::max(0.0, words_.get('P')) / 1000.0;
+    if (words_.has('S'))
+      dwell_s = std::max(0.0, words_.get('S'));
+    else if (words_.has('P'))
+      dwell_s = std::max(0.0, words_.get('P')) / 1000.0;
+    else if (words_.has('X'))
+      dwell_s = std::max(0.0, words_.get('X'));
     program_.dwell_s += dwell_s;
     program_.pauses.push_back(GcodePause{program_.moves.size(), dwell_s, line_number});
   }

@@ -106,6 +106,11 @@ struct GcodeProgram {
   // Klipper's named commands: none in a file that is no G-code (a README, a YAML file)
   int n_code_lines = 0;
   std::vector<IgnoredAxisCode> ignored_axis_codes;  // in order of first occurrence
+  // the line that ended the program (M2 or M30 alone, or the `%` closing one that opened the
+  // file, as RS274/NGC and grbl end it), 0 when none did; the lines after it that hold
+  // anything are not read (LinuxCNC ignores them)
+  int program_end_line = 0;
+  int n_lines_after_end = 0;
 };
 
 // "G41", "G51.1": a G code as written, from its number in tenths (IgnoredAxisCode::tenths)

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "scenario/scenario_test_util.hpp"
@@ -109,6 +110,50 @@ TEST(Gcode, McodeAxisWordsAreParametersNotMoves) {
   // the modal G1 still holds for a bare axis line after the M codes
   expect_points(imported.toolpath.paths[0],
                 {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(2, 1, 0)});
+}
+
+// an M code that takes no axis words (coolant, spindle, tool change, fan) beside a modal
+// move: the move runs (Fanuc's `X20. M8`, Haas's `G43 H01 Z0.1 M08`), as LinuxCNC runs it; a
+// line that starts with one is no exception
+TEST(Gcode, ModalMovesBesideCoolantAndSpindleCodesRun) {
+  const GcodeImport imported = parse(
+      "G21 G90 G1 F600\nX0 Y0 E0 M8\nX10 E1 M9\nM7 Y10 E2\nG43 H01 Z1 M08\nX0 E3 M106\n"
+      "M201 X1000\n");
+  ASSERT_EQ(imported.toolpath.paths.size(), 2u);
+  expect_points(imported.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(10, 10, 0)});
+  expect_points(imported.toolpath.paths[1], {Vec3(10, 10, 1), Vec3(0, 10, 1)});
+}
+
+// M2 or M30 alone ends the program, and so does the `%` closing one a `%` opened (RS274/NGC,
+// grbl): nothing after them is read, only counted; Marlin's `M30 file.gco` deletes a file
+TEST(Gcode, TheProgramEndsAtM2M30OrTheClosingPercent) {
+  GcodeOptions options;
+  for (const auto& [text, end_line, after] : std::vector<std::tuple<std::string, int, int>>{
+           {"G1 X10 E1 F600\nM30 (end)\n\nG1 X500 E2\nG1 Y500 E3\n", 2, 2},
+           {"G1 X10 E1 F600\nG0 Z5 M2\nG1 X500 E2\n", 2, 1},
+           {"%\nG1 X10 E1 F600\n%\nG1 X500 E2\n", 3, 1},
+           {"G1 X10 E1 F600\nM30 part.gco\n", 0, 0},
+           {"G1 X10 E1 F600\n%\n", 0, 0}}) {
+    const GcodeProgram program = parse_gcode_program(text, "end.gcode", options);
+    EXPECT_EQ(program.program_end_line, end_line) << text;
+    EXPECT_EQ(program.n_lines_after_end, after) << text;
+    const GcodeImport imported = import_gcode_program(program, options);
+    ASSERT_EQ(imported.toolpath.paths.size(), 1u) << text;
+    expect_points(imported.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+  }
+}
+
+// G4: S in seconds wins over P in milliseconds (Marlin), Fanuc's X is seconds
+TEST(Gcode, DwellsReadSOverPAndFanucX) {
+  GcodeOptions options;
+  const GcodeProgram program = parse_gcode_program(
+      "G1 X1 E1 F600\nG4 S1 P250\nG4 P500\nG04 X2.\nG4 S0.25\n", "dwell.gcode", options);
+  ASSERT_EQ(program.pauses.size(), 4u);
+  EXPECT_DOUBLE_EQ(program.pauses[0].duration_s, 1.0);
+  EXPECT_DOUBLE_EQ(program.pauses[1].duration_s, 0.5);
+  EXPECT_DOUBLE_EQ(program.pauses[2].duration_s, 2.0);
+  EXPECT_DOUBLE_EQ(program.pauses[3].duration_s, 0.25);
+  EXPECT_DOUBLE_EQ(program.dwell_s, 3.75);
 }
 
 // a PrusaSlicer start block: firmware checks whose parameters are text (M862.3 P "MK3S",
