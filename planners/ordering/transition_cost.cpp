@@ -151,6 +151,13 @@ double TransitionCost::along_line_time(double d, double v0, double v1,
 }
 
 double TransitionCost::operator()(int from, int to) const {
+  // two paths' ends at one point (neither the job's start nor its end): the print goes on
+  // through the joint, as the planners join such paths (split_into_segments'
+  // joined_to_previous), with no transition; else a zero-length move at the two paths'
+  // speeds would be charged, and the order's cost and lower bound would exceed the plans
+  if (from < start_node() && to < start_node() &&
+      (positions_[to] - positions_[from]).norm() <= kJoinTolerance_mm)
+    return 0.0;
   // the limits over the box the move may sweep, as the planners' transitions take them
   const MachineLimits limits = tcp_limits_.for_transition(positions_[from], exit_velocity_[from],
                                                           positions_[to], -exit_velocity_[to]);

@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "motion/mtt.hpp"
 #include "planners/ordering/exact.hpp"
+#include "planners/ordering/lower_bound.hpp"
 #include "planners/ordering/transition_cost.hpp"
 
 namespace depotwin {
@@ -110,6 +111,38 @@ TEST(TransitionCost, OrderCostAddsPrintTimeAndTransitions) {
   EXPECT_NEAR(cost.order_cost(order), 20.0 / 3.0 + 2.0 * from_rest + gap / 4.0 + 1.0 / 120.0,
               1e-12);
   EXPECT_NEAR(cost.transition_length_mm(order), 20.0 + gap + 20.0, 1e-12);
+}
+
+// two paths that meet at a corner are printed through it (the planners join them): the joint
+// costs nothing under either model, the order costs the print time plus the start's and the
+// end's moves, and the matching bound is that cost (before, a zero-length move at the two
+// paths' speeds was charged: (3 + 3 sqrt 2) / 30 s here, above every plan)
+TEST(TransitionCost, PathsMeetingAtAPointAreJoinedAtNoCost) {
+  Toolpath corner;
+  corner.start_mm = Vec3(0, 0, 0);
+  corner.end_mm = Vec3(3, 3, 0);
+  corner.paths = {segment(Vec3(0, 0, 0), Vec3(3, 0, 0)), segment(Vec3(3, 0, 0), Vec3(3, 3, 0))};
+  for (CostModel model : {CostModel::machine, CostModel::along_line}) {
+    const TransitionCost cost(corner, kPaperLimits, model);
+    const int exit0 = TransitionCost::exit_node(0, false);
+    const int entry1 = TransitionCost::entry_node(1, false);
+    EXPECT_EQ(cost(exit0, entry1), 0.0);
+    EXPECT_EQ(cost(entry1, exit0), 0.0);
+    OrderResult order;
+    order.order = {0, 1};
+    order.reversed = {false, false};
+    // from rest at the first path's start to 3 mm/s, and from 3 mm/s to rest at the end:
+    // (3 + 3 sqrt 2) / 30 s each, zero-displacement moves of one axis
+    const double at_rest_end = (3.0 + 3.0 * std::sqrt(2.0)) / 30.0;
+    if (model == CostModel::machine) {
+      EXPECT_NEAR(cost(cost.start_node(), TransitionCost::entry_node(0, false)), at_rest_end,
+                  1e-12);
+      EXPECT_NEAR(cost.order_cost(order), 2.0 + 2.0 * at_rest_end, 1e-12);
+      // (the matching works in whole microseconds)
+      EXPECT_LE(matching_lower_bound(cost), cost.order_cost(order));
+      EXPECT_NEAR(matching_lower_bound(cost), cost.order_cost(order), 1e-5);
+    }
+  }
 }
 
 // paths too fast where the machine's joints slow the TCP (limits that fall with x, as an arm's
