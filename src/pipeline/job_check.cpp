@@ -356,7 +356,7 @@ Scenario check_scenario(const std::string& path, const JobBudget& budget, std::s
 
 std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerSpec>& planners,
                                     bool simulate, std::vector<Problem>& problems,
-                                    bool solve_poses) {
+                                    const JobBudget* pose_budget) {
   std::vector<RunEstimate> runs;
   for (const PlannerSpec& spec : planners) {
     // planned and measured; the plan itself is small (pieces, not samples), so the job keeps
@@ -369,10 +369,9 @@ std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerS
       const RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
       // validate, plan and export: its every pose solved now, as the simulation will (a
       // planner's move may leave the travel or the reach between the toolpath's points); a run
-      // too long for sim.max_steps is refused for that instead (size_problems), before any
-      // such work
-      if (solve_poses &&
-          (!simulate || run.steps <= static_cast<double>(job.scenario.sim.max_steps)))
+      // too large (sim.max_steps, the memory) is refused for that instead (size_problems),
+      // before any such work
+      if (pose_budget && size_problems(job.scenario, {run}, *pose_budget).empty())
         check_plan_poses(job, spec, plan);
       runs.push_back(run);
     } catch (const InputError& e) {
@@ -396,7 +395,8 @@ PreparedJob prepare_checked_job(const Scenario& scenario, const std::vector<Plan
     }
   }();
   std::vector<Problem> problems;
-  const std::vector<RunEstimate> runs = check_runs(job, planners, simulate, problems, solve_poses);
+  const std::vector<RunEstimate> runs =
+      check_runs(job, planners, simulate, problems, solve_poses ? &budget : nullptr);
   if (problems.empty()) {
     const std::vector<Problem> size = size_problems(scenario, runs, budget);
     problems.insert(problems.end(), size.begin(), size.end());

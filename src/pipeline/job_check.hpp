@@ -67,16 +67,18 @@ Scenario check_scenario(const std::string& path, const JobBudget& budget, std::s
                         bool simulate = true);
 
 // Stage 2 (above): each planner's plan on the prepared job, measured; problems (a plan the
-// planner refuses, a run too large) appended to `problems`, the estimates returned. With
-// solve_poses (validate, plan, export: the verbs that simulate nothing), each run's plan is
-// also solved pose by pose as the simulation will solve it (check_plan_poses: a plan leaving
-// the travel or the reach); run and compare leave
+// planner refuses, a run too large) appended to `problems`, the estimates returned. With a
+// pose_budget (validate, plan, export: the verbs that simulate nothing), each run's plan that
+// fits it (sim.max_steps and the memory: size_problems finds nothing, so a plan of 1e8
+// samples is refused for its size at once, not solved first) is also solved pose by pose as
+// the simulation will solve it (check_plan_poses: a plan leaving the travel or the reach);
+// run and compare leave
 // that to the simulation itself, which says the same word for word (on an arm the inverse
 // kinematics of every step is most of a run's cost, and would be paid twice). Each plan is
 // kept in job.checked_plans, where plan_job takes it.
 std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerSpec>& planners,
                                     bool simulate, std::vector<Problem>& problems,
-                                    bool solve_poses = false);
+                                    const JobBudget* pose_budget = nullptr);
 
 // What a verb does before its work: stage 2 on the job prepared for it (the lower bound of
 // the print order computed only when `with_lower_bound`: a report shows it, validate does

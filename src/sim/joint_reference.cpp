@@ -39,24 +39,25 @@ TrajectorySample planned_sample(TrajectoryCursor& plan, double t, double duratio
 void joints_at(const Machine& machine, const TrajectorySample& sample, const JointVector* seed,
                JointVector& joints) {
   std::string why;
-  const double t = sample.t_s;
-  // where in the plan: a print path's samples name it; a transition leaves the toolpath's
-  // points, which the scenario check found reachable (a planner's move overshoots them)
-  const std::string at =
-      "at t = " + format_number(t) + " s (" +
-      (sample.path_index >= 0 ? "printing path " + std::to_string(sample.path_index)
-                              : std::string("in a transition the planner added")) +
-      "): ";
+  // where in the plan, written only for a message: a print path's samples name it; a
+  // transition leaves the toolpath's points, which the scenario check found reachable (a
+  // planner's move overshoots them)
+  const auto at = [&sample] {
+    return "at t = " + format_number(sample.t_s) + " s (" +
+           (sample.path_index >= 0 ? "printing path " + std::to_string(sample.path_index)
+                                   : std::string("in a transition the planner added")) +
+           "): ";
+  };
   const bool solved = seed ? machine.inverse_near(sample.pose(), *seed, joints, &why)
                            : machine.inverse(sample.pose(), joints, &why);
-  if (!solved) throw InputError("trajectory", at + why);
+  if (!solved) throw InputError("trajectory", at() + why);
   const std::vector<JointLimit>& limits = machine.joint_limits();
   if (joints.size() != limits.size())
     throw InternalError("machine " + machine.name() + " returned " + std::to_string(joints.size()) +
                         " joints, expected " + std::to_string(limits.size()));
   for (size_t j = 0; j < joints.size(); ++j) {
     if (joints[j] < limits[j].min - 1e-9 || joints[j] > limits[j].max + 1e-9)
-      throw InputError("trajectory", at + "joint " + limits[j].name + " at " +
+      throw InputError("trajectory", at() + "joint " + limits[j].name + " at " +
                                          format_number(joints[j]) + " is outside its travel [" +
                                          format_number(limits[j].min) + ", " +
                                          format_number(limits[j].max) + "]");
