@@ -151,6 +151,8 @@ std::string node_name(const PrintPath& path, const PathNode& node) {
 
 // an arc meets its neighbour tangentially when their directions differ by at most this (rad)
 constexpr double kTangentJoin_rad = 2e-3;
+// a vertex whose edges turn by at most this (rad) is straight on: no corner, one line
+constexpr double kStraightTurnRad = 1e-10;
 
 // the arc edge's radius vector at its start, in its plane (from the centre at the start's level)
 Vec3 arc_radius(const PrintPath& path, size_t edge) {
@@ -279,6 +281,20 @@ PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& origi
     lengths[i] = (points[i + 1] - points[i]).norm();
     dirs[i] = (points[i + 1] - points[i]) / lengths[i];
   }
+  // a vertex between two straight edges that turns by at most kStraightTurnRad is no corner:
+  // its edges are one line (no blend: a blend of a 0-degree turn is a piece of the line at
+  // constant speed, and clipped to half of short edges it leaves lines of length 0 between
+  // blends, where no ramp fits); `run` is the length of the merged line each edge is part of
+  std::vector<bool> straight(points.size(), false);
+  for (size_t j = 1; j < edges; ++j)
+    straight[j] = !is_arc_edge(path, j - 1) && !is_arc_edge(path, j) &&
+                  dirs[j - 1].dot(dirs[j]) > 0.0 &&
+                  dirs[j - 1].cross(dirs[j]).norm() <= kStraightTurnRad;
+  std::vector<double> run = lengths;
+  for (size_t e = 1; e < edges; ++e)
+    if (straight[e]) run[e] += run[e - 1];
+  for (size_t e = edges - 1; e-- > 0;)
+    if (straight[e + 1]) run[e] = run[e + 1];
 
   // a straight line from a to b along dir (trimmed by the blends below)
   const auto line_between = [&](const Vec3& a, const Vec3& b, const Vec3& dir) {
@@ -310,7 +326,7 @@ PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& origi
       return node;
     }
     // fillet distance, clipped to half the shorter adjacent line
-    const double room = 0.5 * std::min(lengths[j - 1], lengths[j]);
+    const double room = 0.5 * std::min(run[j - 1], run[j]);
     double delta = settings.delta_mm;
     if (delta > room) {
       delta = room;
@@ -367,6 +383,11 @@ PathGeometry build_geometry(const PrintPath& path, const std::vector<int>& origi
   g.nodes.back().exact = true;
   for (size_t e = 0; e < edges; ++e) {
     if (!is_arc_edge(path, e)) {
+      if (e > 0 && straight[e]) {  // straight on: the line before runs on to this edge's end
+        const Vec3 from = g.lines.back().from_mm;
+        g.lines.back() = line_between(from, points[e + 1], (points[e + 1] - from).normalized());
+        continue;
+      }
       if (e > 0 && !is_arc_edge(path, e - 1)) g.nodes.push_back(corner_node(e));
       g.lines.push_back(line_between(points[e], points[e + 1], dirs[e]));
       continue;

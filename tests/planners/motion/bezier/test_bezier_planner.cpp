@@ -420,5 +420,35 @@ TEST(BezierPlanner, LeadInPrintsOnlyAtFullSpeed) {
   expect_contract(trajectory, toolpath, limits, 0.45);
 }
 
+// A vertex that goes straight on is no corner (no blend): a 10 mm line given as 101 points
+// every 0.1 mm plans exactly as the 2-point line, at print speed, without warnings. Before,
+// each vertex got a blend clipped to 0.05 mm, the lines between them had length 0, and the
+// constant-speed blends held the speed reached on the first 0.05 mm: 1.616 mm/s.
+TEST(BezierPlanner, CollinearPointsPlanAsOneLine) {
+  const MachineLimits limits = MachineLimits::uniform(4.0, 30.0);
+  BezierSettings settings;  // delta 0.5 mm, T_s 1 ms
+  const BezierPlanner planner(settings);
+  std::vector<Vec3> fine;
+  for (int i = 0; i <= 100; ++i) fine.push_back(Vec3(-5.0 + 0.1 * i, 0.0, 0.0));
+  const Toolpath fine_path = single_path(fine, 3.0);
+  const Trajectory two = planner.plan(single_path({Vec3(-5, 0, 0), Vec3(5, 0, 0)}, 3.0), limits);
+  const Trajectory many = planner.plan(fine_path, limits);
+  EXPECT_TRUE(many.warnings().empty());
+  EXPECT_NEAR(many.duration_s(), two.duration_s(), 1e-9);
+  EXPECT_NEAR(many.depositing_time_s(), two.depositing_time_s(), 1e-9);
+  double peak = 0.0;
+  for (const TrajectoryPiece& piece : many.pieces())
+    if (piece.depositing)
+      for (const Vec3& v : sampled(piece).velocity_mm_s) peak = std::max(peak, v.norm());
+  EXPECT_NEAR(peak, 3.0, 1e-9);
+  expect_contract(many, fine_path, limits, 0.5);
+  // a straight run counts as one line for the fillet room of the corner after it: no clip
+  std::vector<Vec3> bent = fine;
+  bent.push_back(Vec3(5.0, 10.0, 0.0));
+  const Trajectory corner = planner.plan(single_path(bent, 3.0), limits);
+  for (const std::string& w : corner.warnings())
+    EXPECT_EQ(w.find("clipped"), std::string::npos) << w;
+}
+
 }  // namespace
 }  // namespace depotwin
