@@ -29,11 +29,17 @@ void MotionSamples::push_back(double t, const Vec3& p, const Vec3& v, bool depos
   desired_speed_mm_s.push_back(desired);
 }
 
+// half of trajectory.csv's time resolution (its times are written to 1e-6 s)
+constexpr double kEndMergeWithin_s = 5e-7;
+
 MotionSamples sample_trajectory(const Trajectory& trajectory, double period_s) {
   MotionSamples samples;
   const double duration = trajectory.duration_s();
-  const long count = static_cast<long>(std::floor(duration / period_s + 1e-9)) + 1;
+  long count = static_cast<long>(std::floor(duration / period_s + 1e-9)) + 1;
   samples.reserve(count + 1);
+  // an end within half a microsecond after the last grid sample takes that sample's place:
+  // trajectory.csv writes times to the microsecond, where the two would share one time
+  if (count > 1 && duration - (count - 1) * period_s < kEndMergeWithin_s) --count;
   for (long k = 0; k < count; ++k) {
     const TrajectorySample s = trajectory.at(k * period_s);
     samples.push_back(s.t_s, s.position_mm, s.velocity_mm_s, s.depositing, s.path_index,
