@@ -7,6 +7,7 @@
 #include "metrics/motion_metrics.hpp"
 #include "planners/motion/lspb_mtt.hpp"
 #include "planners/motion/stop_and_go.hpp"
+#include "planners/motion/transition.hpp"
 
 namespace depotwin {
 namespace {
@@ -124,6 +125,27 @@ TEST(ThompsonFig11, PeakSpeedErrorGrowsAsTheJointAngleShrinks) {
   const double extent = (hi - lo).head<2>().maxCoeff();
   const PathErrorStats error = path_error(sample_trajectory(plan, 1e-3), toolpath);
   EXPECT_LE(error.max_mm, 0.015 * extent) << "extent " << extent;
+}
+
+// sampled every period, a plan whose end lies a fraction of a nanosecond after a sample: the
+// end takes that sample's place (trajectory.csv writes microseconds, where the two rows would
+// share a time), and the final rest state is still the last sample
+TEST(StopAndGo, AnEndJustAfterASampleReplacesIt) {
+  const TcpLimits limits(MachineLimits::uniform(4.0, 30.0));
+  const Trajectory plan("test", {transition_piece(0.0, Vec3(0, 0, 0), Vec3::Zero(), Vec3(10, 0, 0),
+                                                  Vec3::Zero(), limits)});
+  const double duration = plan.duration_s();
+  for (double after : {2e-10, 4e-7}) {
+    const double period = (duration - after) / 1000.0;
+    const MotionSamples samples = sample_trajectory(plan, period);
+    ASSERT_EQ(samples.size(), 1001u) << after;
+    EXPECT_EQ(samples.t_s.back(), duration);
+    EXPECT_NEAR(samples.t_s[999], 999.0 * period, 1e-15);
+    EXPECT_EQ(samples.velocity_mm_s.back(), Vec3::Zero());
+  }
+  // an end farther after its sample is a sample of its own
+  const MotionSamples apart = sample_trajectory(plan, (duration - 1e-6) / 1000.0);
+  EXPECT_EQ(apart.size(), 1002u);
 }
 
 TEST(StopAndGo, RestToRestSegmentsAtPrintSpeed) {
