@@ -28,6 +28,16 @@ std::string message_number(double value) {
   return text;
 }
 
+std::string message_number_beside(double value, double bound, int significant_digits) {
+  // the fewest digits from significant_digits on at which the two texts differ
+  char text[40], bound_text[40];
+  for (int digits = significant_digits;; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, value);
+    std::snprintf(bound_text, sizeof bound_text, "%.*g", digits, bound);
+    if (value == bound || digits >= 17 || std::string(text) != bound_text) return text;
+  }
+}
+
 void append_number(std::string& out, double value, int significant_digits) {
   char text[32];  // "-1.2345678901234567e-308": 24 characters at 17 digits
   const std::to_chars_result end = std::to_chars(text, text + sizeof text, value,

@@ -18,6 +18,11 @@ std::optional<double> parse_double(const std::string& text);
 // a number as messages print it: at most 6 significant digits (%.6g: 3, 0.25, 1e-05, 1e+300)
 std::string message_number(double value);
 
+// `value` as message_number writes it, with as many more digits (up to 17) as it takes to
+// read differently from `bound` when it differs: a value just outside a limit never reads as
+// the limit ("1000005" beside 1e+06, "50.0001" beside 50, not "1e+06" or "50")
+std::string message_number_beside(double value, double bound, int significant_digits = 6);
+
 // `value` appended to `out` as printf's "%.<digits>g" writes it in the C locale (std::to_chars
 // with chars_format::general, which the standard defines so): for data files of millions of
 // numbers (trajectory.csv, thickness.csv, plot data). digits: 1 to 17.

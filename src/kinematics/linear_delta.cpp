@@ -6,6 +6,8 @@
 #include <limits>
 #include <sstream>
 
+#include "core/number_text.hpp"
+
 namespace depotwin {
 
 namespace {
@@ -236,7 +238,8 @@ bool LinearDelta::inverse(const Pose& pose, JointVector& joints, std::string* wh
     if (horizontal_mm > reach_mm) {
       const double angle_deg =
           horizontal_mm < rod_mm ? rad_to_deg(std::asin(horizontal_mm / rod_mm)) : 90.0;
-      return fail("the rods of " + arm_name + " would lean " + format_mm(angle_deg) +
+      return fail("the rods of " + arm_name + " would lean " +
+                  message_number_beside(angle_deg, geometry_.max_rod_angle_deg, 4) +
                   " deg from vertical, beyond the " + format_mm(geometry_.max_rod_angle_deg) +
                   " deg limit (" + format_mm(horizontal_mm - reach_mm) +
                   " mm outside the reachable region)");

@@ -202,7 +202,8 @@ std::optional<double> read_number(const Field& field, ProblemList& problems, con
   }
   if (!range.contains(*value)) {
     problems.add(field.line, field.key,
-                 "must be " + range.text() + ", got " + format_number(*value));
+                 "must be " + range.text() + ", got " +
+                     message_number_beside(*value, *value < range.min ? range.min : range.max));
     return std::nullopt;
   }
   return value;
@@ -215,7 +216,8 @@ std::optional<long long> read_integer(const Field& field, ProblemList& problems,
   const Range range{static_cast<double>(min_value), true, static_cast<double>(max_value), true};
   if (std::floor(*value) != *value || !range.contains(*value)) {
     problems.add(field.line, field.key,
-                 "must be a whole number " + range.text() + ", got " + format_number(*value));
+                 "must be a whole number " + range.text() + ", got " +
+                     message_number_beside(*value, *value < range.min ? range.min : range.max));
     return std::nullopt;
   }
   return static_cast<long long>(*value);

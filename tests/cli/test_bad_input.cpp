@@ -234,7 +234,7 @@ std::vector<Row> rows() {
   r.push_back(scenario("PlanLeavesTheTravel",
                        probe_with("limits:", "limits: {v_max: 4, a_max: 0.05}"),
                        "{s}:11: planners: the lspb_mtt plan at t = [0-9.]+ s \\(in a transition "
-                       "the planner added\\): joint x at 50 mm is outside its travel"));
+                       "the planner added\\): joint x at 50\\.00[0-9]+ mm is outside its travel"));
   // plan and export, which simulate nothing, refuse it too rather than write it
   for (const auto& [name, verb] : std::vector<std::pair<std::string, std::string>>{
            {"PlanVerbRefusesAPlanLeavingTheTravel", "plan {dir}/scenario.yaml --out {out}"},
@@ -243,7 +243,7 @@ std::vector<Row> rows() {
     r.push_back(
         command(name, verb,
                 "{s}:11: planners: the lspb_mtt plan at t = [0-9.]+ s \\(in a transition "
-                "the planner added\\): joint x at 50 mm is outside its travel",
+                "the planner added\\): joint x at 50\\.00[0-9]+ mm is outside its travel",
                 {{"scenario.yaml", probe_with("limits:", "limits: {v_max: 4, a_max: 0.05}")}}));
   r.push_back(scenario("SlowPrintTooManySteps", probe_with("  speed:", "  speed: 1e-5"),
                        "{s}:6: toolpath\\.speed: the job would take .* physics steps, more than "

@@ -50,6 +50,20 @@ std::vector<double> edge_values() {
           std::nan("")};
 }
 
+// a value just outside a bound never reads as the bound: digits are added until it differs
+TEST(NumberText, AValueBesideItsBoundReadsDifferently) {
+  EXPECT_EQ(message_number_beside(1000005.0, 1e6), "1000005");
+  EXPECT_EQ(message_number_beside(50.0001, 50.0, 4), "50.0001");
+  EXPECT_EQ(message_number_beside(-50.00002, -50.0, 4), "-50.00002");
+  EXPECT_EQ(message_number_beside(55.00001, 55.0, 4), "55.00001");
+  // far from the bound, or equal to it: as message_number writes it
+  EXPECT_EQ(message_number_beside(1.5e6, 1e6), message_number(1.5e6));
+  EXPECT_EQ(message_number_beside(1e6, 1e6), "1e+06");
+  // doubles that differ in the 17th digit only: 17 digits, never more
+  const double next = std::nextafter(1.0, 2.0);
+  EXPECT_EQ(message_number_beside(next, 1.0), "1.0000000000000002");
+}
+
 TEST(NumberText, AppendNumberIsPrintfsG) {
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> mantissa(-1.0, 1.0);

@@ -158,7 +158,7 @@ planners: [lspb_mtt]
     const std::string& message = problem.message;
     EXPECT_EQ(message.rfind("the lspb_mtt plan at t = ", 0), 0u) << message;
     EXPECT_NE(message.find(" s (in a transition the planner added): the cartesian machine's x "
-                           "axis at 100 mm is outside its travel [-100, 100] mm, by 0.01"),
+                           "axis at 100.01 mm is outside its travel [-100, 100] mm, by 0.01"),
               std::string::npos)
         << message;
   };
