@@ -22,6 +22,9 @@ namespace {
 
 // the plan's samples, as plan_job takes them (trajectory.csv, planned metrics)
 constexpr double kSamplePeriod_s = 0.001;
+// a plan this many times the bound before planning, from a planner given parameters: the
+// planner's parameters make it long (RunEstimate::planner_line)
+constexpr double kPlannerDrivenRatio = 10.0;
 // What a run keeps, per unit, measured on thompson_fig7 stretched to 340 s (430 B per 1 ms
 // step on the XY stage, both kinds together) and rounded up: per physics step the recorded
 // state (73 B + 32 B per joint), the simulated and re-sampled motion and the joint
@@ -182,6 +185,17 @@ std::string size_driver(const Scenario& scenario, const RunEstimate& run, bool m
   return "limits.a_max";
 }
 
+// a size problem at the key that drives it: the planner's entry when its parameters make the
+// plan long (RunEstimate::planner_line), else the scenario key size_driver names
+Problem at_driver(const Scenario& scenario, const RunEstimate& run, bool memory,
+                  const std::string& message) {
+  if (run.planner_line > 0)
+    return Problem{scenario.file, run.planner_line, "planners",
+                   message + "; the " + run.label +
+                       " plan is far longer than the paths at their speeds: check its parameters"};
+  return scenario.problem_at(size_driver(scenario, run, memory), message);
+}
+
 // what a run's duration is made of, for messages
 std::string duration_text(const Scenario& scenario, const RunEstimate& run) {
   std::string text = run.label.empty()
@@ -285,8 +299,8 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
   const double max_steps = static_cast<double>(scenario.sim.max_steps);
   for (const RunEstimate& run : runs) {
     if (!run.simulated || !(run.steps > max_steps)) continue;
-    problems.push_back(scenario.problem_at(
-        size_driver(scenario, run, false),
+    problems.push_back(at_driver(
+        scenario, run, false,
         (run.label.empty() ? std::string("the job") : "run " + run.label) + " would take " +
             count_text(run.steps) + " physics steps, more than sim.max_steps = " +
             count_text(max_steps) + ": " + duration_text(scenario, run) + ", at sim.timestep_s " +
@@ -307,8 +321,8 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
     std::string parts = (run.simulated ? count_text(run.steps) + " physics steps, " : "") +
                         count_text(run.samples) + " samples of the plan";
     if (run.cells > 0.0) parts += ", " + count_text(run.cells) + " deposition cells";
-    problems.push_back(scenario.problem_at(
-        size_driver(scenario, run, true),
+    problems.push_back(at_driver(
+        scenario, run, true,
         std::string(runs.size() > 1 ? "the " + std::to_string(runs.size()) + " runs" : "the run") +
             " would need about " + format_bytes(memory_bytes) +
             " of memory, more than --max-memory " + format_bytes(budget.max_memory_bytes) + ": " +
@@ -366,7 +380,11 @@ std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerS
         job.checked_plans.push_back(
             {spec, std::make_shared<const Trajectory>(plan_trajectory(job, spec))});
       const Trajectory& plan = *job.checked_plan(spec);
-      const RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
+      RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
+      if (!spec.params.empty() &&
+          run.duration_s >
+              kPlannerDrivenRatio * estimate_before_planning(job.scenario, simulate).duration_s)
+        run.planner_line = planner_entry_line(job.scenario, spec);
       // validate, plan and export: its every pose solved now, as the simulation will (a
       // planner's move may leave the travel or the reach between the toolpath's points); a run
       // too large (sim.max_steps, the memory) is refused for that instead (size_problems),

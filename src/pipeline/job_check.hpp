@@ -47,6 +47,10 @@ struct RunEstimate {
   double cells = 0.0;         // deposition grid cells (every field of the deposit)
   double memory_bytes = 0.0;  // what the run keeps at its peak
   bool simulated = true;      // false: a plan only (`depotwin plan`)
+  // the planner's entry line when its own parameters, not the scenario's limits, make the plan
+  // long (a plan 10 times the bound before planning, from a planner given parameters, such
+  // as firmware's max_velocity): a size problem is named there; 0 otherwise
+  int planner_line = 0;
 };
 
 // The run of `scenario` before planning: a lower bound on its duration (every path at its

@@ -245,6 +245,15 @@ std::vector<Row> rows() {
                 "{s}:11: planners: the lspb_mtt plan at t = [0-9.]+ s \\(in a transition "
                 "the planner added\\): joint x at 50\\.00[0-9]+ mm is outside its travel",
                 {{"scenario.yaml", probe_with("limits:", "limits: {v_max: 4, a_max: 0.05}")}}));
+  // a planner's own caps (firmware's max_velocity) make its plan long, not the limits: the
+  // size problem is named at that planner's entry
+  r.push_back(scenario("PlannerCapsMakeThePlanLong",
+                       probe_with("planners:",
+                                  "planners:\n  - {name: firmware, max_velocity: "
+                                  "1e-3}"),
+                       "{s}:12: planners: run firmware would take .* physics steps, more than "
+                       "sim\\.max_steps .*the firmware plan is far longer than the paths at "
+                       "their speeds: check its parameters"));
   r.push_back(scenario("SlowPrintTooManySteps", probe_with("  speed:", "  speed: 1e-5"),
                        "{s}:6: toolpath\\.speed: the job would take .* physics steps, more than "
                        "sim\\.max_steps"));
