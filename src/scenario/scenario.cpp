@@ -1836,13 +1836,15 @@ Problem path_problem(const Scenario& scenario, int source_index, const std::stri
     if (!source.key.empty() && source.file != scenario.file)
       return Problem{source.file, first_line, source.key,
                      "the print path from this line: " + message};
-    // a path of the scenario file: its own key for the detail when given, else its entry
+    // a path of the scenario file: its own key for the detail when given (its `speed:`), else
+    // its entry (its own line, not the toolpath's shared `speed:`): never a key the file
+    // does not hold
     if (!source.key.empty()) {
       const auto own = scenario.key_lines.find(source.key + below);
-      const int line = own != scenario.key_lines.end() ? own->second
-                       : first_line > 0                ? first_line
-                                                       : scenario.line_of(source.key);
-      return Problem{scenario.file, line, source.key + below, message};
+      if (own != scenario.key_lines.end())
+        return Problem{scenario.file, own->second, own->first, message};
+      const int line = first_line > 0 ? first_line : scenario.line_of(source.key);
+      return Problem{scenario.file, line, source.key, message};
     }
   }
   return Problem{scenario.file, scenario.toolpath_line, "toolpath",

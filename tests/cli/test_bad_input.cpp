@@ -314,14 +314,15 @@ std::vector<Row> rows() {
       "{s}:7: toolpath\\.start: the start \\(0\\.000, 0\\.000, 2000\\.000\\) mm "
       "is out of the arm's reach"));
   // near the arm's base its joints allow the TCP less than limits.v_max: the path is named at
-  // its own line (not the ordering's "toolpath.paths[0]"), a G-code path at its first move
+  // its own line and key (not the ordering's "toolpath.paths[0]", nor a `speed:` it does not
+  // hold), a G-code path at its first move
   r.push_back(scenario(
       "ArmPathTooFastNearItsBase",
       replace_line(replace_line(replace_line(probe_with("machine:", "machine: arm6"),
                                              "limits:", "limits: {v_max: 200, a_max: 2000}"),
                                 "  speed:", "  speed: 30"),
                    "    - [[2, 2], [8, 2]]", "    - [[-300, 2], [-290, 2]]"),
-      "{s}:9: toolpath\\.segments\\[0\\]\\.speed: print speed 30 mm/s exceeds "
+      "{s}:9: toolpath\\.segments\\[0\\]: print speed 30 mm/s exceeds "
       "v_max = [0-9.]+ mm/s of axis x at its ends \\(the machine's joint limits "
       "mapped over this path; limits v_max is 200\\)"));
   r.push_back(scenario("ArmGcodeTooFastNearItsBase",
