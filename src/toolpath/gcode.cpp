@@ -147,6 +147,17 @@ const char* packed_gcode_reason(const std::string& text) {
            "project): unzip it; the G-code is Metadata/plate_1.gcode";
   if (text.compare(0, 2, "\x1f\x8b") == 0)
     return "a gzip-compressed file: decompress it first (gunzip)";
+  // UTF-16 text (a byte order mark, or a NUL beside every ASCII character): a Windows editor's
+  // "Unicode" save
+  const bool utf16_mark =
+      text.compare(0, 2, "\xFF\xFE") == 0 || text.compare(0, 2, "\xFE\xFF") == 0;
+  const bool utf16_ascii =
+      text.size() >= 4 &&
+      ((text[0] != '\0' && text[1] == '\0' && text[2] != '\0' && text[3] == '\0') ||
+       (text[0] == '\0' && text[1] != '\0' && text[2] == '\0' && text[3] != '\0'));
+  if (utf16_mark || utf16_ascii)
+    return "UTF-16 text, where G-code is read as ASCII or UTF-8: save it as UTF-8 (e.g. "
+           "iconv -f UTF-16 -t UTF-8)";
   return nullptr;
 }
 
@@ -459,8 +470,9 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   }
   // grbl's system commands ($H homing, $X unlock, $$ settings): not G-code
   if (*p == '$') return;
-  // Klipper's extended commands (a name, not a letter and a number): not motion
-  if (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_')) return;
+  // Klipper's extended commands (a name, not a letter and a number; a macro's may start with
+  // `_`, as `_CLIENT_RETRACT`): not motion
+  if (*p == '_' || (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_'))) return;
   ++program_.n_code_lines;
   // the first code after an optional line number: Marlin's text commands end here
   const char* q = p;
@@ -632,9 +644,14 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
                                  "' (at most " + std::to_string(kMaxCodeNumber) + ")");
         return false;
       }
-      if (value < 0.0 || std::abs(tenths - std::round(tenths)) > 1e-6 ||
-          words_.n_codes == static_cast<int>(words_.codes.size())) {
+      if (value < 0.0 || std::abs(tenths - std::round(tenths)) > 1e-6) {
         problem(line_number, "malformed code '" + printable(word_start, p) + "'");
+        return false;
+      }
+      if (words_.n_codes == static_cast<int>(words_.codes.size())) {
+        problem(line_number, "more than " + std::to_string(words_.codes.size()) +
+                                 " G and M codes on one line (at '" + printable(word_start, p) +
+                                 "')");
         return false;
       }
       words_.codes[words_.n_codes++] = Code{letter, static_cast<int>(std::lround(tenths))};

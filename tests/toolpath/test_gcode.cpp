@@ -143,6 +143,19 @@ TEST(Gcode, TheProgramEndsAtM2M30OrTheClosingPercent) {
   }
 }
 
+// a Klipper macro whose name starts with `_` is a named command like any other (no motion);
+// more G and M codes on a line than the reader holds are named as that
+TEST(Gcode, UnderscoreMacrosAndCrowdedLines) {
+  const GcodeImport imported = parse("_CLIENT_RETRACT LENGTH=1\nG1 X1 E1 F600\n");
+  ASSERT_EQ(imported.toolpath.paths.size(), 1u);
+  std::string crowded = "G1 X1";
+  for (int i = 0; i < 20; ++i) crowded += " M" + std::to_string(220 + i);
+  const auto problems = problems_of(crowded + "\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].message.rfind("more than 16 G and M codes on one line (at 'M235')", 0), 0u)
+      << problems[0].str();
+}
+
 // G4: S in seconds wins over P in milliseconds (Marlin), Fanuc's X is seconds
 TEST(Gcode, DwellsReadSOverPAndFanucX) {
   GcodeOptions options;
@@ -411,12 +424,25 @@ TEST(Gcode, EveryMalformedLineIsReported) {
 }
 
 TEST(Gcode, PackedFilesAreNamedWithTheWayOut) {
-  // PrusaSlicer's binary G-code, a Bambu .gcode.3mf (zip) and a gzip file: one problem at
+  // PrusaSlicer's binary G-code, a Bambu .gcode.3mf (zip), a gzip file, UTF-16: one problem at
   // line 1 naming the container, instead of a control byte at a column
   const std::vector<std::pair<std::string, std::string>> packed = {
       {std::string("GCDE\x01\x00\x00\x00", 8), "binary G-code file (PrusaSlicer's .bgcode"},
       {std::string("PK\x03\x04\x14\x00", 6), "Metadata/plate_1.gcode"},
-      {std::string("\x1f\x8b\x08\x00", 4), "gzip-compressed"}};
+      {std::string("\x1f\x8b\x08\x00", 4), "gzip-compressed"},
+      // UTF-16, with its byte order mark or without (a NUL beside each ASCII character)
+      {std::string("\xFF\xFE"
+                   "G\0"
+                   "1\0",
+                   6),
+       "UTF-16 text"},
+      {std::string("G\0"
+                   "1\0"
+                   " \0"
+                   "X\0"
+                   "1\0",
+                   10),
+       "UTF-16 text"}};
   for (const auto& [bytes, named] : packed) {
     const auto problems = problems_of(bytes);
     ASSERT_EQ(problems.size(), 1u) << dump(problems);
