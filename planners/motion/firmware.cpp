@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/number_text.hpp"
 #include "planners/motion/print_segments.hpp"
 #include "planners/motion/transition.hpp"
 
@@ -665,7 +666,25 @@ Trajectory FirmwarePlanner::plan(const Toolpath& toolpath, const TcpLimits& limi
     first = end;
   }
   travel_to(toolpath.end_mm, toolpath.end_orientation());
-  return Trajectory("firmware", std::move(pieces));
+  // a max_velocity below print speeds slows those segments, as a firmware's M203 would: said,
+  // since every other planner refuses a speed above its limit
+  std::vector<std::string> warnings;
+  if (settings.max_velocity > 0.0) {
+    std::size_t capped = 0;
+    double fastest = 0.0;
+    for (const PrintSegment& s : segments)
+      if (s.speed_mm_s > settings.max_velocity) {
+        ++capped;
+        fastest = std::max(fastest, s.speed_mm_s);
+      }
+    if (capped > 0)
+      warnings.push_back("max_velocity " + message_number(settings.max_velocity) +
+                         " mm/s is below the print speed of " + std::to_string(capped) + " of " +
+                         std::to_string(segments.size()) + " segments (up to " +
+                         message_number(fastest) + " mm/s): they print at most at " +
+                         message_number(settings.max_velocity) + " mm/s");
+  }
+  return Trajectory("firmware", std::move(pieces), std::move(warnings));
 }
 
 std::vector<PlannerParameter> firmware_parameters() {

@@ -172,11 +172,20 @@ TEST(Firmware, SingleTrapezoidTime) {
       plan_with({"firmware", {{"max_accel_to_decel", {500.0}}}, 0, {{"mode", "klipper"}}},
                 polyline_job({{0, 0, 0}, {1.5, 0, 0}}, 50), limits);
   EXPECT_NEAR(older.duration_s(), klipper.duration_s(), 1e-12);
-  // max_velocity and max_accel cap the limits' own
-  EXPECT_NEAR(plan_with({"firmware", {{"max_velocity", {20.0}}, {"max_accel", {400.0}}}, 0},
+  // max_velocity and max_accel cap the limits' own; a max_velocity below the print speed is
+  // said in the plan's warnings
+  const Trajectory capped =
+      plan_with({"firmware", {{"max_velocity", {20.0}}, {"max_accel", {400.0}}}, 0},
+                polyline_job({{0, 0, 0}, {10, 0, 0}}, 50), limits);
+  EXPECT_NEAR(capped.duration_s(), 10.0 / 20 + 20.0 / 400, 1e-12);
+  ASSERT_EQ(capped.warnings().size(), 1u);
+  EXPECT_EQ(capped.warnings()[0],
+            "max_velocity 20 mm/s is below the print speed of 1 of 1 segments (up to 50 mm/s): "
+            "they print at most at 20 mm/s");
+  EXPECT_TRUE(plan_with({"firmware", {{"max_velocity", {60.0}}}, 0},
                         polyline_job({{0, 0, 0}, {10, 0, 0}}, 50), limits)
-                  .duration_s(),
-              10.0 / 20 + 20.0 / 400, 1e-12);
+                  .warnings()
+                  .empty());
 }
 
 TEST(Firmware, ZigZagKeepsTheContract) {
