@@ -381,10 +381,11 @@ std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerS
             {spec, std::make_shared<const Trajectory>(plan_trajectory(job, spec))});
       const Trajectory& plan = *job.checked_plan(spec);
       RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
-      if (!spec.params.empty() &&
-          run.duration_s >
-              kPlannerDrivenRatio * estimate_before_planning(job.scenario, simulate).duration_s)
-        run.planner_line = planner_entry_line(job.scenario, spec);
+      if (!spec.params.empty()) {
+        const double bound_s = estimate_before_planning(job.scenario, simulate).duration_s;
+        if (bound_s > 0.0 && run.duration_s > kPlannerDrivenRatio * bound_s)
+          run.planner_line = planner_entry_line(job.scenario, spec);
+      }
       // validate, plan and export: its every pose solved now, as the simulation will (a
       // planner's move may leave the travel or the reach between the toolpath's points); a run
       // too large (sim.max_steps, the memory) is refused for that instead (size_problems),
