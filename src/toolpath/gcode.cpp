@@ -824,8 +824,9 @@ void GcodeParser::execute(int line_number) {
     feed_mm_s_ = words_.get('F') * unit_mm_ / kSecondsPerMinute;
   }
   if (dwell) {
-    // S in seconds over P in milliseconds (Marlin, Klipper, RepRapFirmware: S wins when both
-    // are given); Fanuc's X in seconds. grbl's and LinuxCNC's P, in seconds, reads as ms here
+    // S in seconds over P in milliseconds (Marlin: S wins when both are given; Klipper's and
+    // RepRapFirmware's P in ms too); Fanuc's X in seconds. grbl's and LinuxCNC's P, in
+    // seconds, reads as ms here
     double dwell_s = 0.0;
     if (words_.has('S'))
       dwell_s = std::max(0.0, words_.get('S'));
