@@ -17,9 +17,9 @@ bool known(const std::vector<std::string>& names, const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
 }
 
-std::string joined(const std::vector<std::string>& names) {
+std::string joined(const std::vector<std::string>& names, const char* separator = ", ") {
   std::string out;
-  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  for (const std::string& name : names) out += (out.empty() ? "" : separator) + name;
   return out;
 }
 
@@ -67,14 +67,10 @@ std::string parse_order_name(const std::string& name, OrderSpec& order) {
   const bool ok = plus == std::string::npos
                       ? known(sequencer_methods(), first) || known(refine_methods(), first)
                       : known(sequencer_methods(), first) && known(refine_methods(), second);
-  if (!ok) {
-    std::string refines;
-    for (const std::string& refine : refine_methods())
-      refines += (refines.empty() ? "" : "|") + refine;
+  if (!ok)
     return "unknown sequencer '" + name + "' (expected " + joined(sequencer_methods()) +
-           ", optionally +" + refines + ", or " + joined(refine_methods()) +
+           ", optionally +" + joined(refine_methods(), "|") + ", or " + joined(refine_methods()) +
            " alone for nearest_neighbor+it)";
-  }
   // a refinement alone is shorthand for nearest_neighbor plus that refinement
   if (known(refine_methods(), first)) {
     order.method = "nearest_neighbor";
