@@ -38,6 +38,10 @@ std::string message_number_beside(double value, double bound, int significant_di
   }
 }
 
+std::string message_number_outside(double value, double min, double max, int significant_digits) {
+  return message_number_beside(value, value < min ? min : max, significant_digits);
+}
+
 void append_number(std::string& out, double value, int significant_digits) {
   char text[32];  // "-1.2345678901234567e-308": 24 characters at 17 digits
   const std::to_chars_result end = std::to_chars(text, text + sizeof text, value,

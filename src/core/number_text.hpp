@@ -22,6 +22,9 @@ std::string message_number(double value);
 // read differently from `bound` when it differs: a value just outside a limit never reads as
 // the limit ("1000005" beside 1e+06, "50.0001" beside 50, not "1e+06" or "50")
 std::string message_number_beside(double value, double bound, int significant_digits = 6);
+// the same beside whichever end of [min, max] a value outside it passes
+std::string message_number_outside(double value, double min, double max,
+                                   int significant_digits = 6);
 
 // `value` appended to `out` as printf's "%.<digits>g" writes it in the C locale (std::to_chars
 // with chars_format::general, which the standard defines so): for data files of millions of

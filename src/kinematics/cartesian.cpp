@@ -56,12 +56,11 @@ class Cartesian : public Machine {
       if (joints[i] < limit.min - kTravelRounding_mm ||
           joints[i] > limit.max + kTravelRounding_mm) {
         if (why)
-          *why =
-              "the cartesian machine's " + limit.name + " axis at " +
-              message_number_beside(joints[i], joints[i] < limit.min ? limit.min : limit.max, 4) +
-              " mm is outside its travel [" + format_mm(limit.min) + ", " + format_mm(limit.max) +
-              "] mm, by " + format_mm(std::max(limit.min - joints[i], joints[i] - limit.max)) +
-              " mm";
+          *why = "the cartesian machine's " + limit.name + " axis at " +
+                 message_number_outside(joints[i], limit.min, limit.max, 4) +
+                 " mm is outside its travel [" + format_mm(limit.min) + ", " +
+                 format_mm(limit.max) + "] mm, by " +
+                 format_mm(std::max(limit.min - joints[i], joints[i] - limit.max)) + " mm";
         return false;
       }
     }

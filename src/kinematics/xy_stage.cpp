@@ -65,12 +65,12 @@ class XyStage : public Machine {
       if (joints[i] < limit.min - kTravelRounding_mm ||
           joints[i] > limit.max + kTravelRounding_mm) {
         if (why)
-          *why =
-              "joint " + limit.name + " at " +
-              message_number_beside(joints[i], joints[i] < limit.min ? limit.min : limit.max, 4) +
-              " mm is outside its travel [" + format_mm(limit.min) + ", " + format_mm(limit.max) +
-              "] mm, by " + format_mm(std::max(limit.min - joints[i], joints[i] - limit.max)) +
-              " mm (TCP " + kTcpAxis[i] + " = " + format_mm(tcp_mm[i]) + " mm)";
+          *why = "joint " + limit.name + " at " +
+                 message_number_outside(joints[i], limit.min, limit.max, 4) +
+                 " mm is outside its travel [" + format_mm(limit.min) + ", " +
+                 format_mm(limit.max) + "] mm, by " +
+                 format_mm(std::max(limit.min - joints[i], joints[i] - limit.max)) + " mm (TCP " +
+                 kTcpAxis[i] + " = " + format_mm(tcp_mm[i]) + " mm)";
         return false;
       }
     }

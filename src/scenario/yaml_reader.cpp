@@ -203,7 +203,7 @@ std::optional<double> read_number(const Field& field, ProblemList& problems, con
   if (!range.contains(*value)) {
     problems.add(field.line, field.key,
                  "must be " + range.text() + ", got " +
-                     message_number_beside(*value, *value < range.min ? range.min : range.max));
+                     message_number_outside(*value, range.min, range.max));
     return std::nullopt;
   }
   return value;
@@ -217,7 +217,7 @@ std::optional<long long> read_integer(const Field& field, ProblemList& problems,
   if (std::floor(*value) != *value || !range.contains(*value)) {
     problems.add(field.line, field.key,
                  "must be a whole number " + range.text() + ", got " +
-                     message_number_beside(*value, *value < range.min ? range.min : range.max));
+                     message_number_outside(*value, range.min, range.max));
     return std::nullopt;
   }
   return static_cast<long long>(*value);

@@ -56,6 +56,9 @@ TEST(NumberText, AValueBesideItsBoundReadsDifferently) {
   EXPECT_EQ(message_number_beside(50.0001, 50.0, 4), "50.0001");
   EXPECT_EQ(message_number_beside(-50.00002, -50.0, 4), "-50.00002");
   EXPECT_EQ(message_number_beside(55.00001, 55.0, 4), "55.00001");
+  // outside a range: beside the end it passes
+  EXPECT_EQ(message_number_outside(-1000005.0, -1e6, 1e6), "-1000005");
+  EXPECT_EQ(message_number_outside(50.0001, -50.0, 50.0, 4), "50.0001");
   // far from the bound, or equal to it: as message_number writes it
   EXPECT_EQ(message_number_beside(1.5e6, 1e6), message_number(1.5e6));
   EXPECT_EQ(message_number_beside(1e6, 1e6), "1e+06");
