@@ -228,12 +228,6 @@ void locate_plan_problems(const Scenario& scenario, const PlannerSpec& spec,
     problem.line = planner_entry_line(scenario, spec);
     problem.key = "planners";
     problem.message = "the " + spec.run_label() + " plan " + problem.message;
-    // a move between paths that leaves or enters one at speed overshoots its end: what helps
-    if (problem.message.find("in a transition the planner added") != std::string::npos)
-      problem.message +=
-          " (a move leaving or entering a path at speed overshoots its end: keep the paths "
-          "farther from the edge, raise limits.a_max, or plan with stop_and_go, which starts "
-          "and ends every path at rest)";
   }
 }
 

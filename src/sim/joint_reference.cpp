@@ -48,9 +48,18 @@ void joints_at(const Machine& machine, const TrajectorySample& sample, const Joi
                                    : std::string("in a transition the planner added")) +
            "): ";
   };
+  // in a transition, what helps: a move that leaves or enters a path at speed overshoots it
+  const auto hint = [&sample] {
+    return sample.path_index >= 0
+               ? std::string()
+               : std::string(
+                     " (a move leaving or entering a path at speed overshoots its end: "
+                     "keep the paths farther from the edge, raise limits.a_max, or plan "
+                     "with stop_and_go, which starts and ends every path at rest)");
+  };
   const bool solved = seed ? machine.inverse_near(sample.pose(), *seed, joints, &why)
                            : machine.inverse(sample.pose(), joints, &why);
-  if (!solved) throw InputError("trajectory", at() + why);
+  if (!solved) throw InputError("trajectory", at() + why + hint());
   const std::vector<JointLimit>& limits = machine.joint_limits();
   if (joints.size() != limits.size())
     throw InternalError("machine " + machine.name() + " returned " + std::to_string(joints.size()) +
@@ -60,7 +69,7 @@ void joints_at(const Machine& machine, const TrajectorySample& sample, const Joi
       throw InputError("trajectory", at() + "joint " + limits[j].name + " at " +
                                          format_number(joints[j]) + " is outside its travel [" +
                                          format_number(limits[j].min) + ", " +
-                                         format_number(limits[j].max) + "]");
+                                         format_number(limits[j].max) + "]" + hint());
   }
 }
 
