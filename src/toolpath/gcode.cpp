@@ -330,6 +330,11 @@ class GcodeParser {
   // words of the line from `p` on into words_; false (and a problem) when malformed
   bool split_words(const char* p, const char* end, int line_number);
   void execute(int line_number);
+  // M2 or M30, unless it is the shutter's open or close code: the program's end
+  bool ends_program(const Code& code) const {
+    return code.letter == 'M' && (code.tenths == 20 || code.tenths == 300) &&
+           !is_shutter_code(open_code_, code) && !is_shutter_code(close_code_, code);
+  }
   void move(int motion, int line_number);
   // a move's record from the present position to target (and there the position)
   void append_move(int motion, const Vec3& target_mm, double e_delta, const EdgeArc& arc,
@@ -494,7 +499,7 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     const bool shutter_code = tenths >= 0 && (is_shutter_code(open_code_, Code{'M', tenths}) ||
                                               is_shutter_code(close_code_, Code{'M', tenths}));
     // M2 or M30 alone: the program's end (RS274/NGC, grbl)
-    if ((tenths == 20 || tenths == 300) && !shutter_code && rest_is_blank(stop, end)) {
+    if (ends_program(Code{'M', tenths}) && rest_is_blank(stop, end)) {
       program_.program_end_line = line_number;
       return;
     }
@@ -531,11 +536,7 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   execute(line_number);
   // M2 or M30 with other words: the program ends after the line (its move made)
   for (int i = 0; i < words_.n_codes; ++i)
-    if (words_.codes[i].letter == 'M' &&
-        (words_.codes[i].tenths == 20 || words_.codes[i].tenths == 300) &&
-        !is_shutter_code(open_code_, words_.codes[i]) &&
-        !is_shutter_code(close_code_, words_.codes[i]))
-      program_.program_end_line = line_number;
+    if (ends_program(words_.codes[i])) program_.program_end_line = line_number;
 }
 
 bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
