@@ -12,16 +12,9 @@
 #include <iterator>
 #include <string>
 
-namespace depotwin::testing_support {
+#include "scratch_folder.hpp"
 
-// a fresh, empty temporary folder per test (removed at the start, left for inspection)
-inline std::string fresh_directory(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                                    ("depotwin_test_" + std::to_string(::getpid())) / name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
+namespace depotwin::testing_support {
 
 inline std::string write_text(const std::string& directory, const std::string& name,
                               const std::string& text) {

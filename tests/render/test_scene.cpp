@@ -15,6 +15,7 @@
 #include "kinematics/machine.hpp"
 #include "kinematics/xy_stage.hpp"
 #include "render/scene.hpp"
+#include "scratch_folder.hpp"
 #include "sim/mujoco_access.hpp"
 #include "sim/mujoco_boundary.hpp"
 #include "sim/part_model.hpp"
@@ -64,7 +65,7 @@ SceneRenderOptions sized(int width, int height) {
 }
 
 std::string temp_path(const std::string& name) {
-  return ::testing::TempDir() + "depotwin_" + std::to_string(::getpid()) + "_" + name;
+  return testing_support::scratch_file(name);
 }
 
 // a panel of a layout as MuJoCo's viewport (framebuffer pixels, bottom-up, no supersampling)

@@ -21,19 +21,14 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "report/output_dir.hpp"
+#include "scratch_folder.hpp"
 
 namespace depotwin {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string fresh_directory(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("depotwin_test_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir.string();
-}
+using testing_support::fresh_directory;
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "kinematics/xy_stage.hpp"
+#include "scratch_folder.hpp"
 #include "sim/mujoco_boundary.hpp"
 #include "sim/simulation.hpp"
 #include "sim_test_util.hpp"
@@ -21,8 +22,7 @@ using testing_util::xy_stage_model;
 
 // an inline MJCF written to a temporary file
 std::string write_model(const std::string& name, const std::string& xml) {
-  const std::string path =
-      ::testing::TempDir() + "depotwin_" + std::to_string(::getpid()) + "_" + name + ".xml";
+  const std::string path = testing_support::scratch_file(name + ".xml");
   std::ofstream(path) << xml;
   return path;
 }

@@ -7,6 +7,7 @@
 
 #include "cli/inspect.hpp"
 #include "core/error.hpp"
+#include "scratch_folder.hpp"
 #include "toolpath/gcode.hpp"
 
 namespace depotwin {
@@ -296,7 +297,7 @@ TEST(GcodeFiles, InspectRefusesAFileWithoutCode) {
   EXPECT_EQ(no_code_problem(0, 0), "is empty (no G-code)");
   EXPECT_EQ(no_code_problem(3, 1), "");
 
-  const std::string path = ::testing::TempDir() + "readme.gcode";
+  const std::string path = testing_support::scratch_file("readme.gcode");
   std::ofstream(path) << "This folder holds the parts.\nSee the README.\n";
   try {
     inspect_gcode_file(path, GcodeOptions{}, InspectBaseline{});
