@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
-#include "core/segment_distance.hpp"
+#include "planners/motion/fine_edges.hpp"
 #include "planners/motion/path_check.hpp"
 #include "planners/motion/transition.hpp"
 #include "planners/motion/uniform/arc_run.hpp"
@@ -351,51 +351,29 @@ MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm) {
     for (size_t i = 0; i < n; ++i) merged.source_point[i] = i;
     return merged;
   }
+  // the points kept: edges of the same path and speed merged within max_error_mm
+  const FineEdgeMerge kept = merge_polyline_edges(
+      chain.points, max_error_mm, kMaxMergedPoints, [&](size_t anchor, size_t edge) {
+        return chain.edge_path[edge] == chain.edge_path[anchor] &&
+               chain.edge_speed_mm_s[edge] == chain.edge_speed_mm_s[anchor];
+      });
   PrintChain& out = merged.chain;
   out.oriented = false;
-  const auto keep_point = [&](size_t i) {
+  for (size_t k = 0; k < kept.kept.size(); ++k) {
+    const size_t i = kept.kept[k];
     out.points.push_back(chain.points[i]);
     out.orientations.push_back(chain.orientations[i]);
     out.point_path.push_back(chain.point_path[i]);
     out.point_index.push_back(chain.point_index[i]);
     merged.source_point.push_back(i);
-  };
-  // the largest distance of points first+1 .. last-1 from the segment first-last
-  const auto chord_error = [&](size_t first, size_t last) {
-    double error = 0.0;
-    for (size_t k = first + 1; k < last; ++k)
-      error = std::max(
-          error, point_segment_distance(chain.points[k], chain.points[first], chain.points[last]));
-    return error;
-  };
-  keep_point(0);
-  size_t anchor = 0;
-  while (anchor + 1 < n) {
-    // extend the edge from the anchor while the next point's edge is of the same path and speed,
-    // every point passed stays within max_error_mm and the edge is at least as long as each one
-    // it replaces (no reversal folded into it; a bounded number of points at once)
-    size_t last = anchor + 1;
-    double error = 0.0;
-    double longest_edge = (chain.points[last] - chain.points[anchor]).norm();
-    while (last + 1 < n && last + 1 - anchor <= kMaxMergedPoints &&
-           chain.edge_path[last] == chain.edge_path[anchor] &&
-           chain.edge_speed_mm_s[last] == chain.edge_speed_mm_s[anchor]) {
-      const double next_edge = (chain.points[last + 1] - chain.points[last]).norm();
-      const double chord = (chain.points[last + 1] - chain.points[anchor]).norm();
-      if (!(chord >= std::max(longest_edge, next_edge))) break;
-      const double longer = chord_error(anchor, last + 1);
-      if (!(longer <= max_error_mm)) break;
-      ++last;
-      error = longer;
-      longest_edge = std::max(longest_edge, next_edge);
-    }
-    keep_point(last);
+    if (k == 0) continue;
+    // the merged edge takes the path, speed and source of the first edge it replaces
+    const size_t anchor = kept.kept[k - 1];
     out.edge_speed_mm_s.push_back(chain.edge_speed_mm_s[anchor]);
     out.edge_path.push_back(chain.edge_path[anchor]);
     out.edge_source.push_back(chain.edge_source[anchor]);
-    merged.edge_error_mm.push_back(error);
-    anchor = last;
   }
+  merged.edge_error_mm = kept.edge_error_mm;
   return merged;
 }
 
