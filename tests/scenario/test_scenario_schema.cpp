@@ -79,7 +79,7 @@ TEST_F(SchemaFiles, PlannerEntryKeysAreNameLabelAndTheRegistrysParameters) {
       problems_of(std::string(kSegments) + "planners: [{name: bezier, label: b, zzz: 1}]\n");
   ASSERT_EQ(problems.size(), 1u) << dump(problems);
   EXPECT_EQ(problems[0].key, "planners[0].zzz");
-  EXPECT_NE(problems[0].message.find("(known: delta, weight, period_s, lead_in)"),
+  EXPECT_NE(problems[0].message.find("(known: delta, weight, period_s, lead_in, merge)"),
             std::string::npos)
       << problems[0].message;
 }

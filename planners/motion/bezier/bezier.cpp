@@ -12,6 +12,7 @@
 #include "motion/jerk.hpp"
 #include "planners/motion/bezier/bezier_curve.hpp"
 #include "planners/motion/bezier/bezier_profile.hpp"
+#include "planners/motion/fine_edges.hpp"
 #include "planners/motion/print_segments.hpp"
 #include "planners/motion/sampled_jerk.hpp"
 #include "planners/motion/transition.hpp"
@@ -265,6 +266,35 @@ PrintPath with_traversable_arcs(const PrintPath& path, double tolerance_mm,
     original_vertex.push_back(static_cast<int>(e + 1));
   }
   if (!out.has_arcs()) out.arcs.clear();
+  return out;
+}
+
+// Fine chords merged (BezierSettings::merge_mm): consecutive straight edges become one where
+// every point dropped stays within max_error_mm of it, so a curve given as many short chords
+// gets corners with room for their fillets. Clipped to half of 0.05 mm chords, the blends
+// left lines of 0 mm between them, where no ramp fits: a circle of radius 10 mm in 0.05 mm
+// chords was printed at a third of its speed. Arcs kept exact are not merged; `original_vertex`
+// keeps the index of each point kept.
+PrintPath with_fine_chords_merged(const PrintPath& path, std::vector<int>& original_vertex,
+                                  double max_error_mm) {
+  constexpr size_t kMaxMergedEdges = 256;  // bounds the work per merged edge
+  const FineEdgeMerge merged = merge_polyline_edges(
+      path.points, max_error_mm, kMaxMergedEdges, [&](size_t anchor, size_t edge) {
+        return !is_arc_edge(path, anchor) && !is_arc_edge(path, edge);
+      });
+  if (merged.kept.size() == path.points.size()) return path;
+  PrintPath out = path;
+  out.points.clear();
+  out.arcs.clear();
+  std::vector<int> kept_vertex;
+  for (size_t k = 0; k < merged.kept.size(); ++k) {
+    const size_t i = merged.kept[k];
+    out.points.push_back(path.points[i]);
+    kept_vertex.push_back(original_vertex[i]);
+    // an edge kept alone keeps its arc; a merged one is straight
+    if (k > 0 && path.has_arcs()) out.arcs.push_back(path.arcs[merged.kept[k - 1]]);
+  }
+  original_vertex = std::move(kept_vertex);
   return out;
 }
 
@@ -910,6 +940,16 @@ std::vector<PlannerParameter> bezier_parameters() {
        {},
        "",
        true},
+      {"merge",
+       0.01,
+       0.0,
+       1.0,
+       "fine chords: consecutive straight edges whose dropped points stay within this of one "
+       "line are merged into it before the corners are blended (0: every point kept; a "
+       "per-corner weight list or a path with tool orientations keeps every point)",
+       false,
+       {},
+       "mm"},
   };
 }
 
@@ -919,6 +959,7 @@ BezierSettings bezier_settings(const PlannerSpec& spec) {
   auto weights = spec.params.find("weight");
   if (weights != spec.params.end() && !weights->second.empty()) settings.weights = weights->second;
   settings.period_s = spec.get("period_s", settings.period_s);
+  settings.merge_mm = spec.get("merge", settings.merge_mm);
   settings.lead_in = spec.get_switch("lead_in", settings.lead_in);
   return settings;
 }
@@ -975,8 +1016,12 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
   for (size_t i = 0; i < toolpath.paths.size(); ++i) {
     // the path with the arcs it can traverse exactly, the others as chords
     std::vector<int> original_vertex;
-    const PrintPath path = with_traversable_arcs(toolpath.paths[i], toolpath.chord_tolerance_mm,
-                                                 original_vertex, !jerk_limited);
+    PrintPath path = with_traversable_arcs(toolpath.paths[i], toolpath.chord_tolerance_mm,
+                                           original_vertex, !jerk_limited);
+    // fine chords merged, unless each corner has its own weight or each point its orientation
+    if (settings_.merge_mm > 0.0 && settings_.weights.size() == 1 && path.normals.empty() &&
+        path.rolls.empty())
+      path = with_fine_chords_merged(path, original_vertex, settings_.merge_mm);
     // the limits over the path's own box (per path: its blends and ramps are planned together)
     const MachineLimits limits =
         path_limits(path, tcp_limits, settings_.lead_in, settings_.period_s);

@@ -2,7 +2,9 @@
 // Bezier blends with fillet distance delta, traversed at constant speed by a 2nd-order
 // Taylor update of the curve parameter.
 //
-// Per print path: the polyline's corners are replaced by blends (eq. 8 / eq. 18) between
+// Per print path: fine chords merged first (beyond the paper: consecutive straight edges within
+// merge_mm of one line become it, so a curve given as short chords has room for its fillets);
+// the polyline's corners are replaced by blends (eq. 8 / eq. 18) between
 // points at distance delta before and after each corner (clipped to half the shorter
 // adjacent line, with a warning). The path is sampled at period T_s: on lines by eq. (5)
 // with grid-aligned trapezoidal ramps (exact on a line), on blends at constant speed by
@@ -63,6 +65,7 @@ struct BezierSettings {
   std::vector<double> weights{1.0};  // one for every corner, or one per corner in order
   double period_s = 0.001;           // sample period T_s of the Taylor update
   bool lead_in = false;              // ramp on extensions of the first/last line, flow off
+  double merge_mm = 0.01;            // fine chords merged within this (0: off)
 };
 
 class BezierPlanner : public Planner {

@@ -4,10 +4,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "bezier_checks.hpp"
 #include "core/error.hpp"
+#include "core/segment_distance.hpp"
 #include "planners/motion/bezier/bezier.hpp"
 #include "toolpath/random_segments.hpp"
 
@@ -52,6 +54,13 @@ TEST(BezierPlanner, DeclaresItsParametersWithRanges) {
   EXPECT_EQ(settings.weights, (std::vector<double>{1.0, 2.0, 0.5}));
   EXPECT_EQ(settings.period_s, 0.0005);
   EXPECT_TRUE(settings.lead_in);
+  EXPECT_EQ(settings.merge_mm, 0.01);  // fine chords merged by default
+  spec.params["merge"] = {0.0};
+  EXPECT_EQ(check_planner_spec(spec), "");
+  EXPECT_EQ(bezier_settings(spec).merge_mm, 0.0);
+  spec.params["merge"] = {-0.01};
+  EXPECT_NE(check_planner_spec(spec).find("'merge'"), std::string::npos);
+  spec.params.erase("merge");
 
   spec.params["delta"] = {0.0};
   EXPECT_NE(check_planner_spec(spec).find("'delta'"), std::string::npos);
@@ -448,6 +457,62 @@ TEST(BezierPlanner, CollinearPointsPlanAsOneLine) {
   const Trajectory corner = planner.plan(single_path(bent, 3.0), limits);
   for (const std::string& w : corner.warnings())
     EXPECT_EQ(w.find("clipped"), std::string::npos) << w;
+}
+
+TEST(BezierPlanner, FineChordsAreMergedWithinMerge) {
+  // a circle of radius 10 mm in 0.05 mm chords (a slicer's or CAM's curve), at 10 mm/s
+  const double radius = 10.0, speed = 10.0;
+  const MachineLimits limits = MachineLimits::uniform(40.0, 500.0);
+  const auto circle = [&](int chords) {
+    std::vector<Vec3> points;
+    for (int k = 0; k <= chords; ++k) {
+      const double angle = 2.0 * kPi * k / chords;
+      points.push_back(Vec3(radius * std::cos(angle), radius * std::sin(angle), 0.0));
+    }
+    return points;
+  };
+  const int fine_chords = 1257;  // 0.0500 mm each
+  const Toolpath fine = single_path(circle(fine_chords), speed);
+  const BezierPlanner merging(BezierSettings{});  // merge 0.01 mm
+  const Trajectory merged = merging.plan(fine, limits);
+  expect_contract(merged, fine, limits, 0.5);
+
+  // printed as fast as the same circle in 1 mm chords, which need no merging
+  const Trajectory coarse = merging.plan(single_path(circle(63), speed), limits);
+  EXPECT_LT(merged.depositing_time_s(), 1.01 * coarse.depositing_time_s());
+
+  // every sample within the merge distance plus a blend's deviation from its merged corner:
+  // a chord of sagitta 0.01 mm turns by at most theta = 2 acos(1 - 0.01 / R) at its ends, and
+  // a blend of fillet delta <= 0.5 mm passes delta sin(theta / 2) / 2 inside its corner
+  const double theta = 2.0 * std::acos(1.0 - 0.01 / radius);
+  const double bound = 0.01 + 0.5 * std::sin(0.5 * theta) / 2.0;
+  double farthest = 0.0;
+  for (const TrajectoryPiece& piece : merged.pieces()) {
+    if (!piece.depositing) continue;
+    for (const Vec3& p : sampled(piece).position_mm) {
+      double nearest = std::numeric_limits<double>::infinity();
+      const double angle = std::atan2(p.y(), p.x());
+      const int k = static_cast<int>(std::floor(angle / (2.0 * kPi) * fine_chords + fine_chords));
+      for (int j = k - 2; j <= k + 2; ++j) {  // the chords around the sample's angle
+        const int e = ((j % fine_chords) + fine_chords) % fine_chords;
+        nearest = std::min(nearest, point_segment_distance(p, fine.paths[0].points[e],
+                                                           fine.paths[0].points[e + 1]));
+      }
+      farthest = std::max(farthest, nearest);
+    }
+  }
+  EXPECT_LE(farthest, bound);
+  EXPECT_GT(farthest, 1e-3);  // the blends do cut inside
+
+  // merge 0 keeps every chord: the fillets clipped to 0.025 mm leave no room to ramp
+  BezierSettings every_point;
+  every_point.merge_mm = 0.0;
+  const Trajectory unmerged = BezierPlanner(every_point).plan(fine, limits);
+  EXPECT_GT(unmerged.depositing_time_s(), 2.0 * merged.depositing_time_s());
+  // as does a weight per corner (each corner keeps its own)
+  BezierSettings weighted;
+  weighted.weights.assign(fine_chords - 1, 1.0);
+  EXPECT_DOUBLE_EQ(BezierPlanner(weighted).plan(fine, limits).duration_s(), unmerged.duration_s());
 }
 
 }  // namespace
