@@ -24,4 +24,19 @@ inline CLI::Validator positive_number() {
       "POSITIVE");
 }
 
+// a finite number in [lo, hi] (a value far outside it would write inf or 0 into a file)
+inline CLI::Validator number_in(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(value) || value < lo ||
+            value > hi)
+          return "expected a number in [" + message_number(lo) + ", " + message_number(hi) +
+                 "], got '" + printable_text(text) + "'";
+        return "";
+      },
+      "[" + message_number(lo) + ", " + message_number(hi) + "]");
+}
+
 }  // namespace depotwin

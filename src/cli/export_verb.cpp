@@ -19,6 +19,7 @@
 #include "pipeline/job.hpp"
 #include "pipeline/job_check.hpp"
 #include "report/output_dir.hpp"
+#include "toolpath/gcode.hpp"
 
 #ifndef DEPOTWIN_VERSION
 #define DEPOTWIN_VERSION "unknown"
@@ -400,6 +401,9 @@ void check_out_path(const std::string& out) {
   if (fs::is_directory(out, error))
     throw InputError("--out",
                      "'" + out + "' is a directory; name a file, e.g. " + out + "/job.gcode");
+  // a device, link or FIFO would be replaced by the file renamed over it
+  if (const std::string problem = replaceable_file_problem(out); !problem.empty())
+    throw InputError("--out", problem);
   const fs::path parent =
       fs::path(out).parent_path().empty() ? fs::path(".") : fs::path(out).parent_path();
   if (!fs::is_directory(parent, error))
@@ -412,6 +416,10 @@ void check_out_path(const std::string& out) {
 
 int export_verb(const ExportOptions& options) {
   check_out_path(options.out);
+  // the shutter codes as inspect and the scenario check them: codes, and not one switch
+  for (const ShutterCodeProblem& problem :
+       shutter_code_problems(options.settings.open_code, options.settings.close_code))
+    throw InputError(problem.at_close ? "--close" : "--open", problem.message);
   // every check before any work (pipeline/job_check.hpp): one run, planned and sampled only
   const Scenario scenario = check_scenario(options.scenario, JobBudget{}, 1, false);
   // never over a file the job reads (its G-code, the scenario itself)

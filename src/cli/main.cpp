@@ -190,11 +190,11 @@ int main(int argc, char** argv) {
   export_gcode
       ->add_option("--tolerance", export_options.settings.chord_tolerance_mm,
                    "every planned point within this of the written lines, mm (default 0.005)")
-      ->check(positive_number());
+      ->check(number_in(1e-6, 10.0));
   export_gcode
       ->add_option("--filament-diameter", export_options.settings.filament_diameter_mm,
                    "extrusion: E is filament length of this diameter, mm (default 1.75)")
-      ->check(positive_number());
+      ->check(number_in(0.01, 100.0));
   export_gcode->add_option("--open", export_options.settings.open_code,
                            "aerosol: the shutter-open code (default M3)");
   export_gcode->add_option("--close", export_options.settings.close_code,

@@ -33,6 +33,24 @@ void write_file_atomically(const std::string& path, const std::string& content) 
   }
 }
 
+std::string replaceable_file_problem(const std::string& path) {
+  if (path == "-")
+    return "'-' (standard output) is not supported; name the file to write, e.g. job.gcode";
+  std::error_code error;
+  const fs::file_status status = fs::symlink_status(path, error);
+  if (!fs::exists(status) || fs::is_regular_file(status)) return "";
+  const std::string is = "'" + path + "' is ";
+  if (fs::is_directory(status)) return is + "a directory; name a file in it";
+  if (fs::is_symlink(status)) {
+    const fs::path target = fs::read_symlink(path, error);
+    return is + "a symbolic link (to '" + target.string() +
+           "'), which the new file would replace; name the file itself";
+  }
+  return is +
+         "not a regular file (a device, FIFO or socket), which the new file would "
+         "replace; name a file to write";
+}
+
 std::string read_text_file(const std::string& path) {
   // checked before opening: reading a FIFO would wait for a writer
   const std::string problem = missing_file_problem("", "", path);

@@ -10,6 +10,12 @@ namespace depotwin {
 // Throws InternalError on I/O failure (the target is then untouched).
 void write_file_atomically(const std::string& path, const std::string& content);
 
+// Why write_file_atomically must not write `path`, or "" when it may: an existing path that is
+// not a regular file, which the rename would replace itself: a directory, a symbolic link
+// (/dev/stdout would become a file), a device (/dev/null), a FIFO or a socket; "-", which
+// names standard output elsewhere and a file called "-" here.
+std::string replaceable_file_problem(const std::string& path);
+
 // The whole file's bytes; InputError naming the path when it is not a regular file (checked
 // first: a FIFO would block the read) or cannot be read.
 std::string read_text_file(const std::string& path);

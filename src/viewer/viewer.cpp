@@ -207,8 +207,11 @@ struct WindowContext {
 int view_verb(const ViewOptions& options) {
   if (options.width < 64 || options.height < 64)
     throw InputError("--size", "the window must be at least 64 x 64 pixels");
-  const ReplayData replay = read_replay(options.run_directory);
   const bool screenshot = !options.screenshot.empty();
+  if (screenshot)
+    if (const std::string problem = replaceable_file_problem(options.screenshot); !problem.empty())
+      throw InputError("--screenshot", problem);
+  const ReplayData replay = read_replay(options.run_directory);
 
   // the window, then the replay's scene and MuJoCo's context in it
   GlfwWindow glfw(options.width, options.height,

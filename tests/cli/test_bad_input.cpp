@@ -406,6 +406,26 @@ std::vector<Row> rows() {
                       "export {dir}/scenario.yaml --planner lspb_mtt --out {out}/part.gcode",
                       "error: --out: '.*part\\.gcode' is a file the scenario reads",
                       {{"scenario.yaml", gcode_job}, {"out/part.gcode", part}}));
+  // export renames its file into place: never over standard output's name, nor with codes
+  // that are no shutter switch, nor with E beyond the doubles
+  r.push_back(command(
+      "ExportToStandardOutput", "export {dir}/scenario.yaml --planner lspb_mtt --out -",
+      "error: --out: '-' \\(standard output\\) is not supported", {{"scenario.yaml", probe()}}));
+  r.push_back(command("ExportOpenCodeIsAMove",
+                      "export {dir}/scenario.yaml --planner lspb_mtt --out {dir}/a.gcode "
+                      "--open 'G1 X100'",
+                      "error: --open: 'G1 X100' is not a G or M code",
+                      {{"scenario.yaml", probe()}}));
+  r.push_back(command("ExportOpenAndCloseTheSame",
+                      "export {dir}/scenario.yaml --planner lspb_mtt --out {dir}/a.gcode "
+                      "--open M5 --close M5",
+                      "error: --close: 'M5' would close what 'M5' opens",
+                      {{"scenario.yaml", probe()}}));
+  r.push_back(command("ExportFilamentTooThin",
+                      "export {dir}/scenario.yaml --planner lspb_mtt --out {dir}/a.gcode "
+                      "--filament-diameter 1e-300",
+                      "--filament-diameter: expected a number in \\[0\\.01, 100\\], got '1e-300'",
+                      {{"scenario.yaml", probe()}}));
   r.push_back(command("RunIntoASweepFolder",
                       "run {dir}/scenario.yaml --out {dir}/study --no-render --quiet",
                       "error: --out: .*study: is a depotwin sweep folder \\(s\\), not a run's",

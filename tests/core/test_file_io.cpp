@@ -71,6 +71,28 @@ TEST(FileIo, MissingFileProblemSaysWhatIsThereInstead) {
 
 // read_text_file checks before it opens: a FIFO is refused at once (reading it would wait
 // for a writer), as are a directory and a missing file; the message names the path
+// What a rename would replace itself is refused before any write: a FIFO, a device, a symbolic
+// link, a directory, "-"; a regular file or a new name may be written.
+TEST(FileIo, ReplaceableFileProblemRefusesDevicesLinksAndFifos) {
+  const fs::path directory = fresh_directory("file_io_replaceable");
+  const fs::path file = directory / "job.gcode";
+  EXPECT_EQ(replaceable_file_problem(file.string()), "");  // not there yet
+  write_file_atomically(file.string(), "G1 X1\n");
+  EXPECT_EQ(replaceable_file_problem(file.string()), "");
+  const fs::path fifo = directory / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(replaceable_file_problem(fifo.string()).find("is not a regular file"),
+            std::string::npos);
+  EXPECT_NE(replaceable_file_problem("/dev/null").find("is not a regular file"), std::string::npos);
+  const fs::path link = directory / "latest.gcode";
+  fs::create_symlink(file, link);
+  EXPECT_NE(replaceable_file_problem(link.string()).find("is a symbolic link (to '"),
+            std::string::npos);
+  EXPECT_NE(replaceable_file_problem(directory.string()).find("is a directory"), std::string::npos);
+  EXPECT_NE(replaceable_file_problem("-").find("standard output"), std::string::npos);
+  fs::remove_all(directory);
+}
+
 TEST(FileIo, ReadTextFileRefusesWhatIsNotARegularFile) {
   const fs::path directory = fresh_directory("file_io_read");
   const fs::path fifo = directory / "pipe.json";
