@@ -41,10 +41,13 @@ Interrupted::Interrupted(int signal_number)
       message_(std::string("interrupted by ") +
                (signal_number == SIGINT    ? "SIGINT"
                 : signal_number == SIGTERM ? "SIGTERM"
+                : signal_number == SIGHUP  ? "SIGHUP"
                                            : "signal " + std::to_string(signal_number))) {}
 
 void install_interrupt_handlers() {
-  for (const int signal_number : {SIGINT, SIGTERM}) {
+  // SIGHUP too: what a closed terminal or a dropped ssh session sends (SIGQUIT keeps its core
+  // dump, for a hang to be looked into)
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction previous {};
     ::sigaction(signal_number, nullptr, &previous);
     if (previous.sa_handler == SIG_IGN) continue;  // ignored by whoever started us: stays so

@@ -1,9 +1,9 @@
-// Stopping on SIGINT and SIGTERM. The handler only records the signal and ends the child
+// Stopping on SIGINT, SIGTERM and SIGHUP. The handler only records the signal and ends the child
 // processes registered with it (gnuplot, ffmpeg), both async-signal-safe; the long loops (the
 // step loop, the posture search, the planners, the writers, the wait for an output lock) call
 // throw_if_interrupted(), and the Interrupted exception unwinds through the owners of the
 // staging folders and the child processes, which clean up. main() turns it into exit status
-// 128 + the signal (130 for SIGINT, 143 for SIGTERM).
+// 128 + the signal (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP).
 #pragma once
 
 #include <sys/types.h>
@@ -28,7 +28,7 @@ class Interrupted : public std::exception {
   std::string message_;  // "interrupted by SIGINT"
 };
 
-// Installs the handler for SIGINT and SIGTERM (SA_RESTART, so no other call sees EINTR). A
+// Installs the handler for SIGINT, SIGTERM and SIGHUP (SA_RESTART, so no other call sees EINTR). A
 // signal ignored when the process started (a shell's background job, nohup) stays ignored.
 // Call once, early in main, before any thread starts.
 void install_interrupt_handlers();

@@ -46,6 +46,12 @@ TEST(Interrupt, TheFirstSignalIsRecordedAndGivesTheShellsExitStatus) {
   EXPECT_EQ(Interrupted(SIGINT).exit_status(), 130);
   clear_interrupt();
   EXPECT_NO_THROW(throw_if_interrupted());
+  // a closed terminal's SIGHUP stops as cleanly
+  ASSERT_EQ(::raise(SIGHUP), 0);
+  EXPECT_EQ(interrupt_signal(), SIGHUP);
+  EXPECT_EQ(Interrupted(SIGHUP).exit_status(), 129);
+  EXPECT_STREQ(Interrupted(SIGHUP).what(), "interrupted by SIGHUP");
+  clear_interrupt();
 }
 
 // a signal ignored by whoever started the process (a shell's background job) stays ignored
