@@ -1229,6 +1229,10 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
                         "' (expected normal: along the surface normal, or z: vertical, as in "
                         "the paper)");
   }
+  if (const Field* f = view.find("chord_tolerance_mm"))
+    surface->chord_tolerance_mm =
+        read_number(*f, problems_, range_of(section, "chord_tolerance_mm"))
+            .value_or(surface->chord_tolerance_mm);
   std::optional<double> speed = default_speed;
   if (const Field* f = view.find("speed"))
     speed = read_number(*f, problems_, range_of(section, "speed"));
@@ -1289,6 +1293,7 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     spec.offset = surface->layer_offset == "z" ? SurfaceHatchSpec::Offset::z
                                                : SurfaceHatchSpec::Offset::normal;
     spec.speed_mm_s = *speed;
+    spec.chord_tolerance_mm = surface->chord_tolerance_mm;
     projector = std::make_shared<const SurfaceProjector>(std::move(part));
     hatch = hatch_surface(*projector, spec);
     // grid points no line prints (a stretch narrower than two spacings: a groove's floor), at

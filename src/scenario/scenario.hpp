@@ -73,6 +73,7 @@ struct SurfaceToolpath {
   double layer_height_mm = 0.5;
   double alpha = 0.5;
   std::string layer_offset = "normal";  // normal | z
+  double chord_tolerance_mm = 0.05;     // chords refined where the surface rises above them
   int line = 0;                         // the `surface:` key's line, for messages
   // per print path (in the scenario's order, PrintPath::source_index): its layer, its grid
   // line and each point's index along that line, for messages naming a point

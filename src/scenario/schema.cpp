@@ -348,6 +348,10 @@ std::vector<SchemaSection> make_schema() {
                  "tool axis: 0 vertical .. 1 the surface normal"),
           word("layer_offset", {"normal", "z"}, surface.layer_offset,
                "layers offset along the surface normal, or along z (the paper)"),
+          number("chord_tolerance_mm", "mm", ValueRange::closed(0.0, 10.0),
+                 surface.chord_tolerance_mm,
+                 "where the surface rises more than this above the chord between two points "
+                 "(a ridge), the point there is added; 0: the grid's points only (the paper)"),
           speed}});
   }
 

@@ -34,6 +34,8 @@ void validate(const SurfaceHatchSpec& spec) {
         "min_normal_z", "the least normal z must be in [0, 1)");
   check(std::isfinite(spec.max_jump_ratio) && spec.max_jump_ratio >= 1.0, "max_jump_ratio",
         "the jump ratio must be at least 1");
+  check(std::isfinite(spec.chord_tolerance_mm) && spec.chord_tolerance_mm >= 0.0,
+        "chord_tolerance_mm", "the chord tolerance must be finite and not negative");
   if (!problems.empty()) throw InputError(std::move(problems));
 }
 
@@ -62,6 +64,61 @@ struct Axis {
     first = 0.5 * (lo + hi) - 0.5 * (n - 1) * h;
   }
 };
+
+// Chords that cut into the part refined (beyond the paper, whose points are the grid's): where
+// the surface halfway between two consecutive points of a piece rises more than
+// spec.chord_tolerance_mm above their chord (a ridge, or any stretch convex enough), that surface
+// point is inserted and both halves are checked again, down to kMaxChordHalvings. Heights are
+// compared vertically, as the points are projected. Without it a roof of slope 0.7 hatched at
+// 2 mm had the nozzle 0.7 mm inside the part on every line across its ridge.
+constexpr int kMaxChordHalvings = 10;
+
+void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& line_origin,
+                  const Vec2& d, double first_u, double h, const SurfaceHatchSpec& spec) {
+  const std::size_t n = piece.points.size();
+  if (n < 2 || !(spec.chord_tolerance_mm > 0.0)) return;
+  const auto along = [&](double u) -> Vec2 { return line_origin + u * d; };
+  // every chord's halfway point at once (one batch per piece)
+  std::vector<Vec2> halfway(n - 1);
+  for (std::size_t m = 0; m + 1 < n; ++m) halfway[m] = along(first_u + (piece.index[m] + 0.5) * h);
+  std::vector<std::optional<SurfaceHit>> hits;
+  projector.project_down(halfway, hits);
+  // the surface point halfway if it rises above the chord a-b by more than the tolerance
+  const auto cut_into = [&](const std::optional<SurfaceHit>& hit, const Vec3& a, const Vec3& b) {
+    return hit && hit->faces_up(spec.min_normal_z) &&
+           hit->point_mm.z() - 0.5 * (a.z() + b.z()) > spec.chord_tolerance_mm;
+  };
+  Piece refined;
+  // the points strictly between (ua, a) and (ub, b), in order, given the hit halfway
+  const auto insert_between = [&](auto&& self, double ua, const Vec3& a, double ub, const Vec3& b,
+                                  const std::optional<SurfaceHit>& middle, int index,
+                                  int depth) -> void {
+    if (!cut_into(middle, a, b)) return;
+    const double um = 0.5 * (ua + ub);
+    const Vec3 m = middle->point_mm;
+    if (depth < kMaxChordHalvings) {
+      const Vec2 left = along(0.5 * (ua + um));
+      self(self, ua, a, um, m, projector.project_down(left.x(), left.y()), index, depth + 1);
+    }
+    refined.index.push_back(index);
+    refined.points.push_back(m);
+    refined.normals.push_back(middle->normal);
+    if (depth < kMaxChordHalvings) {
+      const Vec2 right = along(0.5 * (um + ub));
+      self(self, um, m, ub, b, projector.project_down(right.x(), right.y()), index, depth + 1);
+    }
+  };
+  for (std::size_t m = 0; m < n; ++m) {
+    refined.index.push_back(piece.index[m]);
+    refined.points.push_back(piece.points[m]);
+    refined.normals.push_back(piece.normals[m]);
+    if (m + 1 == n) break;
+    insert_between(insert_between, first_u + piece.index[m] * h, piece.points[m],
+                   first_u + piece.index[m + 1] * h, piece.points[m + 1], hits[m], piece.index[m],
+                   1);
+  }
+  piece = std::move(refined);
+}
 
 AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
                        const SurfaceHatchSpec& spec) {
@@ -108,6 +165,7 @@ AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
     auto close = [&] {
       if (piece.points.size() >= 2) {
         grid.printed_points += static_cast<int>(piece.points.size());
+        refine_piece(projector, piece, v * e, d, along.first, h, spec);
         line.push_back(std::move(piece));
       } else if (piece.points.size() == 1) {
         lone.emplace_back(piece.points.front(), line.size());

@@ -11,6 +11,9 @@
 //    normal with n_z <= min_normal_z: a wall) and where consecutive surface points are more
 //    than max_jump_ratio * hatch_mm apart in 3-D (a step); every piece of at least two
 //    points is a PrintPath (the planner joins pieces by travels);
+//  - beyond the paper, a chord between two points that the surface rises above by more than
+//    chord_tolerance_mm halfway (a ridge between grid points: the nozzle would cut into the
+//    part) gets the surface point there, and its halves are checked again;
 //  - lines go in order across the part (increasing e), every other printed line reversed
 //    (zig-zag; the alternation counts lines that have a piece, so a line lost entirely to a
 //    hole does not break it); a reversed line's pieces come in reverse order, each reversed;
@@ -48,6 +51,9 @@ struct SurfaceHatchSpec {
   double speed_mm_s = 10.0;
   double min_normal_z = 0.1;    // a surface whose normal has n_z <= this is no surface
   double max_jump_ratio = 3.0;  // consecutive points farther apart than this * hatch_mm: a break
+  // a chord between consecutive points whose surface rises more than this above it halfway is
+  // refined by the surface point there (0: the grid's points only, as in the paper)
+  double chord_tolerance_mm = 0.05;
 };
 
 // Where each path came from and what the surface is like under it.

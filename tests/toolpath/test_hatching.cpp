@@ -312,6 +312,70 @@ TEST(Hatching, StepSplitsALine) {
   EXPECT_EQ(walls.toolpath.paths.size(), 2u * 9u);
 }
 
+// A roof z = 20 - 0.7 |x - 9.6|: its ridge falls between grid points 2 mm apart (8.3, 10.3). The
+// paper's chord across it runs below the ridge (the nozzle inside the part); refined, no chord's
+// halfway point is more than the tolerance below the surface, and as the surface under a chord
+// is a tent (one kink), no point of it is more than twice that.
+TEST(Hatching, ChordsAcrossARidgeAreRefinedToTheTolerance) {
+  const double ridge_x = 9.6, slope = 0.7;
+  HeightField field = plane(20.6, 4.2, 0.0);
+  field.z = [&](double x, double) { return 20.0 - slope * std::abs(x - ridge_x); };
+  field.x_breaks = {ridge_x};
+  const TriangleMesh mesh = tessellate(field, TessellationOptions{});
+  const SurfaceProjector projector(mesh);
+  SurfaceHatchSpec spec;
+  spec.hatch_mm = 2.0;
+  spec.angles_deg = {0};
+  // the largest depth of the surface above a chord, sampled finely
+  const auto deepest_cut = [&](const SurfaceHatch& hatch) {
+    double deepest = 0.0;
+    for (const PrintPath& path : hatch.toolpath.paths)
+      for (std::size_t i = 0; i + 1 < path.points.size(); ++i)
+        for (int k = 1; k < 200; ++k) {
+          const Vec3 p = path.points[i] + (k / 200.0) * (path.points[i + 1] - path.points[i]);
+          if (const std::optional<double> h = projector.height_at(p.x(), p.y()))
+            deepest = std::max(deepest, *h - p.z());
+        }
+    return deepest;
+  };
+
+  // the paper's grid: the chord between the grid points either side of the ridge
+  spec.chord_tolerance_mm = 0.0;
+  const SurfaceHatch grid = hatch_surface(projector, spec);
+  expect_well_formed(grid);
+  const PrintPath& first = grid.toolpath.paths.front();
+  std::size_t across = 0;
+  while (std::max(first.points[across].x(), first.points[across + 1].x()) < ridge_x ||
+         std::min(first.points[across].x(), first.points[across + 1].x()) > ridge_x)
+    ++across;
+  const Vec3& a = first.points[across];
+  const Vec3& b = first.points[across + 1];
+  const double chord_z = a.z() + (ridge_x - a.x()) / (b.x() - a.x()) * (b.z() - a.z());
+  EXPECT_GT(20.0 - chord_z, 0.5);
+  EXPECT_NEAR(deepest_cut(grid), 20.0 - chord_z, 1e-3);
+
+  // refined at 0.01 mm (the default is 0.05 mm)
+  spec.chord_tolerance_mm = 0.01;
+  const SurfaceHatch refined = hatch_surface(projector, spec);
+  expect_well_formed(refined);
+  ASSERT_EQ(refined.toolpath.paths.size(), grid.toolpath.paths.size());
+  EXPECT_LE(deepest_cut(refined), 2.0 * spec.chord_tolerance_mm + 1e-9);
+  for (std::size_t p = 0; p < refined.toolpath.paths.size(); ++p) {
+    const PrintPath& path = refined.toolpath.paths[p];
+    // points added around the ridge only: the grid's points kept, at most 2 per halving
+    EXPECT_GT(path.points.size(), grid.toolpath.paths[p].points.size());
+    EXPECT_LE(path.points.size(), grid.toolpath.paths[p].points.size() + 20);
+    for (const Vec3& q : grid.toolpath.paths[p].points)
+      EXPECT_TRUE(std::any_of(path.points.begin(), path.points.end(),
+                              [&](const Vec3& r) { return (r - q).norm() < 1e-12; }));
+    for (std::size_t i = 0; i + 1 < path.points.size(); ++i)
+      if (std::abs(path.points[i].x() - ridge_x) > 2.0 &&
+          std::abs(path.points[i + 1].x() - ridge_x) > 2.0) {
+        EXPECT_NEAR((path.points[i + 1] - path.points[i]).head<2>().norm(), 2.0, 1e-9);
+      }
+  }
+}
+
 TEST(Hatching, Deterministic) {
   SurfaceHatchSpec spec;
   spec.layers = 3;
