@@ -74,7 +74,8 @@ std::string absolute(const std::string& path) {
   return fs::absolute(path).lexically_normal().string();
 }
 
-// "done" (up to date), "failed", "stale" (a result of other inputs) or "-" (not run)
+// "done" (up to date), "failed", "stale" (a result of other inputs), "missing" (its
+// metrics.json gone or cut short: run again) or "-" (not run)
 std::string task_state(const Sweep& sweep, std::uint64_t index) {
   const std::optional<TaskRecord> record = read_task_record(sweep.task_folder(index));
   if (!record) return "-";
@@ -85,7 +86,8 @@ std::string task_state(const Sweep& sweep, std::uint64_t index) {
     return "-";
   }
   if (record->input_hash != hash) return "stale";
-  return record->status == "ok" ? "done" : "failed";
+  if (record->status != "ok") return "failed";
+  return task_up_to_date(sweep, index, hash) ? "done" : "missing";
 }
 
 int list_tasks(const Sweep& sweep, const SweepOptions& options) {

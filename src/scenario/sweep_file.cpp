@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -132,11 +133,21 @@ std::optional<std::vector<SweepValue>> read_values(const Field& field, ProblemLi
     }
     values.push_back(value_of(item));
   }
-  // a value twice would run the same task twice
-  std::set<std::string> seen;
-  for (const SweepValue& value : values)
-    if (!seen.insert(value.yaml).second)
-      problems.add(field.line, field.key, "lists " + value.text + " twice");
+  // a value twice would run the same task twice; numbers are one value whatever their text
+  // (2, 2.0, 2e0 and +2 are one speed)
+  std::map<std::string, std::string> seen;  // the value's identity -> its text as first given
+  for (const SweepValue& value : values) {
+    char exact[32];
+    if (value.number) std::snprintf(exact, sizeof exact, "%.17g", *value.number);
+    const std::string identity = value.number ? std::string("number ") + exact : value.yaml;
+    const auto [first, added] = seen.emplace(identity, value.text);
+    if (added) continue;
+    problems.add(field.line, field.key,
+                 "lists " + value.text + " twice" +
+                     (first->second == value.text
+                          ? std::string()
+                          : " (" + first->second + " and " + value.text + " are one value)"));
+  }
   return values;
 }
 

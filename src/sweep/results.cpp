@@ -208,8 +208,14 @@ TaskRow read_task_row(const Sweep& sweep, std::uint64_t index) {
     MetricsReader reader(row.metrics);
     Json::sax_parse(text, &reader);
   } catch (const std::exception& error) {
+    // none of a half-read file's values: the row's numbers would pass for the task's
+    row.metrics.clear();
     row.status = "missing";
-    row.error = "its metrics.json cannot be read (" + std::string(error.what()) + "): run it again";
+    std::string why = error.what();
+    const size_t id = why.find("[json.exception.");  // nlohmann's error id: no help to a reader
+    if (id != std::string::npos && why.find("] ", id) != std::string::npos)
+      why.erase(id, why.find("] ", id) + 2 - id);
+    row.error = "its metrics.json cannot be read (" + why + "): run it again";
   }
   return row;
 }

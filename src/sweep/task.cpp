@@ -58,8 +58,12 @@ bool task_up_to_date(const Sweep& sweep, std::uint64_t index, const std::string&
   const std::string folder = sweep.task_folder(index);
   const std::optional<TaskRecord> record = read_task_record(folder);
   if (!record || record->status != "ok" || record->input_hash != input_hash) return false;
-  std::error_code error;
-  return fs::is_regular_file(fs::path(folder) / record->run / "metrics.json", error);
+  // its metrics.json whole: one cut short (a full disk, a copy interrupted) is run again, as
+  // the merge asks, instead of being skipped for ever
+  std::ifstream in(fs::path(folder) / record->run / "metrics.json", std::ios::binary);
+  if (!in) return false;
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  return nlohmann::json::accept(text);
 }
 
 namespace {

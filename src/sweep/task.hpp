@@ -29,7 +29,7 @@ std::string task_record_json(const TaskRecord& record);
 // the record in `folder`/task.json; nothing when it is absent or unreadable
 std::optional<TaskRecord> read_task_record(const std::string& folder);
 
-// an `ok` record with this input hash is in the task's folder (its metrics.json too)
+// an `ok` record with this input hash is in the task's folder, and its metrics.json, whole
 bool task_up_to_date(const Sweep& sweep, std::uint64_t index, const std::string& input_hash);
 
 // Runs the task and writes its folder: task.json, and for a task that ran

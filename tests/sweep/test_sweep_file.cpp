@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 
@@ -141,6 +142,20 @@ zip:
           "together, so they need one length",
   };
   EXPECT_EQ(problems, expected);
+}
+
+// numbers are one value whatever their text: 2, 2.0, 2e0 and +2 would run one task four times
+TEST(SweepFile, ANumberWrittenTwoWaysIsOneValue) {
+  const std::string dir = fresh_directory("sweep_number_twice");
+  const std::string file = write_text(dir, "twice.yaml",
+                                      "base: nowhere.yaml\ngrid:\n  toolpath.speed: [2, 2.0, 3]\n"
+                                      "  limits.a_max: [2e1, 20.5, +20]\n");
+  const std::vector<std::string> problems = problems_of([&] { read_sweep_file(file); });
+  const auto has = [&](const std::string& text) {
+    return std::find(problems.begin(), problems.end(), text) != problems.end();
+  };
+  EXPECT_TRUE(has(file + ":3: grid.toolpath.speed: lists 2.0 twice (2 and 2.0 are one value)"));
+  EXPECT_TRUE(has(file + ":4: grid.limits.a_max: lists +20 twice (2e1 and +20 are one value)"));
 }
 
 TEST(SweepFile, AnEmptyGridAndAMissingBaseAreErrors) {

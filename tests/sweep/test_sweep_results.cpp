@@ -160,6 +160,33 @@ TEST(SweepMerge, TheTableHasARowPerTaskAndAColumnPerParameterAndScalarMetric) {
   EXPECT_FALSE(fs::exists(path + ".partial-" + std::to_string(::getpid())));
 }
 
+// a metrics.json cut short (a full disk, a copy interrupted): the task is not up to date, so
+// the next sweep reruns it, and the merge takes none of the half-read file's values
+TEST(SweepMerge, AMetricsFileCutShortIsMissingAndRunAgain) {
+  const std::string dir = fresh_directory("sweep_cut_short");
+  const Sweep sweep(write_sweep(dir), dir + "/out");
+  write_task(sweep, 0, "ok", metrics_of(22.5, 0.1, false));
+  write_task(sweep, 1, "ok", metrics_of(23.5, 0.2, false));
+  const std::string hash = sweep.input_hash(sweep.task(0));
+  EXPECT_TRUE(task_up_to_date(sweep, 0, hash));
+  const std::string metrics = sweep.task_folder(0) + "/lspb_mtt/metrics.json";
+  const std::string whole = read_text(metrics);
+  const size_t cut = whole.find("\"thickness\"");  // after time_s.total
+  ASSERT_NE(cut, std::string::npos);
+  write_text(sweep.task_folder(0) + "/lspb_mtt", "metrics.json", whole.substr(0, cut));
+  EXPECT_FALSE(task_up_to_date(sweep, 0, hash));
+  const ResultsTable table = collect_results(sweep, 1);
+  EXPECT_EQ(std::get<std::string>(table.rows[0][3]), "missing");
+  EXPECT_EQ(std::get<std::string>(table.rows[0][4]),
+            "its metrics.json cannot be read (at byte 141: parse error at line 8, column 3: "
+            "syntax error while parsing object key - unexpected end of input; expected string "
+            "literal): run it again");
+  const int total = table.column("time_s.total");
+  ASSERT_GE(total, 0);
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(table.rows[0][total]));
+  EXPECT_EQ(std::get<double>(table.rows[1][total]), 23.5);
+}
+
 TEST(SweepMerge, AResultOfOtherInputsIsMissing) {
   const std::string dir = fresh_directory("sweep_stale");
   const Sweep sweep(write_sweep(dir), dir + "/out");
