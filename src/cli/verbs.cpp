@@ -86,8 +86,10 @@ int validate_verb(const std::string& path, const std::string& max_memory) {
   const auto longest = std::max_element(
       runs.begin(), runs.end(),
       [](const RunEstimate& a, const RunEstimate& b) { return a.steps < b.steps; });
-  double memory_bytes = 0.0;
-  for (const RunEstimate& run : runs) memory_bytes += run.memory_bytes;
+  // the runs' data, and all the memory --max-memory is compared with
+  double data_bytes = 0.0;
+  for (const RunEstimate& run : runs) data_bytes += run.memory_bytes;
+  const double memory_bytes = job_memory_bytes(scenario, runs);
   std::cout << path << ": ok — scenario " << scenario.name << ", machine " << job.machine->name()
             << ", " << scenario.toolpath.paths.size() << " print paths, "
             << scenario.planners.size() << " planner(s)\n";
@@ -96,7 +98,8 @@ int validate_verb(const std::string& path, const std::string& max_memory) {
               << message_number(longest->duration_s) << " s, " << message_number(longest->steps)
               << " physics steps (sim.max_steps "
               << message_number(static_cast<double>(scenario.sim.max_steps)) << "); about "
-              << format_bytes(memory_bytes) << " for the runs' data (--max-memory "
+              << format_bytes(memory_bytes) << " of memory, the runs' data "
+              << format_bytes(data_bytes) << " of it (--max-memory "
               << format_bytes(budget.max_memory_bytes) << ")\n";
   // what loading found and every run will repeat (a surface turned over, a G-code rule chosen)
   for (const std::string& note : scenario.notes) std::cout << "warning: " << note << '\n';

@@ -291,6 +291,13 @@ RunEstimate estimate_planned(const PreparedJob& job, const std::string& label, d
   return sized(job.scenario, static_cast<int>(job.machine->joint_limits().size()), run);
 }
 
+double job_memory_bytes(const Scenario& scenario, const std::vector<RunEstimate>& runs) {
+  double memory_bytes =
+      kProcessBytes + kBytesPerPath * 3.0 * static_cast<double>(scenario.toolpath.paths.size());
+  for (const RunEstimate& run : runs) memory_bytes += run.memory_bytes;
+  return memory_bytes;
+}
+
 std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<RunEstimate>& runs,
                                    const JobBudget& budget) {
   std::vector<Problem> problems;
@@ -309,13 +316,10 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
     if (run.label.empty()) break;  // before planning every run is the same estimate
   }
   // every run a verb keeps together, against the memory budget
-  double memory_bytes =
-      kProcessBytes + kBytesPerPath * 3.0 * static_cast<double>(scenario.toolpath.paths.size());
+  const double memory_bytes = job_memory_bytes(scenario, runs);
   const RunEstimate* largest = &runs.front();
-  for (const RunEstimate& run : runs) {
-    memory_bytes += run.memory_bytes;
+  for (const RunEstimate& run : runs)
     if (run.memory_bytes > largest->memory_bytes) largest = &run;
-  }
   if (memory_bytes > budget.max_memory_bytes) {
     const RunEstimate& run = *largest;
     std::string parts = (run.simulated ? count_text(run.steps) + " physics steps, " : "") +

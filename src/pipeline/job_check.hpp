@@ -60,8 +60,13 @@ RunEstimate estimate_before_planning(const Scenario& scenario, bool simulate);
 RunEstimate estimate_planned(const PreparedJob& job, const std::string& label, double duration_s,
                              bool simulate);
 
+// The memory a verb that keeps these runs together would need, as --max-memory counts it: the
+// process itself (libraries, MuJoCo, the renderer), the toolpath's copies and every run's data
+double job_memory_bytes(const Scenario& scenario, const std::vector<RunEstimate>& runs);
+
 // The runs' problems against sim.max_steps (each run) and the budget (all runs together, as a
-// verb keeps them), each at the scenario key that drives it, naming the limit to raise
+// verb keeps them: job_memory_bytes), each at the scenario key that drives it, naming the
+// limit to raise
 std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<RunEstimate>& runs,
                                    const JobBudget& budget);
 

@@ -2,6 +2,10 @@
 // posture problems at the dotted key and line of the point they name.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <regex>
+#include <string>
+
 #include "pipeline/pipeline_test_util.hpp"
 
 namespace depotwin {
@@ -77,6 +81,31 @@ toolpath: {gcode: square.gcode}
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find(path + ": ok"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("\nwarning: toolpath.gcode: "), std::string::npos) << r.output;
+}
+
+// the memory validate prints is the figure --max-memory is compared with: a budget 3 % below it
+// refuses the job, 3 % above accepts it
+TEST(ValidateVerb, TheMemoryItPrintsIsWhatMaxMemoryIsComparedWith) {
+  const std::string scenario = testing_support::scenario_path("thompson_fig7.yaml");
+  const auto r = depotwin("validate " + scenario);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::smatch found = [&] {
+    std::smatch match;
+    std::regex_search(r.output, match, std::regex("about (\\d+) MB of memory, the runs' data "));
+    return match;
+  }();
+  ASSERT_FALSE(found.empty()) << r.output;
+  const double megabytes = std::stod(found[1].str());
+  EXPECT_GT(megabytes, 250.0);  // the process's own share counts
+  const auto budget = [&](double factor) {
+    return depotwin("validate " + scenario + " --max-memory " +
+                    std::to_string(std::lround(megabytes * factor)) + "M");  // MB of 1024^2
+  };
+  const auto below = budget(0.97);
+  EXPECT_EQ(below.status, 2) << below.output;
+  EXPECT_NE(below.output.find("of memory, more than --max-memory"), std::string::npos)
+      << below.output;
+  EXPECT_EQ(budget(1.03).status, 0);
 }
 
 }  // namespace
