@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <utility>
 
 namespace depotwin {
@@ -134,6 +135,37 @@ bool TriangleMesh::face_outward_and_up() {
   if (!reversed) return false;
   for (auto& t : triangles) std::swap(t[1], t[2]);
   return true;
+}
+
+TriangleMesh::DownFacingPieces TriangleMesh::down_facing_pieces() const {
+  // the pieces: triangles joined by shared vertices (union-find over the vertices)
+  std::vector<int> parent(vertices.size());
+  for (size_t v = 0; v < parent.size(); ++v) parent[v] = static_cast<int>(v);
+  const auto root = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& t : triangles)
+    for (int c = 1; c < 3; ++c) parent[root(t[c])] = root(t[0]);
+  // per piece, its signed area projected on xy (n_z A per facet) and the absolute sum
+  std::map<int, std::pair<double, double>> areas;
+  for (const auto& t : triangles) {
+    const Vec3& a = vertices[t[0]];
+    const double projected = 0.5 * (vertices[t[1]] - a).cross(vertices[t[2]] - a).z();
+    auto& [signed_area, absolute_area] = areas[root(t[0])];
+    signed_area += projected;
+    absolute_area += std::abs(projected);
+  }
+  DownFacingPieces result;
+  result.pieces = areas.size();
+  for (const auto& [piece, area] : areas) {
+    // an open piece (its projected areas do not cancel, as a closed one's do) facing down
+    const auto& [signed_area, absolute_area] = area;
+    if (std::abs(signed_area) <= kClosedAreaRatio * absolute_area || signed_area >= 0.0) continue;
+    ++result.down;
+    result.down_area_mm2 += -signed_area;
+  }
+  return result;
 }
 
 size_t TriangleMesh::orient_consistently() {

@@ -46,6 +46,17 @@ struct TriangleMesh {
   // solid wound outward, or a closed one whose signed volume is 0 is left as it is. Returns
   // whether it turned the triangles over.
   bool face_outward_and_up();
+  // The pieces (triangles joined by shared vertices) that are open surfaces facing down on the
+  // whole (their facets' signed areas projected on xy sum below 0): after face_outward_and_up
+  // has judged the whole mesh, such a piece beside others facing up is not printed (the hatch
+  // looks for the faces seen from above). It may be meant so (the underside of a shell given
+  // as two patches) or wound the wrong way (a patch exported reversed), so it is only counted.
+  struct DownFacingPieces {
+    size_t pieces = 0;           // every piece
+    size_t down = 0;             // the open ones facing down
+    double down_area_mm2 = 0.0;  // their area projected on xy
+  };
+  DownFacingPieces down_facing_pieces() const;
   // Turns over the triangles wound against their neighbours, as an STL with some facets
   // reversed has them: across every edge that exactly two triangles share, the two must run
   // it in opposite directions. In each connected piece (joined by such edges) the winding of

@@ -1268,6 +1268,15 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
       scenario_.notes.push_back("toolpath.surface: '" + given_file +
                                 "' faced down or inside out (its triangles wound clockwise "
                                 "seen from outside); its triangles were turned over");
+    // a separate patch that still faces down is not printed: say so (it may be meant so)
+    if (const TriangleMesh::DownFacingPieces down = part.down_facing_pieces(); down.down > 0)
+      scenario_.notes.push_back(
+          "toolpath.surface: " + std::to_string(down.down) + " of the " +
+          std::to_string(down.pieces) + " separate pieces of '" + given_file +
+          (down.down == 1 ? "' faces down (an open surface" : "' face down (open surfaces") +
+          " wound clockwise seen from above, " + format_number(down.down_area_mm2) +
+          " mm² projected) while the rest faces up: not printed; if meant to be, turn " +
+          (down.down == 1 ? "it" : "them") + " over in the STL");
     // the grid's size before it is built: every layer's points over the part's (x, y) bounds
     Vec3 lo, hi;
     part.bounds(lo, hi);

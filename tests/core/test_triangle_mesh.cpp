@@ -85,6 +85,28 @@ TriangleMesh wavy_grid(int n) {
   return mesh;
 }
 
+// a separate patch facing down beside one facing up is counted with its projected area; a
+// closed solid beside them is not (its projected areas cancel), nor is a patch facing up
+TEST(TriangleMesh, DownFacingPiecesAreTheOpenOnesFacingDownOnTheWhole) {
+  TriangleMesh mesh = wavy_grid(4);  // 16 mm^2 projected, facing up
+  const TriangleMesh second = turned_over(wavy_grid(3));
+  const int offset = static_cast<int>(mesh.vertices.size());
+  for (const Vec3& v : second.vertices) mesh.vertices.push_back(v + Vec3(10.0, 0.0, 0.0));
+  for (auto t : second.triangles)
+    mesh.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  const TriangleMesh solid = cube(Vec3(0.0, 20.0, 0.0));
+  const int solid_offset = static_cast<int>(mesh.vertices.size());
+  for (const Vec3& v : solid.vertices) mesh.vertices.push_back(v);
+  for (auto t : solid.triangles)
+    mesh.triangles.push_back({t[0] + solid_offset, t[1] + solid_offset, t[2] + solid_offset});
+  EXPECT_FALSE(mesh.face_outward_and_up());  // on the whole it faces up
+  const TriangleMesh::DownFacingPieces down = mesh.down_facing_pieces();
+  EXPECT_EQ(down.pieces, 3u);
+  EXPECT_EQ(down.down, 1u);
+  EXPECT_NEAR(down.down_area_mm2, 9.0, 1e-12);
+  EXPECT_EQ(wavy_grid(4).down_facing_pieces().down, 0u);
+}
+
 TEST(TriangleMesh, TrianglesWoundAgainstTheirNeighboursAreTurnedToMatch) {
   // a surface with every 7th facet reversed (and the first two, at a corner): those are turned
   // back, whichever way the rest runs, and a consistent mesh is left alone
