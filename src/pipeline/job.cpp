@@ -61,9 +61,22 @@ std::vector<Problem> at_toolpath(const Scenario& scenario, const std::vector<Nam
                                  std::vector<Problem> problems) {
   for (Problem& p : problems) {
     if (!p.file.empty()) continue;
-    const auto point = std::find_if(named.begin(), named.end(), [&](const NamedPoint& n) {
-      return p.message.rfind(n.name, 0) == 0;
-    });
+    // the point a message is about: named at its start, or after the branch's number in the
+    // summary of a job no branch prints ("no posture ... (branch 4: the start ... is ...)")
+    const auto about = [&](const std::string& name) {
+      if (p.message.rfind(name, 0) == 0) return true;
+      const size_t branch = p.message.find("(branch ");
+      const size_t colon = branch == std::string::npos ? branch : p.message.find(": ", branch);
+      return colon != std::string::npos && p.message.compare(colon + 2, name.size(), name) == 0;
+    };
+    const auto point = std::find_if(named.begin(), named.end(),
+                                    [&](const NamedPoint& n) { return about(n.name); });
+    if (point != named.end() && p.message.rfind(point->name, 0) != 0) {
+      p.file = point->location.file;  // in the summary: its place, the message as it is
+      p.line = point->location.line;
+      p.key = point->location.key;
+      continue;
+    }
     if (point != named.end()) {
       p.file = point->location.file;
       p.line = point->location.line;
@@ -79,7 +92,7 @@ std::vector<Problem> at_toolpath(const Scenario& scenario, const std::vector<Nam
          {std::tuple<const char*, const char*, int>{"the start ", "toolpath.start",
                                                     scenario.start_line},
           std::tuple<const char*, const char*, int>{"the end ", "toolpath.end", scenario.end_line}})
-      if (p.message.rfind(name, 0) == 0) {
+      if (about(name)) {
         p.key = key;
         if (line > 0) p.line = line;
       }

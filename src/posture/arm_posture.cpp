@@ -427,26 +427,35 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   // the ladder is built (between stations too), then how far to raise them
   std::vector<Problem> below;
   size_t below_count = 0;
+  size_t print_points_below = 0;  // the summary's: raising the print points lifts these
   double lowest_z = 0.0;
-  const auto check_above_table = [&](const Vec3& p, const std::function<std::string()>& where) {
+  const auto check_above_table = [&](const Vec3& p, const std::function<std::string()>& where,
+                                     bool print_point) {
     if (!arm.below_table(p)) return;
-    lowest_z = std::min(lowest_z, p.z());
+    if (print_point) {
+      lowest_z = std::min(lowest_z, p.z());
+      ++print_points_below;
+    }
     if (++below_count <= kMaxNamedPoints)
       below.push_back(Problem{"", 0, "toolpath",
                               where() + " " + point_text(p) +
                                   " is below the table's top (z = 0 of the work frame, where "
                                   "the part stands): the nozzle would be inside the table"});
   };
-  check_above_table(toolpath.start_mm, [] { return std::string("the start"); });
+  check_above_table(
+      toolpath.start_mm, [] { return std::string("the start"); }, false);
   for (size_t p = 0; p < toolpath.paths.size(); ++p)
     for (size_t i = 0; i < toolpath.paths[p].points.size(); ++i)
-      check_above_table(toolpath.paths[p].points[i], [&] { return name(p, i); });
-  check_above_table(toolpath.end_mm, [] { return std::string("the end"); });
-  if (below_count > 0)
+      check_above_table(
+          toolpath.paths[p].points[i], [&] { return name(p, i); }, true);
+  check_above_table(
+      toolpath.end_mm, [] { return std::string("the end"); }, false);
+  // how far to raise the print points (a start or end below the table is its own problem)
+  if (print_points_below > 0)
     below.push_back(Problem{
         "", 0, "toolpath",
-        std::to_string(below_count) +
-            " point(s) below the table's top, the lowest at z = " + format("%.3f", lowest_z) +
+        std::to_string(print_points_below) +
+            " print point(s) below the table's top, the lowest at z = " + format("%.3f", lowest_z) +
             " mm: raise the toolpath by at least " + format("%.3f", -lowest_z) +
             " mm (toolpath.offset's z; a part: toolpath.surface.offset's)"});
   if (!below.empty()) throw InputError(below);

@@ -426,6 +426,21 @@ std::vector<Row> rows() {
                       "--filament-diameter 1e-300",
                       "--filament-diameter: expected a number in \\[0\\.01, 100\\], got '1e-300'",
                       {{"scenario.yaml", probe()}}));
+  // a start under a part's patch: the summary of the branches names the start, so it stands
+  // at toolpath.start's line, not at the surface's
+  const std::string plate_stl =
+      "solid plate\nfacet normal 0 0 1\nouter loop\nvertex -10 -10 5\nvertex 10 -10 5\n"
+      "vertex 10 10 5\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex -10 -10 5\n"
+      "vertex 10 10 5\nvertex -10 10 5\nendloop\nendfacet\nendsolid plate\n";
+  r.push_back(scenario("ArmStartUnderThePart",
+                       "name: under\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
+                       "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
+                       "toolpath:\n  speed: 30\n  start: [0, 0, 1]\n"
+                       "  surface: {file: plate.stl, hatch_mm: 4, angles: [0]}\n"
+                       "planners: [conformal]\n",
+                       "{s}:7: toolpath\\.start: no posture of arm6 .*\\(branch \\d: the start "
+                       "\\(0\\.000, 0\\.000, 1\\.000\\) mm is too close to the part",
+                       {{"plate.stl", plate_stl}}));
   r.push_back(command("RunIntoASweepFolder",
                       "run {dir}/scenario.yaml --out {dir}/study --no-render --quiet",
                       "error: --out: .*study: is a depotwin sweep folder \\(s\\), not a run's",

@@ -532,10 +532,24 @@ TEST(Cli, APartOrAPathBelowTheTableIsRefused) {
       << d.output;
   EXPECT_EQ(d.output.find("point 0 ("), std::string::npos) << d.output;
   EXPECT_EQ(d.output.find("point 2 ("), std::string::npos) << d.output;
-  EXPECT_NE(d.output.find(dip + ":5: toolpath: 1 point(s) below the table's top, the lowest at "
-                                "z = -0.500 mm: raise the toolpath by at least 0.500 mm"),
+  EXPECT_NE(d.output.find(dip + ":5: toolpath: 1 print point(s) below the table's top, the "
+                                "lowest at z = -0.500 mm: raise the toolpath by at least 0.500 mm"),
             std::string::npos)
       << d.output;
+  // a start below the table is named at its key, and raising the print points is no advice
+  const std::string low_start = write_text(
+      dir, "low_start.yaml",
+      "name: low_start\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
+      "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
+      "toolpath:\n  speed: 20\n  start: [0, 0, -5]\n  end: [20, 0, 5]\n"
+      "  polylines:\n    - [[0, 0, 1], [10, 0, 1], [20, 0, 1]]\nplanners: [conformal]\n");
+  const Result l = depotwin("validate " + low_start);
+  EXPECT_EQ(l.status, 2) << l.output;
+  EXPECT_NE(l.output.find(low_start + ":7: toolpath.start: the start (0.000, 0.000, -5.000) mm is "
+                                      "below the table's top"),
+            std::string::npos)
+      << l.output;
+  EXPECT_EQ(l.output.find("raise the toolpath"), std::string::npos) << l.output;
 }
 
 // `arm:` on a machine without a wrist
