@@ -45,8 +45,6 @@ constexpr double kMaxSurfaceGridPoints = 2e7;
 constexpr std::size_t kMaxSpeedProblems = 20;
 // an arc's directions, for the feed clamp, come from chords within this sagitta
 constexpr double kClampChordTolerance_mm = 1e-3;
-// a surface toolpath's path problems listed before the rest are counted
-constexpr std::size_t kMaxSurfacePathProblems = 5;
 // a surface whose up-facing area is hidden under another part of it by more than this
 // fraction is noted: the hatch leaves that area bare
 constexpr double kHiddenAreaNoted = 0.01;
@@ -138,6 +136,11 @@ struct PathOrigin {
   std::string key;               // e.g. toolpath.segments[2]
   std::vector<int> point_lines;  // per point
   bool name_segments = true;     // false for a 2-point `segments` entry (the key says it all)
+  // a hatch line's: its name ("layer 0, line 3") before each segment's, and its print speed's
+  // key and line, where a speed above the limits is named (empty: the path's own)
+  std::string path_name = {};
+  std::string speed_key = {};
+  int speed_line = 0;
 };
 
 class Loader {
@@ -232,6 +235,7 @@ class Loader {
   std::optional<LiftedSegments> lifted_;
   std::optional<TcpLimits> tcp_limits_;
   std::size_t speed_problems_ = 0;  // print segments over speed, listed up to a count
+  int toolpath_speed_line_ = 0;     // toolpath.speed's line, 0 when not given
   bool speed_missing_ = false;      // reported once, not per path
 };
 
@@ -542,6 +546,7 @@ void Loader::read_toolpath(const Field* field) {
   // default print speed, start and end (end defaults to start)
   std::optional<double> default_speed;
   if (const Field* f = view.find("speed")) {
+    toolpath_speed_line_ = f->line;
     default_speed = read_number(*f, problems_, range_of("toolpath", "speed"));
     speed_missing_ = !default_speed;  // already reported: do not repeat per path
   }
@@ -1234,8 +1239,14 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
         read_number(*f, problems_, range_of(section, "chord_tolerance_mm"))
             .value_or(surface->chord_tolerance_mm);
   std::optional<double> speed = default_speed;
-  if (const Field* f = view.find("speed"))
+  // where the hatch's speed is given, for the segments it is too fast on
+  std::string speed_key = "toolpath.speed";
+  int speed_line = toolpath_speed_line_;
+  if (const Field* f = view.find("speed")) {
     speed = read_number(*f, problems_, range_of(section, "speed"));
+    speed_key = f->key;
+    speed_line = f->line;
+  }
   if (!speed && !speed_missing_ && !view.has("speed")) {
     problems_.add(field.key_line, field.key, "no print speed: give toolpath.speed or speed: here");
     speed_missing_ = true;
@@ -1375,27 +1386,25 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
   }
 
   // the paths, where each came from, and a start and end above the part by default (a
-  // hatch has hundreds of paths: their problems are listed for the first few, then counted)
+  // segment too fast is named by its layer, line and segment at the speed's key; check_path
+  // lists the first kMaxSpeedProblems of them and counts the rest)
   Toolpath& toolpath = scenario_.toolpath;
-  const std::size_t problems_before_paths = problems_.size();
   for (std::size_t i = 0; i < hatch.toolpath.paths.size(); ++i) {
     PrintPath path = hatch.toolpath.paths[i];
     path.source_index = static_cast<int>(i);
-    check_path(path, PathOrigin{problems_.file(), field.key,
-                                std::vector<int>(path.points.size(), field.key_line), false});
+    PathOrigin path_origin{problems_.file(), field.key,
+                           std::vector<int>(path.points.size(), field.key_line), true};
+    path_origin.path_name = "layer " + std::to_string(hatch.info[i].layer) + ", line " +
+                            std::to_string(hatch.info[i].line);
+    path_origin.speed_key = speed_key;
+    path_origin.speed_line = speed_line > 0 ? speed_line : field.key_line;
+    check_path(path, path_origin);
     toolpath.paths.push_back(std::move(path));
     SurfaceToolpath::PathOrigin origin;
     origin.layer = hatch.info[i].layer;
     origin.line = hatch.info[i].line;
     origin.point_index = hatch.info[i].point_index;
     surface->origins.push_back(std::move(origin));
-  }
-  std::vector<Problem>& listed = problems_.problems();
-  if (listed.size() > problems_before_paths + kMaxSurfacePathProblems) {
-    const std::size_t more = listed.size() - problems_before_paths - kMaxSurfacePathProblems;
-    listed.resize(problems_before_paths + kMaxSurfacePathProblems);
-    problems_.add(field.key_line, field.key,
-                  "... and " + std::to_string(more) + " more hatch lines with such a problem");
   }
   const Vec3& lo = projector->lower_bound();
   const Vec3& hi = projector->upper_bound();
@@ -1416,10 +1425,11 @@ void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
     scenario_.path_sources[index] = PathSource{origin.file, origin.key, origin.point_lines};
   }
   for (std::size_t k = 0; k + 1 < path.points.size(); ++k) {
-    const std::string segment = origin.name_segments
-                                    ? "segment " + std::to_string(k) + " (points " +
-                                          std::to_string(k) + " and " + std::to_string(k + 1) + ")"
-                                    : "segment";
+    const std::string segment =
+        (origin.path_name.empty() ? "" : origin.path_name + ", ") +
+        (origin.name_segments ? "segment " + std::to_string(k) + " (points " + std::to_string(k) +
+                                    " and " + std::to_string(k + 1) + ")"
+                              : "segment");
     const Vec3 step = path.points[k + 1] - path.points[k];
     const double length_mm = step.norm();
     // a segment's problem at the line of its end point, a whole path's (a `segments` entry, a
@@ -1468,12 +1478,13 @@ void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
                   "'s joint limits mapped over this segment; limits v_max is " +
                   format_speed(requested_mm_s) + ")"
             : "above limits v_max " + format_speed(requested_mm_s);
-    problems_.add_problem(Problem{origin.file, line, origin.key,
-                                  (origin.name_segments ? segment + ": " : std::string()) +
-                                      "print speed " + format_speed(path.speed_mm_s) +
-                                      " mm/s needs " + format_speed(needed_mm_s) + " mm/s on " +
-                                      kAxisNames[worst_axis] + ", " + limit_text +
-                                      " (lower the speed or raise the limit)"});
+    problems_.add_problem(Problem{
+        origin.file, origin.speed_key.empty() ? line : origin.speed_line,
+        origin.speed_key.empty() ? origin.key : origin.speed_key,
+        (origin.name_segments || !origin.path_name.empty() ? segment + ": " : std::string()) +
+            "print speed " + format_speed(path.speed_mm_s) + " mm/s needs " +
+            format_speed(needed_mm_s) + " mm/s on " + kAxisNames[worst_axis] + ", " + limit_text +
+            " (lower the speed or raise the limit)"});
   }
 }
 

@@ -441,6 +441,16 @@ std::vector<Row> rows() {
                        "{s}:7: toolpath\\.start: no posture of arm6 .*\\(branch \\d: the start "
                        "\\(0\\.000, 0\\.000, 1\\.000\\) mm is too close to the part",
                        {{"plate.stl", plate_stl}}));
+  // a hatch too fast: each segment by its layer, line and segment, at the surface's speed key
+  r.push_back(scenario("ArmSurfaceSpeedAboveTheLimits",
+                       "name: fast\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
+                       "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
+                       "toolpath:\n  speed: 30\n  surface:\n    file: plate.stl\n"
+                       "    hatch_mm: 4\n    angles: [0]\n    speed: 250\n"
+                       "planners: [conformal]\n",
+                       "{s}:11: toolpath\\.surface\\.speed: layer 0, line 0, segment 0 \\(points 0 "
+                       "and 1\\): print speed 250 mm/s needs 250 mm/s on x, above limits v_max 200",
+                       {{"plate.stl", plate_stl}}));
   r.push_back(command("RunIntoASweepFolder",
                       "run {dir}/scenario.yaml --out {dir}/study --no-render --quiet",
                       "error: --out: .*study: is a depotwin sweep folder \\(s\\), not a run's",
