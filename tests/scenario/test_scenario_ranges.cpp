@@ -111,8 +111,8 @@ TEST_F(EveryNumber, HugeAndTinyValuesAreRefusedAtTheirKey) {
       expect_refused(section, key, "1" + std::string(400, '0'));
     }
   // every section's numbers: limits (9), process (7), toolpath (1), polylines (1), gcode (1),
-  // random_segments (3), surface (5), arm (10), order (1), sim (6), outputs (2)
-  EXPECT_EQ(keys, 46);
+  // random_segments (3), surface (6), arm (10), order (1), sim (6), outputs (2)
+  EXPECT_EQ(keys, 47);
 }
 
 // the coordinates of every point: finite and within +-1e6 mm
