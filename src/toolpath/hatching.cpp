@@ -83,10 +83,14 @@ void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& l
   for (std::size_t m = 0; m + 1 < n; ++m) halfway[m] = along(first_u + (piece.index[m] + 0.5) * h);
   std::vector<std::optional<SurfaceHit>> hits;
   projector.project_down(halfway, hits);
-  // the surface point halfway if it rises above the chord a-b by more than the tolerance
+  // the surface point halfway if it rises above the chord a-b by more than the tolerance, and
+  // is no step away from its ends (a shelf above the chord: a point there would be a spike,
+  // where the grid's own points break the line)
+  const double max_jump = spec.max_jump_ratio * h;
   const auto cut_into = [&](const std::optional<SurfaceHit>& hit, const Vec3& a, const Vec3& b) {
     return hit && hit->faces_up(spec.min_normal_z) &&
-           hit->point_mm.z() - 0.5 * (a.z() + b.z()) > spec.chord_tolerance_mm;
+           hit->point_mm.z() - 0.5 * (a.z() + b.z()) > spec.chord_tolerance_mm &&
+           (hit->point_mm - a).norm() <= max_jump && (hit->point_mm - b).norm() <= max_jump;
   };
   Piece refined;
   // the points strictly between (ua, a) and (ub, b), in order, given the hit halfway
