@@ -124,6 +124,73 @@ void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& l
   piece = std::move(refined);
 }
 
+// A path offset along the surface normal folds back over a concave crease (a groove's floor):
+// the points either side are pushed past each other, and the line would lay material twice
+// over the crease. Measured along the path's own horizontal direction t (first point to last),
+// a fold is where that coordinate goes back. The offset lines either side cross (in the plane
+// of t and z): the line of a segment before the fold, from its start on, meets the line of a
+// segment after it, up to its end; the points between are cut out for that crossing, which
+// lies on both sides' offsets. Returns how many folds were cut; `info` is kept in step.
+std::size_t trim_folds(PrintPath& path, HatchPathInfo& info, double window_mm) {
+  std::size_t cut = 0;
+  if (path.points.size() < 3) return cut;
+  Vec2 t = (path.points.back() - path.points.front()).head<2>();
+  if (!(t.norm() > 0.0)) return cut;
+  t.normalize();
+  const auto at = [&](std::size_t i) {
+    return Vec2(path.points[i].head<2>().dot(t), path.points[i].z());
+  };
+  // the crossing of segment a's line (s along it, from point a) and segment b's (v along it)
+  const auto crossing = [&](std::size_t a, std::size_t b, double& s, double& v) {
+    const Vec2 p = at(a), r = at(a + 1) - p, q = at(b), w = at(b + 1) - q;
+    const double denominator = r.x() * w.y() - r.y() * w.x();
+    if (std::abs(denominator) < 1e-12 * r.norm() * w.norm()) return false;  // parallel
+    const Vec2 qp = q - p;
+    s = (qp.x() * w.y() - qp.y() * w.x()) / denominator;
+    v = (qp.x() * r.y() - qp.y() * r.x()) / denominator;
+    const double u = p.x() + s * r.x();
+    return s >= 0.0 && v <= 1.0 && u >= p.x() && u <= at(b + 1).x();
+  };
+  for (std::size_t f = 0; f + 1 < path.points.size(); ++f) {
+    if (at(f + 1).x() > at(f).x()) continue;
+    // the fold turns back after point f: the nearest segments either side whose lines cross
+    bool found = false;
+    for (std::size_t a = f; !found && a-- > 0;) {
+      if (at(f).x() - at(a).x() > window_mm) break;
+      for (std::size_t b = f + 1; !found && b + 1 < path.points.size(); ++b) {
+        if (at(b).x() - at(f).x() > window_mm) break;
+        double s = 0.0, v = 0.0;
+        if (!crossing(a, b, s, v)) continue;
+        // points a+1 .. b become the crossing; its data from segment a, where it lies on it
+        const double on_a = std::min(s, 1.0);
+        const auto lerp = [&](const Vec3& x, const Vec3& y) { return Vec3(x + on_a * (y - x)); };
+        const Vec3 point = path.points[a] + s * (path.points[a + 1] - path.points[a]);
+        const Vec3 axis = lerp(path.normals[a], path.normals[a + 1]).normalized();
+        const Vec3 surface = lerp(info.surface_points_mm[a], info.surface_points_mm[a + 1]);
+        const Vec3 normal = lerp(info.surface_normals[a], info.surface_normals[a + 1]).normalized();
+        const int index = info.point_index[a];
+        // (a crossing on a kept point is that point: consecutive points must differ)
+        const bool distinct = (point - path.points[a]).norm() > kJoinTolerance_mm &&
+                              (point - path.points[b + 1]).norm() > kJoinTolerance_mm;
+        const auto replace = [&](auto& values, const auto& value) {
+          values.erase(values.begin() + static_cast<std::ptrdiff_t>(a + 1),
+                       values.begin() + static_cast<std::ptrdiff_t>(b + 1));
+          if (distinct) values.insert(values.begin() + static_cast<std::ptrdiff_t>(a + 1), value);
+        };
+        replace(path.points, point);
+        replace(path.normals, axis);
+        replace(info.surface_points_mm, surface);
+        replace(info.surface_normals, normal);
+        replace(info.point_index, index);
+        ++cut;
+        found = true;
+        f = a;  // go on from the crossing
+      }
+    }
+  }
+  return cut;
+}
+
 AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
                        const SurfaceHatchSpec& spec) {
   const double theta = deg_to_rad(angle_deg);
@@ -268,6 +335,9 @@ SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatch
           info.surface_points_mm.push_back(p);
           info.surface_normals.push_back(normal);
         }
+        // offset along the normal: folds over concave creases cut out
+        if (offset > 0.0 && spec.offset == SurfaceHatchSpec::Offset::normal)
+          trim_folds(path, info, 4.0 * offset + 2.0 * spec.hatch_mm);
         if (path.points.size() < 2) continue;
         path.speed_mm_s = spec.speed_mm_s;
         path.layer = layer;

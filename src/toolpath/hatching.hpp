@@ -19,7 +19,8 @@
 //    hole does not break it); a reversed line's pieces come in reverse order, each reversed;
 //  - points are offset from the surface by k * layer_height_mm along the smooth surface
 //    normal (Offset::normal: parallel layers of equal thickness) or along +z (Offset::z, as
-//    in the paper);
+//    in the paper); along the normal, a line that folds back over a concave crease (the
+//    points either side pushed past each other) is cut at the crossing of its two sides;
 //  - the tool axis is the smooth surface normal tilted back toward vertical by alpha: the
 //    slerp from +z (alpha = 0) to the normal (alpha = 1). The paper scales its rotation angles
 //    R_x = -atan(n_y / n_z), R_y = atan(n_x / n_z) by alpha; the slerp scales the single

@@ -376,6 +376,46 @@ TEST(Hatching, ChordsAcrossARidgeAreRefinedToTheTolerance) {
   }
 }
 
+// A V-groove z = 10 + 0.7 |x - 9.6| (its crease between grid points 8.3 and 10.3) offset
+// along its normals: each side's points move along its own facet normal (corner normals do
+// not average across the crease), so layer k's two offset lines cross at x = 9.6,
+// z = 10 + k h sqrt(1 + 0.7^2), and the points beyond the crossing fold back over it. Cut,
+// every path runs forward along x and its lowest point is that crossing.
+TEST(Hatching, OffsetLayersDoNotFoldBackOverAConcaveCrease) {
+  const double crease_x = 9.6, slope = 0.7, layer_height = 1.0;
+  HeightField field = plane(20.6, 4.2, 0.0);
+  field.z = [&](double x, double) { return 10.0 + slope * std::abs(x - crease_x); };
+  field.x_breaks = {crease_x};
+  const TriangleMesh mesh = tessellate(field, TessellationOptions{});
+  SurfaceHatchSpec spec;
+  spec.hatch_mm = 2.0;
+  spec.angles_deg = {0};
+  spec.layers = 4;
+  spec.layer_height_mm = layer_height;
+  const SurfaceHatch hatch = hatch_surface(mesh, spec);
+  expect_well_formed(hatch);
+  for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p) {
+    const PrintPath& path = hatch.toolpath.paths[p];
+    const double direction = path.back().x() > path.front().x() ? 1.0 : -1.0;
+    for (std::size_t i = 0; i + 1 < path.points.size(); ++i)
+      EXPECT_GT(direction * (path.points[i + 1].x() - path.points[i].x()), 0.0)
+          << "path " << p << " point " << i;
+    if (path.layer == 0) continue;
+    // never below the offsets' crossing; on it where the grid points either side have passed
+    // each other (from layer 2: 8.3 + 0.573 k > 10.3 - 0.573 k), above it (a chord over the
+    // concave corner) where they have not
+    const auto lowest =
+        std::min_element(path.points.begin(), path.points.end(),
+                         [](const Vec3& a, const Vec3& b) { return a.z() < b.z(); });
+    const double apex_z = 10.0 + path.layer * layer_height * std::sqrt(1.0 + slope * slope);
+    EXPECT_GE(lowest->z(), apex_z - 1e-9) << "path " << p;
+    if (path.layer >= 2) {
+      EXPECT_NEAR(lowest->x(), crease_x, 1e-9) << "path " << p;
+      EXPECT_NEAR(lowest->z(), apex_z, 1e-9) << "path " << p;
+    }
+  }
+}
+
 TEST(Hatching, Deterministic) {
   SurfaceHatchSpec spec;
   spec.layers = 3;
