@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <string>
 
 #include "core/number_text.hpp"
@@ -28,10 +29,8 @@ inline CLI::Validator positive_number() {
 inline CLI::Validator number_in(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& text) -> std::string {
-        char* end = nullptr;
-        const double value = std::strtod(text.c_str(), &end);
-        if (end == text.c_str() || *end != '\0' || !std::isfinite(value) || value < lo ||
-            value > hi)
+        const std::optional<double> value = parse_double(text);
+        if (!value || !std::isfinite(*value) || *value < lo || *value > hi)
           return "expected a number in [" + message_number(lo) + ", " + message_number(hi) +
                  "], got '" + printable_text(text) + "'";
         return "";

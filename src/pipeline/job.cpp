@@ -71,17 +71,13 @@ std::vector<Problem> at_toolpath(const Scenario& scenario, const std::vector<Nam
     };
     const auto point = std::find_if(named.begin(), named.end(),
                                     [&](const NamedPoint& n) { return about(n.name); });
-    if (point != named.end() && p.message.rfind(point->name, 0) != 0) {
-      p.file = point->location.file;  // in the summary: its place, the message as it is
-      p.line = point->location.line;
-      p.key = point->location.key;
-      continue;
-    }
     if (point != named.end()) {
       p.file = point->location.file;
       p.line = point->location.line;
       p.key = point->location.key;
-      p.message = point->location.message + p.message.substr(point->name.size());
+      // named at the start, the user's name for it leads; in the summary the message stays
+      if (p.message.rfind(point->name, 0) == 0)
+        p.message = point->location.message + p.message.substr(point->name.size());
       continue;
     }
     p.file = scenario.file;

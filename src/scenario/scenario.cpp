@@ -1478,13 +1478,13 @@ void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
                   "'s joint limits mapped over this segment; limits v_max is " +
                   format_speed(requested_mm_s) + ")"
             : "above limits v_max " + format_speed(requested_mm_s);
-    problems_.add_problem(Problem{
-        origin.file, origin.speed_key.empty() ? line : origin.speed_line,
-        origin.speed_key.empty() ? origin.key : origin.speed_key,
-        (origin.name_segments || !origin.path_name.empty() ? segment + ": " : std::string()) +
-            "print speed " + format_speed(path.speed_mm_s) + " mm/s needs " +
-            format_speed(needed_mm_s) + " mm/s on " + kAxisNames[worst_axis] + ", " + limit_text +
-            " (lower the speed or raise the limit)"});
+    problems_.add_problem(Problem{origin.file, origin.speed_key.empty() ? line : origin.speed_line,
+                                  origin.speed_key.empty() ? origin.key : origin.speed_key,
+                                  (origin.name_segments ? segment + ": " : std::string()) +
+                                      "print speed " + format_speed(path.speed_mm_s) +
+                                      " mm/s needs " + format_speed(needed_mm_s) + " mm/s on " +
+                                      kAxisNames[worst_axis] + ", " + limit_text +
+                                      " (lower the speed or raise the limit)"});
   }
 }
 

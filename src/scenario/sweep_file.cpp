@@ -137,9 +137,8 @@ std::optional<std::vector<SweepValue>> read_values(const Field& field, ProblemLi
   // (2, 2.0, 2e0 and +2 are one speed)
   std::map<std::string, std::string> seen;  // the value's identity -> its text as first given
   for (const SweepValue& value : values) {
-    char exact[32];
-    if (value.number) std::snprintf(exact, sizeof exact, "%.17g", *value.number);
-    const std::string identity = value.number ? std::string("number ") + exact : value.yaml;
+    std::string identity = value.number ? "number " : value.yaml;
+    if (value.number) append_number(identity, *value.number, 17);
     const auto [first, added] = seen.emplace(identity, value.text);
     if (added) continue;
     problems.add(field.line, field.key,
