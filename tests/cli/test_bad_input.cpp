@@ -432,22 +432,23 @@ std::vector<Row> rows() {
       "solid plate\nfacet normal 0 0 1\nouter loop\nvertex -10 -10 5\nvertex 10 -10 5\n"
       "vertex 10 10 5\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex -10 -10 5\n"
       "vertex 10 10 5\nvertex -10 10 5\nendloop\nendfacet\nendsolid plate\n";
+  // an arm hatching plate.stl with `conformal`; `toolpath` its toolpath section's lines
+  const auto arm_on_plate = [](const std::string& toolpath) {
+    return "name: plate\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
+           "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
+           "toolpath:\n  speed: 30\n" +
+           toolpath + "planners: [conformal]\n";
+  };
   r.push_back(scenario("ArmStartUnderThePart",
-                       "name: under\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
-                       "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
-                       "toolpath:\n  speed: 30\n  start: [0, 0, 1]\n"
-                       "  surface: {file: plate.stl, hatch_mm: 4, angles: [0]}\n"
-                       "planners: [conformal]\n",
+                       arm_on_plate("  start: [0, 0, 1]\n"
+                                    "  surface: {file: plate.stl, hatch_mm: 4, angles: [0]}\n"),
                        "{s}:7: toolpath\\.start: no posture of arm6 .*\\(branch \\d: the start "
                        "\\(0\\.000, 0\\.000, 1\\.000\\) mm is too close to the part",
                        {{"plate.stl", plate_stl}}));
   // a hatch too fast: each segment by its layer, line and segment, at the surface's speed key
   r.push_back(scenario("ArmSurfaceSpeedAboveTheLimits",
-                       "name: fast\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
-                       "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
-                       "toolpath:\n  speed: 30\n  surface:\n    file: plate.stl\n"
-                       "    hatch_mm: 4\n    angles: [0]\n    speed: 250\n"
-                       "planners: [conformal]\n",
+                       arm_on_plate("  surface:\n    file: plate.stl\n"
+                                    "    hatch_mm: 4\n    angles: [0]\n    speed: 250\n"),
                        "{s}:11: toolpath\\.surface\\.speed: layer 0, line 0, segment 0 \\(points 0 "
                        "and 1\\): print speed 250 mm/s needs 250 mm/s on x, above limits v_max 200",
                        {{"plate.stl", plate_stl}}));

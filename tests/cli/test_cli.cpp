@@ -516,13 +516,18 @@ TEST(Cli, APartOrAPathBelowTheTableIsRefused) {
   EXPECT_EQ(ok.status, 0) << ok.output;
   expect_bad_run("arm_below_table", arm_beam_scenario("[0, 0, -2]"), "below the work surface");
 
+  // an arm printing one polyline with `conformal`; `toolpath` its toolpath section's lines
+  const auto arm_polyline = [&](const std::string& name, const std::string& toolpath) {
+    return write_text(dir, name + ".yaml",
+                      "name: " + name +
+                          "\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
+                          "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
+                          "toolpath:\n  speed: 20\n" +
+                          toolpath + "planners: [conformal]\n");
+  };
   // a polyline dipping 0.5 mm into the table: its one point below is named
-  const std::string dip = write_text(
-      dir, "dip.yaml",
-      "name: dip\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
-      "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
-      "toolpath:\n  speed: 20\n  polylines:\n    - [[0, 0, 1], [10, 0, -0.5], [20, 0, 1]]\n"
-      "planners: [conformal]\n");
+  const std::string dip =
+      arm_polyline("dip", "  polylines:\n    - [[0, 0, 1], [10, 0, -0.5], [20, 0, 1]]\n");
   const Result d = depotwin("validate " + dip);
   EXPECT_EQ(d.status, 2) << d.output;
   EXPECT_NE(d.output.find(dip + ":8: toolpath.polylines[0]: point 1 (10.000, 0.000, -0.500) mm is "
@@ -537,12 +542,10 @@ TEST(Cli, APartOrAPathBelowTheTableIsRefused) {
             std::string::npos)
       << d.output;
   // a start below the table is named at its key, and raising the print points is no advice
-  const std::string low_start = write_text(
-      dir, "low_start.yaml",
-      "name: low_start\nmachine: arm6\nlimits: {v_max: 200, a_max: 2000}\n"
-      "process: {type: extrusion, bead_width_mm: 0.5, layer_height_mm: 0.5}\n"
-      "toolpath:\n  speed: 20\n  start: [0, 0, -5]\n  end: [20, 0, 5]\n"
-      "  polylines:\n    - [[0, 0, 1], [10, 0, 1], [20, 0, 1]]\nplanners: [conformal]\n");
+  const std::string low_start =
+      arm_polyline("low_start",
+                   "  start: [0, 0, -5]\n  end: [20, 0, 5]\n"
+                   "  polylines:\n    - [[0, 0, 1], [10, 0, 1], [20, 0, 1]]\n");
   const Result l = depotwin("validate " + low_start);
   EXPECT_EQ(l.status, 2) << l.output;
   EXPECT_NE(l.output.find(low_start + ":7: toolpath.start: the start (0.000, 0.000, -5.000) mm is "

@@ -35,6 +35,15 @@ TriangleMesh plate(double size_x, double size_y, double height,
   return tessellate(plane(size_x, size_y, height), options);
 }
 
+// z = kink_z + slope |x - kink_x| over [0, 20.6] x [0, 4.2], a vertex column on the kink: a
+// groove (slope > 0) or a ridge (slope < 0), whose grid points at 2 mm fall at 0.3 + 2 i
+TriangleMesh v_shaped(double kink_z, double slope, double kink_x) {
+  HeightField field = plane(20.6, 4.2, 0.0);
+  field.z = [=](double x, double) { return kink_z + slope * std::abs(x - kink_x); };
+  field.x_breaks = {kink_x};
+  return tessellate(field, TessellationOptions{});
+}
+
 // every path: at least two points, consecutive points distinct, finite, unit tool axes, its
 // info the same length
 void expect_well_formed(const SurfaceHatch& hatch) {
@@ -318,10 +327,7 @@ TEST(Hatching, StepSplitsALine) {
 // is a tent (one kink), no point of it is more than twice that.
 TEST(Hatching, ChordsAcrossARidgeAreRefinedToTheTolerance) {
   const double ridge_x = 9.6, slope = 0.7;
-  HeightField field = plane(20.6, 4.2, 0.0);
-  field.z = [&](double x, double) { return 20.0 - slope * std::abs(x - ridge_x); };
-  field.x_breaks = {ridge_x};
-  const TriangleMesh mesh = tessellate(field, TessellationOptions{});
+  const TriangleMesh mesh = v_shaped(20.0, -slope, ridge_x);
   const SurfaceProjector projector(mesh);
   SurfaceHatchSpec spec;
   spec.hatch_mm = 2.0;
@@ -383,10 +389,7 @@ TEST(Hatching, ChordsAcrossARidgeAreRefinedToTheTolerance) {
 // every path runs forward along x and its lowest point is that crossing.
 TEST(Hatching, OffsetLayersDoNotFoldBackOverAConcaveCrease) {
   const double crease_x = 9.6, slope = 0.7, layer_height = 1.0;
-  HeightField field = plane(20.6, 4.2, 0.0);
-  field.z = [&](double x, double) { return 10.0 + slope * std::abs(x - crease_x); };
-  field.x_breaks = {crease_x};
-  const TriangleMesh mesh = tessellate(field, TessellationOptions{});
+  const TriangleMesh mesh = v_shaped(10.0, slope, crease_x);
   SurfaceHatchSpec spec;
   spec.hatch_mm = 2.0;
   spec.angles_deg = {0};
