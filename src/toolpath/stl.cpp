@@ -108,7 +108,7 @@ class AsciiStlReader {
       // "solid", or "solid" and the name with no space between (as begins_with_solid allows)
       if (!is(word.substr(0, 5), "solid"))
         fail("expected 'solid' (or the end of the file), got " + shown(word));
-      skip_line();  // the solid's name, if any
+      skip_name();
       ++solids_;
       read_facets();
     }
@@ -122,7 +122,7 @@ class AsciiStlReader {
     std::string_view word;
     for (;;) {
       if (!next(word))
-        fail_at(line_, "the file ends without 'endsolid' (solid " + std::to_string(solids_) +
+        fail_at(line_, "the file ends without 'endsolid' (solid " + std::to_string(solids_ - 1) +
                            " is not closed: a truncated file?)");
       if (is(word, "endsolid")) {
         skip_line();
@@ -149,7 +149,7 @@ class AsciiStlReader {
         ++vertices;
       }
       if (vertices != 3)
-        fail_at(facet_line, "facet " + std::to_string(facets_) + " has " +
+        fail_at(facet_line, "facet " + std::to_string(facets_ - 1) + " has " +
                                 std::to_string(vertices) +
                                 " vertices: an STL facet is a triangle, with 3");
       expect("endfacet", "after 'endloop'");
@@ -163,9 +163,10 @@ class AsciiStlReader {
     Vec3 mm;
     for (int i = 0; i < 3; ++i) {
       const double value = number("a vertex");
-      if (!std::isfinite(value)) fail("non-finite coordinate in facet " + std::to_string(facets_));
+      if (!std::isfinite(value))
+        fail("non-finite coordinate in facet " + std::to_string(facets_ - 1));
       if (std::abs(value) > std::numeric_limits<float>::max())
-        fail("coordinate " + message_number(value) + " in facet " + std::to_string(facets_) +
+        fail("coordinate " + message_number(value) + " in facet " + std::to_string(facets_ - 1) +
              " is beyond STL's 32-bit floats");
       const float f = static_cast<float>(value) + 0.0f;  // -0 as +0
       std::memcpy(&bits[static_cast<std::size_t>(i)], &f, 4);
@@ -216,6 +217,30 @@ class AsciiStlReader {
     while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
   }
 
+  // a solid's name (any number of words, or none): the rest of its line, up to a `facet
+  // normal` or an `endsolid` on that line (a file written on one line)
+  void skip_name() {
+    const auto blank = [&](std::size_t i) {
+      return text_[i] != '\n' && std::isspace(static_cast<unsigned char>(text_[i]));
+    };
+    const auto word_at = [&](std::size_t i) {
+      std::size_t end = i;
+      while (end < text_.size() && !std::isspace(static_cast<unsigned char>(text_[end]))) ++end;
+      return std::string_view(text_).substr(i, end - i);
+    };
+    for (;;) {
+      while (pos_ < text_.size() && blank(pos_)) ++pos_;
+      if (pos_ == text_.size() || text_[pos_] == '\n') return;
+      const std::string_view word = word_at(pos_);
+      std::size_t after = pos_ + word.size();
+      while (after < text_.size() && blank(after)) ++after;
+      if (is(word, "endsolid") ||
+          (is(word, "facet") && after < text_.size() && is(word_at(after), "normal")))
+        return;
+      pos_ += word.size();
+    }
+  }
+
   static bool is(std::string_view word, const char* keyword) {
     const std::size_t n = std::strlen(keyword);
     if (word.size() != n) return false;
@@ -230,7 +255,7 @@ class AsciiStlReader {
 
   [[noreturn]] void ends_inside_facet() const {
     fail_at(line_,
-            "the file ends inside facet " + std::to_string(facets_) + " (a truncated file?)");
+            "the file ends inside facet " + std::to_string(facets_ - 1) + " (a truncated file?)");
   }
   [[noreturn]] void fail(const std::string& message) const { fail_at(word_line_, message); }
   [[noreturn]] void fail_at(int line, const std::string& message) const {
@@ -340,8 +365,8 @@ TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& path, d
       const aiVector3D& p = mesh->mVertices[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
         throw InputError(path, 0, key,
-                         "non-finite coordinate in triangle " + std::to_string(v / 3 + 1) +
-                             (scene->mNumMeshes > 1 ? " of solid " + std::to_string(m + 1) : ""));
+                         "non-finite coordinate in triangle " + std::to_string(v / 3) +
+                             (scene->mNumMeshes > 1 ? " of solid " + std::to_string(m) : ""));
       }
     }
   }

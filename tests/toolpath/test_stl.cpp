@@ -4,6 +4,7 @@
 // (an ASCII one also its line).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -198,7 +199,7 @@ TEST(Stl, BrokenFilesNameTheFile) {
   std::memcpy(&nan_bytes[84 + 12 + 4], &nan, 4);  // first triangle, first vertex, y
   const std::string nan_binary = scratch("nan_binary.stl");
   write_bytes(nan_binary, nan_bytes);
-  expect_problem(nan_binary, "non-finite coordinate in triangle 1");
+  expect_problem(nan_binary, "non-finite coordinate in triangle 0");
 
   const std::string nan_ascii = scratch("nan_ascii.stl");
   write_bytes(nan_ascii,
@@ -209,7 +210,7 @@ TEST(Stl, BrokenFilesNameTheFile) {
   const std::string ascii = stl_ascii_text(tetrahedron(), "tetra");
   const std::string ascii_cut = scratch("ascii_cut.stl");
   write_bytes(ascii_cut, ascii.substr(0, 200));  // in the middle of the second facet
-  expect_problem(ascii_cut, "the file ends inside facet 2");
+  expect_problem(ascii_cut, "the file ends inside facet 1");
 
   const std::string zero = scratch("zero_triangles.stl");
   write_bytes(zero, stl_binary_bytes(TriangleMesh{}, "nothing"));
@@ -296,16 +297,16 @@ TEST(Stl, AsciiDeparturesFromTheGrammarNameTheirLine) {
   expect_at(square_with_third_vertex("  vertex 0 10 1 7"), 6,
             "expected 'vertex' or 'endloop', got '7' (a vertex has three coordinates)");
   expect_at(square_with_third_vertex("  vertex 0 10 1\n  vertex 5 5 1"), 2,
-            "facet 1 has 4 vertices: an STL facet is a triangle, with 3");
+            "facet 0 has 4 vertices: an STL facet is a triangle, with 3");
   expect_at(square_with_third_vertex("  vertex 0 1e50 1"), 6,
-            "coordinate 1e+50 in facet 1 is beyond STL's 32-bit floats");
-  expect_at(square_with_third_vertex("  vertex 0 nan 1"), 6, "non-finite coordinate in facet 1");
+            "coordinate 1e+50 in facet 0 is beyond STL's 32-bit floats");
+  expect_at(square_with_third_vertex("  vertex 0 nan 1"), 6, "non-finite coordinate in facet 0");
   expect_at(square_with_third_vertex("  vertex 0 10 1\n  endlop"), 7,
             "expected 'vertex' or 'endloop', got 'endlop'");
   // a file cut after a whole facet: no `endsolid`, not a smaller part
   const std::string whole = square_with_third_vertex("  vertex 0 10 1");
   expect_at(whole.substr(0, whole.find("endsolid")), 16,
-            "the file ends without 'endsolid' (solid 1 is not closed: a truncated file?)");
+            "the file ends without 'endsolid' (solid 0 is not closed: a truncated file?)");
   expect_at(whole + "garbage\n", 17, "expected 'solid' (or the end of the file), got 'garbage'");
 }
 
@@ -324,6 +325,20 @@ TEST(Stl, AsciiAsExportersWriteItReads) {
   ASSERT_EQ(read.vertices.size(), 4u);  // the diagonal's two vertices shared
   EXPECT_EQ(read.vertices, plain.vertices);
   EXPECT_EQ(read.triangles, plain.triangles);
+
+  // the whole file on one line, a name of several words (one of them `facet`, not followed by
+  // `normal`), and a name with the first facet on its line: the same two triangles
+  std::string one_line = square_with_third_vertex("  vertex 0 10 1");
+  std::replace(one_line.begin(), one_line.end(), '\n', ' ');
+  const std::string many_words = "solid Exported from a facet modeller 2.9\n" +
+                                 square_with_third_vertex("  vertex 0 10 1").substr(8);
+  const std::string name_then_facet =
+      "solid part " + square_with_third_vertex("  vertex 0 10 1").substr(8);
+  for (const std::string& text : {one_line, many_words, name_then_facet}) {
+    const TriangleMesh same = read_stl_bytes(text, "same.stl", 1.0);
+    EXPECT_EQ(same.vertices, plain.vertices) << text;
+    EXPECT_EQ(same.triangles, plain.triangles) << text;
+  }
 }
 
 }  // namespace
