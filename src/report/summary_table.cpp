@@ -1,6 +1,7 @@
 #include "report/summary_table.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace depotwin {
@@ -193,7 +194,15 @@ nlohmann::ordered_json summary_json(const std::vector<MetricsReport>& reports) {
     Json row = Json::object();
     for (const SummaryColumn& c : columns) {
       const SummaryCell cell = c.cell(r);
-      row[c.name] = cell.is_text ? Json(cell.text) : cell.number ? Json(*cell.number) : Json();
+      // (a count, the columns of no decimals, as a whole number: 3, not 3.0)
+      if (cell.is_text)
+        row[c.name] = cell.text;
+      else if (!cell.number)
+        row[c.name] = Json();
+      else if (c.digits == 0)
+        row[c.name] = static_cast<long long>(std::llround(*cell.number));
+      else
+        row[c.name] = *cell.number;
     }
     rows.push_back(row);
   }

@@ -24,7 +24,8 @@ struct SummaryCell {
 struct SummaryColumn {
   const char* name;
   bool simulated;  // needs a simulation (left out of a plan's table)
-  int digits;      // decimals on the console and in markdown (csv and json: full precision)
+  int digits;      // decimals on the console and in markdown (csv and json: full precision;
+                   // 0: a count, a whole number in json)
   SummaryCell (*cell)(const MetricsReport&);
 };
 

@@ -102,6 +102,10 @@ TEST(SummaryTable, PlannedAndSimulatedColumnsAreNamedApart) {
   const nlohmann::ordered_json json = summary_json(run);
   EXPECT_DOUBLE_EQ(json["rows"][0]["planned_vel_err_max_pct"].get<double>(), 61.83);
   EXPECT_DOUBLE_EQ(json["rows"][0]["sim_vel_err_steady_max_pct"].get<double>(), 0.4);
+  // a count is a whole number in json (0, not 0.0), a figure a float
+  EXPECT_TRUE(json["rows"][0]["warnings"].is_number_integer());
+  EXPECT_EQ(json["rows"][0]["warnings"].dump(), "0");
+  EXPECT_TRUE(json["rows"][0]["time_s"].is_number_float());
   EXPECT_NE(summary_csv(run).find(",61.83,"), std::string::npos);
   EXPECT_NE(summary_console(run).find("planned_vel_err_steady_max_pct      0.38\n"),
             std::string::npos)
