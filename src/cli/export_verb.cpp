@@ -18,6 +18,7 @@
 #include "metrics/polyline_distance.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/job_check.hpp"
+#include "pipeline/step_heartbeat.hpp"
 #include "report/output_dir.hpp"
 #include "toolpath/gcode.hpp"
 
@@ -416,6 +417,7 @@ void check_out_path(const std::string& out) {
 
 int export_verb(const ExportOptions& options) {
   check_out_path(options.out);
+  const StepHeartbeat heartbeat = job_heartbeat(options.scenario, options.quiet);
   // the shutter codes as inspect and the scenario check them: codes, and not one switch
   for (const ShutterCodeProblem& problem :
        shutter_code_problems(options.settings.open_code, options.settings.close_code))
@@ -458,6 +460,7 @@ int export_verb(const ExportOptions& options) {
   // refused, not written)
   const PreparedJob job =
       prepare_checked_job(scenario, planners, JobBudget{}, false, false, nullptr, true);
+  const WorkingStep step("writing the G-code");
   const PlannedRun planned = plan_job(job, planners.front());
 
   GcodeExportJob export_job;

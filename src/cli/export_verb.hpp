@@ -55,6 +55,7 @@ struct ExportOptions {
   std::string out;      // the .gcode file
   GcodeExportSettings settings;
   bool no_wait = false;  // another writer of --out holds its lock: exit 2 instead of waiting
+  bool quiet = false;    // the job's long steps not shown (pipeline/step_heartbeat.hpp)
 };
 
 // Plans the scenario with one planner and writes the G-code atomically. InputError (exit 2)

@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
       ->check(kNamesGiven);
   run->add_option("--out", run_options.out, "output directory (default: results/<scenario name>)");
   run->add_flag("--no-render", run_options.no_render, "write no images or plots");
-  run->add_flag("--quiet", run_options.quiet, "no progress line");
+  run->add_flag("--quiet", run_options.quiet, "no progress lines");
   run->add_flag("--no-wait", run_options.no_wait,
                 "exit (status 2) instead of waiting while another depotwin writes --out");
   run->add_option("--max-memory", run_options.max_memory, kMaxMemoryHelp);
@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
   compare->add_option("--out", compare_options.run.out,
                       "output directory (default: results/<scenario name>)");
   compare->add_flag("--no-render", compare_options.run.no_render, "write no images or plots");
-  compare->add_flag("--quiet", compare_options.run.quiet, "no progress line");
+  compare->add_flag("--quiet", compare_options.run.quiet, "no progress lines");
   compare->add_flag("--no-wait", compare_options.run.no_wait,
                     "exit (status 2) instead of waiting while another depotwin writes --out");
   compare->add_option("--max-memory", compare_options.run.max_memory, kMaxMemoryHelp);
@@ -141,14 +141,17 @@ int main(int argc, char** argv) {
   plan->add_flag("--no-wait", plan_options.no_wait,
                  "exit (status 2) instead of waiting while another depotwin writes --out");
   plan->add_option("--max-memory", plan_options.max_memory, kMaxMemoryHelp);
+  plan->add_flag("--quiet", plan_options.quiet, "no progress lines");
 
   std::string validate_scenario, validate_max_memory;
+  bool validate_quiet = false;
   CLI::App* validate = app.add_subcommand(
       "validate",
       "every check `run` makes before it simulates (the file, the MJCF model, the plans, the "
       "job's size); lists every problem");
   validate->add_option("scenario", validate_scenario, "scenario YAML file")->required();
   validate->add_option("--max-memory", validate_max_memory, kMaxMemoryHelp);
+  validate->add_flag("--quiet", validate_quiet, "no progress lines");
 
   // ---- view (a finished run replayed in a window: src/viewer/viewer.cpp) ----
   ViewOptions view_options;
@@ -201,6 +204,7 @@ int main(int argc, char** argv) {
                            "aerosol: the shutter-close code (default M5)");
   export_gcode->add_flag("--no-wait", export_options.no_wait,
                          "exit (status 2) instead of waiting while another depotwin writes --out");
+  export_gcode->add_flag("--quiet", export_options.quiet, "no progress lines");
   // ---- end export ----
 
   // ---- inspect (facts of a G-code file: src/cli/inspect.cpp) ----
@@ -279,7 +283,7 @@ int main(int argc, char** argv) {
     if (*run) return run_verb(run_options);
     if (*compare) return compare_verb(compare_options);
     if (*plan) return plan_verb(plan_options);
-    if (*validate) return validate_verb(validate_scenario, validate_max_memory);
+    if (*validate) return validate_verb(validate_scenario, validate_max_memory, validate_quiet);
     if (*view) return view_verb(view_options);                              // view
     if (*describe) return describe_verb(describe_topic, describe_as_json);  // describe
     if (*export_gcode) return export_verb(export_options);                  // export

@@ -10,6 +10,7 @@
 #include "pipeline/job.hpp"
 #include "pipeline/job_check.hpp"
 #include "pipeline/run.hpp"
+#include "pipeline/step_heartbeat.hpp"
 #include "render/scene.hpp"
 #include "report/output_dir.hpp"
 
@@ -47,6 +48,7 @@ JobBudget job_budget(const std::string& max_memory) {
 }  // namespace
 
 int plan_verb(const RunOptions& options) {
+  const StepHeartbeat heartbeat = job_heartbeat(options.scenario, options.quiet);
   // every check before any work (pipeline/job_check.hpp), the same as validate's
   const JobBudget budget = job_budget(options.max_memory);
   const Scenario scenario = check_scenario(options.scenario, budget, 0, false);
@@ -73,7 +75,8 @@ int plan_verb(const RunOptions& options) {
   return kExitOk;
 }
 
-int validate_verb(const std::string& path, const std::string& max_memory) {
+int validate_verb(const std::string& path, const std::string& max_memory, bool quiet) {
+  const StepHeartbeat heartbeat = job_heartbeat(path, quiet);
   // every check `run` makes before it simulates, made the same way (pipeline/job_check.hpp),
   // and the plans' poses, which `run` checks as it simulates; no lower bound of the print order
   // (a report shows it, validate does not)
@@ -127,6 +130,7 @@ RunSettings run_settings(const Scenario& scenario, const RunOptions& options) {
 }  // namespace
 
 int run_verb(const RunOptions& options) {
+  const StepHeartbeat heartbeat = job_heartbeat(options.scenario, options.quiet);
   // every check before any work (pipeline/job_check.hpp), the same as validate's
   const JobBudget budget = job_budget(options.max_memory);
   const Scenario scenario = check_scenario(options.scenario, budget);
@@ -152,7 +156,10 @@ int run_verb(const RunOptions& options) {
                   settings);
     reports.push_back(runs.back().report);
   }
-  writer.wait();
+  {
+    const WorkingStep step("writing the results");
+    writer.wait();
+  }
   out.commit();
   std::cout << "scenario " << scenario.name << " (" << scenario.file << "), machine "
             << job.machine->name() << ", process " << scenario.process.type << ", order "
@@ -165,6 +172,7 @@ int run_verb(const RunOptions& options) {
 }
 
 int compare_verb(const CompareOptions& options) {
+  const StepHeartbeat heartbeat = job_heartbeat(options.run.scenario, options.run.quiet);
   // every check before any work (pipeline/job_check.hpp), the same as validate's; each case
   // is prepared and planned in compare_runs before the first simulates
   const JobBudget budget = job_budget(options.run.max_memory);

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "pipeline/step_heartbeat.hpp"
 #include "plots/plots.hpp"
 #include "render/scene.hpp"
 #include "report/metrics_json.hpp"
@@ -145,6 +146,7 @@ std::vector<ComparisonRow> compare_runs(const Scenario& scenario,
     writer.submit(job, run, (fs::path(directory) / c.label).string(), settings);
     rows.push_back({c.label, run.report});
   }
+  const WorkingStep step("writing the results");
   writer.wait();
 
   // the tables, then the side-by-side sheet on a shared colour scale

@@ -12,6 +12,7 @@
 #include "kinematics/arm6.hpp"
 #include "pipeline/models_dir.hpp"
 #include "pipeline/run.hpp"
+#include "pipeline/step_heartbeat.hpp"
 #include "report/metrics_json.hpp"
 #include "report/output_dir.hpp"
 #include "report/summary_table.hpp"
@@ -173,7 +174,11 @@ PreparedJob prepare_job(const Scenario& scenario, const PrepareOptions& options)
   // order's job never needs it, and a hatched part has hundreds of paths)
   SequencerOptions sequencing;
   sequencing.lower_bound = options.lower_bound && scenario.order.method != "as_given";
-  job.order = sequence(scenario.toolpath, job.limits, scenario.order, sequencing);
+  {
+    const WorkingStep step("ordering " + std::to_string(scenario.toolpath.paths.size()) +
+                           " print paths (" + scenario.order.label() + ")");
+    job.order = sequence(scenario.toolpath, job.limits, scenario.order, sequencing);
+  }
   job.toolpath = apply_order(scenario.toolpath, job.order);
   // G-code arcs: exact for the planners that consume them, and finely chorded as the path the
   // metrics measure against (the file's own geometry, not the planners' chords)
@@ -186,7 +191,11 @@ PreparedJob prepare_job(const Scenario& scenario, const PrepareOptions& options)
   }
 
   // an arm: its roll at every point and its branch, away from limits, singularities and the part
-  if (arm) choose_posture(scenario, *arm, job);
+  if (arm) {
+    const WorkingStep step("choosing the arm's posture along " +
+                           std::to_string(job.toolpath.paths.size()) + " print paths");
+    choose_posture(scenario, *arm, job);
+  }
   return job;
 }
 
@@ -331,6 +340,7 @@ std::vector<MetricsReport> write_plans(const PreparedJob& job,
                                        const std::string& directory) {
   std::vector<MetricsReport> reports;
   for (const PlannerSpec& spec : planners) {
+    const WorkingStep step("writing the " + spec.run_label() + " plan");
     const PlannedRun run = plan_job(job, spec);
     StagedDirectory out((fs::path(directory) / spec.run_label()).string());
     write_file_atomically(out.file("metrics.json"), metrics_json_text(run.report));

@@ -12,6 +12,7 @@
 #include "deposition/process.hpp"
 #include "pipeline/models_dir.hpp"
 #include "pipeline/run.hpp"
+#include "pipeline/step_heartbeat.hpp"
 #include "sim/simulation.hpp"
 
 namespace depotwin {
@@ -341,6 +342,7 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
 
 Scenario check_scenario(const std::string& path, const JobBudget& budget, std::size_t runs,
                         bool simulate) {
+  const WorkingStep step("reading the scenario");
   ScenarioReading reading = read_scenario(path);
   std::vector<Problem>& problems = reading.problems;
   if (!reading.document_read) throw InputError(std::move(problems));
@@ -380,9 +382,11 @@ std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerS
     // planned and measured; the plan itself is small (pieces, not samples), so the job keeps
     // it for the verb (PreparedJob::checked_plans) rather than plan it again
     try {
-      if (!job.checked_plan(spec))
+      if (!job.checked_plan(spec)) {
+        const WorkingStep step("planning " + spec.run_label());
         job.checked_plans.push_back(
             {spec, std::make_shared<const Trajectory>(plan_trajectory(job, spec))});
+      }
       const Trajectory& plan = *job.checked_plan(spec);
       RunEstimate run = estimate_planned(job, spec.run_label(), plan.duration_s(), simulate);
       if (!spec.params.empty()) {
@@ -394,8 +398,10 @@ std::vector<RunEstimate> check_runs(PreparedJob& job, const std::vector<PlannerS
       // planner's move may leave the travel or the reach between the toolpath's points); a run
       // too large (sim.max_steps, the memory) is refused for that instead (size_problems),
       // before any such work
-      if (pose_budget && size_problems(job.scenario, {run}, *pose_budget).empty())
+      if (pose_budget && size_problems(job.scenario, {run}, *pose_budget).empty()) {
+        const WorkingStep step("solving every pose of the " + spec.run_label() + " plan");
         check_plan_poses(job, spec, plan);
+      }
       runs.push_back(run);
     } catch (const InputError& e) {
       const std::vector<Problem> found = job.scenario.located(e.problems());

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <future>
 #include <iostream>
+#include <optional>
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
@@ -18,6 +19,7 @@
 #include "pipeline/deposition_worker.hpp"
 #include "pipeline/progress_line.hpp"
 #include "pipeline/replay.hpp"  // moving pictures
+#include "pipeline/step_heartbeat.hpp"
 #include "plots/plots.hpp"
 #include "render/scene.hpp"
 #include "render/video.hpp"  // moving pictures
@@ -130,7 +132,10 @@ std::unique_ptr<LayeredDeposit> job_deposit(const PreparedJob& job) {
 SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
                           const RunSettings& settings) {
   SimulatedRun run;
-  run.plan = plan_job(job, spec);
+  {
+    const WorkingStep step("sampling the " + spec.run_label() + " plan");
+    run.plan = plan_job(job, spec);
+  }
   const Trajectory& trajectory = run.plan.trajectory;
   const Scenario& scenario = job.scenario;
 
@@ -161,7 +166,9 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
     if (deposition_step(before, after, job_end_s, step)) depositing.push(step, layer);
     states.on_step(after);
   };
-  // the progress line names the run (a compare's order and planner: its label)
+  // the progress line names the run (a compare's order and planner: its label); no step shown
+  // meanwhile, then the scores'
+  std::optional<WorkingStep> step(std::in_place, "");
   ProgressLine progress(scenario.name + "/" + spec.run_label() + ": simulating",
                         ProgressLine::style_for_stderr(settings.progress));
   // a plan that leaves the machine's reach or travel is the planner's doing: said at its entry
@@ -176,6 +183,8 @@ SimulatedRun simulate_job(const PreparedJob& job, const PlannerSpec& spec,
   }
   depositing.finish();
   progress.finish();
+  step.reset();
+  step.emplace("scoring the " + spec.run_label() + " run");
   run.simulation->set_feedforward_hook({});  // it refers to this function's locals
 
   // extrusion: what still flows when the job ends lands where the nozzle stopped
