@@ -1,5 +1,6 @@
 #include "core/number_text.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
@@ -22,9 +23,9 @@ std::optional<double> parse_double(const std::string& text) {
   return value;
 }
 
-std::string message_number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", value);
+std::string message_number(double value, int significant_digits) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.*g", std::clamp(significant_digits, 1, 17), value);
   return text;
 }
 

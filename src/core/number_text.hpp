@@ -15,8 +15,9 @@ namespace depotwin {
 // subnormals for tiny ones), or nothing
 std::optional<double> parse_double(const std::string& text);
 
-// a number as messages print it: at most 6 significant digits (%.6g: 3, 0.25, 1e-05, 1e+300)
-std::string message_number(double value);
+// a number as messages print it: at most 6 significant digits (%.6g: 3, 0.25, 1e-05, 1e+300),
+// or as many as given (1 to 17; the machines' travel messages give 4)
+std::string message_number(double value, int significant_digits = 6);
 
 // `value` as message_number writes it, with as many more digits (up to 17) as it takes to
 // read differently from `bound` when it differs: a value just outside a limit never reads as

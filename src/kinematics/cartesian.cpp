@@ -21,12 +21,6 @@ constexpr double kAccelerationXY_mm_s2 = 3000.0;
 constexpr double kVelocityZ_mm_s = 15.0;
 constexpr double kAccelerationZ_mm_s2 = 300.0;
 
-std::string format_mm(double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.4g", value);
-  return text;
-}
-
 class Cartesian : public Machine {
  public:
   Cartesian()
@@ -58,9 +52,9 @@ class Cartesian : public Machine {
         if (why)
           *why = "the cartesian machine's " + limit.name + " axis at " +
                  message_number_outside(joints[i], limit.min, limit.max, 4) +
-                 " mm is outside its travel [" + format_mm(limit.min) + ", " +
-                 format_mm(limit.max) + "] mm, by " +
-                 format_mm(std::max(limit.min - joints[i], joints[i] - limit.max)) + " mm";
+                 " mm is outside its travel [" + message_number(limit.min, 4) + ", " +
+                 message_number(limit.max, 4) + "] mm, by " +
+                 message_number(std::max(limit.min - joints[i], joints[i] - limit.max), 4) + " mm";
         return false;
       }
     }

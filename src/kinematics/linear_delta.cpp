@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "core/number_text.hpp"
 
@@ -41,13 +40,6 @@ double joint_for_platform_mm(const LinearDeltaGeometry& geometry, int arm,
 // largest horizontal distance from a column at which a rod stays within its angle limit
 double max_reach_mm(const LinearDeltaGeometry& geometry) {
   return geometry.rod_length_mm * std::sin(deg_to_rad(geometry.max_rod_angle_deg));
-}
-
-std::string format_mm(double value) {
-  std::ostringstream out;
-  out.precision(4);
-  out << value;
-  return out.str();
 }
 
 // rod vectors w_i = p - C_i of the three arms at platform position p and carriage heights q
@@ -223,8 +215,8 @@ bool LinearDelta::inverse(const Pose& pose, JointVector& joints, std::string* wh
   if (const std::string tilted = vertical_axis_problem(name(), pose); !tilted.empty())
     return fail(tilted);
   if (tcp_mm.z() < geometry_.min_tcp_z_mm) {
-    return fail("z = " + format_mm(tcp_mm.z()) + " mm puts the nozzle more than " +
-                format_mm(-geometry_.min_tcp_z_mm) + " mm into the substrate");
+    return fail("z = " + message_number(tcp_mm.z(), 4) + " mm puts the nozzle more than " +
+                message_number(-geometry_.min_tcp_z_mm, 4) + " mm into the substrate");
   }
 
   // each arm: q_i = p_z - sqrt(L^2 - |p_xy - D u_i|^2) - H
@@ -240,18 +232,20 @@ bool LinearDelta::inverse(const Pose& pose, JointVector& joints, std::string* wh
           horizontal_mm < rod_mm ? rad_to_deg(std::asin(horizontal_mm / rod_mm)) : 90.0;
       return fail("the rods of " + arm_name + " would lean " +
                   message_number_beside(angle_deg, geometry_.max_rod_angle_deg, 4) +
-                  " deg from vertical, beyond the " + format_mm(geometry_.max_rod_angle_deg) +
-                  " deg limit (" + format_mm(horizontal_mm - reach_mm) +
+                  " deg from vertical, beyond the " +
+                  message_number(geometry_.max_rod_angle_deg, 4) + " deg limit (" +
+                  message_number(horizontal_mm - reach_mm, 4) +
                   " mm outside the reachable region)");
     }
     const double joint_mm = joint_for_platform_mm(geometry_, arm, platform_mm);
     if (joint_mm < geometry_.carriage_min_mm - kTravelRounding_mm ||
         joint_mm > geometry_.carriage_max_mm + kTravelRounding_mm) {
-      return fail(arm_name + " would be at " + format_mm(joint_mm) + " mm, outside its travel [" +
-                  format_mm(geometry_.carriage_min_mm) + ", " +
-                  format_mm(geometry_.carriage_max_mm) + "] mm, by " +
-                  format_mm(std::max(geometry_.carriage_min_mm - joint_mm,
-                                     joint_mm - geometry_.carriage_max_mm)) +
+      return fail(arm_name + " would be at " + message_number(joint_mm, 4) +
+                  " mm, outside its travel [" + message_number(geometry_.carriage_min_mm, 4) +
+                  ", " + message_number(geometry_.carriage_max_mm, 4) + "] mm, by " +
+                  message_number(std::max(geometry_.carriage_min_mm - joint_mm,
+                                          joint_mm - geometry_.carriage_max_mm),
+                                 4) +
                   " mm");
     }
     joints[arm] = joint_mm;

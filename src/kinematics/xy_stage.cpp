@@ -21,12 +21,6 @@ constexpr double kNozzleY_mm = 0.0;
 // the plate cannot move in z: a TCP off the substrate plane is unreachable
 constexpr double kPlaneTolerance_mm = 1e-6;
 
-std::string format_mm(double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.4g", value);
-  return text;
-}
-
 class XyStage : public Machine {
  public:
   XyStage()
@@ -56,7 +50,7 @@ class XyStage : public Machine {
     if (std::abs(tcp_mm.z()) > kPlaneTolerance_mm) {
       if (why)
         *why = "the XY stage has no z axis: the TCP must lie on the substrate (z = 0), got z = " +
-               format_mm(tcp_mm.z()) + " mm";
+               message_number(tcp_mm.z(), 4) + " mm";
       return false;
     }
     static const char* kTcpAxis[2] = {"x", "y"};
@@ -67,10 +61,10 @@ class XyStage : public Machine {
         if (why)
           *why = "joint " + limit.name + " at " +
                  message_number_outside(joints[i], limit.min, limit.max, 4) +
-                 " mm is outside its travel [" + format_mm(limit.min) + ", " +
-                 format_mm(limit.max) + "] mm, by " +
-                 format_mm(std::max(limit.min - joints[i], joints[i] - limit.max)) + " mm (TCP " +
-                 kTcpAxis[i] + " = " + format_mm(tcp_mm[i]) + " mm)";
+                 " mm is outside its travel [" + message_number(limit.min, 4) + ", " +
+                 message_number(limit.max, 4) + "] mm, by " +
+                 message_number(std::max(limit.min - joints[i], joints[i] - limit.max), 4) +
+                 " mm (TCP " + kTcpAxis[i] + " = " + message_number(tcp_mm[i], 4) + " mm)";
         return false;
       }
     }
