@@ -379,6 +379,7 @@ class GcodeParser {
   bool power_off_ = false;               // the modal S is 0 (a laser's or spindle's power)
   bool machine_frame_ = false;           // this line's G53
   bool opened_by_percent_ = false;       // a `%` came before any code (RS274/NGC tape)
+  bool closed_by_percent_ = false;       // and its closing `%` came (at or after the end)
   bool retracting_ = false;              // the last E change was a decrease
   // positions G60 saved (machine frame) with the programmed E, per slot
   struct SavedPosition {
@@ -438,9 +439,16 @@ void GcodeParser::problem(int line_number, const std::string& message) {
 }
 
 void GcodeParser::line(const char* begin, const char* end, int line_number) {
-  // after the program's end nothing runs: what follows is counted, not read
+  // after the program's end nothing runs: what follows is counted, not read (but the `%` that
+  // closes a program opened by one, after its M2 or M30, is the tape's end, as CAM writes it)
   if (program_.program_end_line > 0) {
-    if (std::any_of(begin, end, [](char c) { return !is_space(c); })) ++program_.n_lines_after_end;
+    const char* first = std::find_if(begin, end, [](char c) { return !is_space(c); });
+    if (first == end) return;
+    if (*first == '%' && opened_by_percent_ && !closed_by_percent_) {
+      closed_by_percent_ = true;
+      return;
+    }
+    ++program_.n_lines_after_end;
     return;
   }
   // control bytes: a binary file, or a broken one (never echoed raw)
@@ -460,8 +468,10 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   if (p < end && *p == '%') {
     if (program_.n_code_lines == 0)
       opened_by_percent_ = true;
-    else if (opened_by_percent_)
+    else if (opened_by_percent_) {
       program_.program_end_line = line_number;
+      closed_by_percent_ = true;
+    }
     return;
   }
   if (p == end || *p == ';' || *p == '(') {

@@ -125,13 +125,16 @@ TEST(Gcode, ModalMovesBesideCoolantAndSpindleCodesRun) {
 }
 
 // M2 or M30 alone ends the program, and so does the `%` closing one a `%` opened (RS274/NGC,
-// grbl): nothing after them is read, only counted; Marlin's `M30 file.gco` deletes a file
+// grbl): nothing after them is read, only counted (not the closing `%` after an M30, as CAM
+// posts end their files); Marlin's `M30 file.gco` deletes a file
 TEST(Gcode, TheProgramEndsAtM2M30OrTheClosingPercent) {
   GcodeOptions options;
   for (const auto& [text, end_line, after] : std::vector<std::tuple<std::string, int, int>>{
            {"G1 X10 E1 F600\nM30 (end)\n\nG1 X500 E2\nG1 Y500 E3\n", 2, 2},
            {"G1 X10 E1 F600\nG0 Z5 M2\nG1 X500 E2\n", 2, 1},
            {"%\nG1 X10 E1 F600\n%\nG1 X500 E2\n", 3, 1},
+           {"%\nG1 X10 E1 F600\nM30\n%\n", 3, 0},
+           {"%\nG1 X10 E1 F600\nM30\n %\n%\nG1 X500 E2\n", 3, 2},
            {"G1 X10 E1 F600\nM30 part.gco\n", 0, 0},
            {"G1 X10 E1 F600\n%\n", 0, 0}}) {
     const GcodeProgram program = parse_gcode_program(text, "end.gcode", options);
