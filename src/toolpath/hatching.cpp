@@ -13,6 +13,9 @@ namespace {
 
 constexpr const char* kKey = "toolpath.surface";
 constexpr double kMaxGridPoints = 2e7;  // per layer
+// an offset point nearer the face below it than its offset by more than this share of the layer
+// height is a dent (drop_dents); a faceted smooth surface's interpolated normals stay well within
+constexpr double kDentTolerance = 0.05;
 
 void validate(const SurfaceHatchSpec& spec) {
   std::vector<Problem> problems;
@@ -191,6 +194,55 @@ std::size_t trim_folds(PrintPath& path, HatchPathInfo& info, double window_mm) {
   return cut;
 }
 
+// A layer's point offset along the normal lies `offset` from its own face; a grid point exactly
+// on a concave crease (a groove's floor on a grid line) has one side's normal only, so its
+// offset lies over the other side, nearer that face than the offset: the nozzle would dig into
+// the layers below (a V-groove of slope 0.7 at 1 mm layers: 0.40 mm into layer 0). Such a point
+// is dropped where the chord between its neighbours keeps the offset from the surface there
+// (over a concave crease the chord passes above it), as if the crease lay between grid points
+// (from the layer where the neighbours pass each other, trim_folds has cut the path at their
+// offsets' crossing first, and the crossing keeps the offset from both faces). The clearance is the
+// distance from the facet plane right below the point (exact over a flat face). Returns how many
+// were dropped; `info` is kept in step.
+std::size_t drop_dents(PrintPath& path, HatchPathInfo& info, const SurfaceProjector& projector,
+                       double offset, double tolerance) {
+  const auto clearance = [&](const Vec3& p) {
+    const std::optional<SurfaceHit> hit = projector.project_down(p.x(), p.y());
+    return hit ? (p - hit->point_mm).dot(hit->facet_normal) : INFINITY;
+  };
+  std::size_t dropped = 0;
+  for (std::size_t i = 1; i + 1 < path.points.size();) {
+    const Vec3& p = path.points[i];
+    const double own = clearance(p);
+    if (own >= offset - tolerance) {
+      ++i;
+      continue;
+    }
+    // the chord's point beside p (its nearest in the plane)
+    const Vec3& a = path.points[i - 1];
+    const Vec3& b = path.points[i + 1];
+    const Vec2 ab = (b - a).head<2>();
+    const double along = ab.squaredNorm() > 0.0
+                             ? std::clamp((p - a).head<2>().dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+                             : 0.5;
+    const double chord = clearance(a + along * (b - a));
+    if (!(chord >= offset - tolerance)) {
+      ++i;
+      continue;
+    }
+    const auto drop = [&](auto& values) {
+      values.erase(values.begin() + static_cast<std::ptrdiff_t>(i));
+    };
+    drop(path.points);
+    drop(path.normals);
+    drop(info.point_index);
+    drop(info.surface_points_mm);
+    drop(info.surface_normals);
+    ++dropped;
+  }
+  return dropped;
+}
+
 AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
                        const SurfaceHatchSpec& spec) {
   const double theta = deg_to_rad(angle_deg);
@@ -335,9 +387,12 @@ SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatch
           info.surface_points_mm.push_back(p);
           info.surface_normals.push_back(normal);
         }
-        // offset along the normal: folds over concave creases cut out
-        if (offset > 0.0 && spec.offset == SurfaceHatchSpec::Offset::normal)
+        // offset along the normal: folds cut out, then a point left over a concave crease too
+        // near its far side dropped
+        if (offset > 0.0 && spec.offset == SurfaceHatchSpec::Offset::normal) {
           trim_folds(path, info, 4.0 * offset + 2.0 * spec.hatch_mm);
+          drop_dents(path, info, projector, offset, kDentTolerance * spec.layer_height_mm);
+        }
         if (path.points.size() < 2) continue;
         path.speed_mm_s = spec.speed_mm_s;
         path.layer = layer;

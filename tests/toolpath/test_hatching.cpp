@@ -382,13 +382,24 @@ TEST(Hatching, ChordsAcrossARidgeAreRefinedToTheTolerance) {
   }
 }
 
-// A V-groove z = 10 + 0.7 |x - 9.6| (its crease between grid points 8.3 and 10.3) offset
-// along its normals: each side's points move along its own facet normal (corner normals do
-// not average across the crease), so layer k's two offset lines cross at x = 9.6,
-// z = 10 + k h sqrt(1 + 0.7^2), and the points beyond the crossing fold back over it. Cut,
-// every path runs forward along x and its lowest point is that crossing.
+// A V-groove z = 10 + 0.7 |x - c| offset along its normals: each side's points move along its
+// own facet normal (corner normals do not average across the crease), so layer k's two offset
+// lines cross at x = c, z = 10 + k h sqrt(1 + 0.7^2), and the points beyond the crossing fold
+// back over it. Cut, every path runs forward along x and its lowest point is that crossing.
+// The crease between grid points 8.3 and 10.3 (c = 9.6), and on grid point 10.3, whose offset
+// along one side's normal lies over the other side, 0.40 mm into layer 0 at layer 1 (dropped:
+// the chord passes over the crease).
+void expect_offsets_clear_the_crease(double crease_x);
+
 TEST(Hatching, OffsetLayersDoNotFoldBackOverAConcaveCrease) {
-  const double crease_x = 9.6, slope = 0.7, layer_height = 1.0;
+  for (const double crease_x : {9.6, 10.3}) {
+    SCOPED_TRACE("crease at x = " + std::to_string(crease_x));
+    expect_offsets_clear_the_crease(crease_x);
+  }
+}
+
+void expect_offsets_clear_the_crease(double crease_x) {
+  const double slope = 0.7, layer_height = 1.0;
   const TriangleMesh mesh = v_shaped(10.0, slope, crease_x);
   SurfaceHatchSpec spec;
   spec.hatch_mm = 2.0;
@@ -415,6 +426,15 @@ TEST(Hatching, OffsetLayersDoNotFoldBackOverAConcaveCrease) {
     if (path.layer >= 2) {
       EXPECT_NEAR(lowest->x(), crease_x, 1e-9) << "path " << p;
       EXPECT_NEAR(lowest->z(), apex_z, 1e-9) << "path " << p;
+    }
+    // and every point a layer's offset from both faces at least (to rounding)
+    const double offset = path.layer * layer_height;
+    for (const Vec3& point : path.points) {
+      const double clear_of_left =
+          (point - Vec3(crease_x, 0, 10)).dot(Vec3(-slope, 0, 1)) / std::sqrt(1.0 + slope * slope);
+      const double clear_of_right =
+          (point - Vec3(crease_x, 0, 10)).dot(Vec3(slope, 0, 1)) / std::sqrt(1.0 + slope * slope);
+      EXPECT_GE(std::min(clear_of_left, clear_of_right), offset - 1e-9) << "path " << p;
     }
   }
 }
