@@ -275,9 +275,13 @@ namespace {
 bool is_sweep_folder(const fs::path& folder) {
   std::error_code error;
   if (fs::exists(folder / kOutputMarker, error)) return true;
+  // (the marker on its way: the temporary file another task writes it through, then renames,
+  // when tasks start side by side in a new folder, GNU parallel's or a Slurm array's)
+  const std::string marker_being_written = std::string(kOutputMarker) + ".tmp-";
   for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
     const std::string name = entry.path().filename().string();
     if ((name == "tasks" || name == "logs") && entry.is_directory(error)) continue;
+    if (name.rfind(marker_being_written, 0) == 0) continue;
     return false;
   }
   return !error;

@@ -78,6 +78,23 @@ nlohmann::ordered_json metrics_of(double time_s, double line_cv, bool flag) {
   return m;
 }
 
+// tasks started side by side in a new folder (GNU parallel's, a Slurm array's): one finds the
+// marker another is writing still under its temporary name, and takes the folder as a sweep's
+// (before, it refused it as "not a depotwin sweep folder", exit 2, and the task went missing);
+// a stranger's file is still refused
+TEST(SweepFolder, AMarkerBeingWrittenByAnotherTaskIsASweepFolder) {
+  const std::string dir = fresh_directory("sweep_marker_race");
+  const Sweep sweep(write_sweep(dir), dir + "/out");
+  fs::create_directories(dir + "/out/logs");
+  write_text(dir + "/out", ".depotwin.tmp-12345", "depotwin sweep folder (s)\n");
+  EXPECT_NO_THROW(sweep.prepare_out_directory());
+  EXPECT_TRUE(fs::exists(dir + "/out/.depotwin"));
+  const Sweep other(write_sweep(dir), dir + "/other");
+  fs::create_directories(dir + "/other/logs");
+  write_text(dir + "/other", "notes.txt", "mine\n");
+  EXPECT_THROW(other.prepare_out_directory(), InputError);
+}
+
 TEST(SweepMerge, TheTableHasARowPerTaskAndAColumnPerParameterAndScalarMetric) {
   const std::string dir = fresh_directory("sweep_merge");
   const Sweep sweep(write_sweep(dir), dir + "/out");
