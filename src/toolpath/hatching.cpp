@@ -243,6 +243,77 @@ std::size_t drop_dents(PrintPath& path, HatchPathInfo& info, const SurfaceProjec
   return dropped;
 }
 
+// Offset along the normal over a convex crease (a ridge) between two consecutive points (or on
+// one of them), each side's point moves along its own side's normal, and the chord between the
+// two offsets cuts the corner the layer below rounds: a roof of slope 0.7 at 1 mm layers, 0.52
+// mm from the ridge at layer 1, half a layer into the one below. The layer's true offset there
+// is the arc of radius `offset` about the crease, from one side's normal to the other's: where
+// the chord's sagitta to that arc exceeds `tolerance`, the arc's points are added, its two ends
+// and as many between as keep each chord's sagitta within the tolerance. The crease is where
+// the two points' tangent planes cross in the line's vertical plane, when that lies between
+// them (or on one) and the slope along the line falls across it (convex); over a concave
+// crease the offsets meet instead (trim_folds, drop_dents).
+// Returns how many points were added.
+std::size_t round_convex_creases(PrintPath& path, HatchPathInfo& info, double offset,
+                                 double tolerance, double alpha) {
+  std::size_t added = 0;
+  if (path.points.size() < 2) return added;
+  const Vec3 up = vertical_tool_axis();
+  // the line's horizontal direction
+  Vec3 along = path.points.back() - path.points.front();
+  along.z() = 0.0;
+  if (!(along.norm() > 0.0)) return added;
+  along.normalize();
+  // the largest turn one chord of the arc may take: offset (1 - cos(turn / 2)) = tolerance
+  const double largest_turn = 2.0 * std::acos(std::max(-1.0, 1.0 - tolerance / offset));
+  for (std::size_t i = 0; i + 1 < path.points.size(); ++i) {
+    const Vec3 s0 = info.surface_points_mm[i], s1 = info.surface_points_mm[i + 1];
+    const Vec3 n0 = info.surface_normals[i], n1 = info.surface_normals[i + 1];
+    const double turn = std::acos(std::clamp(n0.dot(n1), -1.0, 1.0));
+    if (!(turn > largest_turn)) continue;
+    // the tangent planes' crossing c = s0 + u along + w z in the line's vertical plane
+    const double a = along.dot(n0), b = n0.z(), c = along.dot(n1), d = n1.z();
+    const double rhs = (s1 - s0).dot(n1);
+    const double determinant = a * d - b * c;
+    if (!(std::abs(determinant) > 1e-9)) continue;
+    const double u = -b * rhs / determinant, w = a * rhs / determinant;
+    const double length = (s1 - s0).dot(along);
+    if (!(u >= -kJoinTolerance_mm && u <= length + kJoinTolerance_mm)) continue;
+    // convex: the surface's slope along the line falls from the first side to the second
+    if (!(-a / b > -c / d)) continue;
+    const Vec3 crease = s0 + u * along + w * Vec3::UnitZ();
+    // the arc from n0 to n1 about the crease (the normals' slerp), its ends included
+    const int pieces = static_cast<int>(std::ceil(turn / largest_turn));
+    std::vector<Vec3> normals;
+    for (int k = 0; k <= pieces; ++k) {
+      const double f = static_cast<double>(k) / pieces;
+      normals.push_back(
+          ((std::sin((1.0 - f) * turn) * n0 + std::sin(f * turn) * n1) / std::sin(turn))
+              .normalized());
+    }
+    std::size_t at = i + 1;
+    for (int k = 0; k <= pieces; ++k) {
+      const Vec3 point = crease + offset * normals[static_cast<std::size_t>(k)];
+      if ((point - path.points[at - 1]).norm() <= kJoinTolerance_mm ||
+          (point - path.points[at]).norm() <= kJoinTolerance_mm)
+        continue;
+      const auto where = static_cast<std::ptrdiff_t>(at);
+      const std::size_t nearer = 2 * k <= pieces ? i : at;  // (point i + 1 is now at `at`)
+      path.points.insert(path.points.begin() + where, point);
+      path.normals.insert(path.normals.begin() + where,
+                          slerp_axis(up, normals[static_cast<std::size_t>(k)], alpha));
+      info.point_index.insert(info.point_index.begin() + where, info.point_index[nearer]);
+      info.surface_points_mm.insert(info.surface_points_mm.begin() + where, crease);
+      info.surface_normals.insert(info.surface_normals.begin() + where,
+                                  normals[static_cast<std::size_t>(k)]);
+      ++at;
+      ++added;
+    }
+    i = at - 1;  // on from the arc's last point (the next segment is its end to point i + 1)
+  }
+  return added;
+}
+
 AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
                        const SurfaceHatchSpec& spec) {
   const double theta = deg_to_rad(angle_deg);
@@ -392,6 +463,8 @@ SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatch
         if (offset > 0.0 && spec.offset == SurfaceHatchSpec::Offset::normal) {
           trim_folds(path, info, 4.0 * offset + 2.0 * spec.hatch_mm);
           drop_dents(path, info, projector, offset, kDentTolerance * spec.layer_height_mm);
+          if (spec.chord_tolerance_mm > 0.0)
+            round_convex_creases(path, info, offset, spec.chord_tolerance_mm, spec.alpha);
         }
         if (path.points.size() < 2) continue;
         path.speed_mm_s = spec.speed_mm_s;

@@ -20,7 +20,9 @@
 //  - points are offset from the surface by k * layer_height_mm along the smooth surface
 //    normal (Offset::normal: parallel layers of equal thickness) or along +z (Offset::z, as
 //    in the paper); along the normal, a line that folds back over a concave crease (the
-//    points either side pushed past each other) is cut at the crossing of its two sides;
+//    points either side pushed past each other) is cut at the crossing of its two sides, a
+//    point on such a crease offset over the far side is dropped, and over a convex crease
+//    the offset's arc about it is added within chord_tolerance_mm;
 //  - the tool axis is the smooth surface normal tilted back toward vertical by alpha: the
 //    slerp from +z (alpha = 0) to the normal (alpha = 1). The paper scales its rotation angles
 //    R_x = -atan(n_y / n_z), R_y = atan(n_x / n_z) by alpha; the slerp scales the single
