@@ -348,7 +348,7 @@ class GcodeParser {
   void set_position();
   // G10 L2 / L20: a work system's offsets; false (and a problem) when malformed
   bool set_work_offsets(int line_number);
-  void home();
+  void home(const Vec3* stored_mm);  // G28 / G30: to 0, or to the stored position
   // machine = programmed + this (the active work system's offsets and G92's)
   Vec3 frame_offset() const { return work_offset_mm_[work_system_] + offset_mm_; }
   void extrude(double delta);
@@ -381,6 +381,9 @@ class GcodeParser {
   bool opened_by_percent_ = false;       // a `%` came before any code (RS274/NGC tape)
   bool closed_by_percent_ = false;       // and its closing `%` came (at or after the end)
   bool retracting_ = false;              // the last E change was a decrease
+  // where G28 and G30 go (machine frame), once G28.1 / G30.1 stored them (RS274/NGC, grbl);
+  // G28 goes to 0 before, and G30, a probe in Marlin, is then ignored
+  std::optional<Vec3> g28_position_mm_, g30_position_mm_;
   // positions G60 saved (machine frame) with the programmed E, per slot
   struct SavedPosition {
     Vec3 machine_mm;
@@ -422,11 +425,17 @@ const char* unsupported_g_code_reason(int tenths) {
       return " is not supported: cutter radius compensation offsets the path by a tool radius "
              "the file does not give (export the toolpath without it, G40)";
     case 160:  // G16 polar coordinates
+    case 520:  // G52 local coordinate offset (RS274/NGC, Fanuc, Mach3)
     case 510:  // G51 scaling
     case 511:  // G51.1 mirroring
     case 680:  // G68 rotation
-      return " is not supported: polar coordinates, scaling, mirroring and rotation change "
-             "every point that follows (export the toolpath with them applied)";
+      return " is not supported: polar coordinates, local offsets, scaling, mirroring and "
+             "rotation change every point that follows (export the toolpath with them applied)";
+    case 650:  // G65 macro call, G66 and G66.1 modal macro calls (Fanuc)
+    case 660:
+    case 661:
+      return " is not supported: a macro call runs moves this file does not hold (export the "
+             "program expanded)";
     default:
       return nullptr;
   }
@@ -693,6 +702,7 @@ void GcodeParser::execute(int line_number) {
   machine_frame_ = false;
   bool uses_axes = false;  // G92, G28, G10, G4, M codes: the axis words belong to the command
   bool dwell = false, set_position = false, home = false, work_offsets = false;
+  const Vec3* home_position = nullptr;  // where G28 or G30 goes (nullptr: machine 0)
   bool save_position = false, g61 = false;
   int foreign_code = -1;  // a G code whose axis words are its own (unknown here, Prusa G80)
   bool opens = false;     // the line holds the open code
@@ -743,6 +753,23 @@ void GcodeParser::execute(int line_number) {
         break;
       case 280:
         home = uses_axes = true;
+        home_position = g28_position_mm_ ? &*g28_position_mm_ : nullptr;
+        break;
+      case 281:  // G28.1, G30.1: the current position stored for G28, G30
+      case 301:
+        uses_axes = true;  // (grbl and LinuxCNC take no axis words here)
+        (code.tenths == 281 ? g28_position_mm_ : g30_position_mm_) = position_mm_;
+        break;
+      case 300:
+        // G30: to the stored position as G28 goes to its own, once G30.1 stored one; else a
+        // firmware's probe (Marlin), whose axis words are its parameters
+        uses_axes = true;
+        if (g30_position_mm_) {
+          home = true;
+          home_position = &*g30_position_mm_;
+        } else {
+          foreign_code = code.tenths;
+        }
         break;
       case 800:
         // the canned cycle cancelled (RS274/NGC), or Prusa's mesh bed levelling, whose axis
@@ -850,7 +877,7 @@ void GcodeParser::execute(int line_number) {
   }
   if (set_position) this->set_position();
   if (work_offsets && !set_work_offsets(line_number)) return;
-  if (home) this->home();
+  if (home) this->home(home_position);
   if (save_position) {
     if (words_.has('X') || words_.has('Y') || words_.has('Z')) {
       problem(line_number,
@@ -1196,12 +1223,13 @@ void GcodeParser::return_to_saved(int line_number) {
   append_move(0, target_mm, 0.0, EdgeArc{}, line_number);
 }
 
-void GcodeParser::home() {
-  // homing goes to 0 on the named axes (all when none is named)
+void GcodeParser::home(const Vec3* stored_mm) {
+  // homing goes to 0, or to the position G28.1 / G30.1 stored, on the named axes (all when
+  // none is named)
   const bool any_axis = words_.has('X') || words_.has('Y') || words_.has('Z');
   for (int axis = 0; axis < 3; ++axis) {
     if (any_axis && !words_.has(static_cast<char>('X' + axis))) continue;
-    position_mm_[axis] = 0.0;
+    position_mm_[axis] = stored_mm ? (*stored_mm)[axis] : 0.0;
     offset_mm_[axis] = 0.0;
   }
 }

@@ -2,7 +2,8 @@
 //
 // Read: G0/G1, G2/G3 arcs (I/J/K offsets or R, R < 0 the long way; a full circle when an
 // I/J/K arc ends where it starts; helical: the third axis moves linearly) in the G17/G18/G19
-// planes, G90/G91 (and G90.1/G91.1 for arc centres), M82/M83, G92, G20/G21, G28, G4 dwell
+// planes, G90/G91 (and G90.1/G91.1 for arc centres), M82/M83, G92, G20/G21, G28 (to 0, or to
+// what G28.1 stored; G30 to what G30.1 stored), G4 dwell
 // (P milliseconds, S seconds, as Marlin and Klipper), F (modal, per minute), E, work systems
 // (G54..G59.3 select, G10 L2/L20 set, G53 one line in the machine frame), saved positions
 // (G60 S saves one; Marlin's G61 and RepRapFirmware's G0/G1 R return to it). Several G/M
@@ -14,9 +15,10 @@
 // `/` (block delete: the line runs, as with the switch off) are skipped, as are Klipper's
 // extended commands (`PRINT_START ...`), the text commands (M117, M118, M23, ...) and every
 // other G or M code, except the ones that would change the geometry and are not supported
-// (G5 splines, canned cycles G73/G76/G81-G89, G93/G95 feed modes, G33 threading) and
+// (G5 splines, canned cycles G73/G76/G81-G89, G93/G95 feed modes, G33 threading, cutter
+// compensation, polar coordinates, G52 local offsets, scaling, mirroring, rotation) and
 // RS274/NGC programming (O-word subroutines and control flow, # parameters, [ ]
-// expressions; Fanuc's M98 P subprogram calls), which are errors, as are binary files (a
+// expressions; Fanuc's M98 P subprogram calls and G65/G66 macro calls), which are errors, as are binary files (a
 // container, PrusaSlicer's .bgcode, a zip or gzip, is named). Lines end at LF, CR LF, or CR
 // alone in a file without LF.
 //

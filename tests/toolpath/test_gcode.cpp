@@ -464,10 +464,10 @@ TEST(Gcode, PackedFilesAreNamedWithTheWayOut) {
 TEST(Gcode, CompensationAndCoordinateTransformsAreRefused) {
   const auto problems = problems_of(
       "G21 G90\nG1 X0 Y0 F600\n"
-      "G41 D1\nG42.1 D2\nG16\nG51 X0 Y0 P2\nG51.1 X0\nG68 X0 Y0 R45\n"
-      "G1 X10 E1\n");
-  ASSERT_EQ(problems.size(), 6u) << dump(problems);
-  const char* codes[6] = {"G41", "G42.1", "G16", "G51", "G51.1", "G68"};
+      "G41 D1\nG42.1 D2\nG16\nG51 X0 Y0 P2\nG51.1 X0\nG68 X0 Y0 R45\nG52 X20 Y10\n"
+      "G65 P9810 X20 Y10\nG66 P9000 X1\nG1 X10 E1\n");
+  ASSERT_EQ(problems.size(), 9u) << dump(problems);
+  const char* codes[9] = {"G41", "G42.1", "G16", "G51", "G51.1", "G68", "G52", "G65", "G66"};
   for (std::size_t i = 0; i < problems.size(); ++i) {
     EXPECT_EQ(problems[i].line, static_cast<int>(i) + 3);
     EXPECT_EQ(problems[i].message.rfind(std::string(codes[i]) + " is not supported: ", 0), 0u)
@@ -475,10 +475,37 @@ TEST(Gcode, CompensationAndCoordinateTransformsAreRefused) {
   }
   EXPECT_NE(problems[0].message.find("cutter radius compensation"), std::string::npos);
   EXPECT_NE(problems[5].message.find("rotation"), std::string::npos);
+  // a local offset (LinuxCNC, Fanuc, Mach3), read as no offset, put the path 20 x 10 mm off;
+  // a macro call's moves (Renishaw's G65 P9810 positioning) are not in the file
+  EXPECT_NE(problems[6].message.find("local offsets"), std::string::npos);
+  EXPECT_NE(problems[7].message.find("macro call"), std::string::npos);
   // the cancels change nothing: one 10 mm print move
   const GcodeImport cancels = parse("G21 G90\nG40\nG15\nG50.1\nG69\nG1 X0 Y0 F600\nG1 X10 E1\n");
   ASSERT_EQ(cancels.toolpath.paths.size(), 1u);
   expect_points(cancels.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+}
+
+// G28.1 and G30.1 store the position G28 and G30 go to (RS274/NGC, grbl): before, G28 went
+// to 0 whatever was stored and the print ran from (0, 0, 0) instead of (20, 20, 1); G30 goes
+// to its stored position once one is (without, it is Marlin's probe, its words parameters)
+TEST(Gcode, G28AndG30GoToThePositionsG28p1AndG30p1Stored) {
+  const GcodeImport g28 =
+      parse("G21 G90\nG0 X20 Y20 Z1\nG28.1\nG0 X0 Y0 Z0\nG28\nG91 G1 X5 E1 F600\n");
+  ASSERT_EQ(g28.toolpath.paths.size(), 1u);
+  expect_points(g28.toolpath.paths[0], {Vec3(20, 20, 1), Vec3(25, 20, 1)});
+  // only the named axes go (through the intermediate point, a travel)
+  const GcodeImport named =
+      parse("G21 G90\nG0 X20 Y20 Z1\nG28.1\nG0 X3 Y4 Z5\nG28 Z7\nG91 G1 X5 E1 F600\n");
+  ASSERT_EQ(named.toolpath.paths.size(), 1u);
+  expect_points(named.toolpath.paths[0], {Vec3(3, 4, 1), Vec3(8, 4, 1)});
+  const GcodeImport g30 =
+      parse("G21 G90\nG0 X7 Y8 Z2\nG30.1\nG0 X0 Y0 Z0\nG28\nG30\nG91 G1 X5 E1 F600\n");
+  ASSERT_EQ(g30.toolpath.paths.size(), 1u);
+  expect_points(g30.toolpath.paths[0], {Vec3(7, 8, 2), Vec3(12, 8, 2)});
+  // no G28.1 before: machine 0; no G30.1: G30 moves nothing
+  const GcodeImport plain = parse("G21 G90\nG0 X20 Y20 Z1\nG28\nG30 Z9\nG1 X5 E1 F600\n");
+  ASSERT_EQ(plain.toolpath.paths.size(), 1u);
+  expect_points(plain.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(5, 0, 0)});
 }
 
 TEST(Gcode, UnknownCodesKeepTheirAxisWords) {
