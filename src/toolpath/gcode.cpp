@@ -706,6 +706,7 @@ void GcodeParser::execute(int line_number) {
   bool save_position = false, g61 = false;
   int foreign_code = -1;  // a G code whose axis words are its own (unknown here, Prusa G80)
   bool opens = false;     // the line holds the open code
+  bool closes = false;    // and the close code
   for (int i = 0; i < words_.n_codes; ++i) {
     const Code code = words_.codes[i];
     if (is_shutter_code(open_code_, code)) {
@@ -713,7 +714,16 @@ void GcodeParser::execute(int line_number) {
       program_.has_shutter_codes = true;
     } else if (is_shutter_code(close_code_, code)) {
       open_ = false;
+      closes = true;
       program_.has_shutter_codes = true;
+    }
+    // both on one line: which holds for its move is no order's (RS274/NGC refuses two codes of
+    // one modal group, M3 and M5, on a line); before, the last won silently
+    if (opens && closes) {
+      problem(line_number,
+              "the open code and the close code on one line: write them on lines "
+              "of their own, in the order they should act");
+      return;
     }
     if (code.letter == 'M') {
       if (code.tenths == 820 || code.tenths == 830) extruder_relative_ = code.tenths == 830;

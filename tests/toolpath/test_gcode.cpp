@@ -508,6 +508,16 @@ TEST(Gcode, G28AndG30GoToThePositionsG28p1AndG30p1Stored) {
   expect_points(plain.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(5, 0, 0)});
 }
 
+// the open and close codes on one line (`S1000 M3 M5`): LinuxCNC refuses two spindle codes on
+// a line; before, the last won and the file printed nothing
+TEST(Gcode, OpenAndCloseCodesOnOneLineAreRefused) {
+  const auto problems = problems_of("G21 G90\nG0 X0 Y0\nS1000 M3 M5\nG1 X10 F600\nM5\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 3);
+  EXPECT_EQ(problems[0].message.rfind("the open code and the close code on one line", 0), 0u)
+      << problems[0].str();
+}
+
 TEST(Gcode, UnknownCodesKeepTheirAxisWords) {
   // a Bambu Lab print's start: G380 probes (relative), G29.1 sets a z trim, G38.2 probes; none
   // is a move, so the first print move starts where the last real move ended
