@@ -396,6 +396,11 @@ class GcodeParser {
 
 // Why a G code the reader refuses would move the path in a way it cannot follow; nullptr for
 // the codes it reads or may ignore
+// a comment with a '(' inside (LinuxCNC refuses it too)
+constexpr const char* kNestedComment =
+    "a comment inside a comment: '(' ... '(' ... ')' (comments do not nest; the first ')' ends "
+    "both)";
+
 const char* unsupported_g_code_reason(int tenths) {
   switch (tenths) {
     case 50:   // G5 cubic spline
@@ -488,6 +493,10 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
       // a line that is a comment, or a comment then words
       const char* close = std::find(p, end, ')');
       if (close == end) return;
+      if (std::find(p + 1, close, '(') != close) {
+        problem(line_number, kNestedComment);
+        return;
+      }
       line(close + 1, end, line_number);
     }
     return;
@@ -575,14 +584,29 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
         problem(line_number, "comment '(' not closed on its line");
         return false;
       }
+      // (RS274/NGC comments do not nest: the first ')' ends it, and what follows would read as
+      // words)
+      if (std::find(p + 1, close, '(') != close) {
+        problem(line_number, kNestedComment);
+        return false;
+      }
       p = close + 1;
       continue;
     }
     if (!is_letter(c)) {
       const char* reason = ngc_programming_reason(line_begin, end);
-      problem(line_number, reason ? std::string(reason)
-                                  : "unexpected '" + printable(p, p + 1) +
-                                        "' (expected a letter followed by a number)");
+      // a number after a space that follows a word's number: `X1 0.5`, a space inside it
+      const char* before = p;
+      while (before > line_begin && is_space(before[-1])) --before;
+      const bool number_split = (is_digit(c) || c == '.') && before < p && before > line_begin &&
+                                (is_digit(before[-1]) || before[-1] == '.');
+      problem(line_number, reason
+                               ? std::string(reason)
+                               : "unexpected '" + printable(p, p + 1) +
+                                     "' (expected a letter followed by a number" +
+                                     (number_split ? "; a space inside a number is not read: write "
+                                                     "X10.5, not X1 0.5)"
+                                                   : ")"));
       return false;
     }
     const char letter = upper(c);

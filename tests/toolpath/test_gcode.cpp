@@ -518,6 +518,23 @@ TEST(Gcode, OpenAndCloseCodesOnOneLineAreRefused) {
       << problems[0].str();
 }
 
+// a space inside a number (`X1 0.5`, which LinuxCNC reads as X10.5) and a nested comment are
+// refused with what they are, not only as an unexpected character or a malformed word
+TEST(Gcode, ASpaceInsideANumberAndANestedCommentAreNamed) {
+  const auto split = problems_of("G21 G90\nG1 X1 0.5 F600\n");
+  ASSERT_EQ(split.size(), 1u) << dump(split);
+  EXPECT_NE(split[0].message.find("a space inside a number is not read"), std::string::npos)
+      << split[0].str();
+  const auto nested = problems_of("G21 G90\n(a (b) c)\nG1 X1 F600\n");
+  ASSERT_EQ(nested.size(), 1u) << dump(nested);
+  EXPECT_EQ(nested[0].line, 2);
+  EXPECT_NE(nested[0].message.find("comments do not nest"), std::string::npos) << nested[0].str();
+  // a stray character elsewhere keeps the plain message
+  const auto stray = problems_of("G21 G90\nG1 X1 F600 ?\n");
+  ASSERT_EQ(stray.size(), 1u) << dump(stray);
+  EXPECT_EQ(stray[0].message.find("space inside"), std::string::npos) << stray[0].str();
+}
+
 TEST(Gcode, UnknownCodesKeepTheirAxisWords) {
   // a Bambu Lab print's start: G380 probes (relative), G29.1 sets a z trim, G38.2 probes; none
   // is a move, so the first print move starts where the last real move ended
