@@ -18,9 +18,9 @@
 // (G5 splines, canned cycles G73/G76/G81-G89, G93/G95 feed modes, G33 threading, cutter
 // compensation, polar coordinates, G52 local offsets, scaling, mirroring, rotation) and
 // RS274/NGC programming (O-word subroutines and control flow, # parameters, [ ]
-// expressions; Fanuc's M98 P subprogram calls and G65/G66 macro calls), which are errors, as are binary files (a
-// container, PrusaSlicer's .bgcode, a zip or gzip, is named). Lines end at LF, CR LF, or CR
-// alone in a file without LF.
+// expressions; Fanuc's M98 P subprogram calls and G65/G66 macro calls), which are errors, as are
+// binary files (a container, PrusaSlicer's .bgcode, a zip or gzip, is named). Lines end at LF, CR
+// LF, or CR alone in a file without LF.
 //
 // Print rules decide which moves deposit: `e` (E increases), `shutter` (G1/G2/G3 while the
 // open code is active (M3 and M4 both, where either is the open code) and the modal S, a laser's or
