@@ -212,6 +212,16 @@ std::size_t drop_dents(PrintPath& path, HatchPathInfo& info, const SurfaceProjec
   };
   std::size_t dropped = 0;
   for (std::size_t i = 1; i + 1 < path.points.size();) {
+    // (over a crease at point i its neighbours' normals turn by the faces' angle phi from its
+    // own, and its clearance from the far face is offset cos phi: where no neighbour turns that
+    // far, no ray is cast)
+    const Vec3& n = info.surface_normals[i];
+    const double turn =
+        1.0 - std::min(n.dot(info.surface_normals[i - 1]), n.dot(info.surface_normals[i + 1]));
+    if (!(offset * turn > tolerance)) {
+      ++i;
+      continue;
+    }
     const Vec3& p = path.points[i];
     const double own = clearance(p);
     if (own >= offset - tolerance) {
@@ -458,8 +468,8 @@ SurfaceHatch hatch_surface(const SurfaceProjector& projector, const SurfaceHatch
           info.surface_points_mm.push_back(p);
           info.surface_normals.push_back(normal);
         }
-        // offset along the normal: folds cut out, then a point left over a concave crease too
-        // near its far side dropped
+        // offset along the normal: folds cut out, a point left over a concave crease too near
+        // its far side dropped, and the offset's arc added over a convex crease
         if (offset > 0.0 && spec.offset == SurfaceHatchSpec::Offset::normal) {
           trim_folds(path, info, 4.0 * offset + 2.0 * spec.hatch_mm);
           drop_dents(path, info, projector, offset, kDentTolerance * spec.layer_height_mm);
