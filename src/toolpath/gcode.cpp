@@ -394,13 +394,13 @@ class GcodeParser {
   GcodeProgram program_;
 };
 
-// Why a G code the reader refuses would move the path in a way it cannot follow; nullptr for
-// the codes it reads or may ignore
 // a comment with a '(' inside (LinuxCNC refuses it too)
 constexpr const char* kNestedComment =
     "a comment inside a comment: '(' ... '(' ... ')' (comments do not nest; the first ')' ends "
     "both)";
 
+// Why a G code the reader refuses would move the path in a way it cannot follow; nullptr for
+// the codes it reads or may ignore
 const char* unsupported_g_code_reason(int tenths) {
   switch (tenths) {
     case 50:   // G5 cubic spline
