@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cstdio>
 #include <map>
+#include <set>
 #include <utility>
 
 #include "core/error.hpp"
@@ -56,6 +57,34 @@ TriangleMesh closed_shell(const TriangleMesh& surface, double thickness_mm) {
   return shell;
 }
 
+// true when two triangles run along an edge in the same direction: MuJoCo 2.2.2 refuses such a
+// mesh ("faces have inconsistent orientation"), and the shell gives one where a surface's
+// boundary passes a vertex twice (two patches touching at a corner, a T-junction between
+// pieces that share no edge, each boundary adding a wall edge down from that vertex) or a
+// closed mesh has a triangle turned over
+bool repeats_directed_edge(const TriangleMesh& mesh) {
+  std::set<std::pair<int, int>> directed;
+  for (const std::array<int, 3>& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k)
+      if (!directed.insert({t[k], t[(k + 1) % 3]}).second) return true;
+  return false;
+}
+
+// the same triangles, each on three vertices of its own: no edge is shared, so none repeats
+// (the part is only drawn: MuJoCo's shading of it is its faces' own, not blended across
+// edges)
+TriangleMesh unshared_vertices(const TriangleMesh& mesh) {
+  TriangleMesh separate;
+  separate.vertices.reserve(3 * mesh.triangles.size());
+  separate.triangles.reserve(mesh.triangles.size());
+  for (const std::array<int, 3>& t : mesh.triangles) {
+    const int first = static_cast<int>(separate.vertices.size());
+    for (int k = 0; k < 3; ++k) separate.vertices.push_back(mesh.vertices[t[k]]);
+    separate.triangles.push_back({first, first + 1, first + 2});
+  }
+  return separate;
+}
+
 }  // namespace
 
 bool mesh_is_closed(const TriangleMesh& mesh) {
@@ -99,7 +128,8 @@ std::string mjcf_with_part(const std::string& mjcf, const std::string& model_pat
   if (tag_end == std::string::npos)
     throw InputError(model_path, 0, "body substrate",
                      "the model has no <body name=\"substrate\"> to carry the part");
-  const TriangleMesh mesh = mesh_is_closed(part_mm) ? part_mm : closed_shell(part_mm, shell_mm);
+  TriangleMesh mesh = mesh_is_closed(part_mm) ? part_mm : closed_shell(part_mm, shell_mm);
+  if (repeats_directed_edge(mesh)) mesh = unshared_vertices(mesh);
   const std::string geom = std::string("<geom name=\"") + kPartGeomName +
                            "\" type=\"mesh\" mesh=\"" + kPartGeomName +
                            "\" contype=\"0\" conaffinity=\"0\" group=\"1\" "

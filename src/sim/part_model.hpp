@@ -21,8 +21,10 @@ constexpr const char* kPartGeomName = "depotwin_part";
 // `mjcf` (the text of the model at `model_path`, for messages) with the part added: a
 // <mesh> asset with the vertices in metres and a geom in the `substrate` body. An open
 // surface (edges with one triangle) is closed into a thin shell `shell_mm` thick below it
-// (MuJoCo refuses a mesh without volume). InputError naming the model file when it has no
-// <mujoco> root or no body named `substrate`.
+// (MuJoCo refuses a mesh without volume). A mesh whose triangles run along an edge in the same
+// direction (MuJoCo refuses it too: a corner where two patches touch, a triangle turned over)
+// is added with every triangle on vertices of its own. InputError naming the model file when it has
+// no <mujoco> root or no body named `substrate`.
 std::string mjcf_with_part(const std::string& mjcf, const std::string& model_path,
                            const TriangleMesh& part_mm, double shell_mm = 1.0);
 

@@ -112,6 +112,33 @@ TEST(PartModel, ClosedMeshIsAddedAsItIs) {
   EXPECT_LT((hi - Vec3(10, 10, 10)).norm(), 1e-3);
 }
 
+// MuJoCo 2.2.2 refuses a mesh whose triangles run along an edge in the same direction: two
+// patches touching at a corner (their shell's walls both leave that vertex downwards) and a
+// closed mesh with a triangle turned over; both are added with every triangle on its own
+// vertices, and compile where the work frame puts them
+TEST(PartModel, PatchesTouchingAtACornerAndATurnedTriangleStillCompile) {
+  TriangleMesh touching;
+  touching.vertices = {Vec3(0, 0, 0),  Vec3(5, 0, 0),   Vec3(5, 5, 0), Vec3(0, 5, 0),
+                       Vec3(10, 5, 0), Vec3(10, 10, 0), Vec3(5, 10, 0)};
+  touching.triangles = {{0, 1, 2}, {0, 2, 3}, {2, 4, 5}, {2, 5, 6}};
+  EXPECT_FALSE(mesh_is_closed(touching));
+  TriangleMesh turned = tetrahedron();
+  turned.triangles[3] = {1, 3, 2};
+  EXPECT_TRUE(mesh_is_closed(turned));
+  for (const TriangleMesh* part : {&touching, &turned}) {
+    const ModelPtr model =
+        load_model_from_string(mjcf_with_part(kModel, "probe.xml", *part), "probe.xml");
+    const int geom = mj_name2id(model.get(), mjOBJ_GEOM, kPartGeomName);
+    ASSERT_GE(geom, 0);
+    Vec3 lo, hi;
+    compiled_bounds(*model, lo, hi);
+    const Vec3 expected_hi = part == &touching ? Vec3(10, 10, 0) : Vec3(10, 10, 10);
+    const Vec3 expected_lo = part == &touching ? Vec3(0, 0, -1) : Vec3(0, 0, 0);
+    EXPECT_LT((lo - expected_lo).norm(), 1e-3);
+    EXPECT_LT((hi - expected_hi).norm(), 1e-3);
+  }
+}
+
 // the body named substrate, not a material or a commented-out body of that name
 TEST(PartModel, TheSubstrateBodyNotAnythingElseOfThatName) {
   const std::string mjcf = R"(<mujoco>
