@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "motion/lspb.hpp"
@@ -87,6 +88,29 @@ TEST(Lspb, RandomFeasibleDurationsAlwaysSolve) {
     ++solved;
   }
   EXPECT_EQ(solved, 5000);
+}
+
+// A short move stretched over a long time (the slow axis of a synchronised move): blends of
+// 1.9e-8 s at 8000 mm/s^2, within the roundoff window of eq. (18). The cruise velocity solves
+// v T - v^2 / alpha = |d|: v = 2 |d| / (T + sqrt(T^2 - 4 |d| / alpha)) (no cancellation).
+// Backwards, case I's candidate 2 (a0 = +alpha, v_c < 0) once passed that window and was
+// clamped to no blend: a profile that never moved; and the root by x - sqrt(gamma) kept only
+// a few digits of the cruise velocity (6e-6 off at 0.001 mm).
+TEST(Lspb, TinyMoveStretchedOverALongTimeInEitherDirection) {
+  const double T = 200.01, alpha = 8000.0;
+  for (const double d : {0.03, -0.03, 0.001, -0.001, 1e-6, -1e-6}) {
+    SCOPED_TRACE(d);
+    const AxisBoundary b{0.0, d, 0.0, 0.0};
+    const auto s = solve_lspb(b, T, alpha, 400.0);
+    ASSERT_TRUE(s.has_value());
+    EXPECT_EQ(s->candidate, d > 0 ? 2 : 4);
+    const double v = 2.0 * std::abs(d) / (T + std::sqrt(T * T - 4.0 * std::abs(d) / alpha));
+    EXPECT_NEAR(s->v_c, std::copysign(v, d), 1e-12 * v);
+    const AxisProfile p = s->profile(b);
+    EXPECT_NEAR(p.q_end(), d, 1e-12 * std::abs(d));
+    // (the last blend's time is T - t_b1, short against T: alpha times a few ulps of T)
+    EXPECT_NEAR(p.v_end(), 0.0, alpha * 8.0 * std::numeric_limits<double>::epsilon() * T);
+  }
 }
 
 }  // namespace

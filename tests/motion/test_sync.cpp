@@ -36,6 +36,17 @@ TEST(Sync, BlockedDurationIsSkipped) {
   EXPECT_NEAR(move.axes[1].q_end(), 0.3, 1e-9);
 }
 
+// the `move` verb's case: a 200 mm axis at 1 mm/s sets 200.01 s, and a fast axis moving
+// 0.03 mm backwards in that time still gets there (it was planned as no motion at all)
+TEST(Sync, ATinyAxisBackwardsUnderALongOneStillMoves) {
+  const std::vector<AxisMove> axes{{{0, 200, 0, 0}, 1, 100}, {{0, -0.03, 0, 0}, 400, 8000}};
+  const SynchronizedMove move = synchronized_move(axes);
+  EXPECT_NEAR(move.duration_s, 200.0 + 1.0 / 100.0, 1e-9);
+  EXPECT_NEAR(move.axes[1].q_end(), -0.03, 1e-14);
+  EXPECT_NEAR(move.axes[1].duration_s(), move.duration_s, 1e-12);
+  EXPECT_LT(move.axes[1].at(0.5 * move.duration_s).q, -0.0149);
+}
+
 TEST(Sync, RandomMovesMeetBoundariesAndLimits) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> pos(-10, 10), vel(-3.9, 3.9);
