@@ -1120,11 +1120,15 @@ bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, 
       problem(line_number, "arc of radius 0 (the centre is the start point)");
       return false;
     }
-    if (std::abs(r_end - r_start) >
-        std::max(kArcRadiusTolerance_mm, kArcRadiusTolerance_rel * r_start)) {
+    const double radius_tolerance =
+        std::max(kArcRadiusTolerance_mm, kArcRadiusTolerance_rel * r_start);
+    if (std::abs(r_end - r_start) > radius_tolerance) {
+      // (the rule applied, with its figure for this arc)
       std::ostringstream message;
       message << "the arc's end is " << r_end << " mm from its centre, its start " << r_start
-              << " mm (they must agree within " << kArcRadiusTolerance_mm << " mm)";
+              << " mm (they must agree within " << radius_tolerance
+              << " mm: " << kArcRadiusTolerance_mm << " mm or " << kArcRadiusTolerance_rel * 100.0
+              << " % of the radius, the larger)";
       problem(line_number, message.str());
       return false;
     }

@@ -689,6 +689,23 @@ TEST(Gcode, LowercaseFilesReadEAsAWord) {
   EXPECT_EQ(script.moves[0].to_mm.x(), 1e-05);
 }
 
+// an arc's end may miss its start's radius by 0.005 mm or 0.1 % of the radius, the larger; the
+// message gives the figure applied to that arc (it once said 0.005 mm for every radius)
+TEST(Gcode, AnArcsRadiusToleranceGrowsWithItsRadiusAndIsNamed) {
+  const auto problems = problems_of(
+      "G1 X0 Y0 F600\nG2 X20.008 Y0 I10 J0 E1\n"  // 2 r 10: 0.008 off, within 0.01 mm
+      "G1 X0 Y0\nG2 X20.02 Y0 I10 J0 E2\n"        // 4 0.02 off
+      "G1 X0 Y0\nG2 X1000.5 Y0 I500 J0 E3\n"      // 6 r 500: 0.5 off, within 0.5 mm
+      "G1 X0 Y0\nG2 X1001 Y0 I500 J0 E4\n");      // 8 1 off
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 4);
+  EXPECT_NE(problems[0].message.find("within 0.01 mm: 0.005 mm or 0.1 % of the radius"),
+            std::string::npos)
+      << problems[0].message;
+  EXPECT_EQ(problems[1].line, 8);
+  EXPECT_NE(problems[1].message.find("within 0.5 mm"), std::string::npos) << problems[1].message;
+}
+
 TEST(Gcode, ArcTurnsBeyondOneAreRefused) {
   // Bambu's spiral lift: a full helical turn, P1 (one turn), the same as without P
   const GcodeProgram lift = parse_gcode_program(
