@@ -16,6 +16,11 @@ namespace {
 constexpr double kChordTolerance_mm = 0.01;
 // the limits asked of the machine: none of its own, so its joints' limits decide
 constexpr double kUnbounded = 1e12;
+// the most pieces one look-ahead chain holds before it is planned and emptied (a stop there):
+// about 130 MB. A file of arcs that never stops is otherwise held whole: 10^5 circles of
+// radius 500 mm (a 2 MB file, 5e7 chords) took 10 GB. A printer's own queue holds 16 to 64
+// moves; the stop costs a deceleration and an acceleration every 2^20 pieces.
+constexpr size_t kMaxChainPieces = size_t{1} << 20;
 
 // The time of one move of a look-ahead chain: a trapezoid from v0 to v1 under the cruise cap
 // over what the junction blends leave of it, plus half of each blend (as FirmwarePlanner).
@@ -108,6 +113,7 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       }
       piece.blend_accel_mm_s2 = axis_accel;
       chain.push_back(piece);
+      if (chain.size() >= kMaxChainPieces) flush();
     }
   }
   flush();
