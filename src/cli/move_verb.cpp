@@ -14,6 +14,10 @@ namespace depotwin {
 
 std::vector<double> parse_number_list(const std::string& text, const std::string& option) {
   std::vector<double> values;
+  // (getline drops an empty last item: "0," would read as one value)
+  if (!text.empty() && text.back() == ',')
+    throw InputError(option, "'" + printable_text(text) +
+                                 "' ends with a comma: a value is missing (expected e.g. 0,5.5)");
   std::stringstream stream(text);
   std::string item;
   while (std::getline(stream, item, ',')) {

@@ -497,6 +497,8 @@ std::vector<Row> rows() {
                       "error: --q1: must be in \\[-1e\\+06, 1e\\+06\\] mm, got 1e\\+300"));
   r.push_back(command("MoveNotANumber", "move --q0 0 --q1 nan --vmax 5 --amax 10",
                       "error: --q1: 'nan' is not a finite number"));
+  r.push_back(command("MoveListEndingInAComma", "move --q0 0,0 --q1 10, --vmax 5 --amax 10",
+                      "error: --q1: '10,' ends with a comma: a value is missing"));
   r.push_back(command("PlannerNamedTwice",
                       "run {dir}/scenario.yaml --planner lspb_mtt,lspb_mtt --out {out} "
                       "--no-render --quiet",
