@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 
 #include "cli/inspect.hpp"
@@ -268,6 +269,26 @@ TEST(GcodeFiles, EstimatedTimeIsTheFirmwaresTrapezoids) {
   EXPECT_NEAR(estimate("G0 X100\n"), 100.0 / 300.0 + 300.0 / a, 1e-9);
   // a corner costs time: the 90 degree junction is slower than going on straight
   EXPECT_GT(estimate("G1 X50 F3000\nG1 Y50\n"), 100.0 / 50.0 + 50.0 / a);
+}
+
+// a look-ahead chain is planned and emptied every 2^20 pieces (bounded memory on a file of
+// arcs that never stops): 2^20 collinear moves of 0.001 mm, then one of 100 mm, are two
+// chains from rest to rest, L / v + 2 v / a, where one chain would be L / v + v / a
+TEST(GcodeFiles, EstimateStopsEveryMillionPieces) {
+  const int kPieces = 1 << 20;
+  std::string text = "G21 G90\nG1 X0 F3000\n";
+  text.reserve(16 * kPieces);
+  char line[48];
+  for (int i = 1; i <= kPieces; ++i) {
+    std::snprintf(line, sizeof line, "G1 X%.3f\n", 0.001 * i);
+    text += line;
+  }
+  const double fine_length = 0.001 * kPieces;
+  text += "G1 X" + std::to_string(fine_length + 100.0) + "\n";
+  const GcodeProgram program = parse_gcode_program(text, "long.gcode", GcodeOptions{});
+  const double a = 3000.0;  // cartesian: 300 mm/s and 3000 mm/s^2 in x
+  EXPECT_NEAR(gcode_facts(program, PrintRule::automatic).estimated_time_s,
+              (fine_length + 100.0) / 50.0 + 2.0 * 50.0 / a, 1e-6);
 }
 
 TEST(GcodeFiles, InspectJsonKeys) {
