@@ -367,7 +367,7 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
 
   // the header: what was exported, from what, and the conventions
   std::ostringstream header;
-  header << "; G-code exported by depotwin " << depotwin_version() << '\n'
+  header << kExportedGcodeStart << " " << depotwin_version() << '\n'
          << "; scenario: " << job.scenario_name << " (" << job.scenario_file << ")\n"
          << "; planner: " << job.planner << '\n'
          << "; machine: " << job.machine << '\n';

@@ -203,6 +203,39 @@ void OutputLock::release() {
   descriptor_ = -1;
 }
 
+namespace {
+
+// `entry`, named like a writer's staging, is what that writer leaves: a `.partial-` or `.old-`
+// folder that is a depotwin output (its marker, or being given one, or empty), or a `.tmp-`
+// file that is empty or begins as `export`'s G-code does. A user's own `results.old-2023`
+// folder or `job.gcode.tmp-1` file is not (it was deleted once: the pid alone decided).
+bool left_by_a_writer(const fs::directory_entry& entry, const std::string& tag) {
+  std::error_code error;
+  const fs::file_status status = entry.symlink_status(error);
+  if (tag == ".tmp-") {
+    if (!fs::is_regular_file(status)) return false;
+    std::ifstream file(entry.path(), std::ios::binary);
+    std::string start(std::strlen(kExportedGcodeStart), '\0');
+    file.read(start.data(), static_cast<std::streamsize>(start.size()));
+    return file.gcount() == 0 || (file && start == kExportedGcodeStart);
+  }
+  if (!fs::is_directory(status)) return false;
+  if (is_depotwin_output(entry.path())) return true;
+  // killed between making the folder and renaming its marker into place
+  const std::string marker_being_written = std::string(kOutputMarker) + ".tmp-";
+  int n_entries = 0;
+  bool only_the_marker_being_written = true;
+  for (const fs::directory_entry& inner : fs::directory_iterator(entry.path(), error)) {
+    ++n_entries;
+    only_the_marker_being_written =
+        only_the_marker_being_written &&
+        inner.path().filename().string().rfind(marker_being_written, 0) == 0;
+  }
+  return !error && n_entries == 1 && only_the_marker_being_written;
+}
+
+}  // namespace
+
 void remove_stale_staging(const std::string& target_path) {
   const fs::path target(target_path);
   const std::string base = target.filename().string();
@@ -214,6 +247,7 @@ void remove_stale_staging(const std::string& target_path) {
       if (pid <= 0 || pid == ::getpid()) continue;
       // a live process keeps its folder (even a reused pid: then it stays until that ends)
       if (::kill(pid, 0) == 0 || errno != ESRCH) continue;
+      if (!left_by_a_writer(entry, tag)) continue;
       std::error_code ignored;
       fs::remove_all(entry.path(), ignored);
     }

@@ -12,6 +12,8 @@ namespace depotwin {
 
 // The marker file in every verb's output folder: a folder holding it is depotwin's to replace.
 inline constexpr const char* kOutputMarker = ".depotwin";
+// how a file `depotwin export` writes begins (its first comment)
+inline constexpr const char* kExportedGcodeStart = "; G-code exported by depotwin";
 
 // the first line of `folder`'s marker file ("depotwin output folder, written by ...", "depotwin
 // sweep folder (NAME): ..."), "" when it has none: what kind of folder it is
@@ -70,8 +72,10 @@ class OutputLock {
 
 // Removes what writers of `target_path` killed outright left beside it: `<target>.partial-<pid>`
 // and `<target>.old-<pid>` folders and `<target>.tmp-<pid>` files whose process is dead (kill(2)
-// says no such process; a live pid, even a reused one, is left alone). Call it holding the
-// target's OutputLock: no live writer of the target can then be staging.
+// says no such process; a live pid, even a reused one, is left alone), and only where they are
+// a writer's: a folder that is a depotwin output (marker, or empty), a file that is empty or
+// begins with kExportedGcodeStart; anything else of such a name is the user's and stays. Call
+// it holding the target's OutputLock: no live writer of the target can then be staging.
 void remove_stale_staging(const std::string& target_path);
 
 // A verb's whole output folder (`--out DIR`): staged beside DIR, written with the

@@ -165,13 +165,35 @@ TEST(StaleStaging, ADeadWritersLeftoversGoALiveOnesStay) {
            "results.partial-" + dead, "results.old-" + dead, "results.partial-" + alive,
            "results.partial-x" + dead, "other.partial-" + dead, "results"}) {
     fs::create_directories(dir + "/" + name);
-    write_text(dir + "/" + name + "/metrics.json", "{}\n");
+    write_text(dir + "/" + name + "/" + kOutputMarker, "depotwin output folder\n");
   }
-  write_text(dir + "/results.tmp-" + dead, "half a file");
+  write_text(dir + "/results.tmp-" + dead, std::string(kExportedGcodeStart) + " 0.1\nG1 X");
   remove_stale_staging(out);
   EXPECT_EQ(names_in(dir),
             (std::vector<std::string>{"other.partial-" + dead, "results",
                                       "results.partial-" + alive, "results.partial-x" + dead}));
+}
+
+// a dead pid's name alone is not enough: what the user keeps under such a name stays (a
+// backup folder `results.old-2023`, a file of theirs), what a killed writer leaves goes (a
+// staging folder killed before or while its marker was written, an empty temporary file)
+TEST(StaleStaging, TheUsersFoldersAndFilesOfSuchNamesStay) {
+  const std::string dir = fresh_directory("stale_staging_users");
+  const std::string out = dir + "/results";
+  const std::string dead = std::to_string(dead_pid());
+  const std::string other_dead = std::to_string(dead_pid());
+  fs::create_directories(dir + "/results.old-" + dead);
+  write_text(dir + "/results.old-" + dead + "/thesis.txt", "chapter 1\n");
+  write_text(dir + "/results.tmp-" + dead, "my notes\n");
+  fs::create_directories(dir + "/results.partial-" + dead);
+  write_text(dir + "/results.partial-" + dead + "/" + kOutputMarker + ".tmp-" + dead, "depot");
+  fs::create_directories(dir + "/results.partial-" + other_dead);
+  write_text(dir + "/results.tmp-" + other_dead, "");
+  remove_stale_staging(out);
+  EXPECT_EQ(names_in(dir),
+            (std::vector<std::string>{"results.old-" + dead, "results.tmp-" + dead}));
+  EXPECT_EQ(read_text(dir + "/results.old-" + dead + "/thesis.txt"), "chapter 1\n");
+  EXPECT_EQ(read_text(dir + "/results.tmp-" + dead), "my notes\n");
 }
 
 // the output as it was before when a signal stops the verb before its commit; after the
