@@ -1062,12 +1062,19 @@ void Loader::clamp_feed_rates(std::vector<PrintPath>& paths, std::vector<std::ve
     std::size_t run_start = 0;
     for (std::size_t k = 1; k <= edge_speed.size(); ++k) {
       if (k < edge_speed.size() && edge_speed[k] == edge_speed[run_start]) continue;
-      PrintPath piece = path;
+      // (the path's fields, its per-point lists cut to the run: a copy of the whole path per
+      // run made a serpentine of 3e6 clamped moves quadratic in memory, 21 GB)
+      PrintPath piece;
+      piece.source_index = path.source_index;
+      piece.layer = path.layer;
       piece.points.assign(path.points.begin() + static_cast<long>(run_start),
                           path.points.begin() + static_cast<long>(k) + 1);
       if (!path.normals.empty())
         piece.normals.assign(path.normals.begin() + static_cast<long>(run_start),
                              path.normals.begin() + static_cast<long>(k) + 1);
+      if (!path.rolls.empty())
+        piece.rolls.assign(path.rolls.begin() + static_cast<long>(run_start),
+                           path.rolls.begin() + static_cast<long>(k) + 1);
       if (!path.arcs.empty())
         piece.arcs.assign(path.arcs.begin() + static_cast<long>(run_start),
                           path.arcs.begin() + static_cast<long>(k));
