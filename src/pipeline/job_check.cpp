@@ -111,7 +111,7 @@ std::vector<Problem> downstream_setting_problems(const Scenario& scenario) {
   } catch (const InputError& e) {
     problems = scenario.located(e.problems());
   }
-  const std::string sim = sim_settings(scenario).validate();
+  const std::string sim = sim_settings(scenario).validate(scenario.machine);
   if (!sim.empty()) problems.push_back(scenario.problem_at("sim", sim));
   return problems;
 }

@@ -1773,7 +1773,8 @@ void Loader::check_settings() {
   // the servo loop's stability: kp dt^2 (sim/servo_controller: an explicit loop)
   const double stiffness =
       sim.kp_scale * std::pow(sim.timestep_s / input_ranges::kReferenceTimestep_s, 2);
-  if (stiffness > input_ranges::kMaxServoStiffnessPerStep * (1.0 + 1e-12)) {
+  const double max_stiffness = input_ranges::max_servo_stiffness_per_step(scenario_.machine);
+  if (stiffness > max_stiffness * (1.0 + 1e-12)) {
     const int kp_line = line_of("sim.kp_scale");
     const int step_line = line_of("sim.timestep_s");
     problems_.add(step_line > 0 ? step_line : kp_line,
@@ -1782,9 +1783,8 @@ void Loader::check_settings() {
                       format_number(sim.kp_scale) +
                       " makes the servos unstable: kp_scale * "
                       "(timestep_s / 1 ms)^2 = " +
-                      format_number(stiffness) + ", at most " +
-                      format_number(input_ranges::kMaxServoStiffnessPerStep) +
-                      " (lower sim.timestep_s or sim.kp_scale)");
+                      format_number(stiffness) + ", at most " + format_number(max_stiffness) +
+                      " on " + scenario_.machine + " (lower sim.timestep_s or sim.kp_scale)");
   }
 }
 

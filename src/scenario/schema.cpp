@@ -427,8 +427,11 @@ std::vector<SchemaSection> make_schema() {
        {number("timestep_s", "s",
                ValueRange::closed(ranges::kMinTimestep_s, ranges::kMaxTimestep_s), sim.timestep_s,
                "MuJoCo's physics step; with kp_scale: kp_scale * (timestep_s / 1 ms)^2 <= " +
-                   format_number(ranges::kMaxServoStiffnessPerStep) +
-                   " (the servo loop's stability)"),
+                   format_number(ranges::kMaxServoStiffnessPerStep) + " (xy_stage, arm6), " +
+                   format_number(ranges::max_servo_stiffness_per_step("cartesian")) +
+                   " (cartesian), " +
+                   format_number(ranges::max_servo_stiffness_per_step("linear_delta")) +
+                   " (linear_delta): the servo loop's stability"),
         number("control_period_s", "s",
                ValueRange::closed(ranges::kMinTimestep_s, ranges::kMaxControlPeriod_s),
                sim.control_period_s,

@@ -45,7 +45,7 @@ long SimSettings::control_stride() const {
   return std::max(1L, std::lround(control_period_s / timestep_s));
 }
 
-std::string SimSettings::validate() const {
+std::string SimSettings::validate(const std::string& machine) const {
   if (!std::isfinite(timestep_s) || timestep_s < kMinTimestep_s || timestep_s > kMaxTimestep_s)
     return "timestep_s must be between " + format_number(kMinTimestep_s) + " and " +
            format_number(kMaxTimestep_s) + " s, got " + format_number(timestep_s);
@@ -60,12 +60,13 @@ std::string SimSettings::validate() const {
     return "kp_scale must be between " + format_number(input_ranges::kMinKpScale) + " and " +
            format_number(input_ranges::kMaxKpScale) + ", got " + format_number(kp_scale);
   const double stiffness = kp_scale * std::pow(timestep_s / input_ranges::kReferenceTimestep_s, 2);
-  if (stiffness > input_ranges::kMaxServoStiffnessPerStep * (1.0 + 1e-12))
+  const double max_stiffness = input_ranges::max_servo_stiffness_per_step(machine);
+  if (stiffness > max_stiffness * (1.0 + 1e-12))
     return "timestep_s " + format_number(timestep_s) + " s with kp_scale " +
            format_number(kp_scale) +
            " makes the servos unstable: kp_scale * (timestep_s / 1 ms)^2 = " +
-           format_number(stiffness) + ", at most " +
-           format_number(input_ranges::kMaxServoStiffnessPerStep);
+           format_number(stiffness) + ", at most " + format_number(max_stiffness) +
+           (machine.empty() ? std::string() : " on " + machine);
   if (!std::isfinite(settle_s) || settle_s < 0.0 || settle_s > input_ranges::kMaxSettle_s)
     return "settle_s must be between 0 and " + format_number(input_ranges::kMaxSettle_s) +
            " s, got " + format_number(settle_s);
@@ -103,7 +104,7 @@ struct Simulation::Impl {
 Simulation::Simulation(const std::string& model_path, const Machine& machine,
                        const SimSettings& settings, const std::string& model_text)
     : impl_(std::make_unique<Impl>()) {
-  const std::string problem = settings.validate();
+  const std::string problem = settings.validate(machine.name());
   if (!problem.empty()) throw InputError("sim", problem);
   Impl& s = *impl_;
   s.bound = bind_model(model_path, machine, settings, model_text);
@@ -120,7 +121,7 @@ Simulation::Simulation(const std::string& model_path, const Machine& machine,
 std::vector<Problem> check_simulation_model(const std::string& model_path, const Machine& machine,
                                             const SimSettings& settings,
                                             const std::string& model_text) {
-  const std::string problem = settings.validate();
+  const std::string problem = settings.validate(machine.name());
   if (!problem.empty()) return {Problem{"", 0, "sim", problem}};
   try {
     bind_model(model_path, machine, settings, model_text);

@@ -49,8 +49,9 @@ struct SimSettings {
   double shutter_time_s = 0.0;  // flap open/close time; 0: the model's `shutter_time_s`
   bool feedforward = true;      // false: plain PD on the joint reference (servo lag shows)
 
-  // "" when usable, else what is wrong (names the field)
-  std::string validate() const;
+  // "" when usable, else what is wrong (names the field); `machine`: the registered machine
+  // (kinematics family) whose servo loop's stability bound applies ("": the largest)
+  std::string validate(const std::string& machine = "") const;
   // physics steps per servo update: control_period_s in whole timesteps, at least one
   long control_stride() const;
 };

@@ -518,6 +518,27 @@ sim:
   expect_problem(problems, scenario_path(), "sim.timestep_s", 5, "(timestep_s / 1 ms)^2 = 100");
 }
 
+// the servo loop's bound is the machine's, measured with its own gains: kp_scale 5 at 2 ms
+// (20) runs on the XY stage and diverged on the linear delta (bound 10) and on the gantry
+// (bound 16, which 4 ms at kp_scale 1 meets)
+TEST_F(ScenarioErrors, TheServoLoopsBoundIsTheMachines) {
+  const std::string toolpath = "toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\n";
+  const std::string stiff = "sim: {kp_scale: 5, timestep_s: 0.002}\n";
+  const auto stage = problems_of("machine: xy_stage\n" + toolpath + stiff);
+  EXPECT_TRUE(stage.empty()) << dump(stage);
+  const auto delta = problems_of("machine: linear_delta\n" + toolpath + stiff);
+  ASSERT_EQ(delta.size(), 1u) << dump(delta);
+  expect_problem(delta, scenario_path(), "sim.timestep_s", 3, "= 20, at most 10 on linear_delta");
+  const std::string gantry =
+      "machine: cartesian\ntoolpath: {speed: 3, segments: [[[50, 50], "
+      "[51, 50]]]}\n";
+  const auto refused = problems_of(gantry + stiff);
+  ASSERT_EQ(refused.size(), 1u) << dump(refused);
+  expect_problem(refused, scenario_path(), "sim.timestep_s", 3, "= 20, at most 16 on cartesian");
+  const auto at_the_bound = problems_of(gantry + "sim: {timestep_s: 0.004}\n");
+  EXPECT_TRUE(at_the_bound.empty()) << dump(at_the_bound);
+}
+
 // a path given twice is refused at the second, naming the first (either way round)
 TEST_F(ScenarioErrors, RepeatedPathsNameTheFirst) {
   const auto problems = problems_of(R"(
