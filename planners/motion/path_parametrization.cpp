@@ -16,6 +16,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kTinyCoefficient = 1e-12;
 // rounds of lowered accelerations where the sampled cubic cannot be fitted
 constexpr int kMaxRepairRounds = 12;
+// where they still fail, limits spread this many times over the failed window are a posture
+// near a singularity (the job's), not the fit's failure
+constexpr double kSingularLimitSpread = 2.0;
 // the sampled cubic's acceleration / velocity counts as over a limit beyond these fractions
 // (the planner contract allows 1e-6 and 1e-9); the velocity fit aims within half of them
 constexpr double kAccelFlag = 1e-9, kSpeedFlag = 1e-12;
@@ -935,11 +938,31 @@ TimedPath time_path(const PathGrid& grid, const std::vector<MachineLimits>& inte
     out.repair_scale = repair;
     if (failed.empty()) return out;
     if (round == kMaxRepairRounds) {
+      // limits that change several-fold within the window are the joints' mapped near a
+      // singular posture (an arm over its base axis, stretched, or with a straight wrist): the
+      // job's, exit 2; limits that hardly change there are this code's failure
+      const auto [s_lo, s_hi] = failed.front();
+      const size_t first = interval_of(grid, s_lo, 0), last = interval_of(grid, s_hi, first);
+      double spread = 1.0;
+      for (int axis = 0; axis < 3; ++axis) {
+        double lo = kInf, hi = 0.0;
+        for (size_t i = first; i <= last && i < interval_limits.size(); ++i) {
+          const AxisLimits& limit = interval_limits[i].axes[axis];
+          lo = std::min({lo, limit.a_max_mm_s2, limit.v_max_mm_s});
+          hi = std::max({hi, limit.a_max_mm_s2, limit.v_max_mm_s});
+        }
+        if (lo > 0.0 && hi > 0.0) spread = std::max(spread, hi / lo);
+      }
       std::ostringstream msg;
-      msg << grid.name << ": the 1 ms samples still exceed an acceleration limit between s = "
-          << failed.front().first << " and " << failed.front().second << " mm after " << round
-          << " rounds of lowered accelerations";
-      throw InternalError(msg.str());
+      msg << "the " << period_s * 1e3
+          << " ms samples still exceed an acceleration limit between s = " << s_lo << " and "
+          << s_hi << " mm after " << round << " rounds of lowered accelerations";
+      if (spread < kSingularLimitSpread) throw InternalError(grid.name + ": " + msg.str());
+      msg << ": the joints' limits, mapped to the tool, change " << spread
+          << "-fold there, faster than the samples can follow (a posture near a singularity: "
+             "over the arm's base axis, stretched out, or with its wrist straight); move the part "
+             "(toolpath.surface.offset) or turn it";
+      throw InputError(grid.name, msg.str());
     }
     // lower the accelerations allowed around each failed window and parametrise again
     std::vector<char> lowered(n, 0);

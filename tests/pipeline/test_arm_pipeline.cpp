@@ -559,6 +559,39 @@ TEST(ArmPipeline, CliNamesAPointTooCloseToThePart) {
   EXPECT_NE(r.output.find(", 5.000) mm is too close to the part"), std::string::npos) << r.output;
 }
 
+// A 40 x 40 mm dome placed where its second line passes near a singular posture of the arm
+// (the joints' limits mapped to the tool change about 25 000-fold within a millimetre): the
+// sampled law cannot be fitted there, and that is the job's problem (exit 2, what to change),
+// not an internal error (exit 1, as it was)
+TEST(ArmPipeline, CliRefusesAPathThroughANearSingularPosture) {
+  const std::string dir = fresh_directory("arm_cli_singular");
+  SphereCapParams dome;
+  dome.radius_mm = 60.0;
+  dome.apex_z_mm = 60.0 - std::sqrt(60.0 * 60.0 - 2.0 * 20.0 * 20.0);
+  dome.mesh.cell_mm = 2.0;
+  write_stl_binary(sphere_cap(dome), dir + "/dome.stl", "DepoTwin test: a dome");
+  const std::string path = write_text(dir, "dome.yaml",
+                                      "name: dome\n"
+                                      "machine: arm6\n"
+                                      "limits: {v_max: 200, a_max: 2000}\n"
+                                      "process: {type: extrusion, bead_width_mm: 1.0, "
+                                      "layer_height_mm: 0.5, tau_s: 0.02}\n"
+                                      "toolpath:\n"
+                                      "  speed: 40\n"
+                                      "  surface:\n"
+                                      "    file: dome.stl\n"
+                                      "    hatch_mm: 1.0\n"
+                                      "    angles: [0]\n"
+                                      "    offset: [130, 0, 0]\n"
+                                      "planners:\n"
+                                      "  - {name: conformal, control: flow}\n");
+  const testing_support::CliResult r = testing_support::depotwin("validate " + path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("a posture near a singularity"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("toolpath.surface.offset"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+}
+
 // ---------------------------------------------------------------------------------------
 // 6. determinism
 
