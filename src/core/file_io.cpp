@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -73,6 +74,17 @@ std::string missing_file_problem(const std::string& kind, const std::string& giv
   if (fs::is_directory(status)) return file + " is a directory" + where + ", not a file";
   if (fs::exists(status)) return file + " is not a regular file" + where;
   return file + " not found" + (given.empty() ? "" : " (looked for " + resolved + ")");
+}
+
+std::string settings_file_size_problem(const std::string& kind, const std::string& path) {
+  std::error_code error;
+  const std::uintmax_t bytes = fs::file_size(path, error);
+  if (error || bytes <= kMaxSettingsFileBytes) return "";
+  char size[64];
+  std::snprintf(size, sizeof size, "%.1f MB", static_cast<double>(bytes) / (1 << 20));
+  return "the " + kind + " file holds " + size + ", more than the " +
+         std::to_string(kMaxSettingsFileBytes >> 20) + " MB a " + kind +
+         " file may: its settings are text; long paths go in a G-code or STL file it names";
 }
 
 }  // namespace depotwin

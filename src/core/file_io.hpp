@@ -28,4 +28,13 @@ std::string read_text_file(const std::string& path);
 std::string missing_file_problem(const std::string& kind, const std::string& given,
                                  const std::string& resolved);
 
+// the most bytes a settings file (a scenario, a sweep) may hold: its long lists go in G-code
+// or STL files, and a 3 GB file of NULs was read whole (6.3 GB of memory) before its first
+// byte was refused
+inline constexpr unsigned long long kMaxSettingsFileBytes = 256ull << 20;
+
+// Why `path` is too large to be a `kind` file ("scenario", "sweep"), or "" (its size is read
+// before any byte: a regular file, as missing_file_problem checks first).
+std::string settings_file_size_problem(const std::string& kind, const std::string& path);
+
 }  // namespace depotwin

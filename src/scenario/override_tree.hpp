@@ -14,9 +14,13 @@
 
 namespace depotwin::scenario_detail {
 
-// A scenario file's text as one YAML document holding something (the loader's rules: malformed
-// YAML, an empty file or several documents are problems); nothing when it is not.
-std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemList& problems);
+// A scenario file's text as one YAML document holding something (the loader's rules: bytes
+// that are not UTF-8 text, malformed YAML, an empty file or several documents are problems);
+// nothing when it is not. `kind` names the file in the messages ("scenario", "sweep").
+// `aliased_positions` (optional, out): YamlDocuments' (the nodes aliases repeat).
+std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemList& problems,
+                                              const std::string& kind = "scenario",
+                                              std::vector<int>* aliased_positions = nullptr);
 
 // One step of an override key: a map key, or a list index (name empty).
 struct KeyStep {
@@ -28,9 +32,12 @@ struct KeyStep {
 std::optional<std::vector<KeyStep>> parse_override_key(const std::string& key, std::string& why);
 
 // Applies the overrides to `root` in order, `planner` last; a problem (at the override's file
-// and line) for each override the tree cannot take.
+// and line) for each override the tree cannot take, and for each that would edit a node an
+// alias repeats (`aliased_positions`, from parse_scenario_text): the edit would change every
+// place the alias names, silently.
 void apply_overrides(YAML::Node root, const std::vector<ScenarioOverride>& overrides,
-                     std::vector<Problem>& problems);
+                     std::vector<Problem>& problems,
+                     const std::vector<int>& aliased_positions = {});
 
 // The loader's problems under an overridden key (the key itself, or one inside its value;
 // for `planner`, anything under `planners`) moved to that override's file and line.

@@ -14,7 +14,9 @@ namespace depotwin {
 
 namespace scenario_detail {
 
-std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemList& problems) {
+std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemList& problems,
+                                              const std::string& kind,
+                                              std::vector<int>* aliased_positions) {
   // text only: a NUL, a control byte or bytes that are not UTF-8 (a Latin-1 name) would reach
   // names, folders and JSON otherwise, or be misread by the YAML parser
   if (const std::size_t at = first_non_text_byte(text); at != std::string::npos) {
@@ -28,8 +30,8 @@ std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemLi
         static_cast<int>(std::count(text.begin(), text.begin() + at, '\n')) + 1, "",
         std::string(control ? "control byte " : "byte ") + shown + (byte == 0 ? " (NUL)" : "") +
             " at column " + std::to_string(column) +
-            (control ? ": a scenario is text (YAML)"
-                     : " is not UTF-8: a scenario is UTF-8 text (YAML); save it as UTF-8"));
+            (control ? ": a " + kind + " is text (YAML)"
+                     : " is not UTF-8: a " + kind + " is UTF-8 text (YAML); save it as UTF-8"));
     return std::nullopt;
   }
   // exactly one YAML document (load_documents: not YAML::LoadAll, which never returns on some
@@ -63,14 +65,18 @@ std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemLi
     return std::nullopt;
   }
   if (documents.count == 0 || documents.first.IsNull()) {
-    problems.add(1, "", "the file holds no settings: expected a map with at least `toolpath:`");
+    problems.add(1, "",
+                 kind == "sweep"
+                     ? "the file holds nothing: expected a map with base: and grid:"
+                     : "the file holds no settings: expected a map with at least `toolpath:`");
     return std::nullopt;
   }
   if (documents.count > 1) {
     problems.add(documents.second_line, "",
-                 "more than one YAML document (---): a scenario file holds one");
+                 "more than one YAML document (---): a " + kind + " file holds one");
     return std::nullopt;
   }
+  if (aliased_positions != nullptr) *aliased_positions = std::move(documents.aliased_positions);
   return documents.first;
 }
 
@@ -161,13 +167,27 @@ std::string what_is(const YAML::Node& node) {
 }
 
 // Sets `steps` in `root` to `value`; "" or what went wrong.
-std::string set_value(YAML::Node root, const std::vector<KeyStep>& steps, const YAML::Node& value) {
+std::string set_value(YAML::Node root, const std::vector<KeyStep>& steps, const YAML::Node& value,
+                      const std::vector<int>& aliased_positions) {
+  // a node an alias repeats is one node in the tree: editing it edits every place it is named
+  const auto aliased = [&](const YAML::Node& node) {
+    return node.IsDefined() && !node.Mark().is_null() &&
+           std::find(aliased_positions.begin(), aliased_positions.end(), node.Mark().pos) !=
+               aliased_positions.end();
+  };
+  const auto shared_problem = [&](const std::string& walked) {
+    return walked +
+           " is an anchored node (&) that an alias (*) repeats in the base scenario: "
+           "an override there would change every place the alias names; write " +
+           walked + " out in the base scenario";
+  };
   YAML::Node current;
   current.reset(root);
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const KeyStep& step = steps[i];
     const bool last = i + 1 == steps.size();
     const std::string walked = key_text(steps, i);
+    if (i > 0 && aliased(current)) return shared_problem(walked);
     if (!step.name.empty()) {
       // a map key: a scalar with a map form becomes that map, e.g. a planner name {name: X}
       if (current.IsScalar() && !map_form_key(steps, i).empty()) {
@@ -179,6 +199,9 @@ std::string set_value(YAML::Node root, const std::vector<KeyStep>& steps, const 
         return walked + " is " + what_is(current) + " in the base scenario, not a map: override " +
                walked + " as a whole";
       if (last) {
+        // a value an alias repeats is unbound from this key first: assigned in place, it
+        // would be replaced everywhere the alias names it
+        if (aliased(current[step.name])) current.remove(step.name);
         // null (~) removes the key, e.g. toolpath.segments before toolpath.polylines is set
         if (value.IsNull())
           current.remove(step.name);
@@ -204,6 +227,8 @@ std::string set_value(YAML::Node root, const std::vector<KeyStep>& steps, const 
                                    : "") +
                ")";
       if (last) {
+        if (aliased(current[static_cast<std::size_t>(step.index)]))
+          return shared_problem(key_text(steps, i + 1));
         if (value.IsNull())
           return walked + "[" + std::to_string(step.index) +
                  "]: a list entry cannot be removed (~); override the whole list";
@@ -268,7 +293,7 @@ bool starts_with(const std::string& text, const std::string& prefix) {
 }  // namespace
 
 void apply_overrides(YAML::Node root, const std::vector<ScenarioOverride>& overrides,
-                     std::vector<Problem>& problems) {
+                     std::vector<Problem>& problems, const std::vector<int>& aliased_positions) {
   if (!root.IsMap()) return;  // the loader says what the file should be
   const auto apply = [&](const ScenarioOverride& override_) {
     const auto problem = [&](const std::string& message) {
@@ -292,7 +317,7 @@ void apply_overrides(YAML::Node root, const std::vector<ScenarioOverride>& overr
       problem(why);
       return;
     }
-    why = set_value(root, *steps, value);
+    why = set_value(root, *steps, value, aliased_positions);
     if (!why.empty()) problem(why);
   };
   // every override in order, `planner` last (planners[i] names the base scenario's list)
@@ -335,9 +360,11 @@ ResolvedScenario resolve_scenario(const std::string& path, const std::string& te
                                   const std::vector<ScenarioOverride>& overrides) {
   using namespace scenario_detail;
   ProblemList problems(path);
-  std::optional<YAML::Node> root = parse_scenario_text(text, problems);
+  std::vector<int> aliased_positions;
+  std::optional<YAML::Node> root =
+      parse_scenario_text(text, problems, "scenario", &aliased_positions);
   if (!root) throw InputError(problems.problems());
-  apply_overrides(*root, overrides, problems.problems());
+  apply_overrides(*root, overrides, problems.problems(), aliased_positions);
   if (!problems.empty()) throw InputError(problems.problems());
 
   ResolvedScenario resolved;

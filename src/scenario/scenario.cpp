@@ -231,6 +231,8 @@ class Loader {
   bool machine_bad_ = false;
   // the machine named (when known) and its TCP limits per move, for the speed and reach checks
   std::unique_ptr<Machine> machine_;
+  // where the nodes that aliases repeat begin (overrides may not edit them)
+  std::vector<int> aliased_positions_;
   // a long segments list read without yaml-cpp (scenario/lifted_list.hpp)
   std::optional<LiftedSegments> lifted_;
   std::optional<TcpLimits> tcp_limits_;
@@ -249,7 +251,8 @@ ScenarioReading Loader::read() {
   }
   // a sweep task's overrides (an override the tree cannot take is a problem at its own line,
   // and the rest of the scenario is still read)
-  if (overrides_ != nullptr) apply_overrides(root, *overrides_, problems_.problems());
+  if (overrides_ != nullptr)
+    apply_overrides(root, *overrides_, problems_.problems(), aliased_positions_);
 
   // the top level: every key optional except the toolpath
   const MapView top(Field{root, "", 1, 1}, keys_of(""), problems_);
@@ -300,7 +303,8 @@ bool Loader::read_document(YAML::Node& root) {
   } else {
     // a directory, a FIFO (reading it would wait for a writer) or nothing at all
     const std::string& file_path = problems_.file();
-    const std::string problem = missing_file_problem("scenario", "", file_path);
+    std::string problem = missing_file_problem("scenario", "", file_path);
+    if (problem.empty()) problem = settings_file_size_problem("scenario", file_path);
     if (!problem.empty()) {
       problems_.add(0, "", problem);
       return false;
@@ -317,7 +321,8 @@ bool Loader::read_document(YAML::Node& root) {
   // a long segments list is read apart (lifted_list.hpp), unless overrides may edit it in the
   // tree; then exactly one YAML document
   if (overrides_ == nullptr) lifted_ = lift_segments(text);
-  std::optional<YAML::Node> document = parse_scenario_text(text, problems_);
+  std::optional<YAML::Node> document =
+      parse_scenario_text(text, problems_, "scenario", &aliased_positions_);
   if (!document) return false;
   root = *document;
   return true;

@@ -183,7 +183,8 @@ class SweepReader {
  private:
   bool read_document(YAML::Node& root) {
     const std::string& path = problems_.file();
-    const std::string problem = missing_file_problem("sweep", "", path);
+    std::string problem = missing_file_problem("sweep", "", path);
+    if (problem.empty()) problem = settings_file_size_problem("sweep", path);
     if (!problem.empty()) {
       problems_.add(0, "", problem);
       return false;
@@ -195,16 +196,10 @@ class SweepReader {
       problems_.add(0, "", "cannot read the sweep file");
       return false;
     }
-    try {
-      root = YAML::Load(text.str());
-    } catch (const YAML::ParserException& e) {
-      problems_.add(e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
-      return false;
-    }
-    if (!root.IsDefined() || root.IsNull()) {
-      problems_.add(1, "", "the file holds nothing: expected a map with base: and grid:");
-      return false;
-    }
+    // the scenario's rules: UTF-8 text, one document, a tab or CR line ends named
+    std::optional<YAML::Node> document = parse_scenario_text(text.str(), problems_, "sweep");
+    if (!document) return false;
+    root = *document;
     return true;
   }
 

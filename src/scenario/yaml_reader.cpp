@@ -35,34 +35,44 @@ bool is_yaml_special_float(const std::string& text) {
   return lower == ".nan" || lower == ".inf" || lower == "+.inf" || lower == "-.inf";
 }
 
-// counts documents as the parser reads them and keeps where the second one's content begins
+// counts documents as the parser reads them and keeps where the second one's content begins,
+// and, in the first, where each anchored node that an alias repeats begins
 class DocumentCounter : public YAML::EventHandler {
  public:
   int count = 0;
   int second_line = 0;
+  std::vector<int> aliased_positions;
 
   void OnDocumentStart(const YAML::Mark&) override { ++count; }
   void OnDocumentEnd() override {}
-  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { node_at(mark); }
-  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { node_at(mark); }
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
-                const std::string&) override {
-    node_at(mark);
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override { node_at(mark, anchor); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    node_at(mark, 0);
+    const auto anchored = anchor_positions_.find(anchor);
+    if (count == 1 && anchored != anchor_positions_.end())
+      aliased_positions.push_back(anchored->second);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                const std::string&) override {
+    node_at(mark, anchor);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
                        YAML::EmitterStyle::value) override {
-    node_at(mark);
+    node_at(mark, anchor);
   }
   void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
                   YAML::EmitterStyle::value) override {
-    node_at(mark);
+    node_at(mark, anchor);
   }
   void OnMapEnd() override {}
 
  private:
-  void node_at(const YAML::Mark& mark) {
+  std::map<YAML::anchor_t, int> anchor_positions_;
+
+  void node_at(const YAML::Mark& mark, YAML::anchor_t anchor) {
     if (count == 2 && second_line == 0) second_line = mark.is_null() ? 0 : mark.line + 1;
+    if (count == 1 && anchor != 0) anchor_positions_[anchor] = mark.pos;
   }
 };
 
@@ -78,6 +88,7 @@ YamlDocuments load_documents(const std::string& text) {
   YamlDocuments documents;
   documents.count = counter.count;
   documents.second_line = counter.second_line;
+  documents.aliased_positions = std::move(counter.aliased_positions);
   if (documents.count > 0) documents.first = YAML::Load(text);
   return documents;
 }

@@ -29,6 +29,9 @@ struct YamlDocuments {
   YAML::Node first;
   int count = 0;
   int second_line = 0;
+  // where (YAML::Mark::pos) each node of the first document that an alias repeats begins: the
+  // tree holds it once, so an edit there changes every place that names it
+  std::vector<int> aliased_positions;
 };
 YamlDocuments load_documents(const std::string& text);
 

@@ -37,6 +37,9 @@ std::string SweepTask::parameters_text() const {
 
 Sweep::Sweep(const std::string& sweep_file, const std::string& out)
     : spec_(read_sweep_file(sweep_file)) {
+  if (const std::string too_large = settings_file_size_problem("scenario", spec_.base);
+      !too_large.empty())
+    throw InputError(spec_.base, 0, "", too_large);
   base_text_ = read_text_file(spec_.base);
   out_ = out.empty() ? (fs::path("results") / spec_.name).string() : out;
   for (const SweepParameter& parameter : spec_.grid) parameter_keys_.push_back(parameter.key);
@@ -309,6 +312,18 @@ void Sweep::prepare_out_directory() const {
           by == std::string::npos ? "" : " " + first_line.substr(by, first_line.find(';', by) - by);
       refuse("is a depotwin output folder" + writer +
              ", not a sweep's; choose an empty or new folder");
+    }
+  }
+  // another sweep's folder: its tasks and this one's would mix under one marker
+  {
+    const std::string first_line = output_marker_line(target.string());
+    const std::string sweep_marker = "depotwin sweep folder (";
+    const std::size_t close = first_line.find("):");
+    if (first_line.rfind(sweep_marker, 0) == 0 && close != std::string::npos) {
+      const std::string owner = first_line.substr(sweep_marker.size(), close - sweep_marker.size());
+      if (owner != spec_.name)
+        refuse("is the folder of sweep '" + owner + "', not of '" + spec_.name +
+               "': their tasks would mix; choose an empty or new folder");
     }
   }
   for (const char* folder : {"tasks", "logs"}) {

@@ -179,6 +179,35 @@ TEST(SweepFile, APathThatIsNotARegularFileIsNamed) {
             std::vector<std::string>{dir + "/none.yaml: sweep file not found"});
 }
 
+// a sweep file is read by the scenario's rules: UTF-8 text, one document, and a size a
+// settings file may have (a 300 MB sparse file is refused before a byte is read)
+TEST(SweepFile, TextOneDocumentAndASizeAsAScenarios) {
+  const std::string dir = fresh_directory("sweep_text");
+  const std::string latin1 = write_text(dir, "latin1.yaml", "name: caf\xE9\nbase: b.yaml\n");
+  EXPECT_EQ(
+      problems_of([&] { read_sweep_file(latin1); }),
+      std::vector<std::string>{latin1 + ":1: byte 0xE9 at column 10 is not UTF-8: a sweep is UTF-8 "
+                                        "text (YAML); save it as UTF-8"});
+  const std::string two =
+      write_text(dir, "two.yaml", "base: b.yaml\ngrid: {toolpath.speed: [1]}\n---\nbase: c\n");
+  EXPECT_EQ(
+      problems_of([&] { read_sweep_file(two); }),
+      std::vector<std::string>{two + ":4: more than one YAML document (---): a sweep file holds "
+                                     "one"});
+  const std::string huge = write_text(dir, "huge.yaml", "base: b.yaml\n");
+  std::filesystem::resize_file(huge, 300u << 20);
+  EXPECT_EQ(
+      problems_of([&] { read_sweep_file(huge); }),
+      std::vector<std::string>{huge + ": the sweep file holds 300.0 MB, more than the 256 MB a "
+                                      "sweep file may: its settings are text; long paths go in a "
+                                      "G-code or STL file it names"});
+  EXPECT_EQ(
+      problems_of([&] { load_scenario(huge); }),
+      std::vector<std::string>{huge + ": the scenario file holds 300.0 MB, more than the 256 MB a "
+                                      "scenario file may: its settings are text; long paths go in "
+                                      "a G-code or STL file it names"});
+}
+
 // the base scenario's text with overrides, as the loader reads it
 Scenario load_with(const std::string& base, const std::vector<ScenarioOverride>& overrides) {
   return load_scenario(base, read_text(base), overrides);
@@ -270,6 +299,32 @@ TEST(ScenarioOverrides, ProblemsOfAnOverrideAreAtItsLineOthersAtTheScenarios) {
   EXPECT_EQ(speed[0], fig7 +
                           ":21: toolpath.segments[0]: print speed 5 mm/s needs 5 mm/s on x, "
                           "above limits v_max 4 (lower the speed or raise the limit)");
+}
+
+// an alias (*ax) is the anchored node itself in the tree: an override inside it would change
+// every place it is named (limits.x.a_max set y's as well, silently), so it is refused; a
+// whole value is unbound from its key first and replaces only that key's
+TEST(ScenarioOverrides, AnAliasedNodeIsNotEditedThroughOneOfItsNames) {
+  const std::string dir = fresh_directory("override_alias");
+  std::string text = read_text(scenario_path("thompson_fig7.yaml"));
+  const std::string limits = "limits: {v_max: 4, a_max: 30}\n";
+  ASSERT_NE(text.find(limits), std::string::npos);
+  text.replace(text.find(limits), limits.size(),
+               "limits:\n  x: &axis {v_max: 4, a_max: 30}\n  y: *axis\n");
+  const std::string base = write_text(dir, "aliased.yaml", text);
+  const std::vector<std::string> inside =
+      problems_of([&] { load_with(base, {at("limits.x.a_max", "10", 4)}); });
+  ASSERT_EQ(inside.size(), 1u);
+  EXPECT_EQ(inside[0],
+            "sweep.yaml:4: limits.x.a_max: limits.x is an anchored node (&) that an alias (*) "
+            "repeats in the base scenario: an override there would change every place the alias "
+            "names; write limits.x out in the base scenario");
+  const Scenario whole = load_with(base, {at("limits.x", "{v_max: 4, a_max: 10}")});
+  EXPECT_EQ(whole.limits.axes[0].a_max_mm_s2, 10.0);
+  EXPECT_EQ(whole.limits.axes[1].a_max_mm_s2, 30.0);
+  const Scenario other = load_with(base, {at("limits.y", "{v_max: 4, a_max: 10}")});
+  EXPECT_EQ(other.limits.axes[0].a_max_mm_s2, 30.0);
+  EXPECT_EQ(other.limits.axes[1].a_max_mm_s2, 10.0);
 }
 
 TEST(ScenarioOverrides, HashesFollowTheInputsNotTheWorkingDirectory) {

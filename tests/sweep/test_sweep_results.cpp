@@ -95,6 +95,30 @@ TEST(SweepFolder, AMarkerBeingWrittenByAnotherTaskIsASweepFolder) {
   EXPECT_THROW(other.prepare_out_directory(), InputError);
 }
 
+// another sweep's folder is refused: the second sweep's task 0 overwrote the first's and
+// the rest of the first's stayed, under the first's marker (exit 0); the same sweep resumes
+TEST(SweepFolder, AnotherSweepsFolderIsRefusedItsOwnResumed) {
+  const std::string dir = fresh_directory("sweep_other_folder");
+  const Sweep sweep(write_sweep(dir), dir + "/out");
+  sweep.prepare_out_directory();
+  EXPECT_NO_THROW(sweep.prepare_out_directory());
+  const std::string other_file =
+      write_text(dir, "other.yaml",
+                 "name: other\nbase: " + scenario_path("thompson_fig7.yaml") +
+                     "\ngrid:\n  planner: [lspb_mtt]\n");
+  const Sweep other(other_file, dir + "/out");
+  try {
+    other.prepare_out_directory();
+    ADD_FAILURE() << "another sweep's folder taken";
+  } catch (const InputError& error) {
+    ASSERT_EQ(error.problems().size(), 1u);
+    EXPECT_EQ(error.problems()[0].message,
+              dir +
+                  "/out: is the folder of sweep 'merged', not of 'other': their tasks would "
+                  "mix; choose an empty or new folder");
+  }
+}
+
 TEST(SweepMerge, TheTableHasARowPerTaskAndAColumnPerParameterAndScalarMetric) {
   const std::string dir = fresh_directory("sweep_merge");
   const Sweep sweep(write_sweep(dir), dir + "/out");
