@@ -106,6 +106,11 @@ int validate_verb(const std::string& path, const std::string& max_memory, bool q
               << format_bytes(budget.max_memory_bytes) << ")\n";
   // what loading found and every run will repeat (a surface turned over, a G-code rule chosen)
   for (const std::string& note : scenario.notes) std::cout << "warning: " << note << '\n';
+  // and what each planner said of its plan, as `plan` and `run` print it
+  for (const PlannerSpec& spec : scenario.planners)
+    if (const Trajectory* plan = job.checked_plan(spec))
+      for (const std::string& warning : plan->warnings())
+        std::cout << "warning (" << spec.run_label() << "): " << warning << '\n';
   return kExitOk;
 }
 

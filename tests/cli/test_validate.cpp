@@ -83,6 +83,20 @@ toolpath: {gcode: square.gcode}
   EXPECT_NE(r.output.find("\nwarning: toolpath.gcode: "), std::string::npos) << r.output;
 }
 
+// each planner's own warnings on its plan, which `plan` and `run` print, validate prints as
+// they do (it had only the loader's notes): bezier slows or stops at corner_sweep's corners
+TEST(ValidateVerb, PrintsThePlannersWarningsAsPlanDoes) {
+  const std::string scenario = testing_support::scenario_path("corner_sweep.yaml");
+  const auto validated = depotwin("validate --quiet " + scenario);
+  ASSERT_EQ(validated.status, 0) << validated.output;
+  const std::string slowed = "warning (bezier): path 3 corner 1: blend slowed to ";
+  EXPECT_NE(validated.output.find(slowed), std::string::npos) << validated.output;
+  const std::string dir = fresh_directory("validate_planner_warnings");
+  const auto planned = depotwin("plan --quiet --planner bezier --out " + dir + "/out " + scenario);
+  ASSERT_EQ(planned.status, 0) << planned.output;
+  EXPECT_NE(planned.output.find(slowed), std::string::npos) << planned.output;
+}
+
 // the memory validate prints is the figure --max-memory is compared with: a budget 3 % below it
 // refuses the job, 3 % above accepts it
 TEST(ValidateVerb, TheMemoryItPrintsIsWhatMaxMemoryIsComparedWith) {
