@@ -1129,6 +1129,14 @@ void Loader::read_random_segments(const Field& field, const std::optional<double
       spec.length_max_mm = (*length)[1];
     }
   }
+  // the bed and the lengths make the instance: required, as the schema says (they were
+  // defaulted silently to a 100 x 100 bed)
+  if (!view.find("bed"))
+    problems_.add(field.key_line, section + ".bed",
+                  "missing: the bed's size [w, h] in mm, inside which the segments lie");
+  if (!view.find("length"))
+    problems_.add(field.key_line, section + ".length",
+                  "missing: the segments' lengths [min, max] in mm");
   if (const Field* f = view.find("seed")) spec.seed = read_seed(*f, problems_).value_or(spec.seed);
   std::optional<double> speed = default_speed;
   bool speed_bad = false;

@@ -799,6 +799,13 @@ toolpath:
   expect_problem(problems, scenario_path(), "toolpath.random_segments.length", 6, "min <= max");
   expect_problem(problems, scenario_path(), "toolpath.random_segments.seed", 7,
                  "whole number >= 0");
+  // the bed and the lengths are required (they were defaulted silently)
+  const auto missing = problems_of("toolpath:\n  speed: 3\n  random_segments: {n: 5}\n");
+  ASSERT_EQ(missing.size(), 2u) << dump(missing);
+  expect_problem(missing, scenario_path(), "toolpath.random_segments.bed", 3,
+                 "missing: the bed's size [w, h] in mm");
+  expect_problem(missing, scenario_path(), "toolpath.random_segments.length", 3,
+                 "missing: the segments' lengths [min, max] in mm");
 }
 
 TEST_F(ScenarioErrors, BadName) {
