@@ -307,11 +307,20 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
   const double max_steps = static_cast<double>(scenario.sim.max_steps);
   for (const RunEstimate& run : runs) {
     if (!run.simulated || !(run.steps > max_steps)) continue;
+    // whole numbers where three digits would show the two as equal ("1e+07, more than 1e+07")
+    std::string steps_text = count_text(run.steps), max_text = count_text(max_steps);
+    if (steps_text == max_text) {
+      char whole[2][48];
+      std::snprintf(whole[0], sizeof whole[0], "%.0f", run.steps);
+      std::snprintf(whole[1], sizeof whole[1], "%.0f", max_steps);
+      steps_text = whole[0];
+      max_text = whole[1];
+    }
     problems.push_back(at_driver(
         scenario, run, false,
         (run.label.empty() ? std::string("the job") : "run " + run.label) + " would take " +
-            count_text(run.steps) + " physics steps, more than sim.max_steps = " +
-            count_text(max_steps) + ": " + duration_text(scenario, run) + ", at sim.timestep_s " +
+            steps_text + " physics steps, more than sim.max_steps = " + max_text + ": " +
+            duration_text(scenario, run) + ", at sim.timestep_s " +
             number(scenario.sim.timestep_s) + " s (check the print speeds, the limits and sim" +
             fewer_layers_hint(scenario) + ", or raise sim.max_steps)"));
     if (run.label.empty()) break;  // before planning every run is the same estimate

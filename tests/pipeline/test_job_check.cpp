@@ -130,10 +130,13 @@ planners: [lspb_mtt]
     ASSERT_EQ(error.problems().size(), 1u) << error.what();
     EXPECT_EQ(error.problems()[0].key, "toolpath.speed");
     EXPECT_EQ(error.problems()[0].line, 2);
-    // 10 mm at 1 um/s: 1e4 s, 1e7 steps at 1 ms, with the ramps just above
-    EXPECT_NE(error.problems()[0].message.find("more than sim.max_steps = 1e+07"),
+    // 10 mm at 1 um/s: 1e4 s, 1e7 steps at 1 ms, with the ramps just above: whole numbers,
+    // which three digits would show as equal ("1e+07 ..., more than ... 1e+07")
+    const std::string& message = error.problems()[0].message;
+    EXPECT_NE(message.find(" physics steps, more than sim.max_steps = 10000000: "),
               std::string::npos)
         << error.what();
+    EXPECT_EQ(message.find("1e+07"), std::string::npos) << error.what();
   }
   JobBudget budget;
   budget.max_memory_bytes = 1e15;
