@@ -1201,12 +1201,17 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
   }
   if (const Field* f = view.find("units")) {
     const std::optional<std::string> units = read_string(*f, problems_);
+    // (a CAD program's export in metres is common: 0.04 read as mm is no part at all)
     if (units && *units == "mm")
       surface->mm_per_unit = 1.0;
+    else if (units && *units == "cm")
+      surface->mm_per_unit = 10.0;
+    else if (units && *units == "m")
+      surface->mm_per_unit = 1000.0;
     else if (units && (*units == "inch" || *units == "in"))
       surface->mm_per_unit = 25.4;
     else if (units)
-      problems_.add(f->line, f->key, "unknown units '" + *units + "' (expected mm or inch)");
+      problems_.add(f->line, f->key, "unknown units '" + *units + "' (expected mm, cm, m or inch)");
   }
   if (const Field* f = view.find("offset"))
     surface->offset_mm = read_point(*f, problems_).value_or(Vec3::Zero());

@@ -332,7 +332,7 @@ std::vector<SchemaSection> make_schema() {
         {"toolpath.surface",
          "conformal hatching of a part's top surface (Shembekar et al. 2018, Algorithm 1)",
          {other("file", "text", "", "required", "the part's STL (ASCII or binary)"),
-          word("units", {"mm", "inch", "in"}, "mm", "the STL's unit"),
+          word("units", {"mm", "cm", "m", "inch", "in"}, "mm", "the STL's unit"),
           other("offset", "point [x, y] (z 0) or [x, y, z], each in [-1e+06, 1e+06]", "mm",
                 "[0, 0, 0]", "the part's placement in the work frame, after rotation"),
           other("rotation", "[rx, ry, rz] or one number (about z), each in [-360, 360]", "deg",

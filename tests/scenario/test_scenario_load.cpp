@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "planners/planner.hpp"
@@ -287,6 +288,38 @@ std::string surface_scenario(const std::string& stl, const std::string& more_key
   return "machine: arm6\nlimits: {v_max: 200, a_max: 2000}\nprocess: {type: aerosol}\n"
          "toolpath:\n  speed: 10\n  surface: {file: " +
          stl + ", hatch_mm: 2" + more_keys + "}\n";
+}
+
+// the STL's unit scales every vertex: a patch written in metres (as CAD programs often
+// export) and in inches hatches as the same patch written in mm
+TEST_F(ScenarioLoad, SurfaceUnitsScaleThePart) {
+  const auto patch = [](double scale) {
+    // (every digit: a hatch line may fall on the patch's edge)
+    const auto corner = [&](double x, double y, double z) {
+      char text[96];
+      std::snprintf(text, sizeof text, "%.17g %.17g %.17g", x * scale, y * scale, z * scale);
+      return std::string(text);
+    };
+    return ascii_stl("patch", {{corner(0, 0, 1), corner(9.5, 0, 2), corner(9.5, 9.5, 2)},
+                               {corner(0, 0, 1), corner(9.5, 9.5, 2), corner(0, 9.5, 1)}});
+  };
+  write("mm.stl", patch(1.0));
+  write("m.stl", patch(1e-3));
+  write("inch.stl", patch(1.0 / 25.4));
+  const Scenario mm = load_scenario(write("mm.yaml", surface_scenario("mm.stl")));
+  const Scenario m = load_scenario(write("m.yaml", surface_scenario("m.stl", ", units: m")));
+  const Scenario inch =
+      load_scenario(write("inch.yaml", surface_scenario("inch.stl", ", units: inch")));
+  ASSERT_GT(mm.toolpath.paths.size(), 3u);
+  for (const Scenario* other : {&m, &inch}) {
+    ASSERT_EQ(other->toolpath.paths.size(), mm.toolpath.paths.size());
+    for (size_t p = 0; p < mm.toolpath.paths.size(); ++p) {
+      ASSERT_EQ(other->toolpath.paths[p].points.size(), mm.toolpath.paths[p].points.size());
+      for (size_t i = 0; i < mm.toolpath.paths[p].points.size(); ++i)
+        EXPECT_LT((other->toolpath.paths[p].points[i] - mm.toolpath.paths[p].points[i]).norm(),
+                  1e-4);
+    }
+  }
 }
 
 // A surface STL wound clockwise seen from above (a patch exported facing down) is turned
