@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "core/file_io.hpp"
 #include "core/number_text.hpp"
@@ -54,6 +55,23 @@ SweepValue number_value(double number) {
   return value;
 }
 
+// the range's values, or a problem where two of them read alike as written (each task's value
+// is its text: `{from: 1, to: 1.000000000001, count: 3}` made three tasks of speed 1)
+std::optional<std::vector<SweepValue>> distinct_range_values(std::vector<SweepValue> values,
+                                                             const Field& field,
+                                                             ProblemList& problems) {
+  for (std::size_t k = 1; k < values.size(); ++k)
+    if (values[k].text == values[k - 1].text) {
+      problems.add(field.line, field.key,
+                   "values " + std::to_string(k - 1) + " and " + std::to_string(k) +
+                       " of the range both read " + values[k].text +
+                       ": its values are closer than the digits a value is written with (widen "
+                       "the range or take fewer values)");
+      return std::nullopt;
+    }
+  return values;
+}
+
 // `{from: a, to: b}` (step 1), `{from, to, step}` or `{from, to, count}` (evenly spaced, ends
 // included)
 std::optional<std::vector<SweepValue>> read_range(const Field& field, ProblemList& problems) {
@@ -88,7 +106,7 @@ std::optional<std::vector<SweepValue>> read_range(const Field& field, ProblemLis
       values.push_back(number_value(*count == 1 ? *from
                                                 : *from + (*to - *from) * static_cast<double>(k) /
                                                               static_cast<double>(*count - 1)));
-    return values;
+    return distinct_range_values(std::move(values), field, problems);
   }
   // from, from + step, ... up to `to` (included within a millionth of a step)
   const double step_size = step.value_or(1.0);
@@ -108,7 +126,7 @@ std::optional<std::vector<SweepValue>> read_range(const Field& field, ProblemLis
   }
   for (long long k = 0; k <= static_cast<long long>(steps); ++k)
     values.push_back(number_value(*from + step_size * static_cast<double>(k)));
-  return values;
+  return distinct_range_values(std::move(values), field, problems);
 }
 
 // the values of one swept key: a list, or a range

@@ -156,6 +156,17 @@ TEST(SweepFile, ANumberWrittenTwoWaysIsOneValue) {
   };
   EXPECT_TRUE(has(file + ":3: grid.toolpath.speed: lists 2.0 twice (2 and 2.0 are one value)"));
   EXPECT_TRUE(has(file + ":4: grid.limits.a_max: lists +20 twice (2e1 and +20 are one value)"));
+  // a range whose values read alike as written would run one task several times
+  const std::string close = write_text(
+      dir, "close.yaml",
+      "base: nowhere.yaml\ngrid:\n  toolpath.speed: {from: 1, to: 1.000000000001, count: 3}\n");
+  const std::vector<std::string> range = problems_of([&] { read_sweep_file(close); });
+  EXPECT_NE(std::find(range.begin(), range.end(),
+                      close + ":3: grid.toolpath.speed: values 0 and 1 of the range both read 1: "
+                              "its values are closer than the digits a value is written with "
+                              "(widen the range or take fewer values)"),
+            range.end())
+      << ::testing::PrintToString(range);
 }
 
 TEST(SweepFile, AnEmptyGridAndAMissingBaseAreErrors) {
