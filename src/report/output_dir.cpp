@@ -81,6 +81,11 @@ bool is_depotwin_output(const fs::path& folder) {
 
 }  // namespace
 
+bool is_marker_being_written(const std::string& file_name) {
+  const std::string prefix = std::string(kOutputMarker) + ".tmp-";
+  return file_name.rfind(prefix, 0) == 0;
+}
+
 std::string output_marker_line(const std::string& folder) {
   std::ifstream marker(fs::path(folder) / kOutputMarker);
   std::string first_line;
@@ -222,14 +227,12 @@ bool left_by_a_writer(const fs::directory_entry& entry, const std::string& tag) 
   if (!fs::is_directory(status)) return false;
   if (is_depotwin_output(entry.path())) return true;
   // killed between making the folder and renaming its marker into place
-  const std::string marker_being_written = std::string(kOutputMarker) + ".tmp-";
   int n_entries = 0;
   bool only_the_marker_being_written = true;
   for (const fs::directory_entry& inner : fs::directory_iterator(entry.path(), error)) {
     ++n_entries;
     only_the_marker_being_written =
-        only_the_marker_being_written &&
-        inner.path().filename().string().rfind(marker_being_written, 0) == 0;
+        only_the_marker_being_written && is_marker_being_written(inner.path().filename().string());
   }
   return !error && n_entries == 1 && only_the_marker_being_written;
 }

@@ -18,6 +18,8 @@ inline constexpr const char* kExportedGcodeStart = "; G-code exported by depotwi
 // the first line of `folder`'s marker file ("depotwin output folder, written by ...", "depotwin
 // sweep folder (NAME): ..."), "" when it has none: what kind of folder it is
 std::string output_marker_line(const std::string& folder);
+// `file_name` is the marker on its way: the temporary file it is written through, then renamed
+bool is_marker_being_written(const std::string& file_name);
 
 // A directory built under a temporary name (`<final>.partial-<pid>`) and renamed to its
 // final name by commit(), replacing an older result. Destroyed without commit(), it is

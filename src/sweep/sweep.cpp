@@ -280,11 +280,10 @@ bool is_sweep_folder(const fs::path& folder) {
   if (fs::exists(folder / kOutputMarker, error)) return true;
   // (the marker on its way: the temporary file another task writes it through, then renames,
   // when tasks start side by side in a new folder, GNU parallel's or a Slurm array's)
-  const std::string marker_being_written = std::string(kOutputMarker) + ".tmp-";
   for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
     const std::string name = entry.path().filename().string();
     if ((name == "tasks" || name == "logs") && entry.is_directory(error)) continue;
-    if (name.rfind(marker_being_written, 0) == 0) continue;
+    if (is_marker_being_written(name)) continue;
     return false;
   }
   return !error;
@@ -301,9 +300,9 @@ void Sweep::prepare_out_directory() const {
   if (fs::is_directory(status) && !is_sweep_folder(target))
     refuse("exists and is not a depotwin sweep folder (it has files but no " +
            std::string(kOutputMarker) + " marker); choose an empty or new folder");
+  const std::string first_line = output_marker_line(target.string());
   // a run's, compare's or plan's folder (their marker) is not a sweep's: the two would mix
   {
-    const std::string first_line = output_marker_line(target.string());
     // ("depotwin output folder, written by `depotwin run`; ...": who wrote it)
     const std::string run_marker = "depotwin output folder";
     if (first_line.rfind(run_marker, 0) == 0) {
@@ -316,7 +315,6 @@ void Sweep::prepare_out_directory() const {
   }
   // another sweep's folder: its tasks and this one's would mix under one marker
   {
-    const std::string first_line = output_marker_line(target.string());
     const std::string sweep_marker = "depotwin sweep folder (";
     const std::size_t close = first_line.find("):");
     if (first_line.rfind(sweep_marker, 0) == 0 && close != std::string::npos) {
