@@ -50,13 +50,18 @@ std::string number(double value) {
   return message_number(value);
 }
 
+// a count as a whole number, every digit
+std::string whole_count_text(double value) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.0f", value);
+  return text;
+}
+
 // "1.2e+07 steps" style counts: whole below a million, else %.3g
 std::string count_text(double value) {
+  if (value < 1e6) return whole_count_text(value);
   char text[32];
-  if (value < 1e6)
-    std::snprintf(text, sizeof text, "%.0f", value);
-  else
-    std::snprintf(text, sizeof text, "%.3g", value);
+  std::snprintf(text, sizeof text, "%.3g", value);
   return text;
 }
 
@@ -310,11 +315,8 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
     // whole numbers where three digits would show the two as equal ("1e+07, more than 1e+07")
     std::string steps_text = count_text(run.steps), max_text = count_text(max_steps);
     if (steps_text == max_text) {
-      char whole[2][48];
-      std::snprintf(whole[0], sizeof whole[0], "%.0f", run.steps);
-      std::snprintf(whole[1], sizeof whole[1], "%.0f", max_steps);
-      steps_text = whole[0];
-      max_text = whole[1];
+      steps_text = whole_count_text(run.steps);
+      max_text = whole_count_text(max_steps);
     }
     problems.push_back(at_driver(
         scenario, run, false,
