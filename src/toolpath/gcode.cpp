@@ -250,6 +250,51 @@ bool code_number_is(const char* p, const char* end, int number) {
   return error == std::errc() && stop > p && value == number && (stop == end || *stop != '.');
 }
 
+// Why a line that starts with a name (Klipper's `SET_VELOCITY_LIMIT VELOCITY=100`, a macro)
+// would move the path the reader cannot follow: Sinumerik's frames and contours (`TRANS X10`,
+// `ROT RPL=45`, `CIP X20 Y10 I1=20 J1=0`), or any name with axis words not written NAME=VALUE
+// (Klipper's parameters always are); "" for a command that is no geometry
+std::string named_command_problem(const char* p, const char* end) {
+  const char* name_end = p;
+  while (name_end < end && (is_letter(*name_end) || is_digit(*name_end) || *name_end == '_'))
+    ++name_end;
+  std::string name(p, name_end);
+  std::transform(name.begin(), name.end(), name.begin(), [](char c) { return upper(c); });
+  static const char* const kSinumerikGeometry[] = {
+      "TRANS",   "ATRANS", "ROT", "AROT", "SCALE",   "ASCALE",  "MIRROR",
+      "AMIRROR", "CIP",    "CT",  "POLY", "ASPLINE", "BSPLINE", "CSPLINE",
+      "RND",     "RNDM",   "CHF", "CHR",  "AROTS"};
+  for (const char* keyword : kSinumerikGeometry)
+    if (name == keyword)
+      return "`" + name +
+             "`: Sinumerik's frames and contour commands (TRANS, ROT, SCALE, MIRROR, CIP, CT, "
+             "splines, roundings) are not supported: they move every point that follows or cut "
+             "a path the file does not write out (export the toolpath as plain G-code)";
+  // the parameters, outside quotes and before a comment: an axis word without '='
+  bool quoted = false;
+  const char* token = name_end;
+  while (token < end) {
+    if (*token == '"') quoted = !quoted;
+    if (!quoted && (*token == ';' || *token == '#')) break;
+    if (quoted || is_space(*token)) {
+      ++token;
+      continue;
+    }
+    const char* token_end = token;
+    while (token_end < end && !is_space(*token_end) && *token_end != ';' && *token_end != '"')
+      ++token_end;
+    const bool axis_letter = std::strchr("XYZIJKABCUVW", upper(*token)) != nullptr;
+    const char next = token + 1 < token_end ? token[1] : '\0';
+    if (axis_letter && (is_digit(next) || next == '-' || next == '+' || next == '.') &&
+        std::find(token, token_end, '=') == token_end)
+      return "`" + name + " " + std::string(token, token_end) +
+             "`: a named command with axis words is not supported (Sinumerik's and other "
+             "controllers' commands move the path; Klipper's parameters are written NAME=VALUE)";
+    token = token_end;
+  }
+  return {};
+}
+
 // Marlin's text commands (M117 message, M23 file name, ...): the rest of the line is text
 bool is_text_command(int number) {
   switch (number) {
@@ -423,12 +468,26 @@ const char* unsupported_g_code_reason(int tenths) {
     case 950:  // G95 feed per revolution
       return " is not supported (splines, canned cycles, threading and inverse-time or "
              "per-revolution feed change the path)";
+    case 720:  // G72, G74, G75, G77, G78, G79: Fanuc's turning and tapping cycles, Haas's G74
+    case 740:  // tapping cycle, whose repeat lines are more cycles
+    case 750:
+    case 770:
+    case 780:
+    case 790:
+      return " is not supported: a canned cycle (tapping, or a lathe's turning cycle) cuts "
+             "moves this file does not hold, and its following lines repeat it";
+    case 700:  // G70, G71: inch and mm in Sinumerik, Heidenhain ISO and Fanuc's system B, but
+    case 710:  // finishing and roughing cycles in Fanuc's lathe system A
+      return " is not supported: it means inch or mm in Sinumerik and Fanuc's system B but a "
+             "lathe's turning cycle in Fanuc's system A; write G20 (inch) or G21 (mm)";
     case 410:  // G41, G41.1, G42, G42.1: cutter radius compensation
     case 411:
     case 420:
     case 421:
       return " is not supported: cutter radius compensation offsets the path by a tool radius "
              "the file does not give (export the toolpath without it, G40)";
+    case 121:  // G12.1, G13.1: Fanuc's polar interpolation
+    case 131:
     case 160:  // G16 polar coordinates
     case 520:  // G52 local coordinate offset (RS274/NGC, Fanuc, Mach3)
     case 510:  // G51 scaling
@@ -504,8 +563,12 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   // grbl's system commands ($H homing, $X unlock, $$ settings): not G-code
   if (*p == '$') return;
   // Klipper's extended commands (a name, not a letter and a number; a macro's may start with
-  // `_`, as `_CLIENT_RETRACT`): not motion
-  if (*p == '_' || (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_'))) return;
+  // `_`, as `_CLIENT_RETRACT`): not motion, unless the name is another controller's geometry
+  if (*p == '_' || (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_'))) {
+    if (const std::string reason = named_command_problem(p, end); !reason.empty())
+      problem(line_number, reason);
+    return;
+  }
   ++program_.n_code_lines;
   // the first code after an optional line number: Marlin's text commands end here
   const char* q = p;
@@ -751,6 +814,10 @@ void GcodeParser::execute(int line_number) {
     }
     if (code.letter == 'M') {
       if (code.tenths == 820 || code.tenths == 830) extruder_relative_ = code.tenths == 830;
+      // M66, M67, M68 (LinuxCNC's analog input and outputs, synchronised with the line's move):
+      // E names the channel, never the extruder
+      if (code.tenths == 660 || code.tenths == 670 || code.tenths == 680)
+        words_.present &= ~(1u << ('E' - 'A'));
       // an M code's axis words are its parameters (M201 X1000: the x acceleration, M92, M203,
       // M205, M906, ...), never a modal move, but for the codes that take none (M8, M3, ...)
       if (!m_code_takes_no_axis_words(code.tenths) && !is_shutter_code(open_code_, code) &&
@@ -760,6 +827,14 @@ void GcodeParser::execute(int line_number) {
     }
     if (const char* reason = unsupported_g_code_reason(code.tenths)) {
       problem(line_number, g_code_name(code.tenths) + reason);
+      return;
+    }
+    // G12 and G13 with a radius I: Mach3's circular pocket, a circle cut about the position
+    // (Marlin's G12, a nozzle clean, takes P, S, T and R: the firmware's own, never printed)
+    if ((code.tenths == 120 || code.tenths == 130) && words_.has('I')) {
+      problem(line_number, g_code_name(code.tenths) +
+                               " I: circular pockets (Mach3) are not supported: they cut a "
+                               "circle the file does not write out (write it as G2/G3 moves)");
       return;
     }
     switch (code.tenths) {
@@ -1134,12 +1209,18 @@ bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, 
     }
     full_circle = chord <= kMinMove_mm;
     if (!full_circle) {
-      // the centre moved onto the chord's bisector: one exact circle through both ends
+      // the centre moved onto the chord's bisector: one exact circle through both ends. An end
+      // a hair off a full circle's start, along the radius, has its bisector far from the
+      // centre (by about r x offset / chord): the given centre stays, the circle is cut nearly
+      // whole (as LinuxCNC and Marlin cut it), its end mismatch within the radius tolerance
       const double m0 = 0.5 * (s0 + e0), m1 = 0.5 * (s1 + e1);
       const double p0 = -chord1 / chord, p1 = chord0 / chord;
       const double along = (c0 - m0) * p0 + (c1 - m1) * p1;
-      c0 = m0 + along * p0;
-      c1 = m1 + along * p1;
+      const double on_bisector0 = m0 + along * p0, on_bisector1 = m1 + along * p1;
+      if (std::hypot(on_bisector0 - c0, on_bisector1 - c1) <= radius_tolerance) {
+        c0 = on_bisector0;
+        c1 = on_bisector1;
+      }
     }
   } else {
     const double radius = words_.get('R') * unit_mm_;

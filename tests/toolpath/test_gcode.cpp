@@ -725,6 +725,88 @@ TEST(Gcode, ArcTurnsBeyondOneAreRefused) {
       << problems[0].str();
 }
 
+// a full circle whose end is a hair off its start along the radius (G2 X10.001 from X10
+// about X0): the chord's bisector lies far from the given centre, which once moved there and
+// left a micrometre semicircle (10 mm printed where the 62.8 mm circle is); the centre stays
+TEST(Gcode, AnEndAHairOffAFullCirclesStartKeepsItsCentre) {
+  const GcodeProgram program =
+      parse_gcode_program("G21 G90 G17\nG0 X10 Y0 Z0\nG1 F600\nG2 X10.001 Y0 I-10 J0\nG1 X20\n",
+                          "c.ngc", GcodeOptions{});
+  ASSERT_EQ(program.moves.size(), 3u);
+  const GcodeMove& circle = program.moves[1];
+  EXPECT_EQ(circle.line, 4);
+  EXPECT_DOUBLE_EQ(circle.arc.sweep_rad, 2.0 * kPi);
+  EXPECT_NEAR(circle.arc.center_mm.x(), 0.0, 1e-12);
+  EXPECT_NEAR(circle.arc.center_mm.y(), 0.0, 1e-12);
+  EXPECT_NEAR(circle.length_mm, 2.0 * kPi * 10.0, 1e-9);
+  // an end off along the tangent is a circle through both ends, short of one turn by the gap
+  const GcodeProgram tangent = parse_gcode_program(
+      "G21 G90 G17\nG0 X10 Y0 Z0\nG1 F600\nG2 X10 Y0.001 I-10 J0\n", "t.ngc", GcodeOptions{});
+  ASSERT_EQ(tangent.moves.size(), 2u);
+  EXPECT_NEAR(tangent.moves[1].arc.sweep_rad, 2.0 * kPi - 1e-4, 1e-9);
+}
+
+// LinuxCNC's M66, M67 and M68 take their channel as E (`G1 X10 M67 E0 Q50`, an analog output
+// set with the move): no extrusion, the print read by the spindle codes (before: rule e, no
+// print at all)
+TEST(Gcode, AnAnalogChannelIsNoExtrusion) {
+  const GcodeImport imported = parse(
+      "G21 G90\nG0 X0 Y0 Z0 F600\nM3 S1000\nG1 X10 M67 E0 Q50\nG1 X20 M67 E0 Q80\n"
+      "G1 X30 M68 E1 Q20\nM5\nM2\n");
+  EXPECT_EQ(imported.rule, PrintRule::shutter) << imported.rule_reason;
+  ASSERT_EQ(imported.toolpath.paths.size(), 1u);
+  expect_points(imported.toolpath.paths[0],
+                {Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(20, 0, 0), Vec3(30, 0, 0)});
+}
+
+// other controllers' codes that cut what the file does not write out, or whose meaning
+// depends on the controller, are refused at their line (before, each was skipped and its
+// geometry lost, or G70's inch read as mm); Marlin's G12 nozzle clean passes
+TEST(Gcode, PocketsCyclesAndAmbiguousUnitCodesAreRefused) {
+  const auto problems = problems_of(
+      "G21 G90\nG1 X0 Y0 F600\nG12 I10\nG13 I5\nG74 X1 Y1 Z-0.5 R0.1 F25\nG70\nG71\n"
+      "G12.1\nG75 X1\nG1 X10 E1\n");
+  ASSERT_EQ(problems.size(), 7u) << dump(problems);
+  const char* codes[7] = {"G12 I: circular pockets",
+                          "G13 I: circular pockets",
+                          "G74 is not supported: a canned cycle",
+                          "G70 is not supported: it "
+                          "means inch or mm",
+                          "G71 is not supported: it means inch or mm",
+                          "G12.1 is not supported: polar",
+                          "G75 is not supported: a canned"};
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    EXPECT_EQ(problems[i].line, static_cast<int>(i) + 3);
+    EXPECT_EQ(problems[i].message.rfind(codes[i], 0), 0u) << problems[i].str();
+  }
+  const GcodeImport clean = parse("G21 G90\nG12 P1 S3 T2\nG1 X0 Y0 F600\nG1 X10 E1\n");
+  ASSERT_EQ(clean.toolpath.paths.size(), 1u);
+  expect_points(clean.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+}
+
+// a line that starts with a name is Klipper's command or macro (NAME=VALUE parameters, no
+// geometry), but Sinumerik's frames and contours (`TRANS X10 Y10`, `ROT RPL=45`, `CIP ...`)
+// and any name with bare axis words move the path: refused at their line, not skipped
+TEST(Gcode, NamedCommandsWithGeometryAreRefusedKlippersPass) {
+  const auto problems = problems_of(
+      "G21 G90\nG1 X0 Y0 F600\nTRANS X10 Y10\nROT RPL=45\nCIP X20 Y10 I1=20 J1=0\n"
+      "MY_MACRO X10\nG1 X10 E1\n");
+  ASSERT_EQ(problems.size(), 4u) << dump(problems);
+  for (std::size_t i = 0; i < problems.size(); ++i)
+    EXPECT_EQ(problems[i].line, static_cast<int>(i) + 3) << problems[i].str();
+  EXPECT_EQ(problems[0].message.rfind("`TRANS`: Sinumerik's frames", 0), 0u) << problems[0].str();
+  EXPECT_EQ(problems[1].message.rfind("`ROT`: Sinumerik's frames", 0), 0u) << problems[1].str();
+  EXPECT_EQ(problems[2].message.rfind("`CIP`: Sinumerik's frames", 0), 0u) << problems[2].str();
+  EXPECT_EQ(problems[3].message.rfind("`MY_MACRO X10`: a named command with axis words", 0), 0u)
+      << problems[3].str();
+  const GcodeImport klipper = parse(
+      "G21 G90\nSET_VELOCITY_LIMIT VELOCITY=100 ACCEL=3000\nRESPOND MSG=\"at X10 Y5\"\n"
+      "_CLIENT_RETRACT LENGTH=1\nSET_KINEMATIC_POSITION X=0 Y=0 Z=0\nPRINT_START ; X10\n"
+      "G1 X0 Y0 F600\nG1 X10 E1\n");
+  ASSERT_EQ(klipper.toolpath.paths.size(), 1u);
+  expect_points(klipper.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+}
+
 TEST(Gcode, PlaceholdersAreNamedAsATemplate) {
   const auto problems = problems_of("G90\nG29.1 Z{+0.0}\nM190 S[bed_temperature]\nG1 X1\n");
   ASSERT_EQ(problems.size(), 1u) << dump(problems);
