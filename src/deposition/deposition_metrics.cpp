@@ -205,9 +205,10 @@ ThicknessStats thickness_stats(const ThicknessField& field, const TargetRegion& 
   if (stats.cells > 0 && sum > 0.0) {
     const double mean = sum / static_cast<double>(stats.cells);
     double squares = 0.0;
-    for_each_stats_cell([&](double v) { squares += (v - mean) * (v - mean); });
+    // (relative to the mean: a tiny flow's squares would underflow to a cv of 0)
+    for_each_stats_cell([&](double v) { squares += ((v - mean) / mean) * ((v - mean) / mean); });
     stats.mean_um = mean * kUmPerMm;
-    stats.cv = std::sqrt(squares / static_cast<double>(stats.cells)) / mean;
+    stats.cv = std::sqrt(squares / static_cast<double>(stats.cells));
     stats.min_rel = min_value / mean;
     stats.max_rel = max_value / mean;
   }
@@ -236,8 +237,9 @@ ThicknessStats thickness_stats(const ThicknessField& field, const TargetRegion& 
     const double line_mean = line_sum / static_cast<double>(samples.size());
     if (line_mean > 0.0) {
       double squares = 0.0;
-      for (double v : samples) squares += (v - line_mean) * (v - line_mean);
-      stats.line_cv = std::sqrt(squares / static_cast<double>(samples.size())) / line_mean;
+      for (double v : samples)
+        squares += ((v - line_mean) / line_mean) * ((v - line_mean) / line_mean);
+      stats.line_cv = std::sqrt(squares / static_cast<double>(samples.size()));
     }
   }
   return stats;

@@ -114,6 +114,27 @@ std::string arm_collision_warning(const ArmStats& arm, const ContactLog& contact
   return warning;
 }
 
+std::string thickness_coverage_warning(const ThicknessStats& stats) {
+  // the scores' cells and samples leave out half a line width at every path's end
+  const bool few_cells = stats.cells < kFewestScoredCells;
+  const bool few_samples = stats.line_samples < kFewestScoredSamples;
+  if (!few_cells && !few_samples) return "";
+  const auto counted = [](size_t count, const char* what) {
+    return count == 0 ? std::string("no ") + what : "only " + std::to_string(count) + " " + what;
+  };
+  std::string scores;
+  if (few_cells)
+    scores =
+        "thickness mean_um, cv, min_rel and max_rel (" + counted(stats.cells, "target cells") + ")";
+  if (few_samples)
+    scores += (scores.empty() ? "thickness line_cv (" : " and line_cv (") +
+              counted(stats.line_samples, "centreline samples") + ")";
+  return scores +
+         " measure too little to score the deposit: they leave out half a line width at each "
+         "path's end, and the paths are hardly longer than the line is wide (a 0 there is no "
+         "perfect score)";
+}
+
 namespace {
 
 ThicknessSummary thickness_summary(const ThicknessStats& stats) {
@@ -249,6 +270,8 @@ void add_simulated_metrics(MetricsReport& r, const RecordedRun& record,
   r.velocity_error_steady = velocity_error(simulated, r.speed_ramps);
   r.path_error = path_error(simulated, toolpath);
   r.thickness = thickness_summary(deposited.thickness);
+  if (const std::string warning = thickness_coverage_warning(deposited.thickness); !warning.empty())
+    r.warnings.push_back(warning);
   material_and_waste(deposited.material, r);
   r.sim = sim_stats(record);
 }

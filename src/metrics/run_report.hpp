@@ -32,6 +32,13 @@ ActuatorStats actuator_stats(const RecordedRun& record, const std::vector<JointL
 // limit 200 mm/s in the simulation"
 std::vector<std::string> actuator_limit_warnings(const ActuatorStats& stats);
 
+// fewer target cells or centreline samples than score a deposit's evenness
+inline constexpr size_t kFewestScoredCells = 10;
+inline constexpr size_t kFewestScoredSamples = 3;
+// The warning for metrics.json when the thickness scores rest on fewer cells or samples than
+// that ("" when they do not): a run of paths shorter than the line is wide reads cv 0
+std::string thickness_coverage_warning(const ThicknessStats& stats);
+
 // An arm's collisions for metrics.json's warnings ("" without any): the contact events by kind
 // (ArmStats) and the first MuJoCo contact (its time and the two geoms) where one was recorded
 std::string arm_collision_warning(const ArmStats& arm, const ContactLog& contacts);

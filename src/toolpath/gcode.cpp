@@ -975,6 +975,13 @@ void GcodeParser::execute(int line_number) {
     // RepRapFirmware's P in ms too); Fanuc's X in seconds. grbl's and LinuxCNC's P, in
     // seconds, reads as ms here
     double dwell_s = 0.0;
+    // a negative dwell is no firmware's wait (Marlin's wraps its clock): refused, not read as 0
+    for (const char letter : {'S', 'P', 'X'})
+      if (words_.has(letter) && words_.get(letter) < 0.0) {
+        problem(line_number, std::string("G4 ") + letter + message_number(words_.get(letter)) +
+                                 ": a dwell must be 0 or more");
+        return;
+      }
     if (words_.has('S'))
       dwell_s = std::max(0.0, words_.get('S'));
     else if (words_.has('P'))

@@ -130,6 +130,25 @@ TEST(MaterialSplit, SplitsLandedMaterialByTargetRegion) {
   EXPECT_DOUBLE_EQ(split.closed_time_s, 0.25);
 }
 
+// a field of the known one's pattern scaled to denormal thicknesses (a flow of 1e-320 mm3/s)
+// keeps its spread: the squares of the differences once underflowed to a cv of 0
+TEST(ThicknessStats, ATinyFieldKeepsItsSpread) {
+  const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, 10.0, 0.0, 3.0);
+  ThicknessField field(kCell), tiny(kCell);
+  for (int iy = -8; iy <= 8; ++iy)
+    for (int ix = -8; ix <= 408; ++ix) {
+      field.add_to_cell(ix, iy, iy < 0 ? 1e-3 : 2e-3);
+      tiny.add_to_cell(ix, iy, iy < 0 ? 1e-310 : 2e-310);
+    }
+  const TargetRegion region(toolpath, 0.4, kCell);
+  const ThicknessStats stats = thickness_stats(field, region, toolpath);
+  const ThicknessStats tiny_stats = thickness_stats(tiny, region, toolpath);
+  ASSERT_GT(stats.cv, 0.3);
+  EXPECT_NEAR(tiny_stats.cv, stats.cv, 1e-6 * stats.cv);
+  EXPECT_NEAR(tiny_stats.min_rel, stats.min_rel, 1e-6);
+  EXPECT_NEAR(tiny_stats.max_rel, stats.max_rel, 1e-6);
+}
+
 TEST(ThicknessStats, EmptyToolpathGivesZeros) {
   ThicknessField field(kCell);
   field.add_to_cell(0, 0, 1.0);

@@ -80,5 +80,27 @@ TEST(ArmCollisionWarning, CountsTheEventsByKindAndNamesTheFirstContact) {
             "0 of the arm with itself");
 }
 
+// thickness scores resting on no target cell or too few (paths hardly longer than the line is
+// wide: ends are left out) are said, so their 0 is not read as a perfect deposit
+TEST(ThicknessCoverage, ScoresOnTooFewCellsOrSamplesAreSaid) {
+  ThicknessStats stats;
+  stats.cells = 0;
+  stats.line_samples = 0;
+  const std::string none = thickness_coverage_warning(stats);
+  EXPECT_NE(none.find("cv, min_rel and max_rel (no target cells) and line_cv (no centreline "
+                      "samples) measure too little"),
+            std::string::npos)
+      << none;
+  stats.cells = kFewestScoredCells - 1;
+  stats.line_samples = kFewestScoredSamples;
+  const std::string few = thickness_coverage_warning(stats);
+  EXPECT_EQ(
+      few.rfind("thickness mean_um, cv, min_rel and max_rel (only 9 target cells) measure", 0), 0u)
+      << few;
+  EXPECT_EQ(few.find("line_cv"), std::string::npos) << few;
+  stats.cells = kFewestScoredCells;
+  EXPECT_EQ(thickness_coverage_warning(stats), "");
+}
+
 }  // namespace
 }  // namespace depotwin
