@@ -170,6 +170,13 @@ TEST(Gcode, DwellsReadSOverPAndFanucX) {
   EXPECT_DOUBLE_EQ(program.pauses[2].duration_s, 2.0);
   EXPECT_DOUBLE_EQ(program.pauses[3].duration_s, 0.25);
   EXPECT_DOUBLE_EQ(program.dwell_s, 3.75);
+  // a negative one is no wait a firmware makes (it was read as 0): refused at its line
+  const auto problems = problems_of("G1 X1 E1 F600\nG4 P-5000\nG4 S-3\nG4 X-1\n");
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 2);
+  EXPECT_EQ(problems[0].message, "G4 P-5000: a dwell must be 0 or more");
+  EXPECT_EQ(problems[1].message, "G4 S-3: a dwell must be 0 or more");
+  EXPECT_EQ(problems[2].line, 4);
 }
 
 // a PrusaSlicer start block: firmware checks whose parameters are text (M862.3 P "MK3S",
