@@ -155,6 +155,7 @@ int main(int argc, char** argv) {
 
   // ---- view (a finished run replayed in a window: src/viewer/viewer.cpp) ----
   ViewOptions view_options;
+  double view_at_s = 0.0;
   CLI::App* view = app.add_subcommand(
       "view", "replay a finished run in an interactive MuJoCo window (needs a display)");
   view->add_option("run_dir", view_options.run_directory,
@@ -162,7 +163,7 @@ int main(int argc, char** argv) {
       ->required();
   view->add_option("--screenshot", view_options.screenshot,
                    "render one frame in the window, write it to this PNG and exit");
-  view->add_option("--at", view_options.at_s,
+  view->add_option("--at", view_at_s,
                    "start at this run time, s (default: the start; a screenshot: the end)");
   view->add_option("--width", view_options.width, "window width, pixels (default 1280)");
   view->add_option("--height", view_options.height, "window height, pixels (default 640)");
@@ -284,7 +285,10 @@ int main(int argc, char** argv) {
     if (*compare) return compare_verb(compare_options);
     if (*plan) return plan_verb(plan_options);
     if (*validate) return validate_verb(validate_scenario, validate_max_memory, validate_quiet);
-    if (*view) return view_verb(view_options);                              // view
+    if (*view) {
+      if (view->count("--at") > 0) view_options.at_s = view_at_s;
+      return view_verb(view_options);
+    }                                                                       // view
     if (*describe) return describe_verb(describe_topic, describe_as_json);  // describe
     if (*export_gcode) return export_verb(export_options);                  // export
     if (*sweep) return sweep_verb(sweep_options);                           // sweep

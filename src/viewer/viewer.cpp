@@ -5,11 +5,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <vector>
 
+#include <unistd.h>
+
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/number_text.hpp"
 #include "core/png.hpp"
 #include "render/video.hpp"
 #include "report/replay_io.hpp"
@@ -202,16 +207,49 @@ struct WindowContext {
   WindowContext& operator=(const WindowContext&) = delete;
 };
 
+// --screenshot names a new file or a PNG to replace, in a folder that can be written: never
+// the run's replay.json or a scenario (a PNG was once written over both), checked before the
+// window opens
+void check_screenshot_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (const std::string problem = replaceable_file_problem(path); !problem.empty())
+    throw InputError("--screenshot", problem);
+  std::error_code error;
+  if (fs::is_regular_file(path, error)) {
+    static const char kPngSignature[] = "\x89PNG\r\n\x1a\n";
+    std::ifstream file(path, std::ios::binary);
+    std::string start(8, '\0');
+    file.read(start.data(), 8);
+    if (!file || start != std::string(kPngSignature, 8))
+      throw InputError("--screenshot", "'" + path +
+                                           "' exists and is not a PNG image (only a PNG is "
+                                           "replaced); name a new file, e.g. frame.png");
+  }
+  const fs::path parent =
+      fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  if (!fs::is_directory(parent, error))
+    throw InputError("--screenshot",
+                     "'" + parent.string() + "' is not a directory (for '" + path + "')");
+  if (access(parent.c_str(), W_OK) != 0)
+    throw InputError("--screenshot",
+                     "cannot write in '" + parent.string() + "' (for '" + path + "')");
+}
+
 }  // namespace
 
 int view_verb(const ViewOptions& options) {
-  if (options.width < 64 || options.height < 64)
-    throw InputError("--size", "the window must be at least 64 x 64 pixels");
+  if (options.width < 64) throw InputError("--width", "the window must be at least 64 pixels wide");
+  if (options.height < 64)
+    throw InputError("--height", "the window must be at least 64 pixels high");
+  if (options.at_s && !(*options.at_s >= 0.0 && std::isfinite(*options.at_s)))
+    throw InputError("--at", "a run time in seconds, 0 or more, is required, got " +
+                                 message_number(*options.at_s));
   const bool screenshot = !options.screenshot.empty();
-  if (screenshot)
-    if (const std::string problem = replaceable_file_problem(options.screenshot); !problem.empty())
-      throw InputError("--screenshot", problem);
+  if (screenshot) check_screenshot_path(options.screenshot);
   const ReplayData replay = read_replay(options.run_directory);
+  if (options.at_s && *options.at_s > replay.timing.duration_s)
+    throw InputError("--at", message_number(*options.at_s) + " s is after the run's end, " +
+                                 message_number(replay.timing.duration_s) + " s");
 
   // the window, then the replay's scene and MuJoCo's context in it
   GlfwWindow glfw(options.width, options.height,
@@ -224,9 +262,7 @@ int view_verb(const ViewOptions& options) {
   viewer.view = &view;
   viewer.frames = replay.frame_count();
   viewer.closeup = options.closeup;
-  const double start_s = options.at_s >= 0.0 ? options.at_s
-                         : screenshot        ? replay.timing.duration_s
-                                             : 0.0;
+  const double start_s = options.at_s ? *options.at_s : screenshot ? replay.timing.duration_s : 0.0;
   viewer.go_to(static_cast<double>(view.frame_at_time(start_s)));
 
   // one frame in the window, read back from its back buffer, written as a PNG

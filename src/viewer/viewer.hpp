@@ -3,6 +3,7 @@
 // (render/video.hpp): the scene with the deposit growing, the overlay, a timeline bar.
 #pragma once
 
+#include <optional>
 #include <string>
 
 namespace depotwin {
@@ -11,8 +12,9 @@ struct ViewOptions {
   std::string run_directory;
   // write this PNG of one frame, rendered in the window, and exit (a test under Xvfb)
   std::string screenshot;
-  double at_s = -1.0;  // start at this run time (negative: the start; a screenshot: the end)
-  int width = 1280;    // window size (pixels)
+  // start at this run time, s (0 to the run's duration); unset: the start, a screenshot the end
+  std::optional<double> at_s;
+  int width = 1280;  // window size (pixels)
   int height = 640;
   bool closeup = true;  // the deposit's close-up panel beside the whole machine
 };

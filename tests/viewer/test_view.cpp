@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <array>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "pipeline/pipeline_test_util.hpp"
@@ -39,6 +41,40 @@ TEST(View, AFolderWithoutReplayDataIsBadInput) {
       << view.output;
   EXPECT_FALSE(fs::exists(dir + "/shot.png"));
   EXPECT_EQ(depotwin("view").status, 2);  // the folder is required
+}
+
+// --screenshot replaces only a PNG (it was written over the run's replay.json and over a
+// scenario), in a folder that exists; --at must be a time of the run (NaN and -1 showed the
+// end); each named by its flag, exit 2, before any window opens and with nothing written
+TEST(View, ScreenshotPathsAndTimesAreChecked) {
+  const std::string dir = fresh_directory("view_bad_options");
+  const std::string data = dir + "/replay.json";
+  { std::ofstream(data) << "{\"kind\": \"replay data\"}\n"; }
+  const CliResult over_data = depotwin("view " + dir + " --screenshot " + data);
+  EXPECT_EQ(over_data.status, 2) << over_data.output;
+  EXPECT_NE(
+      over_data.output.find("error: --screenshot: '" + data + "' exists and is not a PNG image"),
+      std::string::npos)
+      << over_data.output;
+  std::ifstream kept(data);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(kept), {}), "{\"kind\": \"replay data\"}\n");
+  const CliResult no_folder = depotwin("view " + dir + " --screenshot " + dir + "/none/x.png");
+  EXPECT_EQ(no_folder.status, 2) << no_folder.output;
+  EXPECT_NE(no_folder.output.find("error: --screenshot: '" + dir + "/none' is not a directory"),
+            std::string::npos)
+      << no_folder.output;
+  for (const char* at : {"nan", "-1", "inf"}) {
+    const CliResult bad_time = depotwin("view " + dir + " --at " + at);
+    EXPECT_EQ(bad_time.status, 2) << at << ": " << bad_time.output;
+    EXPECT_NE(bad_time.output.find("error: --at: a run time in seconds, 0 or more"),
+              std::string::npos)
+        << bad_time.output;
+  }
+  const CliResult narrow = depotwin("view " + dir + " --width -1");
+  EXPECT_EQ(narrow.status, 2) << narrow.output;
+  EXPECT_NE(narrow.output.find("error: --width: the window must be at least 64 pixels wide"),
+            std::string::npos)
+      << narrow.output;
 }
 
 // pixels of a PNG as RGB
@@ -122,6 +158,12 @@ TEST(View, AScreenshotInTheWindowUnderXvfbShowsTheDepositGrown) {
   const size_t at_end = viridis_pixels(end_image), at_start = viridis_pixels(start_image);
   EXPECT_GT(at_end, 300u);
   EXPECT_LT(at_start, 10u) << at_start << " at the start, " << at_end << " at the end";
+  // a time after the run's end is named (it showed the end), and the PNG there stays
+  const CliResult late = screenshot(end_png, "--at 1e308");
+  EXPECT_EQ(late.status, 2) << late.output;
+  EXPECT_NE(late.output.find("error: --at: 1e+308 s is after the run's end"), std::string::npos)
+      << late.output;
+  EXPECT_EQ(load(end_png).width, 640);
 }
 
 }  // namespace
