@@ -841,17 +841,10 @@ std::vector<unsigned char> SceneRenderer::render_rgb(const mjModel& model, const
                                                      const HeightMap& deposit,
                                                      const SceneRenderOptions& options) {
   install_mujoco_handlers();
-  // the image must fit the model's offscreen buffer
-  if (options.width <= 0 || options.width > model.vis.global.offwidth)
-    throw InputError("outputs.image_width", "must be between 1 and " +
-                                                std::to_string(model.vis.global.offwidth) +
-                                                " (the model's <visual><global offwidth>), got " +
-                                                std::to_string(options.width));
-  if (options.height <= 0 || options.height > model.vis.global.offheight)
-    throw InputError("outputs.image_height", "must be between 1 and " +
-                                                 std::to_string(model.vis.global.offheight) +
-                                                 " (the model's <visual><global offheight>), got " +
-                                                 std::to_string(options.height));
+  // the image needs no room in the model's <global offwidth offheight>: the render context is
+  // made from a copy of the model sized to the image (RenderContextOwner)
+  if (options.width <= 0 || options.height <= 0)
+    throw InternalError("render: the image must be at least 1 x 1 pixels");
   if (options.supersampling < 1 || options.supersampling > kMaxSupersampling)
     throw InternalError("render: supersampling must be between 1 and " +
                         std::to_string(kMaxSupersampling));
