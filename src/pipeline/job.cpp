@@ -204,8 +204,19 @@ std::vector<PlannerSpec> select_planners(const Scenario& scenario, const std::st
   std::vector<PlannerSpec> selected;
   std::stringstream list(names);
   std::string name;
+  // an empty name (`a,`, `a,,b`: a comma with no name beside it) is refused, as `move`
+  // refuses its lists' (it was skipped); spaces around a name are not part of it
+  const auto empty_name = [&] {
+    return InputError("--planner",
+                      "'" + names + "' has an empty name (a comma with no name beside it)");
+  };
+  if (names.find_last_not_of(" \t") != std::string::npos &&
+      names[names.find_last_not_of(" \t")] == ',')
+    throw empty_name();
   while (std::getline(list, name, ',')) {
-    if (name.empty()) continue;
+    const size_t first = name.find_first_not_of(" \t");
+    if (first == std::string::npos) throw empty_name();
+    name = name.substr(first, name.find_last_not_of(" \t") - first + 1);
     bool found = false;
     // a run's label, else every run of the planner of that name
     for (const PlannerSpec& spec : scenario.planners) {

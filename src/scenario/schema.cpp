@@ -179,8 +179,8 @@ std::vector<SchemaSection> make_schema() {
     SchemaKey j =
         number("j_max", "mm/s^3", ValueRange::closed(0.0, ranges::kMaxJerk_mm_s3), 0.0,
                "jerk limit " + scope + ", 0 or at least " + format_number(ranges::kMinLimit) +
-                   "; 0: none (lspb_mtt and stop_and_go then plan "
-                   "double-S moves; bezier refuses one)");
+                   "; 0: none (above 0 every planner plans jerk-limited motion; "
+                   "lspb_mtt and stop_and_go then plan double-S moves)");
     if (joint) {
       v.default_text = a.default_text = "required";
       v.default_value = a.default_value = std::nullopt;

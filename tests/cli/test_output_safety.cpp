@@ -461,7 +461,22 @@ TEST(OutputSafety, APlannerNamedTwiceIsRefusedEveryTime) {
       depotwin("compare " + fig7 + " --planners lspb_mtt,lspb_mtt --out " + dir + "/results");
   EXPECT_EQ(compare.status, 2);
   EXPECT_EQ(compare.output, "error: --planners: 'lspb_mtt' is named twice\n");
+  // an empty name (a stray comma) is refused as move refuses its lists' (it was skipped)
+  const auto stray =
+      depotwin("compare " + fig7 + " --planners lspb_mtt, --out " + dir + "/results");
+  EXPECT_EQ(stray.status, 2);
+  EXPECT_EQ(stray.output,
+            "error: --planners: 'lspb_mtt,' has an empty name (a comma with no name beside it)\n");
+  const auto doubled =
+      depotwin("plan " + fig7 + " --planner lspb_mtt,,stop_and_go --out " + dir + "/results");
+  EXPECT_EQ(doubled.status, 2) << doubled.output;
   EXPECT_TRUE(names_in(dir).empty());
+  // spaces beside a name are not part of it
+  const auto spaced =
+      depotwin("plan " + fig7 + " --planner 'lspb_mtt, stop_and_go' --out " + dir + "/results");
+  EXPECT_EQ(spaced.status, 0) << spaced.output;
+  EXPECT_EQ(names_in(dir + "/results"),
+            (std::vector<std::string>{".depotwin", "lspb_mtt", "stop_and_go"}));
 }
 
 }  // namespace
