@@ -1436,6 +1436,33 @@ std::optional<PrintRule> print_rule_from_name(const std::string& name) {
   return std::nullopt;
 }
 
+namespace {
+
+// the G codes the reader follows itself: motion, dwell, plane, unit, homing, positioning modes
+bool reads_as_motion_or_mode(int tenths) {
+  switch (tenths) {
+    case 0:
+    case 10:
+    case 20:
+    case 30:
+    case 40:
+    case 170:
+    case 180:
+    case 190:
+    case 200:
+    case 210:
+    case 280:
+    case 900:
+    case 910:
+    case 920:
+      return true;
+    default:
+      return false;
+  }
+}
+
+}  // namespace
+
 std::vector<ShutterCodeProblem> shutter_code_problems(const std::string& open,
                                                       const std::string& close) {
   std::vector<ShutterCodeProblem> problems;
@@ -1447,6 +1474,16 @@ std::vector<ShutterCodeProblem> shutter_code_problems(const std::string& open,
     if (!*code)
       problems.push_back({at_close, "'" + printable(given->data(), given->data() + given->size()) +
                                         "' is not a G or M code (e.g. M3, M5, M106, M107)"});
+  // a code the reader follows as motion or a mode cannot switch the shutter as well (`--open
+  // G1` read every G1 line as opening it)
+  for (const auto& [at_close, given, code] :
+       {std::tuple<bool, const std::string*, const std::optional<Code>*>{false, &open, &open_code},
+        {true, &close, &close_code}})
+    if (*code && (*code)->letter == 'G' && reads_as_motion_or_mode((*code)->tenths))
+      problems.push_back(
+          {at_close, "'" + printable(given->data(), given->data() + given->size()) +
+                         "' is a motion or mode code the reader follows (G0-G4, G17-G21, G28, "
+                         "G90-G92); a shutter code is a switch (e.g. M3 and M5, M106 and M107)"});
   // two different switches, else nothing can be read under them
   if (open_code && close_code && is_shutter_code(open_code, *close_code)) {
     const std::string why = open_code->tenths == close_code->tenths

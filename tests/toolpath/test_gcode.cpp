@@ -222,6 +222,16 @@ TEST(Gcode, HugeCodeNumbersAreRefused) {
                 "'" + code + "' is not a G or M code (e.g. M3, M5, M106, M107)");
     }
   }
+  // a code the reader follows as motion or a mode cannot be the shutter's too (`--open G1`
+  // opened it on every G1 line); another G code can (a machine's own)
+  const std::vector<ShutterCodeProblem> motion = shutter_code_problems("G1", "G0");
+  ASSERT_EQ(motion.size(), 2u);
+  EXPECT_FALSE(motion[0].at_close);
+  EXPECT_EQ(motion[0].message.rfind("'G1' is a motion or mode code the reader follows", 0), 0u)
+      << motion[0].message;
+  EXPECT_TRUE(motion[1].at_close);
+  EXPECT_EQ(shutter_code_problems("G91", "M5").size(), 1u);
+  EXPECT_TRUE(shutter_code_problems("G800", "G801").empty());
 }
 
 TEST(Gcode, PowerZeroClosesTheShutter) {
