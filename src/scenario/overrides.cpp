@@ -334,8 +334,12 @@ void attribute_to_overrides(std::vector<Problem>& problems,
     std::size_t owner_length = 0;
     for (const ScenarioOverride& override_ : overrides) {
       const std::string key = override_.key == "planner" ? "planners" : override_.key;
+      // (or a key the override made on its way, unknown: `bogus.key` makes `bogus`)
+      const bool makes_unknown =
+          starts_with(problem.message, "unknown key") &&
+          (starts_with(key, problem.key + ".") || starts_with(key, problem.key + "["));
       const bool under = problem.key == key || starts_with(problem.key, key + ".") ||
-                         starts_with(problem.key, key + "[");
+                         starts_with(problem.key, key + "[") || makes_unknown;
       // the most specific override wins (limits.x.v_max over limits)
       if (under && key.size() >= owner_length) {
         owner = &override_;

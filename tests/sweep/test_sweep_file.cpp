@@ -310,6 +310,14 @@ TEST(ScenarioOverrides, ProblemsOfAnOverrideAreAtItsLineOthersAtTheScenarios) {
   EXPECT_EQ(speed[0], fig7 +
                           ":21: toolpath.segments[0]: print speed 5 mm/s needs 5 mm/s on x, "
                           "above limits v_max 4 (lower the speed or raise the limit)");
+
+  // an unknown section an override makes on its way (`bogus.key` makes `bogus`) is the
+  // override's, at its line (it was the base file's line 1)
+  const std::vector<std::string> made =
+      problems_of([&] { load_with(fig7, {at("bogus.key", "1", 9)}); });
+  ASSERT_EQ(made.size(), 1u);
+  EXPECT_EQ(made[0].rfind("sweep.yaml:9: bogus: unknown key (expected one of: name,", 0), 0u)
+      << made[0];
 }
 
 // an alias (*ax) is the anchored node itself in the tree: an override inside it would change
