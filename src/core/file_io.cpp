@@ -73,6 +73,10 @@ std::string missing_file_problem(const std::string& kind, const std::string& giv
   if (fs::is_regular_file(status)) return "";
   if (fs::is_directory(status)) return file + " is a directory" + where + ", not a file";
   if (fs::exists(status)) return file + " is not a regular file" + where;
+  // a path the system cannot follow (a loop of symbolic links, a name too long, a folder on
+  // the way that cannot be searched) is not a missing file: its reason is said
+  if (error && error != std::errc::no_such_file_or_directory)
+    return file + " cannot be opened" + where + ": " + error.message();
   return file + " not found" + (given.empty() ? "" : " (looked for " + resolved + ")");
 }
 

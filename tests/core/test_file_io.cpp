@@ -67,6 +67,16 @@ TEST(FileIo, MissingFileProblemSaysWhatIsThereInstead) {
   const fs::path nowhere = directory / "none.stl";
   EXPECT_EQ(missing_file_problem("STL", "none.stl", nowhere.string()),
             "STL file 'none.stl' not found (looked for " + nowhere.string() + ")");
+  // a path the system cannot follow is not "not found": a loop of links, a name too long
+  const fs::path loop_a = directory / "a.yaml", loop_b = directory / "b.yaml";
+  fs::create_symlink(loop_b, loop_a);
+  fs::create_symlink(loop_a, loop_b);
+  EXPECT_EQ(missing_file_problem("scenario", "a.yaml", loop_a.string()),
+            "scenario file 'a.yaml' cannot be opened (" + loop_a.string() +
+                "): " + std::make_error_code(std::errc::too_many_symbolic_link_levels).message());
+  const fs::path long_name = directory / (std::string(300, 'a') + ".yaml");
+  EXPECT_NE(missing_file_problem("scenario", "", long_name.string()).find("cannot be opened: "),
+            std::string::npos);
 }
 
 // read_text_file checks before it opens: a FIFO is refused at once (reading it would wait
