@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -740,8 +741,12 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
     (void)mantissa;
     if (error != std::errc() || stop != p || !std::isfinite(value) ||
         std::abs(value) > kMaxMagnitude) {
+      // (a number too close to 0 for a double, `X1e-400`, is no "at most 1e9" case)
+      const bool underflow = error == std::errc::result_out_of_range &&
+                             std::strtod(std::string(convert_from, p).c_str(), nullptr) == 0.0;
       problem(line_number, "number out of range in '" + printable(word_start, p) +
-                               "' (at most 1e9 in magnitude)");
+                               (underflow ? "' (too close to 0 to be read; write 0)"
+                                          : "' (at most 1e9 in magnitude)"));
       return false;
     }
     if (letter == 'G' || letter == 'M') {

@@ -433,6 +433,11 @@ TEST(Gcode, EveryMalformedLineIsReported) {
   EXPECT_NE(problems[4].message.find("X given twice"), std::string::npos);
   EXPECT_NE(problems[5].message.find("two motion commands"), std::string::npos);
   EXPECT_EQ(problems[6].message, "number out of range in 'X1e308' (at most 1e9 in magnitude)");
+  // a number too close to 0 for a double is said as such
+  const auto tiny = problems_of("G1 X1e-400 F600\n");
+  ASSERT_EQ(tiny.size(), 1u) << dump(tiny);
+  EXPECT_EQ(tiny[0].message,
+            "number out of range in 'X1e-400' (too close to 0 to be read; write 0)");
   EXPECT_NE(problems[7].message.find("unexpected '#'"), std::string::npos);
   EXPECT_EQ(problems[8].message,
             "binary or control byte \\x01 at column 5 (is this a G-code text file?)");
