@@ -64,19 +64,13 @@ bool is_within(const fs::path& inner, const fs::path& outer) {
   return true;
 }
 
-// a folder depotwin may replace: empty, holding the marker, or shaped like a result written
-// before the marker existed (comparison.* files and run folders holding a metrics.json)
+// a folder depotwin may replace: empty or holding the marker. A folder shaped like an old
+// result (run folders with a metrics.json) is not enough: that name is common, and a user's
+// files beside it would go with it
 bool is_depotwin_output(const fs::path& folder) {
   std::error_code error;
   if (fs::exists(folder / kOutputMarker, error)) return true;
-  for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
-    const std::string name = entry.path().filename().string();
-    const fs::file_status status = entry.symlink_status();
-    if (fs::is_directory(status) && fs::is_regular_file(entry.path() / "metrics.json")) continue;
-    if (fs::is_regular_file(status) && name.rfind("comparison.", 0) == 0) continue;
-    return false;
-  }
-  return !error;
+  return fs::is_empty(folder, error) && !error;
 }
 
 }  // namespace
@@ -328,6 +322,13 @@ OutputFolder::OutputFolder(const std::string& final_path, const std::string& ver
              " marker); it is replaced whole, so choose an empty or new folder, or remove it");
     if (::access(target.c_str(), W_OK | X_OK) != 0)
       refuse(std::string("cannot be replaced: ") + std::strerror(errno));
+    // a mount point (a container's volume, an NFS root) cannot be swapped with a folder
+    // beside it: say so now, not after the work
+    struct stat own {
+    }, parent{};
+    if (::stat(target.c_str(), &own) == 0 && ::stat(target.parent_path().c_str(), &parent) == 0 &&
+        own.st_dev != parent.st_dev)
+      refuse("is a mount point, which cannot be replaced whole; give a folder inside it");
   };
   check_target();
 
