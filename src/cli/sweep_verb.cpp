@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 #include <thread>
+#include <utility>
 
 #include "cli/cli_checks.hpp"
 #include "core/error.hpp"
@@ -198,6 +199,18 @@ int emit_script(const Sweep& sweep, const SweepOptions& options) {
   emit.executable = current_executable();
   emit.sweep_file = absolute(options.file);
   emit.out = absolute(sweep.out_directory());
+  // the scripts carry these in comments, heredocs and quoted words: a line break or another
+  // control byte in them would end one early and run the rest as commands
+  const std::pair<const char*, const std::string*> words[] = {
+      {"name", &sweep.spec().name},
+      {"--out", &emit.out},
+      {"the sweep file's path", &emit.sweep_file}};
+  for (const auto& [what, text] : words)
+    if (std::any_of(text->begin(), text->end(),
+                    [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+      throw InputError("--emit", std::string(what) +
+                                     " holds a line break or a control byte, which a script "
+                                     "cannot carry safely; rename it");
   emit.max_running =
       options.jobs > 0 ? options.jobs : (options.emit == "slurm" ? 100 : default_jobs());
   std::cout << (options.emit == "slurm" ? slurm_script(sweep, emit)

@@ -73,8 +73,10 @@ std::string slurm_script(const Sweep& sweep, const EmitOptions& options) {
   s += "#SBATCH --output=" + shell_quoted(logs + "/merge.log") + "\n";
   s += sweep_command(options, "--merge --quiet") + "\n";
   s += "SBATCH\n)\n";
-  s += "echo \"" + name + ": submitted array job(s)${arrays//:/ } (" + std::to_string(count) +
-       " tasks) and merge job ${merge%%;*}; results in " + options.out + "\"\n";
+  // the user's words single-quoted, the job ids expanded between them
+  s += "echo " + shell_quoted(name + ": submitted array job(s)") + "\"${arrays//:/ }\"" +
+       shell_quoted(" (" + std::to_string(count) + " tasks) and merge job ") + "\"${merge%%;*}\"" +
+       shell_quoted("; results in " + options.out) + "\n";
   return s;
 }
 

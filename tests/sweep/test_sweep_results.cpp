@@ -5,6 +5,7 @@
 #include <sqlite3.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -322,6 +323,33 @@ TEST(SweepEmit, SlurmArraysAreChunkedWithOffsetsAndTheMergeWaitsForAll) {
                 "/out dir/logs'\\''/task-{}.log 2>&1'; /opt/depotwin sweep " + file + " --out '" +
                 dir + "/out dir' --merge\n");
   EXPECT_EQ(shell_quoted("it's"), "'it'\\''s'");
+}
+
+// the sweep's name and --out are the user's words: the script prints them, never runs them
+TEST(SweepEmit, TheSlurmScriptRunsNothingOfTheNameOrTheOutFolder) {
+  const std::string dir = fresh_directory("sweep_emit_quoted");
+  const std::string file =
+      write_text(dir, "s.yaml",
+                 "name: \"x$(touch made_by_name)`touch made_by_tick`\"\nbase: " +
+                     scenario_path("ganganath_n20.yaml") +
+                     "\ngrid:\n  toolpath.random_segments.seed: [1, 2]\n");
+  const std::string out = dir + "/out $(touch made_by_out)";
+  const Sweep sweep(file, out);
+  const std::string script = write_text(
+      dir, "submit.sh", slurm_script(sweep, EmitOptions{"/opt/depotwin", file, out, 8, 1000}));
+  // sbatch stubbed: it swallows the job script and answers a job id
+  fs::create_directories(dir + "/bin");
+  const std::string stub = write_text(dir, "bin/sbatch", "#!/bin/sh\ncat > /dev/null\necho 7\n");
+  fs::permissions(stub, fs::perms::owner_all);
+  const std::string command =
+      "cd '" + dir + "' && PATH='" + dir + "/bin':$PATH bash submit.sh > said.txt";
+  ASSERT_EQ(std::system(command.c_str()), 0) << read_text(script);
+  for (const char* made : {"made_by_name", "made_by_tick", "made_by_out"})
+    EXPECT_FALSE(fs::exists(dir + "/" + made)) << made;
+  EXPECT_EQ(read_text(dir + "/said.txt"),
+            "x$(touch made_by_name)`touch made_by_tick`: submitted array job(s) 7 (2 tasks) and "
+            "merge job 7; results in " +
+                out + "\n");
 }
 
 TEST(SweepLocalRunner, AWorkerThatDiesHasItsTaskRecordedAndIsReplaced) {
