@@ -2,6 +2,9 @@
 // Exit status: 0 success, 2 bad input (file:line: key: message), 1 internal failure, 130 or 143
 // when SIGINT or SIGTERM stopped it (the output is then as it was before).
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <functional>
 #include <iostream>
 #include <string>
@@ -70,7 +73,8 @@ int check_verb(CLI::App& app, int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// parse the command line and run its verb; the exit status
+int run_command_line(int argc, char** argv) {
   CLI::App app{
       "DepoTwin: a physics-simulated digital twin of material-deposition machines.\n"
       "Plan a scenario's toolpath, simulate the machine in MuJoCo, record where material\n"
@@ -328,4 +332,19 @@ int main(int argc, char** argv) {
     return kExitInternal;
   }
   return kExitInternal;
+}
+
+int main(int argc, char** argv) {
+  const int status = run_command_line(argc, argv);
+  // what a verb printed (a script, JSON, a table) may be cut short by a full disk or a closed
+  // pipe: that must not end as success
+  std::cout.flush();
+  const bool flushed = std::fflush(stdout) == 0;
+  if (!std::cout || !flushed || std::ferror(stdout) != 0) {
+    const int reason = errno;
+    std::cerr << "error: the standard output could not be written whole"
+              << (reason != 0 ? std::string(": ") + std::strerror(reason) : std::string()) << "\n";
+    return status == kExitOk ? kExitInternal : status;
+  }
+  return status;
 }

@@ -36,6 +36,21 @@ TEST(Cli, HelpOnEveryVerb) {
   EXPECT_EQ(depotwin("fly-to-mars").status, 2);
 }
 
+// what a verb prints that cannot be written whole (a full disk: /dev/full) is an error, never
+// a success with half a JSON document or script
+TEST(Cli, StandardOutputThatCannotBeWrittenIsAnError) {
+  for (const std::string arguments :
+       {"describe planners --json", "move --q0 0 --q1 1 --vmax 1 --amax 1"}) {
+    const Result r = testing_support::shell("{ " + std::string(DEPOTWIN_BINARY_DIR) + "/depotwin " +
+                                            arguments + " > /dev/full; }");
+    EXPECT_EQ(r.status, 1) << arguments << ": " << r.output;
+    EXPECT_NE(r.output.find("error: the standard output could not be written whole: No space "
+                            "left on device"),
+              std::string::npos)
+        << arguments << ": " << r.output;
+  }
+}
+
 // the text after `prefix` up to the end of its line
 std::string line_after(const std::string& text, const std::string& prefix) {
   const size_t at = text.find(prefix);
@@ -304,6 +319,24 @@ TEST(CliOut, AReadOnlyFolderIsBadInput) {
   EXPECT_TRUE(folder_names(dir).empty());
 }
 
+// a mount point cannot be swapped with the staging folder beside it: refused before any
+// work (mounting a tmpfs needs root; elsewhere the test is skipped)
+TEST(CliOut, AMountPointIsRefusedBeforeAnyWork) {
+  const std::string dir = fresh_directory("cli_out_mount");
+  fs::create_directories(dir + "/volume");
+  const std::string mount = "mount -t tmpfs -o size=1m tmpfs '" + dir + "/volume' 2>/dev/null";
+  if (::geteuid() != 0 || std::system(mount.c_str()) != 0)
+    GTEST_SKIP() << "mounting a tmpfs needs root";
+  const Result r =
+      depotwin("plan " + scenario_path("thompson_fig7.yaml") + " --out " + dir + "/volume");
+  const std::string unmount = "umount '" + dir + "/volume'";
+  EXPECT_EQ(std::system(unmount.c_str()), 0);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("error: --out: " + dir + "/volume: is a mount point"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(folder_names(dir), std::vector<std::string>{"volume"});
+}
+
 // a folder with someone else's files is never replaced
 TEST(CliOut, AFolderThatIsNotADepotwinOutputIsRefused) {
   const std::string dir = fresh_directory("cli_out_foreign");
@@ -326,7 +359,7 @@ TEST(CliOut, AFolderThatIsNotADepotwinOutputIsRefused) {
 }
 
 // a compare's folder run into by `plan`: the old comparison.* and run folders are gone, and
-// the folder carries the marker; a result from before the marker is recognised and replaced
+// the folder carries the marker; without the marker, a folder shaped like a result is refused
 TEST(CliOut, AVerbReplacesItsFolderWhole) {
   const std::string dir = fresh_directory("cli_out_replace");
   const std::string out = dir + "/results";
@@ -342,13 +375,16 @@ TEST(CliOut, AVerbReplacesItsFolderWhole) {
   EXPECT_EQ(folder_names(out), (std::vector<std::string>{".depotwin", "stop_and_go"}));
   EXPECT_EQ(folder_names(dir), std::vector<std::string>{"results"});  // nothing staged left
 
-  // an older result without the marker: comparison files and run folders with metrics.json
+  // without the marker, a folder shaped like a result (run folders holding a metrics.json)
+  // is the user's: refused, and their file beside the metrics stays
   fs::remove(out + "/.depotwin");
-  write_text(out, "comparison.csv", "label\n");
+  write_text(out + "/stop_and_go", "model.ckpt", "weights\n");
   const Result again =
       depotwin("plan " + scenario_path("thompson_fig7.yaml") + " --planner lspb_mtt --out " + out);
-  ASSERT_EQ(again.status, 0) << again.output;
-  EXPECT_EQ(folder_names(out), (std::vector<std::string>{".depotwin", "lspb_mtt"}));
+  EXPECT_EQ(again.status, 2) << again.output;
+  EXPECT_NE(again.output.find("is not a depotwin output folder"), std::string::npos)
+      << again.output;
+  EXPECT_TRUE(fs::exists(out + "/stop_and_go/model.ckpt"));
 }
 
 // every order under every planner, each in its own folder; the progress lines (every update
