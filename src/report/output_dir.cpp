@@ -324,10 +324,11 @@ OutputFolder::OutputFolder(const std::string& final_path, const std::string& ver
       refuse(std::string("cannot be replaced: ") + std::strerror(errno));
     // a mount point (a container's volume, an NFS root) cannot be swapped with a folder
     // beside it: say so now, not after the work
-    struct stat own {
-    }, parent{};
-    if (::stat(target.c_str(), &own) == 0 && ::stat(target.parent_path().c_str(), &parent) == 0 &&
-        own.st_dev != parent.st_dev)
+    struct stat own_status = {};
+    struct stat parent_status = {};
+    if (::stat(target.c_str(), &own_status) == 0 &&
+        ::stat(target.parent_path().c_str(), &parent_status) == 0 &&
+        own_status.st_dev != parent_status.st_dev)
       refuse("is a mount point, which cannot be replaced whole; give a folder inside it");
   };
   check_target();
