@@ -1031,26 +1031,31 @@ void Loader::clamp_feed_rates(std::vector<PrintPath>& paths, std::vector<std::ve
     std::vector<double> edge_speed(path.points.size() - 1, path.speed_mm_s);
     int last_clamped_line = -1;
     for (std::size_t k = 0; k + 1 < path.points.size() && path.speed_mm_s > 0.0; ++k) {
-      // the edge's directions: the line's, or an arc's as fine chords of it
-      std::vector<Vec3> edge_points{path.points[k], path.points[k + 1]};
+      // the edge's directions: the line's, or an arc's as fine chords of it and as the
+      // chords the checks and the polyline planners get (chord_tolerance_mm), whose
+      // directions differ: a coarse chord across an arc's top runs along the axis
+      std::vector<std::vector<Vec3>> edge_chords{{path.points[k], path.points[k + 1]}};
       if (!path.arcs.empty() && path.arcs[k].is_arc()) {
         PrintPath arc_edge;
-        arc_edge.points = edge_points;
+        arc_edge.points = edge_chords.front();
         arc_edge.arcs = {path.arcs[k]};
-        edge_points = arc_edge.chorded(kClampChordTolerance_mm).points;
+        edge_chords = {arc_edge.chorded(kClampChordTolerance_mm).points,
+                       arc_edge.chorded(settings.chord_tolerance_mm).points};
       }
       double allowed_mm_s = path.speed_mm_s;
-      for (std::size_t c = 0; c + 1 < edge_points.size(); ++c) {
-        const Vec3 step = edge_points[c + 1] - edge_points[c];
-        const double length_mm = step.norm();
-        if (length_mm <= kJoinTolerance_mm) continue;
-        const MachineLimits limits =
-            tcp_limits_ ? tcp_limits_->along(edge_points[c], edge_points[c + 1]) : scenario_.limits;
-        for (int axis = 0; axis < 3; ++axis)
-          if (axis_v_max_known_[axis] && std::abs(step[axis]) > 0.0)
-            allowed_mm_s = std::min(
-                allowed_mm_s, limits.axes[axis].v_max_mm_s * length_mm / std::abs(step[axis]));
-      }
+      for (const std::vector<Vec3>& edge_points : edge_chords)
+        for (std::size_t c = 0; c + 1 < edge_points.size(); ++c) {
+          const Vec3 step = edge_points[c + 1] - edge_points[c];
+          const double length_mm = step.norm();
+          if (length_mm <= kJoinTolerance_mm) continue;
+          const MachineLimits limits = tcp_limits_
+                                           ? tcp_limits_->along(edge_points[c], edge_points[c + 1])
+                                           : scenario_.limits;
+          for (int axis = 0; axis < 3; ++axis)
+            if (axis_v_max_known_[axis] && std::abs(step[axis]) > 0.0)
+              allowed_mm_s = std::min(
+                  allowed_mm_s, limits.axes[axis].v_max_mm_s * length_mm / std::abs(step[axis]));
+        }
       if (allowed_mm_s >= path.speed_mm_s) continue;
       edge_speed[k] = allowed_mm_s;
       // a move (a line of the file) counts once, however many chords it has

@@ -240,6 +240,30 @@ toolpath: {gcode: {file: arc.gcode, chord_tolerance_mm: 0.01}}
   EXPECT_GE(clamped.toolpath.paths.size(), 2u);
 }
 
+// A full circle far above the speed limits is slowed to them along the chords the checks see
+// too: a coarse chord across the circle's top runs along x where no fine chord does, and the
+// clamp from fine chords alone refused this file ("needs 300 mm/s on x, above v_max 300").
+// Every chord of the loaded path then needs at most v_max on each axis.
+TEST_F(ScenarioGcode, AFastCircleIsClampedAlongTheChordsTheChecksSee) {
+  write("circle.gcode",
+        "G21\nG90\nM83\nG1 X0 Y0 Z0.2 F6000\n"
+        "G2 X0 Y0 I1.14554 J4.23418 E0.02 F60960\n");
+  const Scenario s = load_scenario(write("s.yaml", R"(
+machine: cartesian
+limits: {v_max: 300, a_max: 3000}
+toolpath: {gcode: {file: circle.gcode, feed: clamp}}
+)"));
+  ASSERT_EQ(s.gcode->clamped_moves, 1);
+  for (const PrintPath& path : s.toolpath.paths)
+    for (std::size_t k = 0; k + 1 < path.points.size(); ++k) {
+      const Vec3 step = path.points[k + 1] - path.points[k];
+      for (int axis = 0; axis < 2; ++axis)
+        EXPECT_LE(path.speed_mm_s * std::abs(step[axis]) / step.norm(), 300.0 * (1.0 + 1e-9))
+            << "chord " << k << ", axis " << axis;
+    }
+  EXPECT_NEAR(s.toolpath.paths.front().speed_mm_s, 300.0, 0.5);
+}
+
 // describe shows the keys (the same tables the loader checks)
 TEST(ScenarioGcodeSchema, TheTablesHoldTheGcodeKeys) {
   const SchemaSection& section = schema_section("toolpath.gcode");
