@@ -723,6 +723,19 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
       const bool placeholder = std::any_of(word_start, word_end, [](char ch) {
         return ch == '{' || ch == '[' || ch == '}' || ch == ']';
       });
+      // except on Bambu's z trim, whose start block keeps `G29.1 Z{+0.0}` in the files it
+      // exports (the printer evaluates it): its axis words are never a move, so its value is
+      // not needed (inspect still lists the code's axis words)
+      const bool bambu_z_trim = placeholder && words_.n_codes == 1 &&
+                                words_.codes[0].letter == 'G' && words_.codes[0].tenths == 291 &&
+                                !words_.has(letter);
+      if (bambu_z_trim) {
+        words_.present |= 1u << (letter - 'A');
+        words_.value[letter - 'A'] = 0.0;
+        words_.text[letter - 'A'] = word_start;
+        p = word_end;
+        continue;
+      }
       if (const char* reason = ngc_programming_reason(line_begin, end)) {
         problem(line_number, reason);
         return false;

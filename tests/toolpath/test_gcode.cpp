@@ -830,11 +830,23 @@ TEST(Gcode, NamedCommandsWithGeometryAreRefusedKlippersPass) {
 }
 
 TEST(Gcode, PlaceholdersAreNamedAsATemplate) {
-  const auto problems = problems_of("G90\nG29.1 Z{+0.0}\nM190 S[bed_temperature]\nG1 X1\n");
+  const auto problems =
+      problems_of("G90\nG1 Z{first_layer_height}\nM190 S[bed_temperature]\nG1 X1\n");
   ASSERT_EQ(problems.size(), 1u) << dump(problems);
   EXPECT_EQ(problems[0].line, 2);
   EXPECT_NE(problems[0].message.find("placeholder not filled in"), std::string::npos)
       << problems[0].str();
+  // Bambu's start block keeps its z trim's expression in exported files: never a move, read
+  const GcodeProgram bambu = parse_gcode_program(
+      "G90\nG1 X5 Y5 F600\nG29.1 Z{+0.0} ; clear z-trim value first\nG1 X10 E1\n", "bambu.gcode",
+      GcodeOptions{});
+  ASSERT_EQ(bambu.moves.size(), 2u);
+  EXPECT_EQ(bambu.moves[1].to_mm, Vec3(10, 5, 0));
+  ASSERT_EQ(bambu.ignored_axis_codes.size(), 1u);
+  EXPECT_EQ(g_code_name(bambu.ignored_axis_codes[0].tenths), "G29.1");
+  EXPECT_EQ(bambu.ignored_axis_codes[0].first_line, 3);
+  // other placeholders on that line, or a second axis word, are still a template
+  EXPECT_EQ(problems_of("G29.1 Z{+0.0} Z{a}\n").size(), 1u);
 }
 
 TEST(Gcode, RotaryAxesAtZeroAreNoMove) {
