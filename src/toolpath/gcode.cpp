@@ -1524,6 +1524,13 @@ GcodeProgram parse_gcode_program(const std::string& text, const std::string& fil
   const char* end = p + text.size();
   // a UTF-8 byte order mark is not part of the first command
   if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) p += 3;
+  // DOS's end-of-file byte (Ctrl-Z), which old CAM posts append, with nothing but blanks and
+  // line ends after it: the file ends there
+  {
+    const char* last = end;
+    while (last > p && (is_space(last[-1]) || last[-1] == '\n')) --last;
+    if (last > p && last[-1] == '\x1A') end = last - 1;
+  }
   // containers a slicer may write instead of text: named, rather than a byte at a column
   if (const char* container = packed_gcode_reason(text))
     throw InputError(file_label, 1, kKey, container);

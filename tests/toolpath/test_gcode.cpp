@@ -446,6 +446,14 @@ TEST(Gcode, EveryMalformedLineIsReported) {
             "axis word A (30) on a move: only X, Y, Z and E are read, so a multi-axis file's "
             "rotary or extra axes would be dropped silently; convert it to 3-axis G-code first "
             "(or, if A is a MakerBot-flavour extruder, export with RepRap/Marlin flavour: E)");
+  // DOS's end-of-file byte at the end (old CAM posts) ends the file; anywhere else it is a
+  // control byte
+  const GcodeImport dos = parse("G1 X0 Y0 F600\r\nG1 X10 E1\r\n\x1A\r\n");
+  ASSERT_EQ(dos.toolpath.paths.size(), 1u);
+  expect_points(dos.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+  const auto inside = problems_of("G1 X0 Y0 F600\n\x1A\nG1 X10 E1\n");
+  ASSERT_EQ(inside.size(), 1u) << dump(inside);
+  EXPECT_EQ(inside[0].line, 2);
 }
 
 TEST(Gcode, PackedFilesAreNamedWithTheWayOut) {
