@@ -15,7 +15,14 @@ LayeredDeposit::LayeredDeposit(const DepositionSettings& settings, double cell_m
 }
 
 void LayeredDeposit::advance(const DepositionStep& step, int k) {
-  layers_[static_cast<size_t>(std::clamp(k, 0, layer_count() - 1))]->advance(step);
+  const auto layer = static_cast<size_t>(std::clamp(k, 0, layer_count() - 1));
+  // one nozzle: the flow still leaving it when the steps move on to another layer (the lag's
+  // tail over a layer change) goes on into that layer, never dropped
+  if (layer != current_layer_) {
+    layers_[layer]->take_nozzle_flow_from(*layers_[current_layer_]);
+    current_layer_ = layer;
+  }
+  layers_[layer]->advance(step);
 }
 
 void LayeredDeposit::finish() {

@@ -31,7 +31,8 @@ class LayeredDeposit {
   int layer_count() const { return static_cast<int>(layers_.size()); }
   Process& layer(int k) { return *layers_.at(static_cast<size_t>(k)); }
   const Process& layer(int k) const { return *layers_.at(static_cast<size_t>(k)); }
-  // one simulation step into layer k's process (k clamped to the layers)
+  // one simulation step into layer k's process (k clamped to the layers); the steps come in
+  // time order, and the nozzle's lagging flow follows them from layer to layer
   void advance(const DepositionStep& step, int k);
 
   // after the last step: every layer's batched steps put down, the layers stacked and, on a
@@ -57,6 +58,7 @@ class LayeredDeposit {
  private:
   std::vector<std::unique_ptr<Process>> layers_;
   NormalZ normal_z_;
+  size_t current_layer_ = 0;  // the layer of the last step (whose process holds the flow)
   bool finished_ = false;
   ThicknessField stacked_;                    // several layers: their sum
   std::unique_ptr<ThicknessField> normal_;    // curved: stacked times n_z

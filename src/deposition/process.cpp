@@ -193,6 +193,14 @@ void ExtrusionProcess::restart() {
   peak_command_mm3_s_ = 0.0;
 }
 
+void ExtrusionProcess::take_nozzle_flow_from(Process& previous) {
+  auto* extruder = dynamic_cast<ExtrusionProcess*>(&previous);
+  if (extruder == nullptr || extruder == this) return;
+  flow_mm3_s_ += extruder->flow_mm3_s_;
+  peak_command_mm3_s_ = std::max(peak_command_mm3_s_, extruder->peak_command_mm3_s_);
+  extruder->flow_mm3_s_ = 0.0;
+}
+
 void ExtrusionProcess::start_steady(const DepositionStep& step) {
   check_step(step);
   flow_mm3_s_ = std::max(0.0, command_mm3_s(step));

@@ -125,6 +125,10 @@ class Process {
   // as if the step's flow command had been held long enough to settle (extrusion: the lagged
   // flow equals it; aerosol: nothing to settle); nothing is deposited
   virtual void start_steady(const DepositionStep& /*step*/) {}
+  // the same nozzle goes on in this process (the next layer): the flow still leaving it
+  // (extrusion's lag tail) moves over from `previous`, which then has none; nothing is
+  // deposited, and no material is lost or counted twice
+  virtual void take_nozzle_flow_from(Process& /*previous*/) {}
 
   // the deposit of every step advanced so far (pending batched steps are put down first;
   // not thread-safe while steps are pending: call flush() before sharing the process)
@@ -185,6 +189,7 @@ class ExtrusionProcess : public Process {
   void advance(const DepositionStep& step) override;
   void start_steady(const DepositionStep& step) override;
   void restart() override;
+  void take_nozzle_flow_from(Process& previous) override;
   double nozzle_flow_mm3_s() const override { return flow_mm3_s_; }
 
  private:
