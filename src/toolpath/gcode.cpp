@@ -92,6 +92,12 @@ struct LineWords {
 
   bool has(char letter) const { return (present >> (letter - 'A')) & 1u; }
   double get(char letter) const { return value[letter - 'A']; }
+  // the word `letter` read as `number`, written at `start`
+  void set(char letter, double number, const char* start) {
+    present |= 1u << (letter - 'A');
+    value[letter - 'A'] = number;
+    text[letter - 'A'] = start;
+  }
 };
 
 // Why a line that does not split into words uses RS274/NGC's programming (LinuxCNC): O-word
@@ -711,9 +717,7 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
                       return code.letter == 'G' && (code.tenths == 280 || code.tenths == 610 ||
                                                     code.tenths == 1610 || code.tenths == 1620);
                     })) {
-      words_.present |= 1u << (letter - 'A');
-      words_.value[letter - 'A'] = 0.0;
-      words_.text[letter - 'A'] = word_start;
+      words_.set(letter, 0.0, word_start);
       continue;
     }
     const bool clean = digits > 0 && (p == end || !(is_digit(*p) || *p == '.'));
@@ -730,9 +734,7 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
                                 words_.codes[0].letter == 'G' && words_.codes[0].tenths == 291 &&
                                 !words_.has(letter);
       if (bambu_z_trim) {
-        words_.present |= 1u << (letter - 'A');
-        words_.value[letter - 'A'] = 0.0;
-        words_.text[letter - 'A'] = word_start;
+        words_.set(letter, 0.0, word_start);
         p = word_end;
         continue;
       }
@@ -787,9 +789,7 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
       problem(line_number, std::string(1, letter) + " given twice on one line");
       return false;
     }
-    words_.present |= 1u << (letter - 'A');
-    words_.value[letter - 'A'] = value;
-    words_.text[letter - 'A'] = word_start;
+    words_.set(letter, value, word_start);
   }
   return true;
 }
