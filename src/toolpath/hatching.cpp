@@ -91,9 +91,11 @@ void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& l
   // where the grid's own points break the line)
   const double max_jump = spec.max_jump_ratio * h;
   const auto cut_into = [&](const std::optional<SurfaceHit>& hit, const Vec3& a, const Vec3& b) {
+    // (a chord up a steep slope is longer than the jump: a point on it lies within the chord)
+    const double reach = std::max(max_jump, (b - a).norm());
     return hit && hit->faces_up(spec.min_normal_z) &&
            hit->point_mm.z() - 0.5 * (a.z() + b.z()) > spec.chord_tolerance_mm &&
-           (hit->point_mm - a).norm() <= max_jump && (hit->point_mm - b).norm() <= max_jump;
+           (hit->point_mm - a).norm() <= reach && (hit->point_mm - b).norm() <= reach;
   };
   Piece refined;
   // the points strictly between (ua, a) and (ub, b), in order, given the hit halfway
@@ -324,6 +326,26 @@ std::size_t round_convex_creases(PrintPath& path, HatchPathInfo& info, double of
   return added;
 }
 
+// Whether the surface between two consecutive grid points a and b, farther apart than the
+// jump (max_jump_ratio * hatch_mm), is one steep slope rather than a step: at a quarter, half
+// and three quarters of the way it faces up and lies within a quarter of their height
+// difference of the straight line between them. A step's wall does not face up and either side
+// of it lies at a's or b's height; a slope steeper than acos(1 / max_jump_ratio) (70.5 deg)
+// that still faces up is surface, and a line across it runs on (it used to break at every
+// point and leave the slope bare without a word).
+bool rises_evenly(const SurfaceProjector& projector, const Vec3& a, const Vec3& b,
+                  double min_normal_z) {
+  const double band = 0.25 * std::abs(b.z() - a.z());
+  for (const double t : {0.25, 0.5, 0.75}) {
+    const Vec3 straight = a + t * (b - a);
+    const std::optional<SurfaceHit> hit = projector.project_down(straight.x(), straight.y());
+    if (!hit || !hit->faces_up(min_normal_z) ||
+        !(std::abs(hit->point_mm.z() - straight.z()) <= band))
+      return false;
+  }
+  return true;
+}
+
 AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
                        const SurfaceHatchSpec& spec) {
   const double theta = deg_to_rad(angle_deg);
@@ -382,7 +404,9 @@ AngleGrid project_grid(const SurfaceProjector& projector, double angle_deg,
         close();
         continue;
       }
-      if (!piece.points.empty() && (hit->point_mm - piece.points.back()).norm() > max_jump) close();
+      if (!piece.points.empty() && (hit->point_mm - piece.points.back()).norm() > max_jump &&
+          !rises_evenly(projector, piece.points.back(), hit->point_mm, spec.min_normal_z))
+        close();
       piece.index.push_back(i);
       piece.points.push_back(hit->point_mm);
       piece.normals.push_back(hit->normal);

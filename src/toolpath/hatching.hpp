@@ -9,7 +9,8 @@
 //  - each grid point is projected straight down onto the top surface;
 //  - a line is broken where the surface is absent (no hit: a hole or beyond an edge; or a
 //    normal with n_z <= min_normal_z: a wall) and where consecutive surface points are more
-//    than max_jump_ratio * hatch_mm apart in 3-D (a step); every piece of at least two
+//    than max_jump_ratio * hatch_mm apart in 3-D where the surface between them is no even
+//    slope (a step: rises_evenly in hatching.cpp); every piece of at least two
 //    points is a PrintPath (the planner joins pieces by travels);
 //  - beyond the paper, a chord between two points that the surface rises above by more than
 //    chord_tolerance_mm halfway (a ridge between grid points: the nozzle would cut into the
@@ -53,7 +54,7 @@ struct SurfaceHatchSpec {
   Offset offset = Offset::normal;
   double speed_mm_s = 10.0;
   double min_normal_z = 0.1;    // a surface whose normal has n_z <= this is no surface
-  double max_jump_ratio = 3.0;  // consecutive points farther apart than this * hatch_mm: a break
+  double max_jump_ratio = 3.0;  // farther apart than this * hatch_mm, no slope between: a break
   // a chord between consecutive points whose surface rises more than this above it halfway is
   // refined by the surface point there (0: the grid's points only, as in the paper)
   double chord_tolerance_mm = 0.05;

@@ -295,30 +295,53 @@ TEST(Hatching, HoleSplitsALineIntoTwoPaths) {
     }
 }
 
-TEST(Hatching, StepSplitsALine) {
-  // z = 0 up to x = 10, a ramp up to 10 mm at x = 11, flat after: the grid points
-  // x = 10.1 (z 1), 10.6 (z 6), 11.1 (z 10) are 5.0 and 4.0 mm apart, over 3 x 0.5 mm
+// z = 0 up to x = 10, a ramp of the given slope up to 10 mm, flat after, over 20.2 x 4.2 mm
+TriangleMesh ramp(double slope) {
   HeightField field = plane(20.2, 4.2, 0.0);
-  field.z = [](double x, double) { return std::clamp(10.0 * (x - 10.0), 0.0, 10.0); };
-  field.x_breaks = {10.0, 11.0};
-  TessellationOptions options;
-  const TriangleMesh mesh = tessellate(field, options);
+  field.z = [slope](double x, double) { return std::clamp(slope * (x - 10.0), 0.0, 10.0); };
+  field.x_breaks = {10.0, 10.0 + 10.0 / slope};
+  return tessellate(field, TessellationOptions{});
+}
+
+// A ramp steeper than the jump (consecutive points more than 3 spacings apart, slope above
+// 70.5 deg) that still faces up is surface: each of the 9 lines runs across it whole (it used to
+// break at every point and leave the ramp bare); a ramp that is a wall (n_z at most
+// min_normal_z) splits every line in two. Steps proper (no surface between two heights) are in
+// LoneGridPointsBetweenStepsAreReported.
+TEST(Hatching, ASteepSlopeIsPrintedAWallSplitsALine) {
+  // slope 10 (n_z 0.0995): the grid points x = 10.1 (z 1), 10.6 (z 6), 11.1 (z 10) are 5.0 and
+  // 4.0 mm apart, over 3 x 0.5 mm
+  const TriangleMesh steep = ramp(10.0);
   SurfaceHatchSpec spec;
   spec.angles_deg = {0};
-  spec.min_normal_z = 0.0;  // the ramp (n_z 0.0995) counts as surface: the jump breaks
-  const SurfaceHatch hatch = hatch_surface(mesh, spec);
-  expect_well_formed(hatch);
-  EXPECT_EQ(hatch.toolpath.paths.size(), 2u * 9u);  // 9 lines, each in two
-  for (std::size_t p = 0; p < hatch.toolpath.paths.size(); ++p) {
-    const PrintPath& path = hatch.toolpath.paths[p];
+  spec.min_normal_z = 0.0;  // the ramp counts as surface
+  const SurfaceHatch across = hatch_surface(steep, spec);
+  expect_well_formed(across);
+  ASSERT_EQ(across.toolpath.paths.size(), 9u);
+  for (const PrintPath& path : across.toolpath.paths) {
+    EXPECT_NEAR(std::min(path.front().x(), path.back().x()), 0.1, 1e-9);
+    EXPECT_NEAR(std::max(path.front().x(), path.back().x()), 20.1, 1e-9);
+    const auto on_ramp = std::find_if(path.points.begin(), path.points.end(),
+                                      [](const Vec3& p) { return std::abs(p.x() - 10.6) < 1e-9; });
+    ASSERT_NE(on_ramp, path.points.end());
+    EXPECT_NEAR(on_ramp->z(), 6.0, 1e-9);
+  }
+  // with the default least normal z (0.1) the ramp is a wall: every line in two, off it
+  spec.min_normal_z = 0.1;
+  const SurfaceHatch walls = hatch_surface(steep, spec);
+  expect_well_formed(walls);
+  ASSERT_EQ(walls.toolpath.paths.size(), 2u * 9u);
+  for (const PrintPath& path : walls.toolpath.paths) {
     const bool low = std::min(path.front().x(), path.back().x()) < 10.0;
-    EXPECT_NEAR(std::max(path.front().x(), path.back().x()), low ? 10.1 : 20.1, 1e-9);
+    EXPECT_NEAR(std::max(path.front().x(), path.back().x()), low ? 9.6 : 20.1, 1e-9);
     EXPECT_NEAR(std::min(path.front().x(), path.back().x()), low ? 0.1 : 11.1, 1e-9);
   }
-  // with the default least normal z (0.1) the ramp is a wall: the same breaks
-  spec.min_normal_z = 0.1;
-  const SurfaceHatch walls = hatch_surface(mesh, spec);
-  EXPECT_EQ(walls.toolpath.paths.size(), 2u * 9u);
+  // a 75 deg ramp (n_z 0.259) with the defaults: points 1.93 mm apart up it, each line whole
+  spec = SurfaceHatchSpec{};
+  spec.angles_deg = {0};
+  const SurfaceHatch seventy_five = hatch_surface(ramp(std::tan(deg_to_rad(75.0))), spec);
+  expect_well_formed(seventy_five);
+  EXPECT_EQ(seventy_five.toolpath.paths.size(), 9u);
 }
 
 // A roof z = 20 - 0.7 |x - 9.6|: its ridge falls between grid points 2 mm apart (8.3, 10.3). The
