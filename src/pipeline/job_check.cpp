@@ -102,7 +102,15 @@ std::vector<Problem> model_problems(const Scenario& scenario) {
     std::string where = shown;
     if (p.line > 0) where += ":" + std::to_string(p.line);
     const std::string element = p.key == "model" ? "" : p.key + ": ";
-    problems.push_back(scenario.problem_at(key, "MJCF " + where + ": " + element + p.message));
+    // a shipped model that is not there: where it was looked for, and why there
+    const bool shipped_missing = scenario.model_path.empty() && p.key == "model" && p.line == 0 &&
+                                 !fs::is_regular_file(model_path);
+    const std::string folder = shipped_missing ? " (the shipped models are looked for in " +
+                                                     models_directory_text() +
+                                                     "; DEPOTWIN_MODELS_DIR names another folder)"
+                                               : "";
+    problems.push_back(
+        scenario.problem_at(key, "MJCF " + where + ": " + element + p.message + folder));
   }
   return problems;
 }
