@@ -123,16 +123,14 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
                           "must be " +
                               range_text(ranges::kMinLimit, ranges::kMaxAcceleration_mm_s2) +
                               " mm/s^2" + got(m.a_max)});
-    if (v_ok && std::abs(m.boundary.v0) > m.v_max)
-      problems.push_back(
-          {"", 0, "--v0",
-           "|v0| exceeds v_max " + message_number(m.v_max) + ", got " +
-               message_number_beside(m.boundary.v0, std::copysign(m.v_max, m.boundary.v0)) + axis});
-    if (v_ok && std::abs(m.boundary.v1) > m.v_max)
-      problems.push_back(
-          {"", 0, "--v1",
-           "|v1| exceeds v_max " + message_number(m.v_max) + ", got " +
-               message_number_beside(m.boundary.v1, std::copysign(m.v_max, m.boundary.v1)) + axis});
+    // a boundary speed over v_max, with the digits that tell them apart
+    for (const auto& [name, v] : {std::pair<const char*, double>{"--v0", m.boundary.v0},
+                                  std::pair<const char*, double>{"--v1", m.boundary.v1}})
+      if (v_ok && std::abs(v) > m.v_max)
+        problems.push_back({"", 0, name,
+                            std::string("|") + (name + 2) + "| exceeds v_max " +
+                                message_number(m.v_max) + ", got " +
+                                message_number_beside(v, std::copysign(m.v_max, v)) + axis});
     if (!request.j_max.empty()) {
       const double j_max = value_for_axis(request.j_max, i);
       if (!(j_max == 0.0 || within(j_max, ranges::kMinLimit, ranges::kMaxJerk_mm_s3)))
