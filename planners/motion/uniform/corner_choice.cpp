@@ -329,13 +329,22 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
                            const DepositModel& model) {
   const double reach = window_reach_mm(chain, corner, geometry, limits, options, model);
 
-  // the window: the two edges around the corner, cut at `reach`
+  // the window: the two edges around the corner, cut at `reach`. An edge too short to hold a
+  // target of its own (within the end clearance and a cell: the next corner a hair away, where
+  // the points could not be merged) is taken on straight to `reach` instead: cut at its end,
+  // the window would hold no targets near the corner (every candidate's error 0, the crawl
+  // chosen) and no room for the speed change (its time a fraction of the plan's)
   CornerWindow w;
   const Vec3& c = chain.points[corner];
   const double edge_in = (c - chain.points[corner - 1]).norm();
   const double edge_out = (chain.points[corner + 1] - c).norm();
-  const Vec3 a = edge_in <= reach ? chain.points[corner - 1] : Vec3(c - reach * geometry.d_in);
-  const Vec3 b = edge_out <= reach ? chain.points[corner + 1] : Vec3(c + reach * geometry.d_out);
+  const double sigma = model.settings.footprint_sigma_mm();
+  const double short_edge_mm = (kEndClearSigmas + kCellSigmas) * sigma;
+  const auto window_end = [&](double edge_mm, const Vec3& end, const Vec3& along) {
+    return edge_mm <= reach && edge_mm >= short_edge_mm ? end : Vec3(c + reach * along);
+  };
+  const Vec3 a = window_end(edge_in, chain.points[corner - 1], -geometry.d_in);
+  const Vec3 b = window_end(edge_out, chain.points[corner + 1], geometry.d_out);
   w.a = a, w.b = b, w.c = c;
   w.cell_mm = kCellSigmas * model.settings.footprint_sigma_mm();
   w.frame_corner = Vec3(kFrameCornerCells * w.cell_mm, kFrameCornerCells * w.cell_mm, 0.0);
@@ -353,8 +362,8 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   w.geometry.resize(3);
   for (int i = 0; i < 3; ++i) w.geometry[i].point = window.points[i];
   w.geometry[1] = geometry;
-  w.geometry[1].max_half_length_mm =
-      max_blend_half_length(geometry, (c - a).norm(), (b - c).norm(), kInf);
+  w.geometry[1].max_half_length_mm = max_blend_half_length(
+      geometry, std::min((c - a).norm(), edge_in), std::min((b - c).norm(), edge_out), kInf);
   w.v_in = window.edge_speed_mm_s[0], w.v_out = window.edge_speed_mm_s[1];
   w.lag_s = options.lag_s;
   // the shared ends: the window less what a kind's candidates change and the shutter's lead

@@ -344,21 +344,29 @@ TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s) {
 MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm) {
   MergedChain merged;
   const size_t n = chain.points.size();
-  if (chain.oriented || n < 3 || !(max_error_mm > 0.0)) {
+  if (n < 3 || !(max_error_mm > 0.0)) {
     merged.chain = chain;
     merged.edge_error_mm.assign(chain.edges(), 0.0);
     merged.source_point.resize(n);
     for (size_t i = 0; i < n; ++i) merged.source_point[i] = i;
     return merged;
   }
-  // the points kept: edges of the same path and speed merged within max_error_mm
+  // the points kept: edges of the same path and speed merged within max_error_mm; on a chain
+  // that turns the tool, only where the tool keeps one orientation (the arm's planar jobs: one
+  // roll everywhere), so the orientation between the kept points is the one given
+  const auto same_orientation = [&](size_t i, size_t j) {
+    const ToolOrientation& p = chain.orientations[i];
+    const ToolOrientation& q = chain.orientations[j];
+    return p.axis == q.axis && p.roll_rad == q.roll_rad;
+  };
   const FineEdgeMerge kept = merge_polyline_edges(
       chain.points, max_error_mm, kMaxMergedPoints, [&](size_t anchor, size_t edge) {
         return chain.edge_path[edge] == chain.edge_path[anchor] &&
-               chain.edge_speed_mm_s[edge] == chain.edge_speed_mm_s[anchor];
+               chain.edge_speed_mm_s[edge] == chain.edge_speed_mm_s[anchor] &&
+               (!chain.oriented || same_orientation(anchor, edge + 1));
       });
   PrintChain& out = merged.chain;
-  out.oriented = false;
+  out.oriented = chain.oriented;
   for (size_t k = 0; k < kept.kept.size(); ++k) {
     const size_t i = kept.kept[k];
     out.points.push_back(chain.points[i]);

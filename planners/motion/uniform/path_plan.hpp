@@ -123,8 +123,8 @@ struct PathMotionOptions {
 // wherever every point dropped lies within max_error_mm of it (greedily, from each kept
 // point as far as the next edge would still hold), so the curve keeps points every
 // 2 sqrt(2 r max_error_mm) or so and their corners fit their blends. A point farther from the
-// chord is kept: the sharp corners the deposit decides stay as given. Chains that carry the
-// tool's orientation are left as they are. edge_error_mm: per merged edge, the largest
+// chord is kept: the sharp corners the deposit decides stay as given. On chains that carry the
+// tool's orientation, only points where it stays the same are dropped. edge_error_mm: per merged edge, the largest
 // distance of a dropped point from it (0 where nothing was dropped); the original polyline
 // stays within that of the edge, so a corner's blend keeps to the tolerance less its edges'
 // errors (corner_geometry).

@@ -103,8 +103,8 @@ TEST(MergeFineEdges, DroppedPointsLieWithinTheirEdgesError) {
 }
 
 // A polyline whose every point is farther from the chord past it than the bound, reversals,
-// and any chain that carries the tool's orientation, stay as given.
-TEST(MergeFineEdges, LeavesCoarseAndOrientedChainsAlone) {
+// and the points where the tool turns, stay as given.
+TEST(MergeFineEdges, LeavesCoarseChainsAndTurningToolsAlone) {
   const std::vector<Vec3> coarse = chorded_circle(10.0, 24);  // sagitta 0.086 mm > 0.025
   const PrintChain chain = print_chains(polyline_job(coarse, 20.0)).front();
   const MergedChain merged = merge_fine_edges(chain, 0.025);
@@ -120,11 +120,45 @@ TEST(MergeFineEdges, LeavesCoarseAndOrientedChainsAlone) {
           .front();
   EXPECT_EQ(merge_fine_edges(reversal, 0.025).chain.points, reversal.points);
 
+  // a tool turning at every point (its axis tilted by the point's angle): nothing merged
   Toolpath oriented = polyline_job(chorded_circle(10.0, 600), 20.0);
-  oriented.paths[0].normals.assign(oriented.paths[0].points.size(), Vec3(0, 0, 1));
+  PrintPath& turning = oriented.paths[0];
+  for (const Vec3& p : turning.points)
+    turning.normals.push_back(Vec3(0.1 * p.x(), 0.1 * p.y(), 1.0).normalized());
   const PrintChain with_normals = print_chains(oriented).front();
   ASSERT_TRUE(with_normals.oriented);
   EXPECT_EQ(merge_fine_edges(with_normals, 0.025).chain.points, with_normals.points);
+}
+
+// The arm's planar jobs carry a roll per point (arm_posture.cpp), one roll all along: its fine
+// chords merge as on a stage, the orientations of the kept points kept; a roll that changes
+// keeps the points where it does. (Left alone, a 90 deg corner between two 1e-4 mm edges was
+// decided on a window of 2e-4 mm: a crawl at 0.012 mm/s.)
+TEST(MergeFineEdges, ChainsWithOneOrientationMergeAsWithout) {
+  const std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(5, 0, 0), Vec3(5.0001, 0, 0),
+                                    Vec3(5.0001, 0.0001, 0), Vec3(5.0001, 5, 0)};
+  Toolpath toolpath = polyline_job(points, 3.0);
+  const PrintChain plain = print_chains(toolpath).front();
+  const MergedChain plain_merged = merge_fine_edges(plain, 0.025);
+  ASSERT_EQ(plain_merged.chain.points.size(), 3u);
+  EXPECT_EQ(plain_merged.chain.points[1], points[3]);
+
+  toolpath.paths[0].rolls.assign(points.size(), 0.3);
+  const PrintChain rolled = print_chains(toolpath).front();
+  ASSERT_TRUE(rolled.oriented);
+  const MergedChain rolled_merged = merge_fine_edges(rolled, 0.025);
+  EXPECT_TRUE(rolled_merged.chain.oriented);
+  EXPECT_EQ(rolled_merged.chain.points, plain_merged.chain.points);
+  EXPECT_EQ(rolled_merged.edge_error_mm, plain_merged.edge_error_mm);
+  for (const ToolOrientation& o : rolled_merged.chain.orientations) EXPECT_EQ(o.roll_rad, 0.3);
+
+  // the roll turns over the second edge: both its ends are kept, the rest merges
+  toolpath.paths[0].rolls = {0.3, 0.3, 0.5, 0.5, 0.5};
+  const MergedChain turned = merge_fine_edges(print_chains(toolpath).front(), 0.025);
+  EXPECT_EQ(turned.chain.points, (std::vector<Vec3>{points[0], points[1], points[2], points[4]}));
+  std::vector<double> rolls;
+  for (const ToolOrientation& o : turned.chain.orientations) rolls.push_back(o.roll_rad);
+  EXPECT_EQ(rolls, (std::vector<double>{0.3, 0.3, 0.5, 0.5}));
 }
 
 // A circle of radius 10 mm in 200 chords of 0.31 mm, or 3000 of 0.021 mm, at 50 mm/s under

@@ -349,6 +349,36 @@ TEST(UniformPlanner, BlendsStayInsideTheToleranceBand) {
   }
 }
 
+// A line with a zig-zag of 1e-4 mm teeth at tolerance 1e-4 mm: the teeth are no fine chords
+// (each 1e-4 mm off the chord past it, more than half the tolerance) and their corners' blends
+// must fit 1e-4 mm, far below what the print speed needs. Each corner's window takes its edges
+// on straight (too short to hold a target of their own): the crawl through the teeth is seen to
+// pile the aerosol (every corner's predicted error above 0) and the shutter closes for it, every
+// deposited sample at the print speed; the corners' extra times add up to what the plan takes
+// beyond the straight line (3.45 s; cut at the teeth, each window was 2e-4 mm long, every error
+// 0 and the crawl at 0.016 mm/s chosen, its extra time 9 x low).
+TEST(UniformPlanner, CornersBetweenHairEdgesAreWeighedOnTheLinesGoingOn) {
+  Toolpath toolpath = single_line(Vec3(0, 0, 0), Vec3(6, 0, 0), Vec3(-6, -7, 0), Vec3(7, -7, 0));
+  toolpath.paths[0].points = {Vec3(0, 0, 0)};
+  for (int k = 0; k <= 10; ++k)
+    toolpath.paths[0].points.emplace_back(3.0 + 1e-4 * k, 1e-4 * (k % 2), 0.0);
+  toolpath.paths[0].points.emplace_back(6, 0, 0);
+  UniformSettings settings;
+  settings.tolerance_mm = 1e-4;
+  const Trajectory plan = UniformPlanner{settings}.plan(toolpath, kLimits);
+  ASSERT_EQ(plan.decisions().size(), 11u);
+  double extra_s = 0.0;
+  for (const PlanDecision& corner : plan.decisions()) {
+    EXPECT_GT(figure(corner, "predicted_error_mm"), 0.0) << "point " << corner.point_index;
+    extra_s += figure(corner, "extra_time_s");
+  }
+  EXPECT_LT(max_speed_error(plan), 1e-6);
+  const Trajectory straight = UniformPlanner{settings}.plan(
+      single_line(Vec3(0, 0, 0), Vec3(6, 0, 0), Vec3(-6, -7, 0), Vec3(7, -7, 0)), kLimits);
+  EXPECT_NEAR(extra_s, plan.duration_s() - straight.duration_s(),
+              0.05 * (plan.duration_s() - straight.duration_s()));
+}
+
 // A slicer's arc is a run of short chords; blends sized for the print speed fill them whole,
 // leaving no line to change speed on. An extruder's path that ends on such an arc (a
 // perimeter's last corner, rounded_square_3_layers.gcode) must still slow down only near its
