@@ -169,10 +169,22 @@ std::optional<std::pair<XyCircle, double>> fit_arc(const std::vector<Vec3>& poin
   return std::make_pair(*circle, sweep);
 }
 
+// Positions (and I, J) are written with at least 4 decimals, more where the chord tolerance is
+// finer: enough that rounding all three axes moves a point by at most a tenth of it
+// (sqrt(3) / 2 10^-d; 4 decimals at 0.00087 mm and above, 9 at most)
+int position_decimals(double chord_tolerance_mm) {
+  int decimals = 4;
+  while (decimals < 9 &&
+         0.5 * std::sqrt(3.0) * std::pow(10.0, -decimals) > 0.1 * chord_tolerance_mm)
+    ++decimals;
+  return decimals;
+}
+
 // The G-code lines, with the modal position and feed rate written only when they change.
 class GcodeWriter {
  public:
-  explicit GcodeWriter(bool extrusion) : extrusion_(extrusion) {}
+  GcodeWriter(bool extrusion, int position_decimals)
+      : extrusion_(extrusion), decimals_(position_decimals) {}
 
   void line(const std::string& text) { body_ << text << '\n'; }
 
@@ -181,7 +193,7 @@ class GcodeWriter {
     std::string text = code;
     const char* axis_names[3] = {" X", " Y", " Z"};
     for (int axis = 0; axis < 3; ++axis) {
-      const std::string value = number_text(to[axis], 4);
+      const std::string value = number_text(to[axis], decimals_);
       if (value != axis_text_[axis]) text += axis_names[axis] + value, axis_text_[axis] = value;
     }
     append_e_and_feed(text, e_mm, feed_mm_min);
@@ -208,12 +220,12 @@ class GcodeWriter {
   // relative to the start, as G90.1 is not assumed), with F and E as for move()
   void arc(bool counter_clockwise, const Vec3& from, const Vec3& to, const Vec3& centre,
            double feed_mm_min, double e_mm) {
-    const std::string i_text = number_text(centre.x() - from.x(), 4);
-    const std::string j_text = number_text(centre.y() - from.y(), 4);
+    const std::string i_text = number_text(centre.x() - from.x(), decimals_);
+    const std::string j_text = number_text(centre.y() - from.y(), decimals_);
     std::string text = counter_clockwise ? "G3" : "G2";
     const char* axis_names[3] = {" X", " Y", " Z"};
     for (int axis = 0; axis < 3; ++axis) {
-      const std::string value = number_text(to[axis], 4);
+      const std::string value = number_text(to[axis], decimals_);
       // an arc's end is always written in the plane, so the reader needs no modal X or Y
       if (axis < 2 || value != axis_text_[axis]) text += axis_names[axis] + value;
       axis_text_[axis] = value;
@@ -223,10 +235,10 @@ class GcodeWriter {
     body_ << text << '\n';
   }
 
-  // whether a move to `to` changes the written position (4 decimals)
+  // whether a move to `to` changes the written position (as written)
   bool changes_position(const Vec3& to) const {
     for (int axis = 0; axis < 3; ++axis)
-      if (number_text(to[axis], 4) != axis_text_[axis]) return true;
+      if (number_text(to[axis], decimals_) != axis_text_[axis]) return true;
     return false;
   }
 
@@ -234,6 +246,7 @@ class GcodeWriter {
 
  private:
   bool extrusion_;
+  int decimals_;  // of positions, I and J
   std::ostringstream body_;
   std::string axis_text_[3];
   std::string feed_text_;
@@ -246,7 +259,8 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
   const bool extrusion = job.process == "extrusion";
   const double filament_area_mm2 =
       kPi * 0.25 * settings.filament_diameter_mm * settings.filament_diameter_mm;
-  GcodeWriter gcode(extrusion);
+  const int decimals = position_decimals(settings.chord_tolerance_mm);
+  GcodeWriter gcode(extrusion, decimals);
   size_t print_moves = 0, print_arcs = 0;
   double print_length_mm = 0.0, e_total_mm = 0.0;
   bool open = false;  // aerosol: the shutter code last written
@@ -383,9 +397,13 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
          << number_text(print_length_mm, 3) << " mm";
   if (extrusion) header << ", E total " << number_text(e_total_mm, 3) << " mm";
   header << '\n'
-         << "; every planned sample within " << number_text(settings.chord_tolerance_mm, 4)
+         << "; every planned sample within "
+         << number_text(settings.chord_tolerance_mm, decimals + 1)
          << " mm of these lines and arcs (G2/G3 in the XY plane, I and J relative to the "
-            "arc's start); F = each move's planned average speed\n"
+            "arc's start), positions rounded to "
+         << decimals
+         << " decimals (adding at most a tenth of the tolerance); F = each move's planned "
+            "average speed\n"
          << "G21 ; millimetres\n"
          << "G90 ; absolute positions\n";
   if (extrusion) header << "M83 ; relative extrusion\n";

@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "kinematics/arm6.hpp"
+#include "metrics/motion_metrics.hpp"
 #include "pipeline/models_dir.hpp"
 #include "pipeline/run.hpp"
 #include "pipeline/step_heartbeat.hpp"
@@ -131,6 +132,28 @@ void choose_posture(const Scenario& scenario, Arm6& arm, PreparedJob& job) {
   }
   arm.set_branch(job.posture->branch);
   job.toolpath = job.posture->toolpath;
+}
+
+// A warning where the plan deposits farther from its toolpath than the line is wide (material
+// beside the line, not on it: e.g. lspb_mtt's blends under a tiny j_max), naming where; ""
+// where it does not
+std::string off_path_warning(const MotionSamples& planned, const Toolpath& toolpath,
+                             double path_error_max_mm, double line_width_mm) {
+  if (!(path_error_max_mm > line_width_mm)) return "";
+  const std::vector<double> distances = path_distances(planned, toolpath);
+  size_t farthest = 0;
+  for (size_t k = 0; k < distances.size(); ++k)
+    if (distances[k] > distances[farthest] || std::isnan(distances[farthest])) farthest = k;
+  const int path = planned.path_index[farthest];
+  const int shown_path = path >= 0 && static_cast<size_t>(path) < toolpath.paths.size()
+                             ? toolpath.paths[static_cast<size_t>(path)].source_index
+                             : path;
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "the plan deposits up to %.4g mm off the toolpath (path %d, at %.3f s), more than "
+                "the line is wide (%.4g mm): that material lands beside the line",
+                path_error_max_mm, shown_path, planned.t_s[farthest], line_width_mm);
+  return text;
 }
 
 }  // namespace
@@ -342,6 +365,10 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   // machine's limits), then the planner's
   r.warnings = job.scenario.notes;
   for (const std::string& warning : run.trajectory.warnings()) r.warnings.push_back(warning);
+  const std::string off_path =
+      off_path_warning(run.planned, job.intended_toolpath(), r.planned_path_error.max_mm,
+                       deposition_settings(job.scenario).resolved_line_width_mm());
+  if (!off_path.empty()) r.warnings.push_back(off_path);
   r.planner_decisions = run.trajectory.decisions();
   return run;
 }

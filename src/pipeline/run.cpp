@@ -311,7 +311,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
       const VideoStats video = write_replay_video(replay, out.file("run.mp4"));
       char line[256];
       std::snprintf(line, sizeof line,
-                    "%s/%s: run.mp4, %.1f s of video at %s (%d frames at %g fps), rendered in "
+                    "%s/%s: run.mp4, %.3g s of video at %s (%d frames at %g fps), rendered in "
                     "%.1f s\n",
                     job.scenario.name.c_str(), run.plan.spec.run_label().c_str(), video.length_s,
                     speedup_text(replay.timing.speedup).c_str(), video.frames, replay.timing.fps,

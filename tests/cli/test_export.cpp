@@ -43,6 +43,40 @@ std::string body(const std::string& gcode) {
   return gcode.substr(gcode.find("G0 "));
 }
 
+// A line off the 1e-4 mm grid (x from 0.123456789 mm) exported within 1e-5 mm: its ends are
+// written to 6 decimals (rounding all three axes within a tenth of the tolerance) and the header
+// names the tolerance as given; at the default 0.005 mm they keep 4 decimals. (4 decimals at
+// any tolerance moved the ends 4.3e-5 mm and the header read "within 0 mm".)
+TEST(ExportGcode, PositionsKeepTheDigitsTheToleranceNeeds) {
+  SampledMotion motion;
+  const double x0 = 0.123456789;
+  for (int k = 0; k <= 1000; ++k) {
+    motion.position_mm.push_back(Vec3(x0 + 0.002 * k, 0.0, 0.0));
+    motion.velocity_mm_s.push_back(Vec3(2.0, 0.0, 0.0));
+  }
+  TrajectoryPiece piece;
+  piece.t_end_s = 1.0;
+  piece.path_index = 0;
+  piece.depositing = true;
+  piece.desired_speed_mm_s = 2.0;
+  piece.motion = motion;
+  const Trajectory line("hand", {piece});
+  GcodeExportJob job;
+  job.process = "aerosol";
+  GcodeExportSettings fine;
+  fine.chord_tolerance_mm = 1e-5;
+  const std::string gcode = trajectory_gcode(line, job, fine);
+  EXPECT_NE(gcode.find("within 0.00001 mm"), std::string::npos) << gcode;
+  EXPECT_NE(body(gcode).find("G0 X0.123457 Y0 Z0\n"), std::string::npos) << gcode;
+  std::istringstream in(gcode);
+  const Toolpath imported = parse_gcode(in, "fine.gcode", GcodeOptions{}).toolpath;
+  ASSERT_EQ(imported.paths.size(), 1u);
+  EXPECT_NEAR(imported.paths[0].points.front().x(), x0, 0.1 * fine.chord_tolerance_mm);
+  EXPECT_NEAR(imported.paths[0].points.back().x(), x0 + 2.0, 0.1 * fine.chord_tolerance_mm);
+  const std::string coarse = body(trajectory_gcode(line, job, GcodeExportSettings{}));
+  EXPECT_EQ(coarse.rfind("G0 X0.1235 Y0 Z0\n", 0), 0u) << coarse;
+}
+
 // extrusion: one G1 with F = 2 mm/s x 60 and E = 0.4 x 0.2 x 2 / (pi 0.875^2) = 0.066520 mm
 TEST(ExportGcode, ExtrusionLineHasFeedAndFilamentE) {
   GcodeExportJob job;
