@@ -22,11 +22,11 @@ using testing_support::fresh_directory;
 using testing_support::read_text;
 using testing_support::scenario_path;
 
-// one depositing piece: (0,0,0) to (2,0,0) at a constant 2 mm/s, sampled every 1 ms
-Trajectory straight_line_trajectory() {
+// one depositing piece: (x0,0,0) to (x0 + 2,0,0) at a constant 2 mm/s, sampled every 1 ms
+Trajectory straight_line_trajectory(double x0 = 0.0) {
   SampledMotion motion;
   for (int k = 0; k <= 1000; ++k) {
-    motion.position_mm.push_back(Vec3(0.002 * k, 0.0, 0.0));
+    motion.position_mm.push_back(Vec3(x0 + 0.002 * k, 0.0, 0.0));
     motion.velocity_mm_s.push_back(Vec3(2.0, 0.0, 0.0));
   }
   TrajectoryPiece piece;
@@ -48,19 +48,8 @@ std::string body(const std::string& gcode) {
 // names the tolerance as given; at the default 0.005 mm they keep 4 decimals. (4 decimals at
 // any tolerance moved the ends 4.3e-5 mm and the header read "within 0 mm".)
 TEST(ExportGcode, PositionsKeepTheDigitsTheToleranceNeeds) {
-  SampledMotion motion;
   const double x0 = 0.123456789;
-  for (int k = 0; k <= 1000; ++k) {
-    motion.position_mm.push_back(Vec3(x0 + 0.002 * k, 0.0, 0.0));
-    motion.velocity_mm_s.push_back(Vec3(2.0, 0.0, 0.0));
-  }
-  TrajectoryPiece piece;
-  piece.t_end_s = 1.0;
-  piece.path_index = 0;
-  piece.depositing = true;
-  piece.desired_speed_mm_s = 2.0;
-  piece.motion = motion;
-  const Trajectory line("hand", {piece});
+  const Trajectory line = straight_line_trajectory(x0);
   GcodeExportJob job;
   job.process = "aerosol";
   GcodeExportSettings fine;

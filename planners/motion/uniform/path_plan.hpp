@@ -124,10 +124,10 @@ struct PathMotionOptions {
 // point as far as the next edge would still hold), so the curve keeps points every
 // 2 sqrt(2 r max_error_mm) or so and their corners fit their blends. A point farther from the
 // chord is kept: the sharp corners the deposit decides stay as given. On chains that carry the
-// tool's orientation, only points where it stays the same are dropped. edge_error_mm: per merged edge, the largest
-// distance of a dropped point from it (0 where nothing was dropped); the original polyline
-// stays within that of the edge, so a corner's blend keeps to the tolerance less its edges'
-// errors (corner_geometry).
+// tool's orientation, only points where it stays the same are dropped. edge_error_mm: per
+// merged edge, the largest distance of a dropped point from it (0 where nothing was dropped);
+// the original polyline stays within that of the edge, so a corner's blend keeps to the
+// tolerance less its edges' errors (corner_geometry).
 struct MergedChain {
   PrintChain chain;
   std::vector<double> edge_error_mm;
