@@ -109,7 +109,7 @@ int validate_verb(const std::string& path, const std::string& max_memory, bool q
   // and what each planner said of its plan, as `plan` and `run` print it
   for (const PlannerSpec& spec : scenario.planners)
     if (const Trajectory* plan = job.checked_plan(spec))
-      for (const std::string& warning : plan->warnings())
+      for (const std::string& warning : plan_warnings(job, *plan))
         std::cout << "warning (" << spec.run_label() << "): " << warning << '\n';
   return kExitOk;
 }

@@ -137,9 +137,11 @@ void choose_posture(const Scenario& scenario, Arm6& arm, PreparedJob& job) {
 // A warning where the plan deposits farther from its toolpath than the line is wide (material
 // beside the line, not on it: e.g. lspb_mtt's blends under a tiny j_max), naming where; ""
 // where it does not
-std::string off_path_warning(const MotionSamples& planned, const Toolpath& toolpath,
-                             double path_error_max_mm, double line_width_mm) {
+std::string off_path_warning(const PreparedJob& job, const MotionSamples& planned,
+                             double path_error_max_mm) {
+  const double line_width_mm = deposition_settings(job.scenario).resolved_line_width_mm();
   if (!(path_error_max_mm > line_width_mm)) return "";
+  const Toolpath& toolpath = job.intended_toolpath();
   const std::vector<double> distances = path_distances(planned, toolpath);
   size_t farthest = 0;
   for (size_t k = 0; k < distances.size(); ++k)
@@ -365,12 +367,19 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   // machine's limits), then the planner's
   r.warnings = job.scenario.notes;
   for (const std::string& warning : run.trajectory.warnings()) r.warnings.push_back(warning);
-  const std::string off_path =
-      off_path_warning(run.planned, job.intended_toolpath(), r.planned_path_error.max_mm,
-                       deposition_settings(job.scenario).resolved_line_width_mm());
+  const std::string off_path = off_path_warning(job, run.planned, r.planned_path_error.max_mm);
   if (!off_path.empty()) r.warnings.push_back(off_path);
   r.planner_decisions = run.trajectory.decisions();
   return run;
+}
+
+std::vector<std::string> plan_warnings(const PreparedJob& job, const Trajectory& plan) {
+  std::vector<std::string> warnings = plan.warnings();
+  const MotionSamples planned = sample_trajectory(plan, kSamplePeriod_s);
+  const std::string off_path =
+      off_path_warning(job, planned, path_error(planned, job.intended_toolpath()).max_mm);
+  if (!off_path.empty()) warnings.push_back(off_path);
+  return warnings;
 }
 
 std::vector<MetricsReport> write_plans(const PreparedJob& job,

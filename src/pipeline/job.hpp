@@ -92,6 +92,9 @@ struct PlannedRun {
 };
 // the plan: the one check_runs made for this spec when there is one, else planned now
 PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec);
+// what the planner said of its plan, and, where the plan deposits farther off the toolpath
+// than the line is wide, how far and where (as plan_job reports them; `validate` lists them)
+std::vector<std::string> plan_warnings(const PreparedJob& job, const Trajectory& plan);
 // the scenario line of a planner's entry (its own list item, else the `planners` key): where
 // a problem of its plan is reported
 int planner_entry_line(const Scenario& scenario, const PlannerSpec& spec);

@@ -237,8 +237,8 @@ namespace {
 
 // lspb_mtt under a jerk limit of 1 mm/s^3 blends a 90 deg corner (between two 1e-4 mm edges)
 // over millimetres with the material on: planned 4.93 mm off the toolpath, 12 line widths. The
-// plan is reported with a warning naming how far, where and the width; at 1000 mm/s^3 it
-// keeps within 0.195 mm (half the 0.4 mm line) and has none.
+// plan is reported (and validated) with a warning naming how far, where and the width; at
+// 1000 mm/s^3 it keeps within 0.195 mm (half the 0.4 mm line) and has none.
 TEST(XyPipeline, ADepositFartherOffThePathThanTheLineIsWideIsWarned) {
   const std::string dir = fresh_directory("off_path_warning");
   const auto plan_with_jerk = [&](const std::string& j_max) {
@@ -249,7 +249,11 @@ TEST(XyPipeline, ADepositFartherOffThePathThanTheLineIsWideIsWarned) {
         "  polylines:\n  - [[0, 0], [5, 0], [5.0001, 0], [5.0001, 0.0001], [5.0001, 5]]\n"
         "planners: [lspb_mtt]\n";
     const std::string file = write_text(dir, "corner_" + j_max + ".yaml", yaml);
-    return plan_job(prepare_job(load_scenario(file)), PlannerSpec{"lspb_mtt", {}, 0}).report;
+    const PreparedJob job = prepare_job(load_scenario(file));
+    const PlannedRun run = plan_job(job, PlannerSpec{"lspb_mtt", {}, 0});
+    // `validate` lists the warnings the run reports
+    EXPECT_EQ(plan_warnings(job, run.trajectory), run.report.warnings);
+    return run.report;
   };
   const auto off_path = [](const MetricsReport& r) {
     for (const std::string& w : r.warnings)
