@@ -158,6 +158,15 @@ std::string off_path_warning(const PreparedJob& job, const MotionSamples& planne
   return text;
 }
 
+// plan_warnings on the plan sampled (`planned`, its largest distance off the toolpath given)
+std::vector<std::string> plan_warnings(const PreparedJob& job, const Trajectory& plan,
+                                       const MotionSamples& planned, double path_error_max_mm) {
+  std::vector<std::string> warnings = plan.warnings();
+  const std::string off_path = off_path_warning(job, planned, path_error_max_mm);
+  if (!off_path.empty()) warnings.push_back(off_path);
+  return warnings;
+}
+
 }  // namespace
 
 PreparedJob prepare_job(const Scenario& scenario, const PrepareOptions& options) {
@@ -366,20 +375,16 @@ PlannedRun plan_job(const PreparedJob& job, const PlannerSpec& spec) {
   // the scenario's own (e.g. the rule a G-code file was read by, moves slowed to the
   // machine's limits), then the planner's
   r.warnings = job.scenario.notes;
-  for (const std::string& warning : run.trajectory.warnings()) r.warnings.push_back(warning);
-  const std::string off_path = off_path_warning(job, run.planned, r.planned_path_error.max_mm);
-  if (!off_path.empty()) r.warnings.push_back(off_path);
+  for (const std::string& warning :
+       plan_warnings(job, run.trajectory, run.planned, r.planned_path_error.max_mm))
+    r.warnings.push_back(warning);
   r.planner_decisions = run.trajectory.decisions();
   return run;
 }
 
 std::vector<std::string> plan_warnings(const PreparedJob& job, const Trajectory& plan) {
-  std::vector<std::string> warnings = plan.warnings();
   const MotionSamples planned = sample_trajectory(plan, kSamplePeriod_s);
-  const std::string off_path =
-      off_path_warning(job, planned, path_error(planned, job.intended_toolpath()).max_mm);
-  if (!off_path.empty()) warnings.push_back(off_path);
-  return warnings;
+  return plan_warnings(job, plan, planned, path_error(planned, job.intended_toolpath()).max_mm);
 }
 
 std::vector<MetricsReport> write_plans(const PreparedJob& job,

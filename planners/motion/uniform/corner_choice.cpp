@@ -346,7 +346,7 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   const Vec3 a = window_end(edge_in, chain.points[corner - 1], -geometry.d_in);
   const Vec3 b = window_end(edge_out, chain.points[corner + 1], geometry.d_out);
   w.a = a, w.b = b, w.c = c;
-  w.cell_mm = kCellSigmas * model.settings.footprint_sigma_mm();
+  w.cell_mm = kCellSigmas * sigma;
   w.frame_corner = Vec3(kFrameCornerCells * w.cell_mm, kFrameCornerCells * w.cell_mm, 0.0);
   w.d_in = geometry.d_in, w.d_out = geometry.d_out;
   PrintChain& window = w.chain;
