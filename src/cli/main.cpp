@@ -18,6 +18,7 @@
 #include "cli/verbs.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "core/number_text.hpp"
 #include "pipeline/models_dir.hpp"
 #include "viewer/viewer.hpp"  // view
 
@@ -66,7 +67,7 @@ int check_verb(CLI::App& app, int argc, char** argv) {
     return verb->check_name(first);
   };
   if (!app.get_subcommands(named).empty()) return -1;
-  std::cerr << "error: unknown verb '" << first << "'; verbs are " << verb_list(app)
+  std::cerr << "error: unknown verb '" << terminal_text(first) << "'; verbs are " << verb_list(app)
             << "\n(depotwin --help says what each does)\n";
   return kExitBadInput;
 }
@@ -328,7 +329,7 @@ int run_command_line(int argc, char** argv) {
                 << "; stopped, the output is as it was\n";
       return Interrupted(interrupt_signal()).exit_status();
     }
-    std::cerr << "internal error: " << error.what() << '\n';
+    std::cerr << "internal error: " << terminal_text(error.what()) << '\n';
     return kExitInternal;
   }
   return kExitInternal;

@@ -63,15 +63,15 @@ int plan_verb(const RunOptions& options) {
       prepare_checked_job(scenario, planners, budget, false, true, nullptr, true);
   const std::vector<MetricsReport> reports = write_plans(job, planners, out.path());
   out.commit();
-  std::cout << "scenario " << scenario.name << " (" << scenario.file << "), machine "
+  std::cout << "scenario " << scenario.name << " (" << terminal_text(scenario.file) << "), machine "
             << job.machine->name() << ", order " << scenario.order.label() << ", "
             << job.toolpath.paths.size() << " print paths\n\n"
             << summary_table(reports) << '\n';
   for (const MetricsReport& report : reports)
     for (const std::string& warning : report.warnings)
       std::cout << "warning (" << (report.label.empty() ? report.planner : report.label)
-                << "): " << warning << '\n';
-  std::cout << "plans written to " << directory << "/<planner>/{metrics.json,trajectory.csv}\n";
+                << "): " << terminal_text(warning) << '\n';
+  std::cout << "plans written to " << terminal_text(directory) << "/<planner>/{metrics.json,trajectory.csv}\n";
   return kExitOk;
 }
 
@@ -93,7 +93,7 @@ int validate_verb(const std::string& path, const std::string& max_memory, bool q
   double data_bytes = 0.0;
   for (const RunEstimate& run : runs) data_bytes += run.memory_bytes;
   const double memory_bytes = job_memory_bytes(scenario, runs);
-  std::cout << path << ": ok — scenario " << scenario.name << ", machine " << job.machine->name()
+  std::cout << terminal_text(path) << ": ok — scenario " << scenario.name << ", machine " << job.machine->name()
             << ", " << scenario.toolpath.paths.size() << " print paths, "
             << scenario.planners.size() << " planner(s)\n";
   if (longest != runs.end())
@@ -105,12 +105,12 @@ int validate_verb(const std::string& path, const std::string& max_memory, bool q
               << format_bytes(data_bytes) << " of it (--max-memory "
               << format_bytes(budget.max_memory_bytes) << ")\n";
   // what loading found and every run will repeat (a surface turned over, a G-code rule chosen)
-  for (const std::string& note : scenario.notes) std::cout << "warning: " << note << '\n';
+  for (const std::string& note : scenario.notes) std::cout << "warning: " << terminal_text(note) << '\n';
   // and what each planner said of its plan, as `plan` and `run` print it
   for (const PlannerSpec& spec : scenario.planners)
     if (const Trajectory* plan = job.checked_plan(spec))
       for (const std::string& warning : plan_warnings(job, *plan))
-        std::cout << "warning (" << spec.run_label() << "): " << warning << '\n';
+        std::cout << "warning (" << spec.run_label() << "): " << terminal_text(warning) << '\n';
   return kExitOk;
 }
 
@@ -119,7 +119,7 @@ namespace {
 void print_warnings(const std::vector<MetricsReport>& reports) {
   for (const MetricsReport& report : reports)
     for (const std::string& warning : report.warnings)
-      std::cout << "warning (" << report.planner << "): " << warning << '\n';
+      std::cout << "warning (" << report.planner << "): " << terminal_text(warning) << '\n';
 }
 
 RunSettings run_settings(const Scenario& scenario, const RunOptions& options) {
@@ -166,12 +166,12 @@ int run_verb(const RunOptions& options) {
     writer.wait();
   }
   out.commit();
-  std::cout << "scenario " << scenario.name << " (" << scenario.file << "), machine "
+  std::cout << "scenario " << scenario.name << " (" << terminal_text(scenario.file) << "), machine "
             << job.machine->name() << ", process " << scenario.process.type << ", order "
             << scenario.order.label() << "\n\n"
             << summary_table(reports) << '\n';
   print_warnings(reports);
-  std::cout << "results written to " << directory << "/<planner>/ (metrics.json, trajectory.csv, "
+  std::cout << "results written to " << terminal_text(directory) << "/<planner>/ (metrics.json, trajectory.csv, "
             << "thickness.csv" << (settings.render ? ", images" : "") << ")\n";
   return kExitOk;
 }
@@ -196,11 +196,11 @@ int compare_verb(const CompareOptions& options) {
   out.commit();
   std::vector<MetricsReport> reports;
   for (const ComparisonRow& row : rows) reports.push_back(row.report);
-  std::cout << "scenario " << scenario.name << " (" << scenario.file
+  std::cout << "scenario " << scenario.name << " (" << terminal_text(scenario.file)
             << "): " << (orders.empty() ? "planners" : "print orders") << " compared\n\n"
             << summary_table(reports) << '\n';
   print_warnings(reports);
-  std::cout << "comparison written to " << directory << "/comparison.{json,csv,md"
+  std::cout << "comparison written to " << terminal_text(directory) << "/comparison.{json,csv,md"
             << (settings.render ? ",png" : "") << "}, one folder per run\n";
   return kExitOk;
 }

@@ -2,17 +2,20 @@
 
 #include <sstream>
 
+#include "core/number_text.hpp"
+
 namespace depotwin {
 
 std::string Problem::str() const {
   std::ostringstream out;
+  // a file name or a message may hold bytes a terminal would act on: they are written as \xNN
   if (!file.empty()) {
-    out << file;
+    out << terminal_text(file);
     if (line > 0) out << ':' << line;
     out << ": ";
   }
-  if (!key.empty()) out << key << ": ";
-  out << message;
+  if (!key.empty()) out << terminal_text(key) << ": ";
+  out << terminal_text(message);
   return out.str();
 }
 

@@ -108,8 +108,16 @@ std::size_t first_non_text_byte(const std::string& text) {
   return std::string::npos;
 }
 
-std::string printable_text(const std::string& text, std::size_t max_chars) {
+namespace {
+void append_escaped_byte(std::string& out, unsigned char byte) {
   static const char* kHex = "0123456789ABCDEF";
+  out += "\\x";
+  out += kHex[byte >> 4];
+  out += kHex[byte & 15];
+}
+}  // namespace
+
+std::string printable_text(const std::string& text, std::size_t max_chars) {
   std::string out;
   std::size_t chars = 0;
   std::size_t at = 0;
@@ -121,14 +129,31 @@ std::string printable_text(const std::string& text, std::size_t max_chars) {
       out.append(text, at, length);
       at += length;
     } else {
-      out += "\\x";
-      out += kHex[byte >> 4];
-      out += kHex[byte & 15];
+      append_escaped_byte(out, byte);
       ++at;
     }
     ++chars;
   }
   if (at < text.size()) out += "...";
+  return out;
+}
+
+std::string terminal_text(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const auto byte = static_cast<unsigned char>(text[at]);
+    if ((byte >= 0x20 && byte < 0x7F) || byte == '\t' || byte == '\n') {
+      out += text[at++];
+    } else if (const std::size_t length = printable_utf8_length(text, at); length > 0) {
+      out.append(text, at, length);
+      at += length;
+    } else {
+      append_escaped_byte(out, byte);
+      ++at;
+    }
+  }
   return out;
 }
 

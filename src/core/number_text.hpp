@@ -44,4 +44,9 @@ std::string printable_text(const std::string& text, std::size_t max_chars = 40);
 // Latin-1 bytes), or std::string::npos when there is none
 std::size_t first_non_text_byte(const std::string& text);
 
+// a message for the terminal: line breaks and tabs kept, printable ASCII and well-formed UTF-8
+// kept, every other byte (an escape sequence, a carriage return, a NUL, broken UTF-8) as \xNN,
+// so a file name or a word in an error cannot recolour the terminal or overwrite the line
+std::string terminal_text(const std::string& text);
+
 }  // namespace depotwin

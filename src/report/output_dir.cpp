@@ -18,6 +18,7 @@
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "core/number_text.hpp"
 
 namespace depotwin {
 
@@ -173,7 +174,7 @@ OutputLock::OutputLock(const std::string& target_path, const std::string& shown_
       refuse("is being written by " + who + " (" + lock_path_ +
              " is locked); run again when it is done, or without --no-wait to wait for it");
     if (!told) {
-      std::cerr << "waiting: " << shown_path << " is being written by " << who
+      std::cerr << "waiting: " << terminal_text(shown_path) << " is being written by " << who
                 << "; this run goes on when it is done (--no-wait: exit instead)" << std::endl;
       told = true;
     }

@@ -167,6 +167,38 @@ TEST(Cli, ValidateReportsEveryProblemWithFileLineAndKey) {
   EXPECT_NE(r.output.find(path + ":7: colour"), std::string::npos) << r.output;
 }
 
+// a file name, a key or a verb holding terminal escape sequences (a hostile download's name)
+// is echoed with those bytes as \xNN: no message can recolour the terminal or overwrite a line
+TEST(Cli, NamesWithControlBytesAreEchoedDisarmed) {
+  const std::string dir = fresh_directory("cli_control_bytes");
+  const std::string scenario = scenario_path("thompson_fig7.yaml");
+  // the same scenario under a name with ESC [31m and a CR in it; a key with ESC in it
+  const std::string name = "fig7\x1B[31m\rred.yaml";
+  fs::copy_file(scenario, fs::path(dir) / name);
+  const std::string bad = write_text(dir, "bad.yaml", "name: bad\nco\x1B[2Jlour: blue\n");
+  const std::string quoted = "\"" + dir + "/$(printf 'fig7\\033[31m\\rred.yaml')\"";
+  for (const std::string& arguments :
+       {"validate " + quoted, "validate " + bad, "validate " + quoted + "x",
+        std::string("\"$(printf 'fr\\033[2Job')\"")}) {
+    const Result r = depotwin(arguments);
+    EXPECT_EQ(r.output.find('\x1B'), std::string::npos) << arguments << ": " << r.output;
+    EXPECT_EQ(r.output.find('\r'), std::string::npos) << arguments << ": " << r.output;
+  }
+  EXPECT_NE(depotwin("validate " + quoted).output.find("fig7\\x1B[31m\\x0Dred.yaml: ok"),
+            std::string::npos);
+  const Result missing = depotwin("validate " + quoted + "x");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.output.find("fig7\\x1B[31m\\x0Dred.yamlx: scenario file not found"),
+            std::string::npos)
+      << missing.output;
+  const Result key = depotwin("validate " + bad);
+  EXPECT_EQ(key.status, 2);
+  EXPECT_NE(key.output.find("bad.yaml:2: control byte 0x1B at column 3"), std::string::npos)
+      << key.output;
+  EXPECT_NE(depotwin("\"$(printf 'fr\\033[2Job')\"").output.find("unknown verb 'fr\\x1B[2Job'"),
+            std::string::npos);
+}
+
 TEST(Cli, PlanWritesMetricsAndTrajectory) {
   const std::string dir = fresh_directory("cli_plan");
   const Result r =

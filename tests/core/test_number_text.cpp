@@ -99,5 +99,20 @@ TEST(NumberText, AppendFixedIsPrintfsF) {
   }
 }
 
+// a message for the terminal keeps its lines, tabs and UTF-8, and writes every byte a
+// terminal would act on (escape sequences, CR, NUL, broken UTF-8) as \xNN
+TEST(NumberText, TerminalTextDisarmsControlBytes) {
+  EXPECT_EQ(terminal_text("plain: a/b.yaml\n\tnext line"), "plain: a/b.yaml\n\tnext line");
+  EXPECT_EQ(terminal_text("d\xC3\xA9p\xC3\xB4t \xE2\x80\x94 \xF0\x9F\x99\x82"),
+            "d\xC3\xA9p\xC3\xB4t \xE2\x80\x94 \xF0\x9F\x99\x82");
+  EXPECT_EQ(terminal_text("a\x1B[31mred\x1B[0m"), "a\\x1B[31mred\\x1B[0m");
+  EXPECT_EQ(terminal_text(std::string("over\rwrite\0end", 14)), "over\\x0Dwrite\\x00end");
+  // a Latin-1 byte, a C1 control in UTF-8 (U+009B, the one-byte CSI) and a DEL
+  EXPECT_EQ(terminal_text("caf\xE9 \xC2\x9B" "2J \x7F"), "caf\\xE9 \\xC2\\x9B2J \\x7F");
+  // already-escaped text is left as it is: escaping twice changes nothing
+  const std::string once = terminal_text("x\x1By\rz");
+  EXPECT_EQ(terminal_text(once), once);
+}
+
 }  // namespace
 }  // namespace depotwin
