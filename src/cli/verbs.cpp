@@ -71,7 +71,8 @@ int plan_verb(const RunOptions& options) {
     for (const std::string& warning : report.warnings)
       std::cout << "warning (" << (report.label.empty() ? report.planner : report.label)
                 << "): " << terminal_text(warning) << '\n';
-  std::cout << "plans written to " << terminal_text(directory) << "/<planner>/{metrics.json,trajectory.csv}\n";
+  std::cout << "plans written to " << terminal_text(directory)
+            << "/<planner>/{metrics.json,trajectory.csv}\n";
   return kExitOk;
 }
 
@@ -93,8 +94,8 @@ int validate_verb(const std::string& path, const std::string& max_memory, bool q
   double data_bytes = 0.0;
   for (const RunEstimate& run : runs) data_bytes += run.memory_bytes;
   const double memory_bytes = job_memory_bytes(scenario, runs);
-  std::cout << terminal_text(path) << ": ok — scenario " << scenario.name << ", machine " << job.machine->name()
-            << ", " << scenario.toolpath.paths.size() << " print paths, "
+  std::cout << terminal_text(path) << ": ok — scenario " << scenario.name << ", machine "
+            << job.machine->name() << ", " << scenario.toolpath.paths.size() << " print paths, "
             << scenario.planners.size() << " planner(s)\n";
   if (longest != runs.end())
     std::cout << "  `run` would take: the longest plan " << longest->label << " "
@@ -105,7 +106,8 @@ int validate_verb(const std::string& path, const std::string& max_memory, bool q
               << format_bytes(data_bytes) << " of it (--max-memory "
               << format_bytes(budget.max_memory_bytes) << ")\n";
   // what loading found and every run will repeat (a surface turned over, a G-code rule chosen)
-  for (const std::string& note : scenario.notes) std::cout << "warning: " << terminal_text(note) << '\n';
+  for (const std::string& note : scenario.notes)
+    std::cout << "warning: " << terminal_text(note) << '\n';
   // and what each planner said of its plan, as `plan` and `run` print it
   for (const PlannerSpec& spec : scenario.planners)
     if (const Trajectory* plan = job.checked_plan(spec))
@@ -171,7 +173,8 @@ int run_verb(const RunOptions& options) {
             << scenario.order.label() << "\n\n"
             << summary_table(reports) << '\n';
   print_warnings(reports);
-  std::cout << "results written to " << terminal_text(directory) << "/<planner>/ (metrics.json, trajectory.csv, "
+  std::cout << "results written to " << terminal_text(directory)
+            << "/<planner>/ (metrics.json, trajectory.csv, "
             << "thickness.csv" << (settings.render ? ", images" : "") << ")\n";
   return kExitOk;
 }
