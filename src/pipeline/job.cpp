@@ -294,6 +294,21 @@ void locate_plan_problems(const Scenario& scenario, const PlannerSpec& spec,
   }
 }
 
+// A planner refusing one of its settings names it "planners.<name>.<key>" (PlannerSpec): the
+// scenario's own key for it is "planners[<index>].<key>", on the planner's entry line
+void locate_planner_setting_problems(const Scenario& scenario, const PlannerSpec& spec,
+                                     std::vector<Problem>& problems) {
+  const std::string prefix = "planners." + spec.name + ".";
+  for (Problem& problem : problems) {
+    if (!problem.file.empty() || problem.key.compare(0, prefix.size(), prefix) != 0) continue;
+    for (std::size_t i = 0; i < scenario.planners.size(); ++i)
+      if (spec.line > 0 && scenario.planners[i].line == spec.line)
+        problem.key = "planners[" + std::to_string(i) + "]." + problem.key.substr(prefix.size());
+    problem.file = scenario.file;
+    problem.line = planner_entry_line(scenario, spec);
+  }
+}
+
 void check_plan_poses(const PreparedJob& job, const PlannerSpec& spec,
                       const Trajectory& trajectory) {
   try {
@@ -320,8 +335,15 @@ Trajectory plan_trajectory(const PreparedJob& job, const PlannerSpec& spec) {
   context.process = std::make_shared<const DepositionSettings>(deposition_settings(job.scenario));
   if (job.scenario.process.shutter_time_s > 0.0)
     context.shutter_time_s = job.scenario.process.shutter_time_s;
-  Trajectory trajectory = make_planner(spec)->plan_in_context(
-      exact ? job.exact_toolpath : job.toolpath, job.limits, context);
+  Trajectory trajectory;
+  try {
+    trajectory = make_planner(spec)->plan_in_context(exact ? job.exact_toolpath : job.toolpath,
+                                                     job.limits, context);
+  } catch (const InputError& e) {
+    std::vector<Problem> problems = e.problems();
+    locate_planner_setting_problems(job.scenario, spec, problems);
+    throw InputError(std::move(problems));
+  }
   // a plan far beyond any real print (e.g. a j_max of 1e-300 mm/s^3) cannot be sampled
   if (!(trajectory.duration_s() / kSamplePeriod_s <= kMaxPlanSamples)) {
     char text[240];

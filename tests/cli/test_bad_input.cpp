@@ -368,6 +368,13 @@ std::vector<Row> rows() {
   r.push_back(scenario("SpeedAboveTheLimits", probe_with("  speed:", "  speed: 5"),
                        "{s}:9: toolpath\\.segments\\[0\\]: print speed 5 mm/s needs 5 mm/s on "
                        "x, above limits v_max 4"));
+  // a planner's own refusal of a setting names the scenario's key and the planner's line
+  r.push_back(scenario("BezierWeightsOnSingleLines",
+                       probe_with("planners:",
+                                  "planners:\n  - lspb_mtt\n"
+                                  "  - {name: bezier, weight: [1, 2]}"),
+                       "{s}:13: planners\\[1\\]\\.weight: has 2 values; the toolpath has no "
+                       "corners \\(every path is a single line\\): give one value"));
   // ---- hostile names ----
   r.push_back(scenario("NameOf300Characters", probe("", std::string(300, 'n')),
                        "{s}:1: name: 'n{40}\\.\\.\\.' is 300 bytes long"));

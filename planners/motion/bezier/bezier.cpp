@@ -986,8 +986,12 @@ Trajectory BezierPlanner::plan(const Toolpath& toolpath, const TcpLimits& tcp_li
   if (settings_.weights.empty() ||
       (settings_.weights.size() != 1 && settings_.weights.size() != corners)) {
     std::ostringstream msg;
-    msg << "has " << settings_.weights.size() << " values; the toolpath has " << corners
-        << " corners (give one value for all, or one per corner in order)";
+    msg << "has " << settings_.weights.size() << " values; ";
+    if (corners == 0)
+      msg << "the toolpath has no corners (every path is a single line): give one value";
+    else
+      msg << "the toolpath has " << corners << (corners == 1 ? " corner" : " corners")
+          << " (give one value for all, or one per corner in order)";
     throw InputError("planners.bezier.weight", msg.str());
   }
 
