@@ -87,10 +87,14 @@ struct Station {
   int path = -1;             // -1: the job's start or end
   size_t point = 0;          // index in the path
   bool after_travel = true;  // the edge from the previous station is a travel
+  // the edge from the previous station is one print edge longer than the station spacing: its
+  // poses in between are checked as a travel's are (a 300 mm line in two points)
+  bool after_long_edge = false;
 };
 
 // the job's start, points along every path about `spacing` apart or where the tool axis has
-// turned by kStationTurn_deg (a fillet), ends always, the job's end
+// turned by kStationTurn_deg (a fillet), both ends of an edge longer than `spacing`, a path's
+// ends always, the job's end
 std::vector<Station> make_stations(const Toolpath& toolpath, double spacing_mm) {
   std::vector<Station> stations;
   stations.push_back(Station{Pose(toolpath.start_mm), -1, 0, true});
@@ -102,9 +106,11 @@ std::vector<Station> make_stations(const Toolpath& toolpath, double spacing_mm) 
       if (i > 0) since += (path.points[i] - path.points[i - 1]).norm();
       const bool last = i + 1 == path.points.size();
       const bool turned = axis_angle_rad(axis, path.tool_axis(i)) >= deg_to_rad(kStationTurn_deg);
-      if (i > 0 && !last && since < spacing_mm && !turned) continue;
-      stations.push_back(
-          Station{Pose(path.points[i], path.tool_axis(i)), static_cast<int>(p), i, i == 0});
+      const bool before_long = !last && (path.points[i + 1] - path.points[i]).norm() > spacing_mm;
+      if (i > 0 && !last && since < spacing_mm && !turned && !before_long) continue;
+      const bool long_edge = i > 0 && (path.points[i] - path.points[i - 1]).norm() > spacing_mm;
+      stations.push_back(Station{Pose(path.points[i], path.tool_axis(i)), static_cast<int>(p), i,
+                                 i == 0, long_edge});
       since = 0.0;
       axis = path.tool_axis(i);
     }
@@ -220,7 +226,7 @@ using TravelCheck = std::function<bool(size_t s, int from, int k)>;
 // max_step; between paths any roll the travel check accepts.
 std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>& stations,
                                double max_step_rad, bool joint_costs,
-                               const TravelCheck& travel_ok = nullptr) {
+                               const TravelCheck& travel_ok = nullptr, size_t* stuck_at = nullptr) {
   const int K = ladder.rolls;
   const size_t n = stations.size();
   std::vector<double> total(K, kInfinity), next(K);
@@ -254,6 +260,11 @@ std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>&
           // the travel's own check (inverse kinematics along it) only where it would win
           if (!(before + edge + here < next[k])) continue;
           if (travel_ok && !travel_ok(s, from, k)) continue;
+        } else if (stations[s].after_long_edge && joint_costs) {
+          // a long print edge: its poses in between, as a travel's, where it would win
+          edge = motion_cost(p, q, print_step) + kRollStepCost * d * d;
+          if (!(before + edge + here < next[k])) continue;
+          if (travel_ok && !travel_ok(s, from, k)) continue;
         } else {
           if (joint_costs &&
               largest_step(p, q) > allowed_step(rolled(stations[s - 1], from * ladder.step_rad),
@@ -272,6 +283,11 @@ std::vector<int> shortest_path(const Ladder& ladder, const std::vector<Station>&
       }
     }
     total.swap(next);
+    // no rung of station s is reached: the sequence breaks between s - 1 and s
+    if (std::none_of(total.begin(), total.end(), [](double t) { return std::isfinite(t); })) {
+      if (stuck_at) *stuck_at = s;
+      return {};
+    }
   }
   int best = -1;
   for (int k = 0; k < K; ++k)
@@ -661,7 +677,8 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     };
     const double max_step = deg_to_rad(settings.max_joint_step_deg);
     // a travel's intermediate poses (position straight, axis and roll turning evenly, as the
-    // planners move) must stay on the branch, off the limits and singularities, continuously
+    // planners move) must stay on the branch, off the limits and singularities, continuously;
+    // a long print edge's too, checked at the station spacing
     std::unordered_map<uint64_t, bool> travel_memo;
     const TravelCheck travel_ok = [&](size_t s, int from, int k) {
       const uint64_t key = (static_cast<uint64_t>(s) * K + from) * K + k;
@@ -672,8 +689,11 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       const double turn = rad_to_deg(axis_angle_rad(a.tool_axis, end.tool_axis) +
                                      std::abs(wrapped(end.roll_rad, a.roll_rad)));
       const double distance = (end.position_mm - a.position_mm).norm();
+      const double check_distance_mm =
+          stations[s].after_travel ? kTravelCheckDistance_mm
+                                   : std::min(kTravelCheckDistance_mm, settings.sample_spacing_mm);
       const int checks = 1 + static_cast<int>(std::ceil(turn / kTravelCheckTurn_deg)) +
-                         static_cast<int>(std::ceil(distance / kTravelCheckDistance_mm));
+                         static_cast<int>(std::ceil(distance / check_distance_mm));
       Arm6Joints previous = ladder.q[ladder.index(s - 1, from)];
       Pose previous_pose = a;
       bool ok = true;
@@ -699,8 +719,9 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       return ok;
     };
     std::vector<int> path;
+    size_t stuck_at = 0;  // where no roll sequence gets past, when none does
     for (int round = 0; round < 64; ++round) {
-      path = shortest_path(ladder, stations, max_step, true, travel_ok);
+      path = shortest_path(ladder, stations, max_step, true, travel_ok, &stuck_at);
       if (path.empty() || !check_part) break;
       // measure along the path; where it is too close, every roll of that station
       bool clear = true;
@@ -746,10 +767,23 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       last_failure += station_name(s) + " is " + reason_text(why) + " for every roll";
       named = true;
     }
-    if (!named)
+    if (!named) {
       last_failure += "no roll sequence keeps every joint within " +
                       format("%.3g", settings.max_joint_step_deg) +
                       " deg between neighbouring points along the paths";
+      if (stuck_at > 0 && stations[stuck_at].after_long_edge)
+        last_failure +=
+            "; none gets along the " +
+            format("%.4g",
+                   (stations[stuck_at].pose.position_mm - stations[stuck_at - 1].pose.position_mm)
+                       .norm()) +
+            " mm edge from " + station_name(stuck_at - 1) + " to " + station_name(stuck_at) +
+            " (a pose on it is beyond a joint's range or the reach, at a "
+            "singularity, or a joint jumps between two of them)";
+      else if (stuck_at > 0)
+        last_failure +=
+            "; none gets from " + station_name(stuck_at - 1) + " to " + station_name(stuck_at);
+    }
     return std::nullopt;
   };
   // rank the most promising branches without the part (cheap), then check the part's clearance
@@ -845,20 +879,22 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
   Pose previous_pose;
   std::vector<Problem> dense_problems;
   // `travel`: reached by a travel from the previous point (any joint motion allowed)
-  // point `point` of path `path` (-1: the start, -2: the end), named only when it fails
-  const auto where = [&](long path, size_t point) {
+  // point `point` of path `path` (-1: the start, -2: the end), named only when it fails;
+  // `inside`: a pose on the long edge that ends at that point
+  const auto where = [&](long path, size_t point, bool inside) {
     if (path == -1) return std::string("the start");
     if (path == -2) return std::string("the end");
-    return name(static_cast<size_t>(path), point);
+    return (inside ? "the edge to " : "") + name(static_cast<size_t>(path), point);
   };
-  const auto visit = [&](const Pose& pose, long path, size_t point, bool travel) {
+  const auto visit = [&](const Pose& pose, long path, size_t point, bool travel,
+                         bool inside = false) {
     if (!solve_on_branch(pose, joints)) {
       if (dense_problems.size() < kMaxNamedPoints)
-        dense_problems.push_back(Problem{"", 0, "toolpath",
-                                         where(path, point) + " " + point_text(pose.position_mm) +
-                                             " is beyond a joint's range on branch " +
-                                             std::to_string(branch) + " at the chosen roll " +
-                                             format("%.1f", rad_to_deg(pose.roll_rad)) + " deg"});
+        dense_problems.push_back(Problem{
+            "", 0, "toolpath",
+            where(path, point, inside) + " " + point_text(pose.position_mm) +
+                " is beyond a joint's range on branch " + std::to_string(branch) +
+                " at the chosen roll " + format("%.1f", rad_to_deg(pose.roll_rad)) + " deg"});
       return;
     }
     const bool jump = !travel && !seed.empty() &&
@@ -866,19 +902,30 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
                           allowed_step(previous_pose, pose, max_dense_step);
     previous_pose = pose;
     if (jump && dense_problems.size() < kMaxNamedPoints)
-      dense_problems.push_back(Problem{"", 0, "toolpath",
-                                       where(path, point) + " " + point_text(pose.position_mm) +
-                                           ": a joint would jump by more than " +
-                                           format("%.3g", settings.max_joint_step_deg) +
-                                           " deg from the previous point"});
+      dense_problems.push_back(Problem{
+          "", 0, "toolpath",
+          where(path, point, inside) + " " + point_text(pose.position_mm) +
+              ": a joint would jump by more than " + format("%.3g", settings.max_joint_step_deg) +
+              " deg from the previous point"});
     seed = joints;
   };
   visit(Pose(out.start_mm, vertical_tool_axis(), out.start_roll_rad), -1, 0, true);
   for (size_t p = 0; p < out.paths.size(); ++p) {
     const PrintPath& path = out.paths[p];
-    for (size_t i = 0; i < path.points.size(); ++i)
+    for (size_t i = 0; i < path.points.size(); ++i) {
+      // a long edge's poses in between, at the station spacing, as the planners move along it
+      const double length = i > 0 ? (path.points[i] - path.points[i - 1]).norm() : 0.0;
+      const int inside = static_cast<int>(std::ceil(length / settings.sample_spacing_mm)) - 1;
+      for (int m = 1; m <= inside; ++m) {
+        const double f = static_cast<double>(m) / (inside + 1);
+        visit(Pose(path.points[i - 1] + f * (path.points[i] - path.points[i - 1]),
+                   slerp_axis(path.tool_axis(i - 1), path.tool_axis(i), f),
+                   path.rolls[i - 1] + f * (path.rolls[i] - path.rolls[i - 1])),
+              static_cast<long>(p), i, false, true);
+      }
       visit(Pose(path.points[i], path.tool_axis(i), path.rolls[i]), static_cast<long>(p), i,
             i == 0);
+    }
     if (!dense_problems.empty()) break;
   }
   visit(Pose(out.end_mm, vertical_tool_axis(), out.end_roll_rad), -2, 0, true);

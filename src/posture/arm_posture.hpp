@@ -8,7 +8,7 @@
 // roll is free (core/pose.hpp); arm6's nozzle is not coaxial with joint 6, so the roll moves
 // joints 1-5 (kinematics/arm6.hpp). The ladder:
 //  - stations: the job's start, points along every print path about sample_spacing_mm apart
-//    (each path's ends always), the job's end;
+//    (each path's ends always, and both ends of an edge longer than that), the job's end;
 //  - rungs: at each station, the roll in steps of roll_step_deg, on one branch. A rung is
 //    valid when the pose is reachable there with joints 1-5 at least min_joint_margin_deg
 //    inside their ranges and the posture is not singular (wrist alignment |sin q5|, wrist
@@ -18,7 +18,9 @@
 //  - rung cost: how close the posture is to a limit or a singularity (inverse squares of the
 //    margins against reference values); edge cost: the joint motion between stations. Along a
 //    print path the roll moves at most one step between stations and no joint more than
-//    max_joint_step_deg (the path stays continuous); between paths (travel) any roll;
+//    max_joint_step_deg (the path stays continuous); between paths (travel) any roll. A travel
+//    and a print edge longer than sample_spacing_mm are checked at poses in between (position
+//    straight, axis and roll turning evenly): each valid, no joint step above the maximum;
 //  - the branch is one for the whole job: the cheapest branch whose ladder has a path. (Changing
 //    branch means passing a singularity: only possible in a joint-space travel, which the
 //    planners here do not make.)

@@ -158,6 +158,27 @@ TEST(ArmPosture, CollidingPointIsNamed) {
   EXPECT_NE(text.find("too close to the part"), std::string::npos) << text;
 }
 
+// a long print edge is checked along its length, not only at its two points: a 400 mm line in
+// two points whose middle passes over the arm's base fails there and names the edge, and one
+// beside the base (where the 51-point line of the same span works) is posed
+TEST(ArmPosture, ALongEdgeIsCheckedBetweenItsPoints) {
+  const Arm6 arm;
+  const auto line = [](double x) {
+    return single_path({Vec3(x, -205, 0), Vec3(x, -200, 0), Vec3(x, 200, 0), Vec3(x, 205, 0)});
+  };
+  const std::string text = problem_text(arm, nullptr, line(-360.0), {});
+  EXPECT_NE(text.find("none gets along the 400 mm edge from path 0, point 1 (-360.000, -200.000, "
+                      "0.000) mm to path 0, point 2 (-360.000, 200.000, 0.000) mm"),
+            std::string::npos)
+      << text;
+  // 110 mm in front of the base: joint 1 swings through about 130 deg along the line, in steps
+  // of a few degrees between the poses in between (one 130 deg step between the two points)
+  const ArmPosture posture =
+      choose_arm_posture(arm, nullptr, line(-250.0), ArmPostureSettings{}, plain_name);
+  EXPECT_GT(posture.chosen_joint_travel_deg, 100.0);
+  EXPECT_EQ(posture.toolpath.paths[0].points.size(), 4u);  // the toolpath keeps its points
+}
+
 // the roll is a real choice: a fixed roll that the wrist cannot hold over the whole path fails
 // where the optimised rolls succeed
 TEST(ArmPosture, OptimisedRollsReachWhereOneFixedRollCannot) {
