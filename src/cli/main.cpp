@@ -44,6 +44,32 @@ void print_problems(const InputError& error) {
   for (const Problem& problem : error.problems()) std::cerr << "error: " << problem.str() << '\n';
 }
 
+// CLI11's refusal of the command line, as every other error reads: "error: ...", a value that
+// is no number named with what was expected ("Could not convert: --jobs = 1.5" alone does not
+// say), then where the options are listed
+void print_parse_error(CLI::App& app, const CLI::ParseError& error) {
+  std::string text = error.what();
+  static const std::string kConvert = "Could not convert: ";
+  const std::size_t equals = text.find(" = ");
+  if (text.rfind(kConvert, 0) == 0 && equals != std::string::npos) {
+    const std::string name = text.substr(kConvert.size(), equals - kConvert.size());
+    const std::string value = text.substr(equals + 3);
+    // the option, in the verb given (parsed) or the app itself
+    const CLI::Option* option = app.get_option_no_throw(name);
+    for (CLI::App* verb : app.get_subcommands())
+      if (const CLI::Option* found = verb->get_option_no_throw(name)) option = found;
+    const std::string type = option ? option->get_type_name() : std::string();
+    const bool whole = type.rfind("INT", 0) == 0;
+    const bool positive = type.find("POSITIVE") != std::string::npos;
+    text = name + ": '" + value + "' is not " + (whole ? "a whole number" : "a number") +
+           (positive ? " above 0" : "");
+  }
+  std::string verb_name;
+  for (const CLI::App* verb : app.get_subcommands()) verb_name = " " + verb->get_name();
+  std::cerr << "error: " << terminal_text(text) << "\n(depotwin" << verb_name
+            << " --help lists the options)\n";
+}
+
 // "run, compare, plan, ...": every verb the app knows, in the order they were added
 std::string verb_list(CLI::App& app) {
   const std::function<bool(CLI::App*)> every = [](CLI::App*) { return true; };
@@ -269,7 +295,7 @@ int run_command_line(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
       return app.exit(e);
     } catch (const CLI::ParseError& e) {
-      app.exit(e);
+      print_parse_error(app, e);
       return kExitBadInput;
     }
     // an option given an empty value (`--task ""`, `--out ""`: an unset shell variable) is

@@ -75,6 +75,23 @@ TEST(Cli, UnknownVerbIsNamedWithTheVerbs) {
   EXPECT_EQ(line_after(none.output, "error: a verb is required; verbs are "), verbs);
 }
 
+// a value the command line cannot read reads as every other error: "error:", the option, the
+// value and what was expected, and where the options are listed (exit 2)
+TEST(Cli, AValueThatIsNoNumberNamesTheOptionAndWhatWasExpected) {
+  const Result jobs = depotwin("sweep x.yaml -j 1.5");
+  EXPECT_EQ(jobs.status, 2);
+  EXPECT_NE(jobs.output.find("error: --jobs: '1.5' is not a whole number above 0\n(depotwin "
+                             "sweep --help lists the options)"),
+            std::string::npos)
+      << jobs.output;
+  const Result at = depotwin("view x --at 2s");
+  EXPECT_EQ(at.status, 2);
+  EXPECT_NE(at.output.find("error: --at: '2s' is not a number\n"), std::string::npos) << at.output;
+  const Result missing = depotwin("run");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_EQ(missing.output.rfind("error: scenario is required\n", 0), 0u) << missing.output;
+}
+
 // a list option given empty is refused (exit 2), never read as "not given" (every planner)
 TEST(Cli, EmptyNameListsAreRefused) {
   const std::string scenario = scenario_path("thompson_fig7.yaml");
