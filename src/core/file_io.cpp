@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -18,19 +20,24 @@ void write_file_atomically(const std::string& path, const std::string& content) 
   const std::string temporary = path + ".tmp-" + std::to_string(::getpid());
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    errno = 0;
     out << content;
     out.flush();
     if (!out) {
+      // why, as the system said it (a full disk: "No space left on device")
+      const int why = errno;
       std::error_code ignored;
       fs::remove(temporary, ignored);
-      throw InternalError("cannot write " + path);
+      throw InternalError("cannot write " + path +
+                          (why != 0 ? std::string(": ") + std::strerror(why) : std::string()));
     }
   }
   std::error_code error;
   fs::rename(temporary, path, error);
   if (error) {
+    const std::string why = error.message();
     fs::remove(temporary, error);
-    throw InternalError("cannot move " + temporary + " to " + path);
+    throw InternalError("cannot move " + temporary + " to " + path + ": " + why);
   }
 }
 

@@ -129,10 +129,15 @@ TemporaryDirectory::~TemporaryDirectory() {
 }
 
 void write_text_file(const std::string& path, const std::string& content) {
+  errno = 0;
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(content.data(), static_cast<std::streamsize>(content.size()));
   out.flush();
-  if (!out) throw InternalError("cannot write " + path);
+  if (!out) {
+    const int why = errno;  // a full disk: "No space left on device"
+    throw InternalError("cannot write " + path +
+                        (why != 0 ? std::string(": ") + std::strerror(why) : std::string()));
+  }
 }
 
 void move_into_place(const std::string& from, const std::string& to) {

@@ -4,7 +4,9 @@
 // refuses it before it opens it.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <iterator>
 #include <string>
@@ -48,6 +50,33 @@ TEST(FileIo, FailureNamesTheFileAndLeavesTheTargetUntouched) {
   EXPECT_EQ(read_text(target.string()), "kept");
   EXPECT_TRUE(fs::is_directory(blocked / "inside"));
   EXPECT_EQ(std::distance(fs::directory_iterator(directory), fs::directory_iterator()), 2);
+  fs::remove_all(directory);
+}
+
+// a full disk: the error says so, the file is as it was and no temporary is left (a tmpfs of
+// 64 KiB; mounting one needs root, elsewhere the test is skipped)
+TEST(FileIo, AFullDiskIsNamedAsTheSystemSaysIt) {
+  const fs::path directory = fresh_directory("file_io_full");
+  fs::create_directories(directory / "volume");
+  const std::string mount =
+      "mount -t tmpfs -o size=64k tmpfs '" + (directory / "volume").string() + "' 2>/dev/null";
+  if (::geteuid() != 0 || std::system(mount.c_str()) != 0)
+    GTEST_SKIP() << "mounting a tmpfs needs root";
+  const fs::path target = directory / "volume" / "metrics.json";
+  write_file_atomically(target.string(), "kept");
+  std::string message;
+  try {
+    write_file_atomically(target.string(), std::string(1 << 20, 'x'));
+  } catch (const InternalError& error) {
+    message = error.what();
+  }
+  const std::size_t left = static_cast<std::size_t>(
+      std::distance(fs::directory_iterator(directory / "volume"), fs::directory_iterator()));
+  const std::string kept = read_text(target.string());
+  EXPECT_EQ(std::system(("umount '" + (directory / "volume").string() + "'").c_str()), 0);
+  EXPECT_EQ(message, "cannot write " + target.string() + ": No space left on device");
+  EXPECT_EQ(kept, "kept");
+  EXPECT_EQ(left, 1u);  // no temporary
   fs::remove_all(directory);
 }
 
