@@ -307,11 +307,12 @@ int run_command_line(int argc, char** argv) {
             if (value.empty())
               throw InputError(option->get_name(),
                                "an empty value (give one, or leave the option out)");
-    // the verbs that write: SIGINT and SIGTERM stop them with their staging folder removed,
-    // their children ended, the output as it was, exit 130 or 143 (core/interrupt.hpp); set
-    // before any thread starts. The others (validate, view, ...) write nothing and keep the
-    // signals' default: they end at once.
-    if (*run || *compare || *plan || *export_gcode) install_interrupt_handlers();
+    // the verbs that write: SIGINT, SIGTERM and SIGHUP stop them with their staging folder
+    // removed, their children ended, the output as it was, exit 130, 143 or 129
+    // (core/interrupt.hpp); set before any thread starts (a local sweep's runner then takes the
+    // signals itself, to end its workers). The others (validate, view, ...) write nothing and
+    // keep the signals' default: they end at once.
+    if (*run || *compare || *plan || *export_gcode || *sweep) install_interrupt_handlers();
     if (*run) return run_verb(run_options);
     if (*compare) return compare_verb(compare_options);
     if (*plan) return plan_verb(plan_options);

@@ -19,6 +19,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "pipeline/progress_line.hpp"
 #include "sweep/task.hpp"
 
@@ -35,7 +36,7 @@ constexpr int kReportFd = 3;
 // characters of the progress bar
 constexpr std::size_t kBarWidth = 24;
 
-// the signal (SIGINT, SIGTERM) that asked the local run to stop, 0 while none has
+// the signal (SIGINT, SIGTERM, SIGHUP) that asked the local run to stop, 0 while none has
 volatile sig_atomic_t g_stop_signal = 0;
 extern "C" void record_stop_signal(int signal_number) {
   if (g_stop_signal == 0) g_stop_signal = signal_number;
@@ -146,13 +147,17 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
   ::sigaction(SIGPIPE, &ignore, &previous);
   // Ctrl-C or a kill: recorded here (the workers ignore SIGINT), the workers ended, then the
   // signal's own action
+  // (SIGHUP too: a closed terminal or a dropped ssh session)
   struct sigaction stop {
-  }, previous_int{}, previous_term{};
+  }, previous_int{}, previous_term{}, previous_hup{};
   stop.sa_handler = record_stop_signal;
   sigemptyset(&stop.sa_mask);
   g_stop_signal = 0;
   ::sigaction(SIGINT, &stop, &previous_int);
   ::sigaction(SIGTERM, &stop, &previous_term);
+  ::sigaction(SIGHUP, &stop, &previous_hup);
+  // a signal that came before (while the tasks were checked) stops the run before it starts
+  if (const int earlier = interrupt_signal(); earlier != 0) g_stop_signal = earlier;
 
   std::deque<std::uint64_t> queue(tasks.begin(), tasks.end());
   std::vector<Worker> workers;
@@ -185,7 +190,7 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
 
   const std::size_t count =
       std::min<std::size_t>(static_cast<std::size_t>(std::max(1, options.workers)), tasks.size());
-  for (std::size_t k = 0; k < count; ++k) {
+  for (std::size_t k = 0; k < count && g_stop_signal == 0; ++k) {
     workers.push_back(spawn_worker(options, sweep));
     give_next(workers.back());
   }
@@ -260,6 +265,7 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
   ::sigaction(SIGPIPE, &previous, nullptr);
   ::sigaction(SIGINT, &previous_int, nullptr);
   ::sigaction(SIGTERM, &previous_term, nullptr);
+  ::sigaction(SIGHUP, &previous_hup, nullptr);
   if (const int signal_number = g_stop_signal; signal_number != 0) {
     // stopped: the workers end at once (their tasks' folders stay as they were: an unfinished
     // task is not recorded and runs again next time), then this process by the signal

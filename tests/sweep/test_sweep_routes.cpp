@@ -286,6 +286,71 @@ grid:
       << resumed.output;
 }
 
+// `depotwin sweep ...` started with `arguments`, standard output to /dev/null
+pid_t spawn_depotwin(std::vector<std::string> arguments) {
+  arguments.insert(arguments.begin(), DEPOTWIN_BINARY_DIR "/depotwin");
+  std::vector<char*> argv;
+  for (std::string& argument : arguments) argv.push_back(argument.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0) pid = 0;
+  posix_spawn_file_actions_destroy(&actions);
+  return pid;
+}
+
+// the names in `folder` and below that hold `text`
+std::vector<std::string> names_holding(const std::string& folder, const std::string& text) {
+  std::vector<std::string> found;
+  std::error_code ignored;
+  for (auto it = fs::recursive_directory_iterator(folder, ignored);
+       it != fs::recursive_directory_iterator(); it.increment(ignored))
+    if (it->path().filename().string().find(text) != std::string::npos)
+      found.push_back(it->path().string());
+  return found;
+}
+
+// one task run by hand (`sweep --task`, as a cluster's job runs it) stopped by SIGTERM (a
+// scheduler's cancel) or SIGHUP (a closed terminal): its staging folder removed, nothing
+// recorded, the shell's exit status (128 + the signal); a local run's SIGHUP ends its workers
+TEST_F(SweepRoutes, ATaskStoppedBySIGTERMOrSIGHUPLeavesNothingHalfWritten) {
+  const std::string sweep = write_text(dir_, "stopped.yaml", R"(base: base.yaml
+grid:
+  planner: [stop_and_go]
+  toolpath.speed: [1.5, 2]
+)");
+  for (const int signal_number : {SIGTERM, SIGHUP}) {
+    const std::string out = dir_ + "/stopped_" + std::to_string(signal_number);
+    const pid_t pid = spawn_depotwin({"sweep", sweep, "--task", "1", "--out", out, "--quiet"});
+    ASSERT_GT(pid, 0);
+    // once the task's staging folder is there (the task is running), the signal
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+    while (names_holding(out, ".partial").empty() && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ::kill(pid, signal_number);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + signal_number)
+        << signal_number << ": " << status;
+    EXPECT_EQ(names_holding(out, ".partial"), std::vector<std::string>{}) << signal_number;
+    EXPECT_FALSE(fs::exists(out + "/tasks/0001/task.json")) << signal_number;
+  }
+  // the local runner: SIGHUP ends it and its workers, as Ctrl-C does
+  const std::string out = dir_ + "/stopped_local";
+  const pid_t pid = spawn_depotwin({"sweep", sweep, "-j", "1", "--out", out, "--quiet"});
+  ASSERT_GT(pid, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (processes_with(out) == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ::kill(pid, SIGHUP);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGHUP) << status;
+  EXPECT_EQ(processes_with(out), 0);
+}
+
 TEST_F(SweepRoutes, KeepAllKeepsWhatRunNoRenderWrites) {
   const std::string sweep = write_text(dir_, "keep_all.yaml", R"(base: base.yaml
 keep: all
