@@ -9,6 +9,7 @@
 #include "cli/cli_checks.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/interrupt.hpp"
 #include "sweep/emit.hpp"
 #include "sweep/local_runner.hpp"
 #include "sweep/results.hpp"
@@ -145,7 +146,10 @@ int merge_results(const Sweep& sweep, const SweepOptions& options, int threads) 
   sweep.prepare_out_directory();
   const ResultsTable table = collect_results(sweep, threads);
   const std::string out = sweep.out_directory();
+  // a signal that asks to stop (core/interrupt.hpp) is taken before each file is replaced
+  throw_if_interrupted();
   write_results_sqlite(table, sweep, out + "/results.sqlite");
+  throw_if_interrupted();
   write_file_atomically(out + "/results.csv", results_csv(table));
   bool plotted = false;
   if (!options.no_render) plotted = write_summary_plot(table, sweep, out + "/summary.png");

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "sweep/task.hpp"
 
 namespace depotwin {
@@ -247,7 +248,7 @@ ResultsTable collect_results(const Sweep& sweep, int threads) {
   std::vector<TaskRow> rows(static_cast<std::size_t>(count));
   std::atomic<std::uint64_t> next{0};
   const auto read = [&] {
-    for (std::uint64_t i = next++; i < count; i = next++)
+    for (std::uint64_t i = next++; i < count && interrupt_signal() == 0; i = next++)
       rows[static_cast<std::size_t>(i)] = read_task_row(sweep, i);
   };
   std::vector<std::thread> helpers;
@@ -255,6 +256,7 @@ ResultsTable collect_results(const Sweep& sweep, int threads) {
     helpers.emplace_back(read);
   read();
   for (std::thread& helper : helpers) helper.join();
+  throw_if_interrupted();  // a signal asked to stop: nothing is written (core/interrupt.hpp)
 
   // the metrics' units, from the first task that ran
   std::map<std::string, std::string> units;
