@@ -628,6 +628,25 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     }
     std::sort(ranked.begin(), ranked.end());
     for (const auto& [c, b] : ranked) branches.push_back(b);
+    // none has a path: the branch with the fewest stations no roll can pose is searched, for
+    // its failure to be named (the first such station, or where the rolls cannot follow)
+    if (branches.empty()) {
+      std::size_t fewest = n + 1;
+      int closest = 0;
+      for (int b = 0; b < kBranches; ++b) {
+        std::size_t unposed = 0;
+        for (size_t st = 0; st < n; ++st) {
+          bool any = false;
+          for (int k = 0; k < K && !any; ++k) any = std::isfinite(cost[at(b, st, k)]);
+          unposed += any ? 0 : 1;
+        }
+        if (unposed < fewest) {
+          fewest = unposed;
+          closest = b;
+        }
+      }
+      branches.push_back(closest);
+    }
   }
 
   // pass 2 on the most promising branches: postures stored, joint-motion edges, clearance
@@ -768,21 +787,30 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       named = true;
     }
     if (!named) {
-      last_failure += "no roll sequence keeps every joint within " +
-                      format("%.3g", settings.max_joint_step_deg) +
-                      " deg between neighbouring points along the paths";
-      if (stuck_at > 0 && stations[stuck_at].after_long_edge)
-        last_failure +=
-            "; none gets along the " +
-            format("%.4g",
-                   (stations[stuck_at].pose.position_mm - stations[stuck_at - 1].pose.position_mm)
-                       .norm()) +
-            " mm edge from " + station_name(stuck_at - 1) + " to " + station_name(stuck_at) +
-            " (a pose on it is beyond a joint's range or the reach, at a "
-            "singularity, or a joint jumps between two of them)";
-      else if (stuck_at > 0)
-        last_failure +=
-            "; none gets from " + station_name(stuck_at - 1) + " to " + station_name(stuck_at);
+      // where the rolls cannot follow: a print step, a long edge or a travel between two
+      // stations every rung of which is valid on its own
+      const std::string within = format("%.3g", settings.max_joint_step_deg) + " deg";
+      const std::string why_between =
+          " (a pose on it is beyond a joint's range or the reach, at a singularity, or a joint "
+          "jumps by more than " +
+          within + " between two of them)";
+      if (stuck_at == 0) {
+        last_failure += "no roll sequence keeps every joint within " + within +
+                        " between neighbouring points along the paths";
+      } else {
+        const Station& from = stations[stuck_at - 1];
+        const Station& to = stations[stuck_at];
+        const std::string ends =
+            " from " + station_name(stuck_at - 1) + " to " + station_name(stuck_at);
+        if (to.after_travel)
+          last_failure += "no roll sequence gets over the travel" + ends + why_between;
+        else if (to.after_long_edge)
+          last_failure += "no roll sequence gets along the " +
+                          format("%.4g", (to.pose.position_mm - from.pose.position_mm).norm()) +
+                          " mm edge" + ends + why_between;
+        else
+          last_failure += "no roll sequence keeps every joint within " + within + ends;
+      }
     }
     return std::nullopt;
   };

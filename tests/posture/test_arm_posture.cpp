@@ -167,8 +167,9 @@ TEST(ArmPosture, ALongEdgeIsCheckedBetweenItsPoints) {
     return single_path({Vec3(x, -205, 0), Vec3(x, -200, 0), Vec3(x, 200, 0), Vec3(x, 205, 0)});
   };
   const std::string text = problem_text(arm, nullptr, line(-360.0), {});
-  EXPECT_NE(text.find("none gets along the 400 mm edge from path 0, point 1 (-360.000, -200.000, "
-                      "0.000) mm to path 0, point 2 (-360.000, 200.000, 0.000) mm"),
+  EXPECT_NE(text.find("no roll sequence gets along the 400 mm edge from path 0, point 1 (-360.000, "
+                      "-200.000, 0.000) mm to path 0, point 2 (-360.000, 200.000, 0.000) mm (a "
+                      "pose on it is beyond"),
             std::string::npos)
       << text;
   // 110 mm in front of the base: joint 1 swings through about 130 deg along the line, in steps
@@ -177,6 +178,42 @@ TEST(ArmPosture, ALongEdgeIsCheckedBetweenItsPoints) {
       choose_arm_posture(arm, nullptr, line(-250.0), ArmPostureSettings{}, plain_name);
   EXPECT_GT(posture.chosen_joint_travel_deg, 100.0);
   EXPECT_EQ(posture.toolpath.paths[0].points.size(), 4u);  // the toolpath keeps its points
+}
+
+// where no branch has a roll sequence at all (a steep bowl, tool square to it: the travel to the
+// second layer has no posture in between), the search still names where it breaks: never an
+// empty reason, "(...)"
+TEST(ArmPosture, ABranchlessJobNamesWhereItBreaks) {
+  const Arm6 arm;
+  // z = 10 + r^2 / 10 over 16 x 16 mm: 66 deg steep at the corners
+  TriangleMesh bowl;
+  const int cells = 40;
+  for (int i = 0; i <= cells; ++i)
+    for (int j = 0; j <= cells; ++j) {
+      const double x = -8.0 + 16.0 * i / cells, y = -8.0 + 16.0 * j / cells;
+      bowl.vertices.emplace_back(x, y, 10.0 + (x * x + y * y) / 10.0);
+    }
+  for (int i = 0; i < cells; ++i)
+    for (int j = 0; j < cells; ++j) {
+      const int a = i * (cells + 1) + j, b = a + cells + 1;
+      bowl.triangles.push_back({a, b, b + 1});
+      bowl.triangles.push_back({a, b + 1, a + 1});
+    }
+  SurfaceHatchSpec spec;
+  spec.hatch_mm = 1.0;
+  spec.angles_deg = {0.0, 90.0};
+  spec.layers = 2;
+  spec.layer_height_mm = 1.0;
+  spec.alpha = 1.0;
+  spec.speed_mm_s = 20.0;
+  Toolpath toolpath = hatch_surface(bowl, spec).toolpath;
+  toolpath.start_mm = toolpath.end_mm = Vec3(0, 0, 45);
+  const std::string text = problem_text(arm, nullptr, toolpath, {});
+  EXPECT_NE(text.find("(branch 0: no roll sequence gets over the travel from path 16, point 16 "
+                      "(8.000, 8.000, 22.800) mm to path 17, point 0"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("()"), std::string::npos) << text;
 }
 
 // the roll is a real choice: a fixed roll that the wrist cannot hold over the whole path fails
