@@ -236,9 +236,10 @@ class Loader {
   // a long segments list read without yaml-cpp (scenario/lifted_list.hpp)
   std::optional<LiftedSegments> lifted_;
   std::optional<TcpLimits> tcp_limits_;
-  std::size_t speed_problems_ = 0;  // print segments over speed, listed up to a count
-  int toolpath_speed_line_ = 0;     // toolpath.speed's line, 0 when not given
-  bool speed_missing_ = false;      // reported once, not per path
+  std::size_t speed_problems_ = 0;     // print segments over speed, listed up to a count
+  Problem last_listed_speed_problem_;  // where the "... and N more" line goes: after it
+  int toolpath_speed_line_ = 0;        // toolpath.speed's line, 0 when not given
+  bool speed_missing_ = false;         // reported once, not per path
 };
 
 ScenarioReading Loader::read() {
@@ -275,11 +276,13 @@ ScenarioReading Loader::read() {
   if (scenario_.arm && !machine_bad_ && scenario_.machine != "arm6")
     problems_.add(scenario_.arm_line, "arm",
                   "applies to machine arm6 (a 6-DOF arm), not to " + scenario_.machine);
-  if (speed_problems_ > kMaxSpeedProblems)
-    problems_.add(scenario_.toolpath_line, "toolpath",
-                  "... and " + std::to_string(speed_problems_ - kMaxSpeedProblems) +
-                      " more print segments above the speed limits (the first " +
-                      std::to_string(kMaxSpeedProblems) + " are listed)");
+  if (speed_problems_ > kMaxSpeedProblems) {
+    Problem more = last_listed_speed_problem_;
+    more.message = "... and " + std::to_string(speed_problems_ - kMaxSpeedProblems) +
+                   " more print segments above the speed limits (the first " +
+                   std::to_string(kMaxSpeedProblems) + " are listed)";
+    problems_.add_problem(std::move(more));
+  }
   // what the machine makes of the paths that were read: every pose within its travel or
   // workspace (the arm's reach depends on the roll its posture chooses: prepare_job)
   // (the keys' lines first: the reach check names them)
@@ -770,6 +773,9 @@ void Loader::check_repeated_paths(std::size_t first, const std::string& kind) {
   };
   std::unordered_multimap<std::size_t, std::size_t> seen;  // hash -> index into paths
   std::size_t repeats = 0;
+  // the last repeat listed: the "... and N more" line goes after it
+  int last_repeat_line = scenario_.toolpath_line;
+  std::string last_repeat_key = "toolpath";
   for (std::size_t i = first; i < paths.size(); ++i) {
     const PrintPath& path = paths[i];
     const bool reversed = canonical_reversed(path);
@@ -789,6 +795,8 @@ void Loader::check_repeated_paths(std::size_t first, const std::string& kind) {
     }
     if (++repeats > kMaxRepeatProblems) continue;
     const PathSource& source = scenario_.path_sources[static_cast<std::size_t>(path.source_index)];
+    last_repeat_line = source.point_lines.empty() ? 0 : source.point_lines.front();
+    last_repeat_key = source.key;
     const PathSource& earlier =
         scenario_.path_sources[static_cast<std::size_t>(paths[same->second].source_index)];
     problems_.add(
@@ -800,7 +808,7 @@ void Loader::check_repeated_paths(std::size_t first, const std::string& kind) {
             "the speed");
   }
   if (repeats > kMaxRepeatProblems)
-    problems_.add(scenario_.toolpath_line, "toolpath",
+    problems_.add(last_repeat_line, last_repeat_key,
                   "... and " + std::to_string(repeats - kMaxRepeatProblems) + " more repeated " +
                       kind + "s (the first " + std::to_string(kMaxRepeatProblems) + " are listed)");
 }
@@ -1508,13 +1516,14 @@ void Loader::check_path(const PrintPath& path, const PathOrigin& origin) {
                   "'s joint limits mapped over this segment; limits v_max is " +
                   format_speed(requested_mm_s) + ")"
             : "above limits v_max " + format_speed(requested_mm_s);
-    problems_.add_problem(Problem{origin.file, origin.speed_key.empty() ? line : origin.speed_line,
-                                  origin.speed_key.empty() ? origin.key : origin.speed_key,
-                                  (origin.name_segments ? segment + ": " : std::string()) +
-                                      "print speed " + format_speed(path.speed_mm_s) +
-                                      " mm/s needs " + format_speed(needed_mm_s) + " mm/s on " +
-                                      kAxisNames[worst_axis] + ", " + limit_text +
-                                      " (lower the speed or raise the limit)"});
+    last_listed_speed_problem_ =
+        Problem{origin.file, origin.speed_key.empty() ? line : origin.speed_line,
+                origin.speed_key.empty() ? origin.key : origin.speed_key,
+                (origin.name_segments ? segment + ": " : std::string()) + "print speed " +
+                    format_speed(path.speed_mm_s) + " mm/s needs " + format_speed(needed_mm_s) +
+                    " mm/s on " + kAxisNames[worst_axis] + ", " + limit_text +
+                    " (lower the speed or raise the limit)"};
+    problems_.add_problem(last_listed_speed_problem_);
   }
 }
 
@@ -2005,12 +2014,17 @@ std::vector<Problem> unreachable_points(const Scenario& scenario, const Machine&
         add(path_point_problem(scenario, path.source_index, i, *why));
         path_out_of_reach = true;
       }
-  if (unlisted > 0)
-    problems.push_back(
-        Problem{scenario.file, surface_line > 0 ? surface_line : scenario.toolpath_line,
-                scenario.surface ? "toolpath.surface" : "toolpath",
-                "... and " + std::to_string(unlisted) + " more unreachable points (the first " +
-                    std::to_string(max_listed) + " are listed)"});
+  // (after the last one listed, where it was given: the problems are sorted by line)
+  if (unlisted > 0) {
+    Problem more =
+        problems.empty()
+            ? Problem{scenario.file, surface_line > 0 ? surface_line : scenario.toolpath_line,
+                      scenario.surface ? "toolpath.surface" : "toolpath", ""}
+            : problems.back();
+    more.message = "... and " + std::to_string(unlisted) + " more unreachable points (the first " +
+                   std::to_string(max_listed) + " are listed)";
+    problems.push_back(std::move(more));
+  }
   if (path_out_of_reach) {
     // (at the offset when given, else at the toolpath)
     const auto offset = scenario.key_lines.find("toolpath.offset");

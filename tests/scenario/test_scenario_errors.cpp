@@ -150,6 +150,23 @@ toolpath:
                  "print speed 5 mm/s needs 4 mm/s on y, above limits v_max 3.9");
 }
 
+// past 20 segments over speed, one line says how many more: after the 20 listed, where the
+// last of them is (the problems are sorted by line), not first
+TEST_F(ScenarioErrors, TheSegmentsOverSpeedBeyondTheListedAreCountedAfterThem) {
+  std::string yaml =
+      "\nlimits: {v_max: 3.9, a_max: 30, x: {v_max: 10}}\ntoolpath:\n  speed: 5\n"
+      "  segments:\n";
+  for (int i = 0; i < 25; ++i)
+    yaml += "    - [[0, " + std::to_string(i) + "], [3, " + std::to_string(i + 4) + "]]\n";
+  const auto problems = problems_of(yaml);
+  ASSERT_EQ(problems.size(), 21u) << dump(problems);
+  EXPECT_EQ(problems[19].key, "toolpath.segments[19]") << dump(problems);
+  EXPECT_EQ(problems[20].str(), scenario_path() +
+                                    ":24: toolpath.segments[19]: ... and 5 more print segments "
+                                    "above the speed limits (the first 20 are listed)")
+      << dump(problems);
+}
+
 TEST_F(ScenarioErrors, MissingFile) {
   const std::string path = (dir_ / "no_such.yaml").string();
   const auto problems = validate_scenario_file(path);
