@@ -109,31 +109,35 @@ std::size_t first_non_text_byte(const std::string& text) {
 }
 
 namespace {
-void append_escaped_byte(std::string& out, unsigned char byte) {
+
+// the character of `text` at `at` appended to `out` as it is (printable ASCII, well-formed
+// UTF-8 of a printable code point, and a tab or line feed when `line_breaks`) or as \xNN for
+// one byte; returns the offset after it
+std::size_t append_shown_char(std::string& out, const std::string& text, std::size_t at,
+                              bool line_breaks) {
   static const char* kHex = "0123456789ABCDEF";
+  const auto byte = static_cast<unsigned char>(text[at]);
+  if ((byte >= 0x20 && byte < 0x7F) || (line_breaks && (byte == '\t' || byte == '\n'))) {
+    out += text[at];
+    return at + 1;
+  }
+  if (const std::size_t length = printable_utf8_length(text, at); length > 0) {
+    out.append(text, at, length);
+    return at + length;
+  }
   out += "\\x";
   out += kHex[byte >> 4];
   out += kHex[byte & 15];
+  return at + 1;
 }
+
 }  // namespace
 
 std::string printable_text(const std::string& text, std::size_t max_chars) {
   std::string out;
-  std::size_t chars = 0;
   std::size_t at = 0;
-  while (at < text.size() && chars < max_chars) {
-    const auto byte = static_cast<unsigned char>(text[at]);
-    if (byte >= 0x20 && byte < 0x7F) {
-      out += text[at++];
-    } else if (const std::size_t length = printable_utf8_length(text, at); length > 0) {
-      out.append(text, at, length);
-      at += length;
-    } else {
-      append_escaped_byte(out, byte);
-      ++at;
-    }
-    ++chars;
-  }
+  for (std::size_t chars = 0; at < text.size() && chars < max_chars; ++chars)
+    at = append_shown_char(out, text, at, false);
   if (at < text.size()) out += "...";
   return out;
 }
@@ -141,19 +145,7 @@ std::string printable_text(const std::string& text, std::size_t max_chars) {
 std::string terminal_text(const std::string& text) {
   std::string out;
   out.reserve(text.size());
-  std::size_t at = 0;
-  while (at < text.size()) {
-    const auto byte = static_cast<unsigned char>(text[at]);
-    if ((byte >= 0x20 && byte < 0x7F) || byte == '\t' || byte == '\n') {
-      out += text[at++];
-    } else if (const std::size_t length = printable_utf8_length(text, at); length > 0) {
-      out.append(text, at, length);
-      at += length;
-    } else {
-      append_escaped_byte(out, byte);
-      ++at;
-    }
-  }
+  for (std::size_t at = 0; at < text.size();) at = append_shown_char(out, text, at, true);
   return out;
 }
 

@@ -237,56 +237,7 @@ int processes_with(const std::string& text) {
   return count;
 }
 
-TEST_F(SweepRoutes, CtrlCStopsTheWorkersAndTheNextRunResumes) {
-  const std::string sweep = write_text(dir_, "interrupted.yaml", R"(base: base.yaml
-grid:
-  planner: [lspb_mtt, stop_and_go]
-  toolpath.speed: [1.5, 2, 2.5, 3]
-)");
-  const std::string out = dir_ + "/interrupted";
-  std::vector<std::string> arguments{DEPOTWIN_BINARY_DIR "/depotwin",
-                                     "sweep",
-                                     sweep,
-                                     "-j",
-                                     "1",
-                                     "--out",
-                                     out,
-                                     "--quiet",
-                                     "--no-render"};
-  std::vector<char*> argv;
-  for (std::string& argument : arguments) argv.push_back(argument.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&actions);
-  // once the first task has its record (at most a minute), Ctrl-C
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
-  while (!fs::exists(out + "/tasks/0000/task.json") && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  ::kill(pid, SIGINT);
-  int status = 0;
-  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-  // ended by the signal, its workers with it, the unfinished tasks not recorded
-  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
-  EXPECT_EQ(processes_with(out), 0);
-  int recorded = 0;
-  for (int i = 0; i < 8; ++i)
-    recorded += fs::exists(out + "/tasks/000" + std::to_string(i) + "/task.json");
-  EXPECT_GE(recorded, 1);
-  EXPECT_LT(recorded, 8);
-  // the next run does the rest
-  const CliResult resumed = depotwin("sweep " + sweep + " -j 2 --quiet --no-render --out " + out);
-  EXPECT_EQ(resumed.status, 0) << resumed.output;
-  EXPECT_NE(resumed.output.find("8 tasks, " + std::to_string(8 - recorded) + " run (0 failed), " +
-                                std::to_string(recorded) + " up to date"),
-            std::string::npos)
-      << resumed.output;
-}
-
-// `depotwin sweep ...` started with `arguments`, standard output to /dev/null
+// depotwin started with `arguments`, standard output to /dev/null
 pid_t spawn_depotwin(std::vector<std::string> arguments) {
   arguments.insert(arguments.begin(), DEPOTWIN_BINARY_DIR "/depotwin");
   std::vector<char*> argv;
@@ -310,6 +261,40 @@ std::vector<std::string> names_holding(const std::string& folder, const std::str
     if (it->path().filename().string().find(text) != std::string::npos)
       found.push_back(it->path().string());
   return found;
+}
+
+TEST_F(SweepRoutes, CtrlCStopsTheWorkersAndTheNextRunResumes) {
+  const std::string sweep = write_text(dir_, "interrupted.yaml", R"(base: base.yaml
+grid:
+  planner: [lspb_mtt, stop_and_go]
+  toolpath.speed: [1.5, 2, 2.5, 3]
+)");
+  const std::string out = dir_ + "/interrupted";
+  const pid_t pid =
+      spawn_depotwin({"sweep", sweep, "-j", "1", "--out", out, "--quiet", "--no-render"});
+  ASSERT_GT(pid, 0);
+  // once the first task has its record (at most a minute), Ctrl-C
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (!fs::exists(out + "/tasks/0000/task.json") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  // ended by the signal, its workers with it, the unfinished tasks not recorded
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
+  EXPECT_EQ(processes_with(out), 0);
+  int recorded = 0;
+  for (int i = 0; i < 8; ++i)
+    recorded += fs::exists(out + "/tasks/000" + std::to_string(i) + "/task.json");
+  EXPECT_GE(recorded, 1);
+  EXPECT_LT(recorded, 8);
+  // the next run does the rest
+  const CliResult resumed = depotwin("sweep " + sweep + " -j 2 --quiet --no-render --out " + out);
+  EXPECT_EQ(resumed.status, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("8 tasks, " + std::to_string(8 - recorded) + " run (0 failed), " +
+                                std::to_string(recorded) + " up to date"),
+            std::string::npos)
+      << resumed.output;
 }
 
 // one task run by hand (`sweep --task`, as a cluster's job runs it) stopped by SIGTERM (a
