@@ -447,6 +447,10 @@ class GcodeParser {
 };
 
 // a comment with a '(' inside (LinuxCNC refuses it too)
+// a '(' without its ')' on the line (LinuxCNC: "Unclosed comment found")
+constexpr const char* kUnclosedComment =
+    "comment '(' not closed on its line (a comment ends on its line: close it with ')', or use "
+    "';' for a comment to the line's end)";
 constexpr const char* kNestedComment =
     "a comment inside a comment: '(' ... '(' ... ')' (comments do not nest; the first ')' ends "
     "both)";
@@ -558,7 +562,11 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     if (p < end && *p == '(') {
       // a line that is a comment, or a comment then words
       const char* close = std::find(p, end, ')');
-      if (close == end) return;
+      // (unclosed: refused as after words, as LinuxCNC does; it could hide the line's words)
+      if (close == end) {
+        problem(line_number, kUnclosedComment);
+        return;
+      }
       if (std::find(p + 1, close, '(') != close) {
         problem(line_number, kNestedComment);
         return;
@@ -651,7 +659,7 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
     if (c == '(') {
       const char* close = std::find(p, end, ')');
       if (close == end) {
-        problem(line_number, "comment '(' not closed on its line");
+        problem(line_number, kUnclosedComment);
         return false;
       }
       // (RS274/NGC comments do not nest: the first ')' ends it, and what follows would read as

@@ -548,8 +548,9 @@ TEST(Gcode, OpenAndCloseCodesOnOneLineAreRefused) {
       << problems[0].str();
 }
 
-// a space inside a number (`X1 0.5`, which LinuxCNC reads as X10.5) and a nested comment are
-// refused with what they are, not only as an unexpected character or a malformed word
+// a space inside a number (`X1 0.5`, which LinuxCNC reads as X10.5), a nested comment and an
+// unclosed one are refused with what they are, not only as an unexpected character or a malformed
+// word
 TEST(Gcode, ASpaceInsideANumberAndANestedCommentAreNamed) {
   const auto split = problems_of("G21 G90\nG1 X1 0.5 F600\n");
   ASSERT_EQ(split.size(), 1u) << dump(split);
@@ -559,6 +560,15 @@ TEST(Gcode, ASpaceInsideANumberAndANestedCommentAreNamed) {
   ASSERT_EQ(nested.size(), 1u) << dump(nested);
   EXPECT_EQ(nested[0].line, 2);
   EXPECT_NE(nested[0].message.find("comments do not nest"), std::string::npos) << nested[0].str();
+  // a '(' left open is refused the same on a line of its own and after words (it could hide
+  // the words after it either way)
+  for (const char* line : {"(G1 X5 Y5 is a move", "G1 X1 F600 (then Y5"}) {
+    const auto unclosed = problems_of("G21 G90\n" + std::string(line) + "\nG1 X2 F600\n");
+    ASSERT_EQ(unclosed.size(), 1u) << line << dump(unclosed);
+    EXPECT_EQ(unclosed[0].line, 2) << line;
+    EXPECT_EQ(unclosed[0].message.rfind("comment '(' not closed on its line", 0), 0u)
+        << unclosed[0].str();
+  }
   // a stray character elsewhere keeps the plain message
   const auto stray = problems_of("G21 G90\nG1 X1 F600 ?\n");
   ASSERT_EQ(stray.size(), 1u) << dump(stray);
