@@ -88,7 +88,15 @@ int check_verb(CLI::App& app, int argc, char** argv) {
     return kExitBadInput;
   }
   const std::string first = argv[1];
-  if (!first.empty() && first[0] == '-') return -1;  // --help, --version, or CLI11's message
+  // --help, --version; any other option before the verb is named with the verbs (CLI11 alone
+  // says "A subcommand is required")
+  if (!first.empty() && first[0] == '-') {
+    if (first == "-h" || first == "--help" || first == "--version") return -1;
+    std::cerr << "error: unknown option '" << terminal_text(first)
+              << "' before the verb; a command reads `depotwin VERB [OPTIONS]`, and the verbs are "
+              << verb_list(app) << "\n(depotwin --help says what each does)\n";
+    return kExitBadInput;
+  }
   const std::function<bool(CLI::App*)> named = [&](CLI::App* verb) {
     return verb->check_name(first);
   };

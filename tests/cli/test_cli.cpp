@@ -68,6 +68,17 @@ TEST(Cli, UnknownVerbIsNamedWithTheVerbs) {
   for (const char* verb : {"run, ", "compare, ", "plan, ", "validate, ", "move"})
     EXPECT_NE(verbs.find(verb), std::string::npos) << verb << " missing from: " << verbs;
 
+  // an option before any verb: named, with the same list of verbs
+  const Result option = depotwin("--out x run");
+  EXPECT_EQ(option.status, 2) << option.output;
+  EXPECT_EQ(option.output.find("A subcommand is required"), std::string::npos) << option.output;
+  EXPECT_NE(option.output.find("error: unknown option '--out' before the verb; a command reads "
+                               "`depotwin VERB [OPTIONS]`, and the verbs are " +
+                               verbs),
+            std::string::npos)
+      << option.output;
+  EXPECT_EQ(depotwin("--version").status, 0);
+
   // no verb at all: the usage, and the same list of verbs
   const Result none = depotwin("");
   EXPECT_EQ(none.status, 2) << none.output;
