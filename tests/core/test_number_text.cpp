@@ -108,7 +108,9 @@ TEST(NumberText, TerminalTextDisarmsControlBytes) {
   EXPECT_EQ(terminal_text("a\x1B[31mred\x1B[0m"), "a\\x1B[31mred\\x1B[0m");
   EXPECT_EQ(terminal_text(std::string("over\rwrite\0end", 14)), "over\\x0Dwrite\\x00end");
   // a Latin-1 byte, a C1 control in UTF-8 (U+009B, the one-byte CSI) and a DEL
-  EXPECT_EQ(terminal_text("caf\xE9 \xC2\x9B" "2J \x7F"), "caf\\xE9 \\xC2\\x9B2J \\x7F");
+  EXPECT_EQ(terminal_text("caf\xE9 \xC2\x9B"
+                          "2J \x7F"),
+            "caf\\xE9 \\xC2\\x9B2J \\x7F");
   // already-escaped text is left as it is: escaping twice changes nothing
   const std::string once = terminal_text("x\x1By\rz");
   EXPECT_EQ(terminal_text(once), once);
