@@ -4,7 +4,6 @@
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdio>
-#include <cstring>
 #include <functional>
 #include <iostream>
 #include <string>
@@ -17,6 +16,7 @@
 #include "cli/sweep_verb.hpp"  // sweep
 #include "cli/verbs.hpp"
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 #include "core/interrupt.hpp"
 #include "core/number_text.hpp"
 #include "pipeline/models_dir.hpp"
@@ -378,8 +378,8 @@ int main(int argc, char** argv) {
   const bool flushed = std::fflush(stdout) == 0;
   if (!std::cout || !flushed || std::ferror(stdout) != 0) {
     const int reason = errno;
-    std::cerr << "error: the standard output could not be written whole"
-              << (reason != 0 ? std::string(": ") + std::strerror(reason) : std::string()) << "\n";
+    std::cerr << "error: the standard output could not be written whole" << system_reason(reason)
+              << "\n";
     return status == kExitOk ? kExitInternal : status;
   }
   return status;

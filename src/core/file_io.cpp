@@ -28,8 +28,7 @@ void write_file_atomically(const std::string& path, const std::string& content) 
       const int why = errno;
       std::error_code ignored;
       fs::remove(temporary, ignored);
-      throw InternalError("cannot write " + path +
-                          (why != 0 ? std::string(": ") + std::strerror(why) : std::string()));
+      throw InternalError("cannot write " + path + system_reason(why));
     }
   }
   std::error_code error;
@@ -39,6 +38,10 @@ void write_file_atomically(const std::string& path, const std::string& content) 
     fs::remove(temporary, error);
     throw InternalError("cannot move " + temporary + " to " + path + ": " + why);
   }
+}
+
+std::string system_reason(int error_number) {
+  return error_number != 0 ? std::string(": ") + std::strerror(error_number) : std::string();
 }
 
 std::string replaceable_file_problem(const std::string& path) {

@@ -10,6 +10,10 @@ namespace depotwin {
 // Throws InternalError on I/O failure (the target is then untouched).
 void write_file_atomically(const std::string& path, const std::string& content);
 
+// ": " and the system's text for `error_number` (errno: "No space left on device"), or "" for
+// 0 (a stream that failed without saying why): the tail of "cannot write PATH"
+std::string system_reason(int error_number);
+
 // Why write_file_atomically must not write `path`, or "" when it may: an existing path that is
 // not a regular file, which the rename would replace itself: a directory, a symbolic link
 // (/dev/stdout would become a file), a device (/dev/null), a FIFO or a socket; "-", which

@@ -15,6 +15,7 @@
 #include <system_error>
 
 #include "core/child_process.hpp"
+#include "core/file_io.hpp"
 #include "core/interrupt.hpp"
 
 extern char** environ;
@@ -135,8 +136,7 @@ void write_text_file(const std::string& path, const std::string& content) {
   out.flush();
   if (!out) {
     const int why = errno;  // a full disk: "No space left on device"
-    throw InternalError("cannot write " + path +
-                        (why != 0 ? std::string(": ") + std::strerror(why) : std::string()));
+    throw InternalError("cannot write " + path + system_reason(why));
   }
 }
 
