@@ -79,6 +79,12 @@ std::string verb_list(CLI::App& app) {
   return list;
 }
 
+// "error: <what><the verbs>" and where they are described; exit 2
+int refuse_with_verbs(CLI::App& app, const std::string& what) {
+  std::cerr << "error: " << what << verb_list(app) << "\n(depotwin --help says what each does)\n";
+  return kExitBadInput;
+}
+
 // The verb comes first: without one, the usage and the verbs; an unknown one is named with
 // the verbs (CLI11 alone says "A subcommand is required"). Returns the exit status when the
 // command line is refused here, -1 otherwise.
@@ -92,18 +98,15 @@ int check_verb(CLI::App& app, int argc, char** argv) {
   // says "A subcommand is required")
   if (!first.empty() && first[0] == '-') {
     if (first == "-h" || first == "--help" || first == "--version") return -1;
-    std::cerr << "error: unknown option '" << terminal_text(first)
-              << "' before the verb; a command reads `depotwin VERB [OPTIONS]`, and the verbs are "
-              << verb_list(app) << "\n(depotwin --help says what each does)\n";
-    return kExitBadInput;
+    return refuse_with_verbs(app, "unknown option '" + terminal_text(first) +
+                                      "' before the verb; a command reads `depotwin VERB "
+                                      "[OPTIONS]`, and the verbs are ");
   }
   const std::function<bool(CLI::App*)> named = [&](CLI::App* verb) {
     return verb->check_name(first);
   };
   if (!app.get_subcommands(named).empty()) return -1;
-  std::cerr << "error: unknown verb '" << terminal_text(first) << "'; verbs are " << verb_list(app)
-            << "\n(depotwin --help says what each does)\n";
-  return kExitBadInput;
+  return refuse_with_verbs(app, "unknown verb '" + terminal_text(first) + "'; verbs are ");
 }
 
 }  // namespace
