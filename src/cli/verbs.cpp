@@ -45,6 +45,16 @@ JobBudget job_budget(const std::string& max_memory) {
   return budget;
 }
 
+// each run's warnings, named by its run label (two runs of one planner with other settings
+// are told apart)
+void print_warnings(const std::vector<MetricsReport>& reports) {
+  for (const MetricsReport& report : reports) {
+    const std::string& run = report.label.empty() ? report.planner : report.label;
+    for (const std::string& warning : report.warnings)
+      std::cout << "warning (" << terminal_text(run) << "): " << terminal_text(warning) << '\n';
+  }
+}
+
 }  // namespace
 
 int plan_verb(const RunOptions& options) {
@@ -67,10 +77,7 @@ int plan_verb(const RunOptions& options) {
             << job.machine->name() << ", order " << scenario.order.label() << ", "
             << job.toolpath.paths.size() << " print paths\n\n"
             << summary_table(reports) << '\n';
-  for (const MetricsReport& report : reports)
-    for (const std::string& warning : report.warnings)
-      std::cout << "warning (" << (report.label.empty() ? report.planner : report.label)
-                << "): " << terminal_text(warning) << '\n';
+  print_warnings(reports);
   std::cout << "plans written to " << terminal_text(directory)
             << "/<planner>/{metrics.json,trajectory.csv}\n";
   return kExitOk;
@@ -112,17 +119,12 @@ int validate_verb(const std::string& path, const std::string& max_memory, bool q
   for (const PlannerSpec& spec : scenario.planners)
     if (const Trajectory* plan = job.checked_plan(spec))
       for (const std::string& warning : plan_warnings(job, *plan))
-        std::cout << "warning (" << spec.run_label() << "): " << terminal_text(warning) << '\n';
+        std::cout << "warning (" << terminal_text(spec.run_label())
+                  << "): " << terminal_text(warning) << '\n';
   return kExitOk;
 }
 
 namespace {
-
-void print_warnings(const std::vector<MetricsReport>& reports) {
-  for (const MetricsReport& report : reports)
-    for (const std::string& warning : report.warnings)
-      std::cout << "warning (" << report.planner << "): " << terminal_text(warning) << '\n';
-}
 
 RunSettings run_settings(const Scenario& scenario, const RunOptions& options) {
   RunSettings settings;

@@ -97,6 +97,29 @@ TEST(ValidateVerb, PrintsThePlannersWarningsAsPlanDoes) {
   EXPECT_NE(planned.output.find(slowed), std::string::npos) << planned.output;
 }
 
+// two runs of one planner under labels: every verb names a warning by the run's label (`run`
+// and `compare` named both "bezier")
+TEST(ValidateVerb, WarningsNameTheRunByItsLabelInEveryVerb) {
+  const std::string dir = fresh_directory("validate_labelled_warnings");
+  std::string text =
+      testing_support::read_text(testing_support::scenario_path("corner_sweep.yaml"));
+  text.replace(text.find("planners:"), std::string::npos,
+               "planners: [{name: bezier, delta: 0.3, label: wide}, {name: bezier, delta: 0.2, "
+               "label: narrow}]\n");
+  const std::string scenario = write_text(dir, "labelled.yaml", text);
+  for (const std::string& verb :
+       std::vector<std::string>{"validate --quiet", "plan --quiet --out " + dir + "/plan",
+                                "run --quiet --no-render --out " + dir + "/run"}) {
+    const auto r = depotwin(verb + " " + scenario);
+    ASSERT_EQ(r.status, 0) << verb << ": " << r.output;
+    EXPECT_NE(r.output.find("warning (wide): path 3 corner 1: "), std::string::npos)
+        << verb << ": " << r.output;
+    EXPECT_NE(r.output.find("warning (narrow): path "), std::string::npos)
+        << verb << ": " << r.output;
+    EXPECT_EQ(r.output.find("warning (bezier)"), std::string::npos) << verb << ": " << r.output;
+  }
+}
+
 // the memory validate prints is the figure --max-memory is compared with: a budget 3 % below it
 // refuses the job, 3 % above accepts it
 TEST(ValidateVerb, TheMemoryItPrintsIsWhatMaxMemoryIsComparedWith) {
