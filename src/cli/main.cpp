@@ -367,7 +367,9 @@ int run_command_line(int argc, char** argv) {
                 << "; stopped, the output is as it was\n";
       return Interrupted(interrupt_signal()).exit_status();
     }
-    std::cerr << "internal error: " << terminal_text(error.what()) << '\n';
+    // the machine's refusal (a full disk) is an error to act on, not a bug to report
+    const bool refused = dynamic_cast<const EnvironmentError*>(&error) != nullptr;
+    std::cerr << (refused ? "error: " : "internal error: ") << terminal_text(error.what()) << '\n';
     return kExitInternal;
   }
   return kExitInternal;

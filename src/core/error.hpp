@@ -1,6 +1,9 @@
 // Error types with the exit-status contract of the CLI:
 //   InputError    -> exit 2: bad scenario, bad file, impossible limits (names file, line, key)
 //   InternalError -> exit 1: a bug or a simulator failure
+//   EnvironmentError (an InternalError) -> exit 1: the machine refused (a full disk, a folder
+//                    that cannot be written, a program that cannot start); printed as an
+//                    error, not as a bug
 #pragma once
 
 #include <stdexcept>
@@ -37,6 +40,14 @@ class InputError : public std::runtime_error {
 class InternalError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// The machine refused what the run needs, and said why: a write on a full disk or in a folder
+// without permission, a file that cannot be moved into place, a helper program that cannot
+// start. Neither the input's fault nor a bug; the message ends with the system's reason.
+class EnvironmentError : public InternalError {
+ public:
+  using InternalError::InternalError;
 };
 
 constexpr int kExitOk = 0;

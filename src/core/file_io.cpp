@@ -28,7 +28,7 @@ void write_file_atomically(const std::string& path, const std::string& content) 
       const int why = errno;
       std::error_code ignored;
       fs::remove(temporary, ignored);
-      throw InternalError("cannot write " + path + system_reason(why));
+      throw EnvironmentError("cannot write " + path + system_reason(why));
     }
   }
   std::error_code error;
@@ -36,7 +36,7 @@ void write_file_atomically(const std::string& path, const std::string& content) 
   if (error) {
     const std::string why = error.message();
     fs::remove(temporary, error);
-    throw InternalError("cannot move " + temporary + " to " + path + ": " + why);
+    throw EnvironmentError("cannot move " + temporary + " to " + path + ": " + why);
   }
 }
 

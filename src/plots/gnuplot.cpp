@@ -95,7 +95,7 @@ std::vector<std::string> run_gnuplot(const std::string& executable, const std::s
   posix_spawn_file_actions_destroy(&actions);
   if (spawn_error == ENOENT) throw GnuplotNotFound();
   if (spawn_error != 0)
-    throw InternalError("cannot start " + executable + ": " + std::strerror(spawn_error));
+    throw EnvironmentError("cannot start " + executable + ": " + std::strerror(spawn_error));
 
   // wait for it; killed because a signal stopped the run, it did not fail: the run stops
   const int status = wait_child_process(child);
@@ -119,8 +119,8 @@ TemporaryDirectory::TemporaryDirectory(const std::string& parent) {
   fs::create_directories(parent, error);
   std::string pattern = (parent.empty() ? std::string(".") : parent) + "/.plots-XXXXXX";
   if (::mkdtemp(pattern.data()) == nullptr)
-    throw InternalError("cannot create a temporary directory in " + parent + ": " +
-                        std::strerror(errno));
+    throw EnvironmentError("cannot create a temporary directory in " + parent + ": " +
+                           std::strerror(errno));
   path_ = fs::absolute(pattern).lexically_normal().string();
 }
 
@@ -136,14 +136,14 @@ void write_text_file(const std::string& path, const std::string& content) {
   out.flush();
   if (!out) {
     const int why = errno;  // a full disk: "No space left on device"
-    throw InternalError("cannot write " + path + system_reason(why));
+    throw EnvironmentError("cannot write " + path + system_reason(why));
   }
 }
 
 void move_into_place(const std::string& from, const std::string& to) {
   std::error_code error;
   fs::rename(from, to, error);
-  if (error) throw InternalError("cannot move " + from + " to " + to + ": " + error.message());
+  if (error) throw EnvironmentError("cannot move " + from + " to " + to + ": " + error.message());
 }
 
 }  // namespace depotwin::plots

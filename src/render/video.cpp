@@ -538,7 +538,7 @@ VideoStats write_replay_video(const ReplayData& replay, const std::string& mp4_p
   // in place only when whole
   std::error_code error;
   fs::rename(temporary, target, error);
-  if (error) throw InternalError("cannot write " + mp4_path + ": " + error.message());
+  if (error) throw EnvironmentError("cannot write " + mp4_path + ": " + error.message());
   cleanup.renamed = true;
 
   VideoStats stats;

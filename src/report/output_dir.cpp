@@ -46,13 +46,13 @@ void replace_directory(const std::string& staging, const std::string& target) {
   const std::string old = target + ".old-" + std::to_string(::getpid());
   if (had_old) {
     fs::rename(target, old, error);
-    if (error) throw InternalError("cannot replace " + target + ": " + error.message());
+    if (error) throw EnvironmentError("cannot replace " + target + ": " + error.message());
   }
   fs::rename(staging, target, error);
   if (error) {
     const std::string reason = error.message();
     if (had_old) fs::rename(old, target, error);
-    throw InternalError("cannot move results to " + target + ": " + reason);
+    throw EnvironmentError("cannot move results to " + target + ": " + reason);
   }
   if (had_old) fs::remove_all(old, error);
 }
@@ -259,7 +259,7 @@ StagedDirectory::StagedDirectory(std::string final_path) : final_path_(std::move
   std::error_code error;
   fs::remove_all(staging_path_, error);
   fs::create_directories(staging_path_, error);
-  if (error) throw InternalError("cannot create " + staging_path_ + ": " + error.message());
+  if (error) throw EnvironmentError("cannot create " + staging_path_ + ": " + error.message());
 }
 
 StagedDirectory::~StagedDirectory() {

@@ -118,8 +118,8 @@ Worker spawn_worker(const LocalRunOptions& options, const Sweep& sweep) {
   if (failed != 0) {
     ::close(command[1]);
     ::close(report[0]);
-    throw InternalError("cannot start a sweep worker (" + options.executable +
-                        "): " + std::strerror(failed));
+    throw EnvironmentError("cannot start a sweep worker (" + options.executable +
+                           "): " + std::strerror(failed));
   }
   worker.command_fd = command[1];
   worker.report_fd = report[0];

@@ -388,7 +388,18 @@ class Database {
 
  private:
   [[noreturn]] void fail(const std::string& what) {
-    throw InternalError("SQLite, " + path_ + ": " + what + ": " + sqlite3_errmsg(db_));
+    const std::string message = "SQLite, " + path_ + ": " + what + ": " + sqlite3_errmsg(db_);
+    // a full disk, a read-only or unreachable file: the machine's refusal, not a bug
+    switch (sqlite3_errcode(db_) & 0xff) {
+      case SQLITE_FULL:
+      case SQLITE_IOERR:
+      case SQLITE_CANTOPEN:
+      case SQLITE_READONLY:
+      case SQLITE_PERM:
+        throw EnvironmentError(message);
+      default:
+        throw InternalError(message);
+    }
   }
   std::string path_;
   sqlite3* db_ = nullptr;
@@ -437,8 +448,9 @@ void write_results_sqlite(const ResultsTable& table, const Sweep& sweep, const s
   }
   fs::rename(temporary, path, ignored);
   if (ignored) {
+    const std::string why = ignored.message();
     fs::remove(temporary, ignored);
-    throw InternalError("cannot move " + temporary + " to " + path);
+    throw EnvironmentError("cannot move " + temporary + " to " + path + ": " + why);
   }
 }
 

@@ -123,6 +123,8 @@ TaskRecord run_task(const Sweep& sweep, const SweepTask& task, const std::string
     record.run = planner.run_label();
   } catch (const InputError& error) {
     record.error = problems_text(error);
+  } catch (const EnvironmentError& error) {
+    record.error = error.what();  // the machine's refusal (a full disk), not a bug
   } catch (const std::runtime_error& error) {
     // InternalError, a library's error; other exceptions (a request to stop) are not the
     // task's failure and leave its folder as it was

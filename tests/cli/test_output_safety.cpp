@@ -2,8 +2,9 @@
 // to the process: SIGINT or SIGTERM at any point of a run (exit 130 or 143, the earlier
 // result byte for byte, no staging folder, no lock file, no gnuplot left), SIGKILL (gnuplot
 // dies with it, the next run clears what it left), two writers at once (one waits; the last
-// one's result whole), --no-wait while another writer holds the lock (exit 2), and a planner
-// named twice (refused every time, nothing written).
+// one's result whole), --no-wait while another writer holds the lock (exit 2), a planner
+// named twice (refused every time, nothing written), and a full disk (said as the system says
+// it, exit 1, nothing left).
 #include <gtest/gtest.h>
 
 #include <dirent.h>
@@ -477,6 +478,29 @@ TEST(OutputSafety, APlannerNamedTwiceIsRefusedEveryTime) {
   EXPECT_EQ(spaced.status, 0) << spaced.output;
   EXPECT_EQ(names_in(dir + "/results"),
             (std::vector<std::string>{".depotwin", "lspb_mtt", "stop_and_go"}));
+}
+
+// ---- a full disk
+
+// the machine's refusal is an error that says why (exit 1), not an "internal error", and
+// nothing is left on the volume (a 16 KiB tmpfs: mounting one needs root, elsewhere skipped)
+TEST(OutputSafety, AFullDiskIsSaidAsTheSystemSaysItAndLeavesNothing) {
+  const std::string dir = fresh_directory("safety_full_disk");
+  const std::string volume = dir + "/volume";
+  fs::create_directories(volume);
+  if (::geteuid() != 0 ||
+      std::system(("mount -t tmpfs -o size=16k tmpfs '" + volume + "' 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "mounting a tmpfs needs root";
+  const auto r = depotwin("plan " + scenario_path("thompson_fig7.yaml") +
+                          " --planner stop_and_go --out " + volume + "/results");
+  const std::vector<std::string> left = names_in(volume);
+  EXPECT_EQ(std::system(("umount '" + volume + "'").c_str()), 0);
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_EQ(r.output.rfind("error: cannot write " + volume + "/results.partial-", 0), 0u)
+      << r.output;
+  EXPECT_NE(r.output.find(": No space left on device\n"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+  EXPECT_TRUE(left.empty()) << left.front();
 }
 
 }  // namespace
