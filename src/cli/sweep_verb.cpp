@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <thread>
 #include <utility>
 
@@ -10,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "core/interrupt.hpp"
+#include "report/output_dir.hpp"
 #include "sweep/emit.hpp"
 #include "sweep/local_runner.hpp"
 #include "sweep/results.hpp"
@@ -55,14 +57,17 @@ CLI::App* add_sweep_verb(CLI::App& app, SweepOptions& options) {
   sweep->add_flag("--force", options.force, "rerun tasks whose results are up to date");
   sweep->add_flag("--no-render", options.no_render, "merge without summary.png");
   sweep->add_flag("--quiet", options.quiet, "no progress line");
+  sweep->add_flag("--no-wait", options.no_wait,
+                  "exit (status 2) instead of waiting while another sweep or merge writes the "
+                  "results folder");
   CLI::Option* worker = sweep->add_flag("--worker", options.worker)->group("");
   for (CLI::Option* a : {list, task, merge, emit, worker})
     for (CLI::Option* b : {list, task, merge, emit, worker})
       if (a != b) a->excludes(b);
   sweep->footer(
       "Exit status: 0 when every task is ok; 100 + k when k tasks failed (--merge: failed or "
-      "missing; 255: 155 or more); 2 bad input (every problem listed, nothing written); 1 "
-      "internal failure.");
+      "missing; 255: 155 or more); 2 bad input (every problem listed, nothing written); 1 the "
+      "machine refused (a full disk: said why) or an internal failure.");
   return sweep;
 }
 
@@ -137,22 +142,60 @@ int list_tasks(const Sweep& sweep, const SweepOptions& options) {
   return kExitOk;
 }
 
-int merge_results(const Sweep& sweep, const SweepOptions& options, int threads) {
+// Moves the staged merge into the sweep folder: results.sqlite, results.csv and summary.png
+// (plotted false: an earlier merge's summary.png is removed, it no longer matches the table).
+void move_merged_files(const std::string& staging, const std::string& out, bool plotted) {
+  std::error_code error;
+  for (const char* name : {"results.sqlite", "results.csv", "summary.png"}) {
+    const std::string from = staging + "/" + name, to = out + "/" + name;
+    if (std::string(name) == "summary.png" && !plotted) {
+      fs::remove(to, error);
+      if (error) throw EnvironmentError("cannot remove the earlier " + to + ": " + error.message());
+      continue;
+    }
+    fs::rename(from, to, error);
+    if (error) throw EnvironmentError("cannot move " + from + " to " + to + ": " + error.message());
+  }
+}
+
+void check_merge_folder(const Sweep& sweep) {
   std::error_code error;
   if (!fs::is_directory(sweep.out_directory(), error))
     throw InputError("--out", sweep.out_directory() +
                                   ": no results folder to merge (run the sweep first, or give "
                                   "--out as it was run)");
+}
+
+// One local sweep or merge of a results folder at a time (report/output_dir.hpp): a second one
+// waits (--no-wait: refuses), then finds the tasks the first ran up to date instead of running
+// them again. The folder is checked and made first: the lock file sits beside it.
+std::unique_ptr<OutputLock> lock_results_folder(const Sweep& sweep, const SweepOptions& options) {
+  sweep.prepare_out_directory();
+  return std::make_unique<OutputLock>(absolute(sweep.out_directory()), sweep.out_directory(),
+                                      "sweep", !options.no_wait);
+}
+
+// called holding the folder's lock (lock_results_folder)
+int merge_results(const Sweep& sweep, const SweepOptions& options, int threads) {
+  check_merge_folder(sweep);
   sweep.prepare_out_directory();
   const ResultsTable table = collect_results(sweep, threads);
   const std::string out = sweep.out_directory();
-  // a signal that asks to stop (core/interrupt.hpp) is taken before each file is replaced
+  // the merge's files are written in a staging folder and moved in together once all are
+  // whole: a signal (core/interrupt.hpp) or a failure on the way leaves the earlier merge's
+  // results.sqlite, results.csv and summary.png as they were, never a mix of old and new
+  const std::string staging_base = out + "/merge";
+  remove_stale_staging(absolute(staging_base));
+  StagedDirectory staged(staging_base);
+  write_file_atomically(staged.file(kOutputMarker), "depotwin sweep merge, staged\n");
   throw_if_interrupted();
-  write_results_sqlite(table, sweep, out + "/results.sqlite");
+  write_results_sqlite(table, sweep, staged.file("results.sqlite"));
   throw_if_interrupted();
-  write_file_atomically(out + "/results.csv", results_csv(table));
+  write_file_atomically(staged.file("results.csv"), results_csv(table));
   bool plotted = false;
-  if (!options.no_render) plotted = write_summary_plot(table, sweep, out + "/summary.png");
+  if (!options.no_render) plotted = write_summary_plot(table, sweep, staged.file("summary.png"));
+  throw_if_interrupted();
+  move_merged_files(staged.path(), out, plotted);
   std::cout << "sweep " << sweep.spec().name << ": " << sweep.size() << " tasks, " << table.ok
             << " ok, " << table.failed << " failed, " << table.missing << " missing\n"
             << "merged into " << out << "/results.sqlite, results.csv"
@@ -225,8 +268,8 @@ int emit_script(const Sweep& sweep, const SweepOptions& options) {
 int run_all(const Sweep& sweep, const SweepOptions& options) {
   const int jobs = options.jobs > 0 ? options.jobs : default_jobs();
   sweep.validate_all(jobs, !options.quiet);
-  sweep.prepare_out_directory();
-  // what is not up to date
+  const auto lock = lock_results_folder(sweep, options);
+  // what is not up to date (once the lock is held: a sweep that ran meanwhile is seen)
   std::vector<std::uint64_t> pending;
   for (std::uint64_t i = 0; i < sweep.size(); ++i)
     if (options.force || !task_up_to_date(sweep, i, sweep.input_hash(sweep.task(i))))
@@ -257,9 +300,12 @@ int sweep_verb(const SweepOptions& options) {
   if (options.worker) return sweep_worker(sweep);
   if (options.list) return list_tasks(sweep, options);
   if (!options.task.empty()) return run_one_task(sweep, options);
-  if (options.merge)
-    return merge_results(sweep, options, options.jobs > 0 ? options.jobs : default_jobs());
   if (!options.emit.empty()) return emit_script(sweep, options);
+  if (options.merge) {
+    check_merge_folder(sweep);
+    const auto lock = lock_results_folder(sweep, options);
+    return merge_results(sweep, options, options.jobs > 0 ? options.jobs : default_jobs());
+  }
   return run_all(sweep, options);
 }
 

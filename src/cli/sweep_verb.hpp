@@ -27,7 +27,8 @@ struct SweepOptions {
   bool force = false;
   bool no_render = false;  // no summary.png
   bool quiet = false;
-  bool worker = false;  // depotwin's own worker processes (hidden)
+  bool no_wait = false;  // refuse, not wait, while another sweep or merge writes the folder
+  bool worker = false;   // depotwin's own worker processes (hidden)
 };
 
 // the exit status that says k tasks failed: 100 + k, at most 255

@@ -2,7 +2,8 @@
 // command line and a local Slurm (when scripts/slurm-local.sh can start one) give the same
 // table apart from wall times; a task equals `depotwin run` on the same scenario; up-to-date
 // tasks are skipped; a failing task is recorded and counted in the exit status; bad input
-// writes nothing.
+// writes nothing; two sweeps of one folder run each task once; a failed merge leaves the
+// earlier one whole.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -348,6 +349,87 @@ grid:
   for (const char* file :
        {"metrics.json", "trajectory.csv", "thickness.csv", "thickness_field.png", "replay.json"})
     EXPECT_TRUE(fs::is_regular_file(out + "/tasks/0000/stop_and_go/" + file)) << file;
+}
+
+// two local sweeps of one folder started together: the second waits for the first's lock and
+// finds its tasks up to date (each task runs once); with --no-wait it exits 2 instead
+TEST_F(SweepRoutes, TwoSweepsOfOneFolderRunEachTaskOnce) {
+  const std::string sweep = write_text(dir_, "together.yaml", R"(base: base.yaml
+grid:
+  planner: [stop_and_go]
+  toolpath.speed: [1.5, 2]
+)");
+  const std::string out = dir_ + "/together";
+  const std::string command = std::string(DEPOTWIN_BINARY_DIR) + "/depotwin sweep " + sweep +
+                              " -j 1 --quiet --no-render --out " + out;
+  shell("(" + command + " > " + dir_ + "/together_1.log 2>&1; echo $? >> " + dir_ +
+        "/together_1.log) & " + command + " > " + dir_ + "/together_2.log 2>&1; echo $? >> " +
+        dir_ + "/together_2.log; wait");
+  const std::string logs =
+      read_text(dir_ + "/together_1.log") + read_text(dir_ + "/together_2.log");
+  EXPECT_NE(logs.find("2 tasks, 2 run (0 failed), 0 up to date"), std::string::npos) << logs;
+  EXPECT_NE(logs.find("2 tasks, 0 run (0 failed), 2 up to date"), std::string::npos) << logs;
+  EXPECT_NE(logs.find("waiting: " + out + " is being written by pid "), std::string::npos) << logs;
+  // each log ends with its exit status
+  for (const char* log : {"/together_1.log", "/together_2.log"}) {
+    const std::string text = read_text(dir_ + log);
+    EXPECT_EQ(text.substr(text.size() - 2), "0\n") << text;
+  }
+  EXPECT_FALSE(fs::exists(out + ".lock"));
+  // --no-wait while a merge holds the folder: refused
+  const pid_t pid = spawn_depotwin({"sweep", sweep, "--merge", "--quiet", "--out", out});
+  ASSERT_GT(pid, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (!fs::exists(out + ".lock") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const CliResult refused = depotwin("sweep " + sweep + " --merge --no-wait --quiet --out " + out);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+  if (refused.output.find("waiting") == std::string::npos && refused.status == 0)
+    GTEST_SKIP() << "the merge ended before the second one started";
+  EXPECT_EQ(refused.status, 2) << refused.output;
+  EXPECT_NE(refused.output.find("error: --out: " + out + ": is being written by pid "),
+            std::string::npos)
+      << refused.output;
+}
+
+// the merge's three files move in together: one that fails on the way (gnuplot failing)
+// leaves the earlier merge's results.sqlite, results.csv and summary.png byte for byte; one
+// without a plot removes the earlier summary.png, which no longer matches
+TEST_F(SweepRoutes, AMergeThatFailsLeavesTheEarlierMergeWhole) {
+  const std::string sweep = write_text(dir_, "merged.yaml", R"(base: base.yaml
+grid:
+  planner: [stop_and_go]
+  toolpath.speed: [1.5, 2]
+)");
+  const std::string out = dir_ + "/merged";
+  const CliResult first = depotwin("sweep " + sweep + " -j 2 --quiet --out " + out);
+  ASSERT_EQ(first.status, 0) << first.output;
+  ASSERT_TRUE(fs::is_regular_file(out + "/summary.png")) << first.output;
+  std::map<std::string, std::string> earlier;
+  for (const char* name : {"results.sqlite", "results.csv", "summary.png"})
+    earlier[name] = read_text(out + "/" + name);
+  // a task's result gone: the next merge's table differs
+  ASSERT_TRUE(fs::remove(out + "/tasks/0001/stop_and_go/metrics.json"));
+  const std::string bin = dir_ + "/failing_gnuplot";
+  fs::create_directories(bin);
+  write_text(bin, "gnuplot", "#!/bin/sh\necho 'gnuplot broke' >&2\nexit 3\n");
+  fs::permissions(bin + "/gnuplot", fs::perms::owner_all);
+  const CliResult failed = shell("PATH=" + bin + ":$PATH " + std::string(DEPOTWIN_BINARY_DIR) +
+                                 "/depotwin sweep " + sweep + " --merge --quiet --out " + out);
+  EXPECT_EQ(failed.status, 1) << failed.output;
+  EXPECT_NE(failed.output.find("gnuplot broke"), std::string::npos) << failed.output;
+  for (const auto& [name, bytes] : earlier)
+    EXPECT_TRUE(read_text(out + "/" + name) == bytes) << name << " changed";
+  EXPECT_EQ(names_holding(out, "merge"), std::vector<std::string>{});
+  // a merge without the plot: the new table, the earlier plot gone
+  const CliResult unplotted = depotwin("sweep " + sweep + " --merge --no-render --out " + out);
+  EXPECT_EQ(unplotted.status, 101) << unplotted.output;
+  EXPECT_NE(unplotted.output.find("2 tasks, 1 ok, 0 failed, 1 missing"), std::string::npos)
+      << unplotted.output;
+  EXPECT_FALSE(fs::exists(out + "/summary.png"));
+  EXPECT_NE(read_text(out + "/results.csv"), earlier["results.csv"]);
 }
 
 TEST_F(SweepRoutes, BadInputExitsTwoAndWritesNothing) {
