@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <map>
 #include <utility>
 
 namespace depotwin {
@@ -137,38 +136,7 @@ bool TriangleMesh::face_outward_and_up() {
   return true;
 }
 
-TriangleMesh::DownFacingPieces TriangleMesh::down_facing_pieces() const {
-  // the pieces: triangles joined by shared vertices (union-find over the vertices)
-  std::vector<int> parent(vertices.size());
-  for (size_t v = 0; v < parent.size(); ++v) parent[v] = static_cast<int>(v);
-  const auto root = [&](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const auto& t : triangles)
-    for (int c = 1; c < 3; ++c) parent[root(t[c])] = root(t[0]);
-  // per piece, its signed area projected on xy (n_z A per facet) and the absolute sum
-  std::map<int, std::pair<double, double>> areas;
-  for (const auto& t : triangles) {
-    const Vec3& a = vertices[t[0]];
-    const double projected = 0.5 * (vertices[t[1]] - a).cross(vertices[t[2]] - a).z();
-    auto& [signed_area, absolute_area] = areas[root(t[0])];
-    signed_area += projected;
-    absolute_area += std::abs(projected);
-  }
-  DownFacingPieces result;
-  result.pieces = areas.size();
-  for (const auto& [piece, area] : areas) {
-    // an open piece (its projected areas do not cancel, as a closed one's do) facing down
-    const auto& [signed_area, absolute_area] = area;
-    if (std::abs(signed_area) <= kClosedAreaRatio * absolute_area || signed_area >= 0.0) continue;
-    ++result.down;
-    result.down_area_mm2 += -signed_area;
-  }
-  return result;
-}
-
-size_t TriangleMesh::orient_consistently() {
+TriangleMesh::Orientation TriangleMesh::orient_consistently() {
   // every directed edge of every triangle with two distinct corners: (undirected key, triangle,
   // whether it runs from the lower vertex index to the higher)
   struct EdgeUse {
@@ -216,27 +184,42 @@ size_t TriangleMesh::orient_consistently() {
   // the turn of the smaller area applied
   std::vector<int8_t> relative(triangles.size(), -1);
   std::vector<uint32_t> piece;
-  size_t turned = 0;
+  Orientation result;
+  const auto turn_over = [&](uint32_t t) {
+    std::swap(triangles[t][1], triangles[t][2]);
+    ++result.turned;
+  };
   for (size_t seed = 0; seed < triangles.size(); ++seed) {
     if (relative[seed] >= 0) continue;
     piece.assign(1, static_cast<uint32_t>(seed));
     relative[seed] = 0;
+    bool orientable = true;
     for (size_t k = 0; k < piece.size(); ++k)
       for (const auto& [other, same_way] : neighbours[piece[k]]) {
-        if (relative[other] >= 0) continue;  // reached already (a conflict keeps the first)
-        relative[other] = static_cast<int8_t>(relative[piece[k]] ^ (same_way ? 1 : 0));
+        const int8_t wanted = static_cast<int8_t>(relative[piece[k]] ^ (same_way ? 1 : 0));
+        if (relative[other] >= 0) {
+          // reached already: by a loop that asks the other winding, the piece has no outside
+          orientable = orientable && relative[other] == wanted;
+          continue;
+        }
+        relative[other] = wanted;
         piece.push_back(other);
       }
+    if (!orientable) {
+      // no winding fits: each triangle faces up on its own (a vertical one is left)
+      ++result.unorientable_pieces;
+      result.unorientable_triangles += piece.size();
+      for (const uint32_t t : piece)
+        if (facet_normal(t).z() < 0.0) turn_over(t);
+      continue;
+    }
     double area[2] = {0.0, 0.0};
     for (const uint32_t t : piece) area[relative[t]] += facet_area_mm2(t);
     const int8_t turn = area[1] > area[0] ? 0 : 1;
     for (const uint32_t t : piece)
-      if (relative[t] == turn) {
-        std::swap(triangles[t][1], triangles[t][2]);
-        ++turned;
-      }
+      if (relative[t] == turn) turn_over(t);
   }
-  return turned;
+  return result;
 }
 
 }  // namespace depotwin

@@ -46,25 +46,21 @@ struct TriangleMesh {
   // solid wound outward, or a closed one whose signed volume is 0 is left as it is. Returns
   // whether it turned the triangles over.
   bool face_outward_and_up();
-  // The pieces (triangles joined by shared vertices) that are open surfaces facing down on the
-  // whole (their facets' signed areas projected on xy sum below 0): after face_outward_and_up
-  // has judged the whole mesh, such a piece beside others facing up is not printed (the hatch
-  // looks for the faces seen from above). It may be meant so (the underside of a shell given
-  // as two patches) or wound the wrong way (a patch exported reversed), so it is only counted.
-  struct DownFacingPieces {
-    size_t pieces = 0;           // every piece
-    size_t down = 0;             // the open ones facing down
-    double down_area_mm2 = 0.0;  // their area projected on xy
-  };
-  DownFacingPieces down_facing_pieces() const;
   // Turns over the triangles wound against their neighbours, as an STL with some facets
   // reversed has them: across every edge that exactly two triangles share, the two must run
   // it in opposite directions. In each connected piece (joined by such edges) the winding of
   // the larger area is kept and the smaller's turned; edges of one triangle or of three or
-  // more (non-manifold), a facet's duplicate, and a piece that cannot be wound consistently (a
-  // Moebius strip: the first winding found is kept), are left as they are. Returns how many
-  // triangles it turned. Before face_outward_and_up, which then judges the whole mesh.
-  size_t orient_consistently();
+  // more (non-manifold) and a facet's duplicate join nothing. A piece that cannot be wound
+  // consistently (a Moebius strip: a loop of neighbours asks a triangle for both windings) has
+  // no outside; each of its triangles is turned to face up instead (facet normal z >= 0), so
+  // the side seen from above, which the hatch prints, is its front everywhere. Before
+  // face_outward_and_up, which then judges the whole mesh.
+  struct Orientation {
+    size_t turned = 0;                  // triangles turned over (both kinds of piece)
+    size_t unorientable_pieces = 0;     // pieces that cannot be wound consistently
+    size_t unorientable_triangles = 0;  // the triangles of those pieces
+  };
+  Orientation orient_consistently();
 };
 
 }  // namespace depotwin

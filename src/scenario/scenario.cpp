@@ -1307,8 +1307,16 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
     // facets wound against their neighbours turned to match them, then an STL wound the wrong
     // way (a surface patch facing down, a solid inside out) turned over; every run says so:
     // the hatch looks for the faces seen from above
-    if (const size_t turned = part.orient_consistently(); turned > 0)
-      scenario_.notes.push_back("toolpath.surface: " + std::to_string(turned) + " of " +
+    const TriangleMesh::Orientation oriented = part.orient_consistently();
+    if (oriented.unorientable_pieces > 0)
+      scenario_.notes.push_back(
+          "toolpath.surface: " + std::to_string(oriented.unorientable_triangles) + " of " +
+          std::to_string(part.triangle_count()) + " triangles of '" + given_file + "' form " +
+          (oriented.unorientable_pieces == 1 ? "a surface" : "surfaces") +
+          " that cannot be wound consistently (one side runs into the other, as on a Moebius "
+          "strip); each of them was turned to face up, so the side seen from above is printed");
+    else if (oriented.turned > 0)
+      scenario_.notes.push_back("toolpath.surface: " + std::to_string(oriented.turned) + " of " +
                                 std::to_string(part.triangle_count()) + " triangles of '" +
                                 given_file +
                                 "' were wound against their neighbours; they were turned over "
@@ -1317,15 +1325,6 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
       scenario_.notes.push_back("toolpath.surface: '" + given_file +
                                 "' faced down or inside out (its triangles wound clockwise "
                                 "seen from outside); its triangles were turned over");
-    // a separate patch that still faces down is not printed: say so (it may be meant so)
-    if (const TriangleMesh::DownFacingPieces down = part.down_facing_pieces(); down.down > 0)
-      scenario_.notes.push_back(
-          "toolpath.surface: " + std::to_string(down.down) + " of the " +
-          std::to_string(down.pieces) + " separate pieces of '" + given_file +
-          (down.down == 1 ? "' faces down (an open surface" : "' face down (open surfaces") +
-          " wound clockwise seen from above, " + format_number(down.down_area_mm2) +
-          " mm² projected) while the rest faces up: not printed; if meant to be, turn " +
-          (down.down == 1 ? "it" : "them") + " over in the STL");
     // the grid's size before it is built: every layer's points over the part's (x, y) bounds
     Vec3 lo, hi;
     part.bounds(lo, hi);

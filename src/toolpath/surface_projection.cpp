@@ -187,6 +187,12 @@ struct SurfaceProjector::Impl {
     const double sum = hit.barycentric.sum();
     hit.barycentric = sum > 0.0 ? Vec3(hit.barycentric / sum) : Vec3::Constant(1.0 / 3.0);
     hit.normal = smooth_normal(t, hit.barycentric);
+    // the side the ray meets is the one seen from above: a triangle facing down there (a
+    // patch wound the other way, a band with a twist) is printed on its back, which faces up
+    if (hit.facet_normal.z() < 0.0) {
+      hit.facet_normal = -hit.facet_normal;
+      hit.normal = -hit.normal;
+    }
     return hit;
   }
 };

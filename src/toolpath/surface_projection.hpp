@@ -24,17 +24,22 @@ using Vec2 = Eigen::Vector2d;
 
 // Where a ray straight down first meets the surface.
 struct SurfaceHit {
-  Vec3 point_mm = Vec3::Zero();       // (x, y) of the ray exactly, z on the hit triangle's plane
-  Vec3 facet_normal = Vec3::UnitZ();  // the hit triangle's unit normal (right-hand rule)
+  Vec3 point_mm = Vec3::Zero();  // (x, y) of the ray exactly, z on the hit triangle's plane
+  // The normals are those of the side the ray meets, seen from above: where the triangle is
+  // wound facing down (a patch exported the other way, a band with a twist) both are turned
+  // over, so the visible side is the one printed.
+  // the hit triangle's unit normal (right-hand rule, turned up where it faced down)
+  Vec3 facet_normal = Vec3::UnitZ();
   // the smooth unit normal: the triangle's corner normals (TriangleMesh::corner_normals:
   // angle-weighted vertex normals that do not average across creases) interpolated by the
-  // hit's barycentric coordinates and renormalised
+  // hit's barycentric coordinates and renormalised (turned with the facet's)
   Vec3 normal = Vec3::UnitZ();
   int triangle = -1;                // index in the mesh
   Vec3 barycentric = Vec3::Zero();  // of the point in the triangle (clamped to it)
 
   // a printable top surface: both normals point up by more than min_normal_z. A vertical wall
-  // (n_z = 0) or an underside (n_z < 0: a mesh with inverted triangles) is not.
+  // (n_z = 0) is not, nor a hit whose smooth normal still points down (a fold, where the
+  // surface turns over).
   bool faces_up(double min_normal_z = 0.0) const {
     return facet_normal.z() > min_normal_z && normal.z() > min_normal_z;
   }
@@ -61,8 +66,7 @@ class SurfaceProjector {
   // The first surface a ray straight down from above the mesh meets at (x, y): the top
   // surface. Nothing where the ray misses (outside the part, through a hole); a point on the
   // outline or a hole's edge (within 1e-5 of the part's size) is on the part, its hit on the
-  // plane of the top triangle there. The hit may face sideways or down (see
-  // SurfaceHit::faces_up).
+  // plane of the top triangle there. The hit may face sideways (see SurfaceHit::faces_up).
   std::optional<SurfaceHit> project_down(double x_mm, double y_mm) const;
   // Many points at once (packets of 16 rays); `hits` is resized to xy.size().
   void project_down(const std::vector<Vec2>& xy,

@@ -1,7 +1,8 @@
 // TriangleMesh::face_outward_and_up: a mesh wound the wrong way (a closed solid inside out, an
 // open surface facing down) is turned over, and one wound right is left alone, judged by the
 // closed form of its signed volume and its signed projected area. orient_consistently: facets
-// wound against their neighbours are turned to match the larger area around them.
+// wound against their neighbours are turned to match the larger area around them; a surface
+// without an outside (a Moebius strip) faces up triangle by triangle.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -85,34 +86,12 @@ TriangleMesh wavy_grid(int n) {
   return mesh;
 }
 
-// a separate patch facing down beside one facing up is counted with its projected area; a
-// closed solid beside them is not (its projected areas cancel), nor is a patch facing up
-TEST(TriangleMesh, DownFacingPiecesAreTheOpenOnesFacingDownOnTheWhole) {
-  TriangleMesh mesh = wavy_grid(4);  // 16 mm^2 projected, facing up
-  const TriangleMesh second = turned_over(wavy_grid(3));
-  const int offset = static_cast<int>(mesh.vertices.size());
-  for (const Vec3& v : second.vertices) mesh.vertices.push_back(v + Vec3(10.0, 0.0, 0.0));
-  for (auto t : second.triangles)
-    mesh.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-  const TriangleMesh solid = cube(Vec3(0.0, 20.0, 0.0));
-  const int solid_offset = static_cast<int>(mesh.vertices.size());
-  for (const Vec3& v : solid.vertices) mesh.vertices.push_back(v);
-  for (auto t : solid.triangles)
-    mesh.triangles.push_back({t[0] + solid_offset, t[1] + solid_offset, t[2] + solid_offset});
-  EXPECT_FALSE(mesh.face_outward_and_up());  // on the whole it faces up
-  const TriangleMesh::DownFacingPieces down = mesh.down_facing_pieces();
-  EXPECT_EQ(down.pieces, 3u);
-  EXPECT_EQ(down.down, 1u);
-  EXPECT_NEAR(down.down_area_mm2, 9.0, 1e-12);
-  EXPECT_EQ(wavy_grid(4).down_facing_pieces().down, 0u);
-}
-
 TEST(TriangleMesh, TrianglesWoundAgainstTheirNeighboursAreTurnedToMatch) {
   // a surface with every 7th facet reversed (and the first two, at a corner): those are turned
   // back, whichever way the rest runs, and a consistent mesh is left alone
   const TriangleMesh right = wavy_grid(12);
   TriangleMesh consistent = right;
-  EXPECT_EQ(consistent.orient_consistently(), 0u);
+  EXPECT_EQ(consistent.orient_consistently().turned, 0u);
   EXPECT_EQ(consistent.triangles, right.triangles);
   TriangleMesh mixed = right;
   size_t reversed = 0;
@@ -122,9 +101,9 @@ TEST(TriangleMesh, TrianglesWoundAgainstTheirNeighboursAreTurnedToMatch) {
       ++reversed;
     }
   TriangleMesh mixed_down = turned_over(mixed);
-  EXPECT_EQ(mixed.orient_consistently(), reversed);
+  EXPECT_EQ(mixed.orient_consistently().turned, reversed);
   EXPECT_EQ(mixed.triangles, right.triangles);
-  EXPECT_EQ(mixed_down.orient_consistently(), reversed);
+  EXPECT_EQ(mixed_down.orient_consistently().turned, reversed);
   EXPECT_EQ(mixed_down.triangles, turned_over(right).triangles);
   EXPECT_TRUE(mixed_down.face_outward_and_up());  // then the whole is turned up
   EXPECT_EQ(mixed_down.triangles, right.triangles);
@@ -134,24 +113,24 @@ TEST(TriangleMesh, TrianglesWoundAgainstTheirNeighboursAreTurnedToMatch) {
   TriangleMesh doubled = right;
   doubled.triangles.insert(doubled.triangles.end(), right.triangles.begin(), right.triangles.end());
   const TriangleMesh doubled_before = doubled;
-  EXPECT_EQ(doubled.orient_consistently(), 0u);
+  EXPECT_EQ(doubled.orient_consistently().turned, 0u);
   EXPECT_EQ(doubled.triangles, doubled_before.triangles);
 
   // a closed cube with one face (two triangles) reversed: its volume back to 8
   TriangleMesh box = cube(Vec3::Zero());
   std::swap(box.triangles[4][1], box.triangles[4][2]);
   std::swap(box.triangles[5][1], box.triangles[5][2]);
-  EXPECT_EQ(box.orient_consistently(), 2u);
+  EXPECT_EQ(box.orient_consistently().turned, 2u);
   EXPECT_EQ(box.triangles, cube(Vec3::Zero()).triangles);
   EXPECT_NEAR(box.signed_volume_mm3(), 8.0, 1e-12);
 
   // an edge of three triangles (non-manifold) joins nothing: such a fan is left as it is; a
-  // Moebius strip cannot be wound consistently and settles after one pass
+  // Moebius strip cannot be wound consistently: its triangles face up, settled after one pass
   TriangleMesh fan;
   fan.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(0, -1, 0)};
   fan.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};  // edge 0-1 used three times
   const TriangleMesh fan_before = fan;
-  EXPECT_EQ(fan.orient_consistently(), 0u);
+  EXPECT_EQ(fan.orient_consistently().turned, 0u);
   EXPECT_EQ(fan.triangles, fan_before.triangles);
   TriangleMesh strip;
   for (int k = 0; k < 8; ++k) {
@@ -167,8 +146,17 @@ TEST(TriangleMesh, TrianglesWoundAgainstTheirNeighboursAreTurnedToMatch) {
     strip.triangles.push_back({a, b, c});
     strip.triangles.push_back({b, d, c});
   }
-  strip.orient_consistently();
-  EXPECT_EQ(strip.orient_consistently(), 0u);  // settled: a second pass turns nothing
+  // the strip has no outside: each of its triangles faces up on its own
+  const TriangleMesh::Orientation strip_oriented = strip.orient_consistently();
+  EXPECT_EQ(strip_oriented.unorientable_pieces, 1u);
+  EXPECT_EQ(strip_oriented.unorientable_triangles, 16u);
+  EXPECT_GT(strip_oriented.turned, 0u);
+  for (size_t t = 0; t < strip.triangle_count(); ++t)
+    EXPECT_GE(strip.facet_normal(t).z(), 0.0) << "triangle " << t;
+  EXPECT_EQ(strip.orient_consistently().turned, 0u);  // settled: a second pass turns nothing
+  // the fan and the consistent meshes have no such piece
+  EXPECT_EQ(fan.orient_consistently().unorientable_pieces, 0u);
+  EXPECT_EQ(box.orient_consistently().unorientable_pieces, 0u);
 }
 
 }  // namespace

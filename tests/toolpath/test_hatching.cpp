@@ -510,6 +510,77 @@ TEST(Hatching, OffsetLayersKeepTheirOffsetOverAConvexCrease) {
   }
 }
 
+// A band around the z axis (radius 30 mm, 20 mm wide, centred 20 mm up) turning over by half
+// a turn along its length and cut open where its ends would meet: wound consistently, it faces
+// up on one half and down on the other, and both halves are seen from above.
+TriangleMesh twisted_band() {
+  const double pi = 3.141592653589793, radius = 30.0, half_width = 10.0;
+  const int along = 120, across = 8;
+  TriangleMesh band;
+  for (int i = 0; i <= along; ++i)
+    for (int j = 0; j <= across; ++j) {
+      const double u = 2.0 * pi * i / along, v = -half_width + 2.0 * half_width * j / across;
+      const double r = radius + v * std::cos(u / 2.0);
+      band.vertices.emplace_back(r * std::cos(u), r * std::sin(u), 20.0 + v * std::sin(u / 2.0));
+    }
+  for (int i = 0; i < along; ++i)
+    for (int j = 0; j < across; ++j) {
+      const int a = i * (across + 1) + j, b = a + across + 1;
+      band.triangles.push_back({a, b, b + 1});
+      band.triangles.push_back({a, b + 1, a + 1});
+    }
+  return band;
+}
+
+// what is seen from above is printed, whichever way its triangles are wound: the band's half
+// facing down is printed on its back (it was left out, silently), as much of it as of the band
+// with every triangle turned to face up, and a mesh turned over whole hatches as it was
+TEST(Hatching, TheSideSeenFromAboveIsPrintedWhicheverWayItIsWound) {
+  const TriangleMesh band = twisted_band();
+  std::size_t facing_down = 0;
+  TriangleMesh faced_up = band;
+  for (std::size_t t = 0; t < band.triangle_count(); ++t)
+    if (band.facet_normal(t).z() < 0.0) {
+      ++facing_down;
+      std::swap(faced_up.triangles[t][1], faced_up.triangles[t][2]);
+    }
+  ASSERT_GT(facing_down, band.triangle_count() / 3);
+  SurfaceHatchSpec spec;
+  spec.hatch_mm = 1.0;
+  spec.min_normal_z = 0.3;
+  const auto points = [&](const TriangleMesh& mesh, int side) {
+    std::size_t count = 0;
+    for (const PrintPath& path : hatch_surface(mesh, spec).toolpath.paths)
+      for (const Vec3& p : path.points) count += (side > 0) == (p.y() > 0.0);
+    return count;
+  };
+  // the band faces up where y < 0 (u in (pi, 2 pi)) and down where y > 0, or the other way
+  for (const int side : {-1, 1}) {
+    const std::size_t printed = points(band, side), reference = points(faced_up, side);
+    EXPECT_GT(reference, 500u) << side;
+    EXPECT_GT(static_cast<double>(printed), 0.95 * static_cast<double>(reference)) << side;
+  }
+  // a bonnet and its copy turned over whole: the same hatch, point for point
+  TriangleMesh bonnet = car_bonnet(CarBonnetParams{});
+  TriangleMesh turned = bonnet;
+  for (std::array<int, 3>& f : turned.triangles) std::swap(f[1], f[2]);
+  spec = SurfaceHatchSpec{};
+  spec.layers = 2;
+  const SurfaceHatch a = hatch_surface(bonnet, spec), b = hatch_surface(turned, spec);
+  ASSERT_EQ(a.toolpath.paths.size(), b.toolpath.paths.size());
+  ASSERT_GT(a.toolpath.paths.size(), 0u);
+  for (std::size_t p = 0; p < a.toolpath.paths.size(); ++p) {
+    ASSERT_EQ(a.toolpath.paths[p].points.size(), b.toolpath.paths[p].points.size()) << p;
+    for (std::size_t i = 0; i < a.toolpath.paths[p].points.size(); ++i) {
+      // (the smooth normal's corners are summed in another order: rounding apart)
+      EXPECT_NEAR((a.toolpath.paths[p].points[i] - b.toolpath.paths[p].points[i]).norm(), 0.0,
+                  1e-9);
+      EXPECT_NEAR((a.toolpath.paths[p].normals[i] - b.toolpath.paths[p].normals[i]).norm(), 0.0,
+                  1e-12);
+    }
+  }
+}
+
 TEST(Hatching, Deterministic) {
   SurfaceHatchSpec spec;
   spec.layers = 3;

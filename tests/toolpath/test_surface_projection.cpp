@@ -2,7 +2,7 @@
 // hit triangle's plane, on the analytic surface at mesh vertices, within the chordal bound
 // elsewhere; smooth normals within the tessellation bound; holes and the outside give no hit,
 // a point exactly on the outline or a hole's edge does; the first hit on a closed solid is its
-// top; undersides are reported as not facing up.
+// top; a surface met on its back (wound facing down) gives the normals of the side seen.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -246,17 +246,26 @@ TEST(SurfaceProjection, BatchEqualsSingleRays) {
   EXPECT_LT(found, 1000);
 }
 
-TEST(SurfaceProjection, InvertedMeshDoesNotFaceUp) {
+// a surface wound facing down is met from above on its back: the hit gives the normals of
+// that side, the same as the surface wound facing up gives (it was an unprintable underside)
+TEST(SurfaceProjection, AnInvertedMeshIsSeenFromAboveOnItsBack) {
   SphereCapParams params;
   params.mesh.solid = false;
-  TriangleMesh mesh = sphere_cap(params);
-  for (std::array<int, 3>& f : mesh.triangles) std::swap(f[1], f[2]);
-  const SurfaceProjector projector(std::move(mesh));
-  const std::optional<SurfaceHit> hit = projector.project_down(1.0, 2.0);
-  ASSERT_TRUE(hit);  // the surface is there ...
-  EXPECT_LT(hit->facet_normal.z(), 0.0);
-  EXPECT_LT(hit->normal.z(), 0.0);
-  EXPECT_FALSE(hit->faces_up());  // ... but it is an underside
+  const TriangleMesh up = sphere_cap(params);
+  TriangleMesh down = up;
+  for (std::array<int, 3>& f : down.triangles) std::swap(f[1], f[2]);
+  ASSERT_LT(down.facet_normal(0).z(), 0.0);
+  const SurfaceProjector upward(up), downward(down);
+  for (const auto& [x, y] : {std::pair{1.0, 2.0}, std::pair{-3.5, 0.25}, std::pair{0.0, 0.0}}) {
+    const std::optional<SurfaceHit> seen = downward.project_down(x, y);
+    const std::optional<SurfaceHit> reference = upward.project_down(x, y);
+    ASSERT_TRUE(seen && reference) << x << ", " << y;
+    EXPECT_TRUE(seen->faces_up()) << x << ", " << y;
+    EXPECT_EQ(seen->triangle, reference->triangle);
+    EXPECT_NEAR((seen->point_mm - reference->point_mm).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((seen->facet_normal - reference->facet_normal).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((seen->normal - reference->normal).norm(), 0.0, 1e-12);
+  }
 }
 
 TEST(SurfaceProjection, EmptyMeshIsNeverHit) {
