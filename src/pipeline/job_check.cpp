@@ -41,6 +41,10 @@ constexpr double kBytesPerCell = 8.0;
 constexpr double kProcessBytes = 250e6;
 // per print path, the toolpath's copies (scenario, job, order) and their metrics
 constexpr double kBytesPerPath = 600.0;
+// per triangle of a conformal job's part: the mesh, the projector's BVH and corner normals,
+// the clearance's tree and the scene's copy; a run on a 1.0e6-triangle STL peaked 1.13 GB
+// above one on 1e4 triangles, validate 1.26 GB (with the STL reader's own copy)
+constexpr double kBytesPerPartTriangle = 1300.0;
 // the footprint's reach (deposition: truncation at 5 sigma, smoothed over 0.25 sigma) and a
 // tile's side in cells (deposition/sparse_tiles.hpp), for the grid's covered area
 constexpr double kFootprintSigmas = 5.25;
@@ -308,6 +312,8 @@ RunEstimate estimate_planned(const PreparedJob& job, const std::string& label, d
 double job_memory_bytes(const Scenario& scenario, const std::vector<RunEstimate>& runs) {
   double memory_bytes =
       kProcessBytes + kBytesPerPath * 3.0 * static_cast<double>(scenario.toolpath.paths.size());
+  if (scenario.part)
+    memory_bytes += kBytesPerPartTriangle * static_cast<double>(scenario.part->triangle_count());
   for (const RunEstimate& run : runs) memory_bytes += run.memory_bytes;
   return memory_bytes;
 }
@@ -345,16 +351,24 @@ std::vector<Problem> size_problems(const Scenario& scenario, const std::vector<R
     std::string parts = (run.simulated ? count_text(run.steps) + " physics steps, " : "") +
                         count_text(run.samples) + " samples of the plan";
     if (run.cells > 0.0) parts += ", " + count_text(run.cells) + " deposition cells";
+    // a conformal job's part: its share, and a coarser STL among the remedies
+    std::string part_share, coarser_part;
+    if (scenario.part) {
+      const double triangles = static_cast<double>(scenario.part->triangle_count());
+      part_share = "; the part's " + count_text(triangles) + " triangles take about " +
+                   format_bytes(kBytesPerPartTriangle * triangles);
+      coarser_part = ", a coarser STL";
+    }
     problems.push_back(at_driver(
         scenario, run, true,
         std::string(runs.size() > 1 ? "the " + std::to_string(runs.size()) + " runs" : "the run") +
             " would need about " + format_bytes(memory_bytes) +
             " of memory, more than --max-memory " + format_bytes(budget.max_memory_bytes) + ": " +
             (run.label.empty() ? "each run " : "run " + run.label + " ") + "keeps " + parts + " (" +
-            duration_text(scenario, run) +
-            "); check the print speeds, the limits, sim.timestep_s and sim.cell_mm, run fewer "
+            duration_text(scenario, run) + ")" + part_share +
+            "; check the print speeds, the limits, sim.timestep_s and sim.cell_mm, run fewer "
             "planners" +
-            fewer_layers_hint(scenario) + ", or raise --max-memory"));
+            fewer_layers_hint(scenario) + coarser_part + ", or raise --max-memory"));
   }
   return problems;
 }

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
 #include <regex>
 #include <string>
 
@@ -143,6 +146,59 @@ TEST(ValidateVerb, TheMemoryItPrintsIsWhatMaxMemoryIsComparedWith) {
   EXPECT_NE(below.output.find("of memory, more than --max-memory"), std::string::npos)
       << below.output;
   EXPECT_EQ(budget(1.03).status, 0);
+}
+
+// a conformal job's part counts in the memory estimate: the same plate as 200 and as 20 000
+// triangles (the same hatch) differs by 1300 bytes a triangle, and a budget it exceeds names
+// the part's share
+TEST(ValidateVerb, ThePartsTrianglesCountInTheMemory) {
+  const std::string dir = fresh_directory("validate_part_memory");
+  // a binary STL of a 40 x 40 mm plate at z = 5 mm, n x n squares of two triangles
+  const auto plate = [&](int n) {
+    const std::string path = dir + "/plate" + std::to_string(n) + ".stl";
+    std::ofstream out(path, std::ios::binary);
+    out << std::string(80, ' ');
+    const std::uint32_t count = static_cast<std::uint32_t>(2 * n * n);
+    out.write(reinterpret_cast<const char*>(&count), 4);
+    const auto facet = [&](std::initializer_list<float> corners) {
+      const float normal[3] = {0.0f, 0.0f, 1.0f};
+      out.write(reinterpret_cast<const char*>(normal), 12);
+      for (const float value : corners) out.write(reinterpret_cast<const char*>(&value), 4);
+      out.write("\0\0", 2);
+    };
+    const float side = 40.0f / static_cast<float>(n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const float x0 = -20.0f + side * static_cast<float>(i), x1 = x0 + side;
+        const float y0 = -20.0f + side * static_cast<float>(j), y1 = y0 + side;
+        facet({x0, y0, 5, x1, y0, 5, x1, y1, 5});
+        facet({x0, y0, 5, x1, y1, 5, x0, y1, 5});
+      }
+    return path;
+  };
+  const auto megabytes = [&](int n, const std::string& options) {
+    const std::string scenario = write_text(
+        dir, "plate" + std::to_string(n) + ".yaml",
+        "machine: arm6\nlimits: {v_max: 200, a_max: 2000}\nprocess: {type: extrusion}\n"
+        "toolpath:\n  speed: 20\n  surface: {file: " +
+            plate(n) + ", hatch_mm: 5, angles: [0], layers: 1}\nplanners: [conformal]\n");
+    const auto r = depotwin("validate --quiet " + scenario + options);
+    std::smatch match;
+    std::regex_search(r.output, match, std::regex("about (\\d+) MB of memory"));
+    return std::make_pair(match.empty() ? -1.0 : std::stod(match[1].str()), r);
+  };
+  const auto [coarse, coarse_run] = megabytes(10, "");
+  const auto [fine, fine_run] = megabytes(100, "");
+  ASSERT_GT(coarse, 0.0) << coarse_run.output;
+  ASSERT_GT(fine, 0.0) << fine_run.output;
+  EXPECT_NEAR(fine - coarse, 1300.0 * 19800.0 / (1024.0 * 1024.0), 1.0)
+      << coarse_run.output << fine_run.output;
+  const auto [refused_mb, refused] =
+      megabytes(100, " --max-memory " + std::to_string(std::lround(coarse + 5.0)) + "M");
+  EXPECT_EQ(refused.status, 2) << refused.output;
+  EXPECT_NE(refused.output.find("); the part's 20000 triangles take about 25 MB; check "),
+            std::string::npos)
+      << refused.output;
 }
 
 }  // namespace
