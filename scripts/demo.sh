@@ -14,7 +14,7 @@ echo "demo: [1/3] checking the Debian packages (installs any that are missing)"
 if [[ -x "$build_dir/depotwin" ]]; then
   echo "demo: [2/3] building into $build_dir (rebuilds only what changed: seconds to minutes)"
 else
-  echo "demo: [2/3] building into $build_dir: a first build takes about 6-8 min on 2 cores" \
+  echo "demo: [2/3] building into $build_dir: a first build takes about 15 min on 2 cores" \
     "(the library, the CLI and the tests); progress below"
 fi
 # the build's percentage lines, errors and warnings; the build's own status decides

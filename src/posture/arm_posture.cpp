@@ -699,10 +699,12 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
     // planners move) must stay on the branch, off the limits and singularities, continuously;
     // a long print edge's too, checked at the station spacing
     std::unordered_map<uint64_t, bool> travel_memo;
-    const TravelCheck travel_ok = [&](size_t s, int from, int k) {
-      const uint64_t key = (static_cast<uint64_t>(s) * K + from) * K + k;
-      const auto known = travel_memo.find(key);
-      if (known != travel_memo.end()) return known->second;
+    const auto edge_key = [&](size_t s, int from, int k) {
+      return (static_cast<uint64_t>(s) * K + from) * K + k;
+    };
+    // the poses checked between station s - 1 at roll `from` and station s at roll k: how
+    // many, and pose i of them (1..count)
+    const auto checks_between = [&](size_t s, int from, int k) {
       const Pose a = rolled(stations[s - 1], from * step_rad);
       const Pose end = rolled(stations[s], k * step_rad);
       const double turn = rad_to_deg(axis_angle_rad(a.tool_axis, end.tool_axis) +
@@ -711,20 +713,31 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       const double check_distance_mm =
           stations[s].after_travel ? kTravelCheckDistance_mm
                                    : std::min(kTravelCheckDistance_mm, settings.sample_spacing_mm);
-      const int checks = 1 + static_cast<int>(std::ceil(turn / kTravelCheckTurn_deg)) +
-                         static_cast<int>(std::ceil(distance / check_distance_mm));
+      return 1 + static_cast<int>(std::ceil(turn / kTravelCheckTurn_deg)) +
+             static_cast<int>(std::ceil(distance / check_distance_mm));
+    };
+    const auto pose_between = [&](size_t s, int from, int k, int i, int checks) {
+      const Pose a = rolled(stations[s - 1], from * step_rad);
+      const Pose end = rolled(stations[s], k * step_rad);
+      const double f = static_cast<double>(i) / (checks + 1);
+      return Pose(a.position_mm + f * (end.position_mm - a.position_mm),
+                  slerp_axis(a.tool_axis, end.tool_axis, f),
+                  a.roll_rad + f * wrapped(end.roll_rad, a.roll_rad));
+    };
+    const TravelCheck travel_ok = [&](size_t s, int from, int k) {
+      const uint64_t key = edge_key(s, from, k);
+      const auto known = travel_memo.find(key);
+      if (known != travel_memo.end()) return known->second;
+      const int checks = checks_between(s, from, k);
       Arm6Joints previous = ladder.q[ladder.index(s - 1, from)];
-      Pose previous_pose = a;
+      Pose previous_pose = rolled(stations[s - 1], from * step_rad);
       bool ok = true;
       Arm6Branches mid_solved;
       for (int i = 1; i <= checks + 1 && ok; ++i) {
-        const double f = static_cast<double>(i) / (checks + 1);
-        Pose mid = end;
+        Pose mid = rolled(stations[s], k * step_rad);
         Arm6Joints q = ladder.q[ladder.index(s, k)];
         if (i <= checks) {
-          mid = Pose(a.position_mm + f * (end.position_mm - a.position_mm),
-                     slerp_axis(a.tool_axis, end.tool_axis, f),
-                     a.roll_rad + f * wrapped(end.roll_rad, a.roll_rad));
+          mid = pose_between(s, from, k, i, checks);
           ok = arm.branch_solutions(mid, mid_solved) &&
                check_rung(arm, mid_solved[b], settings).reason == Reason::ok;
           if (!ok) break;
@@ -736,6 +749,38 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       }
       travel_memo.emplace(key, ok);
       return ok;
+    };
+    // A long print edge of the path clear of the part at its poses in between (the stations
+    // are measured on their own), as the planners move along it. Travels are not: the planners
+    // lift over the part there, which the straight poses checked for the joints do not follow.
+    // An edge too close is closed to the search (travel_memo) and the path searched again.
+    std::unordered_map<uint64_t, double> edge_clearance;  // the smallest, per edge measured
+    const auto long_edges_clear = [&](const std::vector<int>& candidate) {
+      bool clear = true;
+      Arm6Branches mid_solved;
+      for (size_t s = 1; s < n; ++s) {
+        if (!stations[s].after_long_edge || stations[s].after_travel) continue;
+        const int from = candidate[s - 1], k = candidate[s];
+        const uint64_t key = edge_key(s, from, k);
+        if (edge_clearance.count(key) == 0) {
+          throw_if_interrupted();
+          double nearest = kInfinity;
+          const int checks = checks_between(s, from, k);
+          for (int i = 1; i <= checks && nearest >= settings.min_clearance_mm; ++i)
+            if (arm.branch_solutions(pose_between(s, from, k, i, checks), mid_solved))
+              nearest = std::min(nearest, check_part
+                                              ->clearance(arm.collision_shapes(),
+                                                          arm.link_frames(to_vector(mid_solved[b])),
+                                                          settings.min_clearance_mm)
+                                              .distance_mm);
+          edge_clearance.emplace(key, nearest);
+        }
+        if (edge_clearance[key] < settings.min_clearance_mm) {
+          travel_memo[key] = false;
+          clear = false;
+        }
+      }
+      return clear;
     };
     std::vector<int> path;
     size_t stuck_at = 0;  // where no roll sequence gets past, when none does
@@ -752,16 +797,18 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
         for (int k = 0; k < K; ++k)
           if (std::isfinite(ladder.cost[ladder.index(s, k)])) measure(s, k);
       }
+      // the stations clear: the long edges between them too
+      if (clear) clear = long_edges_clear(path);
       if (clear) {
         // the clearance costs changed the path's cost: one more search settles it
         const std::vector<int> again = shortest_path(ladder, stations, max_step, true, travel_ok);
         bool same = again == path;
-        if (!same) {
+        if (!same && !again.empty()) {
           for (size_t s = 0; s < n; ++s) measure(s, again[s]);
           same = true;
           for (size_t s = 0; s < n && same; ++s)
             same = std::isfinite(ladder.cost[ladder.index(s, again[s])]);
-          if (same) path = again;
+          if (same && long_edges_clear(again)) path = again;
         }
         break;
       }
@@ -770,6 +817,7 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       bool valid = true;
       for (size_t s = 0; s < n && valid; ++s)
         valid = std::isfinite(ladder.cost[ladder.index(s, path[s])]);
+      if (valid && check_part) valid = long_edges_clear(path);
       if (valid) return std::make_pair(path_cost(ladder, path), path);
     }
     // name the station where this branch fails: the first with no valid rung, else a gap
@@ -805,9 +853,16 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
         if (to.after_travel)
           last_failure += "no roll sequence gets over the travel" + ends + why_between;
         else if (to.after_long_edge)
-          last_failure += "no roll sequence gets along the " +
-                          format("%.4g", (to.pose.position_mm - from.pose.position_mm).norm()) +
-                          " mm edge" + ends + why_between;
+          last_failure +=
+              "no roll sequence gets along the " +
+              format("%.4g", (to.pose.position_mm - from.pose.position_mm).norm()) + " mm edge" +
+              ends +
+              (check_part ? " (a pose on it is beyond a joint's range or the reach, at a "
+                            "singularity, or within arm.min_clearance_mm " +
+                                format("%.3g", settings.min_clearance_mm) +
+                                " mm of the part, or a joint jumps by more than " + within +
+                                " between two of them)"
+                          : why_between);
         else
           last_failure += "no roll sequence keeps every joint within " + within + ends;
       }

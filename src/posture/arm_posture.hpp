@@ -21,6 +21,8 @@
 //    max_joint_step_deg (the path stays continuous); between paths (travel) any roll. A travel
 //    and a print edge longer than sample_spacing_mm are checked at poses in between (position
 //    straight, axis and roll turning evenly): each valid, no joint step above the maximum;
+//    the long print edges of the path found also clear of the part there (an edge too close
+//    is closed and the path searched again; a travel is not: the planners lift over the part);
 //  - the branch is one for the whole job: the cheapest branch whose ladder has a path. (Changing
 //    branch means passing a singularity: only possible in a joint-space travel, which the
 //    planners here do not make.)

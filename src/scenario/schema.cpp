@@ -374,7 +374,8 @@ std::vector<SchemaSection> make_schema() {
                  "the ladder's roll step; divides 360"),
           number("sample_spacing_mm", "mm", ValueRange::closed(0.1, 1000.0), arm.sample_spacing_mm,
                  "stations along each path (also where the tool turns 5 deg); a longer edge is "
-                 "checked at poses this far apart"),
+                 "checked at poses this far apart (joints, and a print edge's clearance to the "
+                 "part)"),
           number("min_joint_margin_deg", "deg", ValueRange::closed(0.0, 90.0),
                  arm.min_joint_margin_deg, "joints 1-5 at least this far inside their ranges"),
           number("min_wrist_alignment", "", ValueRange{0.0, true, 1.0, false},

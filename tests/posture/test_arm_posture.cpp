@@ -180,6 +180,35 @@ TEST(ArmPosture, ALongEdgeIsCheckedBetweenItsPoints) {
   EXPECT_EQ(posture.toolpath.paths[0].points.size(), 4u);  // the toolpath keeps its points
 }
 
+// a long print edge's poses in between are kept clear of the part, not only its two points: a
+// 120 mm line through a block, its ends 50 mm clear of it, is refused naming the edge (it was
+// posed, the nozzle through the block); with the block beside the line, it is posed
+TEST(ArmPosture, ALongEdgeIsKeptClearOfThePartBetweenItsPoints) {
+  const Arm6 arm;
+  const auto block_at = [](double x0, double x1) {
+    TriangleMesh block;
+    block.vertices = {Vec3(x0, -20, 0),  Vec3(x1, -20, 0),  Vec3(x1, 20, 0),  Vec3(x0, 20, 0),
+                      Vec3(x0, -20, 40), Vec3(x1, -20, 40), Vec3(x1, 20, 40), Vec3(x0, 20, 40)};
+    block.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                       {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+    return block;
+  };
+  Toolpath line = single_path({Vec3(-65, 0, 5), Vec3(-60, 0, 5), Vec3(60, 0, 5), Vec3(65, 0, 5)});
+  line.start_mm = line.end_mm = Vec3(0, 0, 120);
+  const PartClearance through(block_at(-10.0, 10.0));
+  const std::string text = problem_text(arm, &through, line, {});
+  EXPECT_NE(text.find("no roll sequence gets along the 120 mm edge from path 0, point 1 (-60.000, "
+                      "0.000, 5.000) mm to path 0, point 2 (60.000, 0.000, 5.000) mm (a pose on "
+                      "it is beyond a joint's range or the reach, at a singularity, or within "
+                      "arm.min_clearance_mm 1 mm of the part"),
+            std::string::npos)
+      << text;
+  const PartClearance beside(block_at(100.0, 140.0));
+  const ArmPosture posed = choose_arm_posture(arm, &beside, line, ArmPostureSettings{}, plain_name);
+  EXPECT_EQ(posed.toolpath.paths[0].points.size(), 4u);
+  EXPECT_GE(posed.chosen.min_clearance_mm, 1.0);
+}
+
 // where no branch has a roll sequence at all (a steep bowl, tool square to it: the travel to the
 // second layer has no posture in between), the search still names where it breaks: never an
 // empty reason, "(...)"
