@@ -1314,7 +1314,7 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
           std::to_string(part.triangle_count()) + " triangles of '" + given_file + "' form " +
           (oriented.unorientable_pieces == 1 ? "a surface" : "surfaces") +
           " that cannot be wound consistently (one side runs into the other, as on a Moebius "
-          "strip); each of them was turned to face up, so the side seen from above is printed");
+          "strip); each now faces up on its own, so the side seen from above is printed");
     else if (oriented.turned > 0)
       scenario_.notes.push_back("toolpath.surface: " + std::to_string(oriented.turned) + " of " +
                                 std::to_string(part.triangle_count()) + " triangles of '" +

@@ -379,6 +379,47 @@ TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
   }
 }
 
+// A Moebius strip (welded: a loop of neighbours asks for both windings) cannot be wound
+// consistently: each triangle faces up on its own, loading says so, and the hatch covers the
+// whole strip, both halves (only one was printed: the other faced down)
+TEST_F(ScenarioLoad, AMoebiusStripFacesUpTriangleByTriangleAndSaysSo) {
+  const double pi = 3.141592653589793;
+  const int along = 60, across = 4;
+  // vertex (i, j) of the strip; i = along is i = 0 with the width reversed (the half twist)
+  const auto vertex = [&](int i, int j) {
+    if (i == along) {
+      i = 0;
+      j = across - j;
+    }
+    const double u = 2.0 * pi * i / along, v = -10.0 + 20.0 * j / across;
+    const double r = 30.0 + v * std::cos(u / 2.0);
+    char text[96];
+    std::snprintf(text, sizeof text, "%.9g %.9g %.9g", r * std::cos(u), r * std::sin(u),
+                  20.0 + v * std::sin(u / 2.0));
+    return std::string(text);
+  };
+  std::vector<std::array<std::string, 3>> facets;
+  for (int i = 0; i < along; ++i)
+    for (int j = 0; j < across; ++j) {
+      facets.push_back({vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1)});
+      facets.push_back({vertex(i, j), vertex(i + 1, j + 1), vertex(i, j + 1)});
+    }
+  write("mobius.stl", ascii_stl("mobius", facets));
+  const Scenario strip = load_scenario(write("mobius.yaml", surface_scenario("mobius.stl")));
+  ASSERT_EQ(strip.notes.size(), 1u);
+  EXPECT_EQ(strip.notes[0],
+            "toolpath.surface: 480 of 480 triangles of 'mobius.stl' form a surface that cannot be "
+            "wound consistently (one side runs into the other, as on a Moebius strip); each now "
+            "faces up on its own, so the side seen from above is printed");
+  std::size_t left = 0, right = 0;
+  for (const PrintPath& path : strip.toolpath.paths)
+    for (const Vec3& point : path.points) (point.y() > 0.0 ? left : right) += 1;
+  EXPECT_GT(left, 100u);
+  EXPECT_GT(right, 100u);
+  EXPECT_LT(std::abs(static_cast<double>(left) - static_cast<double>(right)),
+            0.25 * static_cast<double>(left + right));
+}
+
 // An up-facing area under another part of the surface gets no deposit, and every run says
 // how much and where: a shelf at z 20 over half of a plate at z 1 hides 3000 of 9000 mm²; so
 // does a groove's floor narrower than two spacings
