@@ -146,16 +146,20 @@ int list_tasks(const Sweep& sweep, const SweepOptions& options) {
 // (plotted false: an earlier merge's summary.png is removed, it no longer matches the table).
 void move_merged_files(const std::string& staging, const std::string& out, bool plotted) {
   std::error_code error;
-  for (const char* name : {"results.sqlite", "results.csv", "summary.png"}) {
+  const auto move = [&](const std::string& name) {
     const std::string from = staging + "/" + name, to = out + "/" + name;
-    if (std::string(name) == "summary.png" && !plotted) {
-      fs::remove(to, error);
-      if (error) throw EnvironmentError("cannot remove the earlier " + to + ": " + error.message());
-      continue;
-    }
     fs::rename(from, to, error);
     if (error) throw EnvironmentError("cannot move " + from + " to " + to + ": " + error.message());
+  };
+  move("results.sqlite");
+  move("results.csv");
+  if (plotted) {
+    move("summary.png");
+    return;
   }
+  fs::remove(out + "/summary.png", error);
+  if (error)
+    throw EnvironmentError("cannot remove the earlier " + out + "/summary.png: " + error.message());
 }
 
 void check_merge_folder(const Sweep& sweep) {
@@ -175,10 +179,8 @@ std::unique_ptr<OutputLock> lock_results_folder(const Sweep& sweep, const SweepO
                                       "sweep", !options.no_wait);
 }
 
-// called holding the folder's lock (lock_results_folder)
+// called holding the folder's lock (lock_results_folder, which checked and prepared it)
 int merge_results(const Sweep& sweep, const SweepOptions& options, int threads) {
-  check_merge_folder(sweep);
-  sweep.prepare_out_directory();
   const ResultsTable table = collect_results(sweep, threads);
   const std::string out = sweep.out_directory();
   // the merge's files are written in a staging folder and moved in together once all are

@@ -838,10 +838,14 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
       // where the rolls cannot follow: a print step, a long edge or a travel between two
       // stations every rung of which is valid on its own
       const std::string within = format("%.3g", settings.max_joint_step_deg) + " deg";
-      const std::string why_between =
-          " (a pose on it is beyond a joint's range or the reach, at a singularity, or a joint "
-          "jumps by more than " +
-          within + " between two of them)";
+      // (a print edge's poses in between are also kept clear of the part; a travel's are not)
+      const auto why_between = [&](bool with_part) {
+        return " (a pose on it is beyond a joint's range or the reach, at a singularity, " +
+               (with_part ? "or within arm.min_clearance_mm " +
+                                format("%.3g", settings.min_clearance_mm) + " mm of the part, "
+                          : std::string()) +
+               "or a joint jumps by more than " + within + " between two of them)";
+      };
       if (stuck_at == 0) {
         last_failure += "no roll sequence keeps every joint within " + within +
                         " between neighbouring points along the paths";
@@ -851,18 +855,11 @@ ArmPosture choose_arm_posture(const Arm6& arm, const PartClearance* part, const 
         const std::string ends =
             " from " + station_name(stuck_at - 1) + " to " + station_name(stuck_at);
         if (to.after_travel)
-          last_failure += "no roll sequence gets over the travel" + ends + why_between;
+          last_failure += "no roll sequence gets over the travel" + ends + why_between(false);
         else if (to.after_long_edge)
-          last_failure +=
-              "no roll sequence gets along the " +
-              format("%.4g", (to.pose.position_mm - from.pose.position_mm).norm()) + " mm edge" +
-              ends +
-              (check_part ? " (a pose on it is beyond a joint's range or the reach, at a "
-                            "singularity, or within arm.min_clearance_mm " +
-                                format("%.3g", settings.min_clearance_mm) +
-                                " mm of the part, or a joint jumps by more than " + within +
-                                " between two of them)"
-                          : why_between);
+          last_failure += "no roll sequence gets along the " +
+                          format("%.4g", (to.pose.position_mm - from.pose.position_mm).norm()) +
+                          " mm edge" + ends + why_between(check_part != nullptr);
         else
           last_failure += "no roll sequence keeps every joint within " + within + ends;
       }
