@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -314,11 +315,89 @@ Curve3 polylines_3d(const std::vector<const std::vector<Vec3>*>& polylines, size
   return thin_to_budget(lines, lines.ranges.size(), max_points);
 }
 
+namespace {
+
+// The triangles seen from above: those facing up (facet normal z > 0.05), and those facing down
+// (z < -0.05) with no triangle of the mesh above their centre, turned over. The second kind is
+// an open surface seen from its back (a band that turns over along its length, a patch wound
+// facing down), which the hatch prints on the side seen from above; a closed solid's underside
+// lies under its top and stays out, as does a patch under an overhang.
+std::vector<std::array<int, 3>> faces_seen_from_above(const TriangleMesh& mesh) {
+  std::vector<std::array<int, 3>> seen;
+  std::vector<size_t> facing_down;
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const double n_z = mesh.facet_normal(t).z();
+    if (n_z > 0.05) seen.push_back(mesh.triangles[t]);
+    if (n_z < -0.05) facing_down.push_back(t);
+  }
+  if (facing_down.empty()) return seen;
+
+  // every triangle with an x-y footprint, bucketed by the grid cells its footprint's box meets
+  // (at most 256 x 256 cells, so a fan of slivers across the part costs 256 cells each)
+  Vec3 lo, hi;
+  mesh.bounds(lo, hi);
+  const double size_mm = std::max((hi - lo).maxCoeff(), 1e-9);
+  const int cells = std::clamp(
+      static_cast<int>(std::ceil(std::sqrt(0.5 * static_cast<double>(mesh.triangle_count())))), 1,
+      256);
+  const Eigen::Vector2d cell_mm = (hi - lo).head<2>().cwiseMax(1e-9) / cells;
+  const auto cell_index = [&](double v, int axis) {
+    return std::clamp(static_cast<int>(std::floor((v - lo[axis]) / cell_mm[axis])), 0, cells - 1);
+  };
+  std::vector<std::vector<int>> bucket(static_cast<size_t>(cells) * cells);
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    if (std::abs(mesh.facet_normal(t).z()) < 1e-9) continue;  // a wall: no footprint
+    Vec3 t_lo = mesh.vertices[mesh.triangles[t][0]], t_hi = t_lo;
+    for (int c = 1; c < 3; ++c) {
+      t_lo = t_lo.cwiseMin(mesh.vertices[mesh.triangles[t][c]]);
+      t_hi = t_hi.cwiseMax(mesh.vertices[mesh.triangles[t][c]]);
+    }
+    for (int i = cell_index(t_lo.x(), 0); i <= cell_index(t_hi.x(), 0); ++i)
+      for (int j = cell_index(t_lo.y(), 1); j <= cell_index(t_hi.y(), 1); ++j)
+        bucket[static_cast<size_t>(i) * cells + j].push_back(static_cast<int>(t));
+  }
+
+  // the height of triangle t above (x, y) where its footprint holds the point (its edges
+  // included, to a hair of the part's size), else nothing
+  const double hair_mm = 1e-9 * size_mm;
+  const auto height_over = [&](int t, const Vec3& p) -> std::optional<double> {
+    const Vec3& a = mesh.vertices[mesh.triangles[t][0]];
+    const Vec3& b = mesh.vertices[mesh.triangles[t][1]];
+    const Vec3& c = mesh.vertices[mesh.triangles[t][2]];
+    const auto cross = [](const Vec3& u, const Vec3& v, const Vec3& w) {
+      return (v.x() - u.x()) * (w.y() - u.y()) - (v.y() - u.y()) * (w.x() - u.x());
+    };
+    const double area = cross(a, b, c);
+    const double wa = cross(p, b, c) / area, wb = cross(a, p, c) / area, wc = cross(a, b, p) / area;
+    const double slack = hair_mm / std::max((b - a).norm() + (c - b).norm(), 1e-300);
+    if (wa < -slack || wb < -slack || wc < -slack) return std::nullopt;
+    return wa * a.z() + wb * b.z() + wc * c.z();
+  };
+  for (size_t t : facing_down) {
+    const std::array<int, 3>& triangle = mesh.triangles[t];
+    const Vec3 centre =
+        (mesh.vertices[triangle[0]] + mesh.vertices[triangle[1]] + mesh.vertices[triangle[2]]) /
+        3.0;
+    bool covered = false;
+    for (int other : bucket[static_cast<size_t>(cell_index(centre.x(), 0)) * cells +
+                            cell_index(centre.y(), 1)]) {
+      if (other == static_cast<int>(t)) continue;
+      const std::optional<double> z = height_over(other, centre);
+      if (z && *z > centre.z() + hair_mm) {
+        covered = true;
+        break;
+      }
+    }
+    if (!covered) seen.push_back({triangle[0], triangle[2], triangle[1]});  // turned to face up
+  }
+  return seen;
+}
+
+}  // namespace
+
 TriangleMesh display_surface(const TriangleMesh& mesh, size_t max_triangles) {
-  // the upward-facing triangles and the vertices they use
-  std::vector<std::array<int, 3>> up;
-  for (size_t t = 0; t < mesh.triangle_count(); ++t)
-    if (mesh.facet_normal(t).z() > 0.05) up.push_back(mesh.triangles[t]);
+  // the triangles seen from above and the vertices they use
+  const std::vector<std::array<int, 3>> up = faces_seen_from_above(mesh);
   TriangleMesh out;
   if (up.empty()) return out;
   Eigen::Vector2d lo = mesh.vertices[up[0][0]].head<2>(), hi = lo;

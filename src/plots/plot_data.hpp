@@ -79,7 +79,9 @@ Curve3 path_curve_3d(const MotionSamples& samples, PathPart part, size_t max_poi
 // the spacing from the last kept one; the spacing grows until at most max_points remain
 Curve3 polylines_3d(const std::vector<const std::vector<Vec3>*>& lines, size_t max_points);
 
-// The part's surface for display: the triangles that face up (facet normal z > 0.05),
+// The part's surface for display: the triangles seen from above, i.e. those that face up
+// (facet normal z > 0.05) and those facing down (z < -0.05) with nothing of the mesh above
+// their centre, turned over (an open surface seen from its back, as the hatch prints it),
 // decimated by vertex clustering on an x-y grid (each grid cell's vertices merged into the
 // one nearest the cell's centre, so every vertex stays on the surface; triangles that collapse
 // or repeat dropped), the grid coarsened until at most max_triangles remain.

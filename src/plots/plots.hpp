@@ -163,7 +163,7 @@ struct RunPlotData {
   // paths3d.png: print paths per layer (index = layer; the toolpath's points, thinned),
   // travels (the planned samples where not depositing), tool-axis segments (two points each:
   // a print path's point and that point + tool_axis_length_mm * its tool axis), the part's
-  // upward-facing surface decimated
+  // surface seen from above, decimated (display_surface)
   std::vector<Curve3> layer_paths;
   Curve3 travels;
   Curve3 tool_axes;

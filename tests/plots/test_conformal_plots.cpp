@@ -294,6 +294,69 @@ TEST(DisplaySurface, KeepsUpwardFacesAndDecimatesOnTheSurface) {
   EXPECT_EQ(plots::display_surface(coarse, 2000).triangle_count(), 2u * 40u * 12u);
 }
 
+// A box's twelve triangles wound outward, corners lo and hi.
+TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi) {
+  TriangleMesh box;
+  for (int i = 0; i < 8; ++i)
+    box.vertices.push_back(
+        Vec3(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()));
+  box.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                   {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return box;
+}
+
+// A flat square patch at height z, wound facing up or down.
+TriangleMesh square_patch(double half_mm, double z, bool facing_up) {
+  TriangleMesh patch;
+  patch.vertices = {Vec3(-half_mm, -half_mm, z), Vec3(half_mm, -half_mm, z),
+                    Vec3(half_mm, half_mm, z), Vec3(-half_mm, half_mm, z)};
+  patch.triangles = facing_up ? std::vector<std::array<int, 3>>{{0, 1, 2}, {0, 2, 3}}
+                              : std::vector<std::array<int, 3>>{{0, 2, 1}, {0, 3, 2}};
+  return patch;
+}
+
+TEST(DisplaySurface, ShowsTheSideSeenFromAboveWhicheverWayItIsWound) {
+  // a closed box: its top alone (the underside lies under it)
+  const TriangleMesh box = box_mesh(Vec3(-5, -5, 0), Vec3(5, 5, 4));
+  const TriangleMesh shown_box = plots::display_surface(box, 2000);
+  ASSERT_EQ(shown_box.triangle_count(), 2u);
+  for (size_t t = 0; t < 2; ++t) {
+    EXPECT_NEAR(shown_box.facet_normal(t).z(), 1.0, 1e-12);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(shown_box.vertices[shown_box.triangles[t][c]].z(), 4.0);
+  }
+  // an open patch wound facing down is seen on its back: both triangles, turned to face up
+  const TriangleMesh shown_patch = plots::display_surface(square_patch(5, 1, false), 2000);
+  ASSERT_EQ(shown_patch.triangle_count(), 2u);
+  for (size_t t = 0; t < 2; ++t) EXPECT_NEAR(shown_patch.facet_normal(t).z(), 1.0, 1e-12);
+  // a patch wound facing down under a roof wound facing up: the roof alone
+  TriangleMesh roofed = square_patch(8, 10, true);
+  const TriangleMesh under = square_patch(3, 2, false);
+  for (const auto& triangle : under.triangles)
+    roofed.triangles.push_back({triangle[0] + 4, triangle[1] + 4, triangle[2] + 4});
+  roofed.vertices.insert(roofed.vertices.end(), under.vertices.begin(), under.vertices.end());
+  const TriangleMesh shown_roofed = plots::display_surface(roofed, 2000);
+  ASSERT_EQ(shown_roofed.triangle_count(), 2u);
+  for (const Vec3& v : shown_roofed.vertices) EXPECT_EQ(v.z(), 10.0);
+  // a band that turns over halfway: half wound up, half down, none under the other; every
+  // triangle is shown, facing up
+  TriangleMesh band;
+  for (int i = 0; i <= 20; ++i)
+    for (int side = 0; side < 2; ++side) band.vertices.push_back(Vec3(i, side * 4.0, 0.1 * i));
+  for (int i = 0; i < 20; ++i) {
+    const int a = 2 * i, b = 2 * i + 2, c = 2 * i + 3, d = 2 * i + 1;
+    if (i < 10) {
+      band.triangles.push_back({a, b, c});
+      band.triangles.push_back({a, c, d});
+    } else {
+      band.triangles.push_back({a, c, b});
+      band.triangles.push_back({a, d, c});
+    }
+  }
+  const TriangleMesh shown_band = plots::display_surface(band, 2000);
+  ASSERT_EQ(shown_band.triangle_count(), 40u);
+  for (size_t t = 0; t < 40; ++t) EXPECT_GT(shown_band.facet_normal(t).z(), 0.9);
+}
+
 // ---- availability and the PNGs ----
 
 TEST(ConformalPlots, AvailableOnlyWithTheirInputs) {
