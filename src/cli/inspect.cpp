@@ -1,5 +1,6 @@
 #include "cli/inspect.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -21,6 +22,10 @@ constexpr double kUnbounded = 1e12;
 // radius 500 mm (a 2 MB file, 5e7 chords) took 10 GB. A printer's own queue holds 16 to 64
 // moves; the stop costs a deceleration and an acceleration every 2^20 pieces.
 constexpr size_t kMaxChainPieces = size_t{1} << 20;
+// the most chords per turn of an arc: arcs of radius above 34 m (1e9 mm is a number a file may
+// hold) are cut coarser than kChordTolerance_mm, at 4096 chords per turn, which turn by
+// 0.09 degrees each and keep the estimate's time; 1000 such circles otherwise took minutes
+constexpr double kMaxChordsPerTurn = 4096.0;
 
 // The time of one move of a look-ahead chain: a trapezoid from v0 to v1 under the cruise cap
 // over what the junction blends leave of it, plus half of each blend (as FirmwarePlanner).
@@ -92,7 +97,10 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       PrintPath arc_path;
       arc_path.points = points;
       arc_path.arcs = {move.arc};
-      points = arc_path.chorded(kChordTolerance_mm).points;
+      const Vec3 radial = move.from_mm - move.arc.center_mm;
+      const double radius_mm = (radial - radial.dot(move.arc.axis) * move.arc.axis).norm();
+      const double coarsest_mm = radius_mm * (1.0 - std::cos(kPi / kMaxChordsPerTurn));
+      points = arc_path.chorded(std::max(kChordTolerance_mm, coarsest_mm)).points;
     }
     for (size_t i = 0; i + 1 < points.size(); ++i) {
       const Vec3 step = points[i + 1] - points[i];

@@ -45,6 +45,9 @@ constexpr double kMaxSurfaceGridPoints = 2e7;
 constexpr std::size_t kMaxSpeedProblems = 20;
 // an arc's directions, for the feed clamp, come from chords within this sagitta
 constexpr double kClampChordTolerance_mm = 1e-3;
+// the most points a G-code toolpath may take with its arcs cut into chords (2^26): a slicer's
+// arc-fitted print of 10^6 arcs takes about 3 * 10^7
+constexpr double kMaxImportedPoints = 67108864.0;
 // a surface whose up-facing area is hidden under another part of it by more than this
 // fraction is noted: the hatch leaves that area bare
 constexpr double kHiddenAreaNoted = 0.01;
@@ -182,6 +185,12 @@ class Loader {
   void read_polylines(const Field& field, const std::optional<double>& default_speed);
   void read_gcode_file(const Field& field, const std::optional<double>& default_speed,
                        bool start_given, bool end_given);
+  // A problem when the paths would take more than kMaxImportedPoints points with their arcs
+  // cut into chords within the file's chord_tolerance_mm (counted, none cut), naming the arc
+  // that takes the most chords (its line kept in largest_arc_line_); else "".
+  std::string chord_count_problem(const std::vector<PrintPath>& paths,
+                                  const std::vector<std::vector<int>>& lines,
+                                  const GcodeToolpath& settings);
   // the moves (distinct lines) among a path's points from `from` on
   static std::size_t distinct_moves(const std::vector<int>& point_lines, std::size_t from);
   // false for a machine that cannot move the TCP in z (the XY stage)
@@ -236,6 +245,7 @@ class Loader {
   // a long segments list read without yaml-cpp (scenario/lifted_list.hpp)
   std::optional<LiftedSegments> lifted_;
   std::optional<TcpLimits> tcp_limits_;
+  int largest_arc_line_ = 0;           // chord_count_problem's arc that takes the most chords
   std::size_t speed_problems_ = 0;     // print segments over speed, listed up to a count
   Problem last_listed_speed_problem_;  // where the "... and N more" line goes: after it
   int toolpath_speed_line_ = 0;        // toolpath.speed's line, 0 when not given
@@ -946,6 +956,15 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   for (const std::vector<int>& path_lines : exact_lines)
     settings->print_moves += static_cast<int>(distinct_moves(path_lines, 1));
 
+  // the points the chords will take, counted before any is cut: an arc of absurd size (radius
+  // 1e9 mm, within the numbers a file may hold) takes 10^6 chords, and a thousand of them
+  // minutes to cut and check before each point is found out of reach
+  if (const std::string too_many = chord_count_problem(exact_paths, exact_lines, *settings);
+      !too_many.empty()) {
+    problems_.add_problem(Problem{resolved.string(), largest_arc_line_, field.key, too_many});
+    return;
+  }
+
   // feed rates above what the machine can do along a move: slowed to it, as firmware does
   if (settings->feed == "clamp") clamp_feed_rates(exact_paths, exact_lines, *settings);
 
@@ -974,6 +993,39 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   scenario_.exact_toolpath.start_mm = toolpath.start_mm;
   scenario_.exact_toolpath.end_mm = toolpath.end_mm;
   scenario_.exact_toolpath.chord_tolerance_mm = tolerance_mm;
+}
+
+std::string Loader::chord_count_problem(const std::vector<PrintPath>& paths,
+                                        const std::vector<std::vector<int>>& lines,
+                                        const GcodeToolpath& settings) {
+  double points = 0.0, largest = 0.0, largest_radius_mm = 0.0;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const PrintPath& path = paths[i];
+    points += static_cast<double>(path.points.size());
+    for (std::size_t k = 0; k < path.arcs.size(); ++k) {
+      const EdgeArc& arc = path.arcs[k];
+      if (!arc.is_arc()) continue;
+      const Vec3 radial = path.points[k] - arc.center_mm;
+      const double radius_mm = (radial - radial.dot(arc.axis) * arc.axis).norm();
+      const double chords = arc_chord_count(radius_mm, arc.sweep_rad, settings.chord_tolerance_mm);
+      points += chords - 1.0;
+      if (chords > largest) {
+        largest = chords;
+        largest_radius_mm = radius_mm;
+        largest_arc_line_ = lines[i].at(k + 1);
+      }
+    }
+  }
+  if (points <= kMaxImportedPoints) return "";
+  std::ostringstream message;
+  const auto whole = [](double count) { return std::to_string(static_cast<long long>(count)); };
+  message << "the print moves take " << whole(points)
+          << " points with their arcs cut into chords within chord_tolerance_mm "
+          << format_number(settings.chord_tolerance_mm) << " mm, more than a job holds ("
+          << whole(kMaxImportedPoints) << "); the arc on this line alone takes " << whole(largest)
+          << " (radius " << format_number(largest_radius_mm)
+          << " mm): check its I, J, K or R, or raise chord_tolerance_mm";
+  return message.str();
 }
 
 std::size_t Loader::distinct_moves(const std::vector<int>& point_lines, std::size_t from) {

@@ -545,35 +545,36 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     }
   }
   const char* p = begin;
-  while (p < end && is_space(*p)) ++p;
-  if (p < end && *p == '/') ++p;  // block delete: the line runs (block delete off)
-  while (p < end && is_space(*p)) ++p;
-  // a `%` before any code opens an RS274/NGC program; the next `%` ends it
-  if (p < end && *p == '%') {
-    if (program_.n_code_lines == 0)
-      opened_by_percent_ = true;
-    else if (opened_by_percent_) {
-      program_.program_end_line = line_number;
-      closed_by_percent_ = true;
-    }
-    return;
-  }
-  if (p == end || *p == ';' || *p == '(') {
-    if (p < end && *p == '(') {
-      // a line that is a comment, or a comment then words
-      const char* close = std::find(p, end, ')');
-      // (unclosed: refused as after words, as LinuxCNC does; it could hide the line's words)
-      if (close == end) {
-        problem(line_number, kUnclosedComment);
-        return;
+  // the line's leading comments, each `(...)` in turn (a loop: a line of 10^5 of them is
+  // read once, with no recursion as deep)
+  for (;;) {
+    while (p < end && is_space(*p)) ++p;
+    if (p < end && *p == '/') ++p;  // block delete: the line runs (block delete off)
+    while (p < end && is_space(*p)) ++p;
+    // a `%` before any code opens an RS274/NGC program; the next `%` ends it
+    if (p < end && *p == '%') {
+      if (program_.n_code_lines == 0)
+        opened_by_percent_ = true;
+      else if (opened_by_percent_) {
+        program_.program_end_line = line_number;
+        closed_by_percent_ = true;
       }
-      if (std::find(p + 1, close, '(') != close) {
-        problem(line_number, kNestedComment);
-        return;
-      }
-      line(close + 1, end, line_number);
+      return;
     }
-    return;
+    if (p == end || *p == ';') return;
+    if (*p != '(') break;
+    // a line that is a comment, or a comment then words
+    const char* close = std::find(p, end, ')');
+    // (unclosed: refused as after words, as LinuxCNC does; it could hide the line's words)
+    if (close == end) {
+      problem(line_number, kUnclosedComment);
+      return;
+    }
+    if (std::find(p + 1, close, '(') != close) {
+      problem(line_number, kNestedComment);
+      return;
+    }
+    p = close + 1;
   }
   // grbl's system commands ($H homing, $X unlock, $$ settings): not G-code
   if (*p == '$') return;
@@ -716,16 +717,20 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
       ++word_end;
     // homing's axes may be named without a number (Marlin's G28 X Y, Prusa's G28 W, G161 and
     // G162 homing to the axes' minimum or maximum in MakerBot's and Repetier's files), and so
-    // may the axes Marlin's G61 returns to a saved position (`G61 S0 X Y`): flags
+    // may the axes Marlin's G61 returns to a saved position (`G61 S0 X Y`): flags; and so is
+    // the I of Marlin's M3, M4 and M5 (`M3 I`: the laser's inline mode, power set per move)
     if (digits == 0 && p == number_start &&
         (p == end || is_space(*p) || *p == ';' || is_letter(*p)) && letter != 'G' &&
         letter != 'M' && !words_.has(letter) &&
         std::any_of(words_.codes.begin(), words_.codes.begin() + words_.n_codes,
-                    [](const Code& code) {
+                    [letter](const Code& code) {
+                      if (code.letter == 'M')
+                        return letter == 'I' &&
+                               (code.tenths == 30 || code.tenths == 40 || code.tenths == 50);
                       return code.letter == 'G' && (code.tenths == 280 || code.tenths == 610 ||
                                                     code.tenths == 1610 || code.tenths == 1620);
                     })) {
-      words_.set(letter, 0.0, word_start);
+      if (letter != 'I') words_.set(letter, 0.0, word_start);  // (M3 I: no arc's I)
       continue;
     }
     const bool clean = digits > 0 && (p == end || !(is_digit(*p) || *p == '.'));
@@ -825,6 +830,8 @@ void GcodeParser::execute(int line_number) {
     if (is_shutter_code(open_code_, code)) {
       open_ = opens = true;
       program_.has_shutter_codes = true;
+      // Marlin's M106 without S runs the fan at full speed (255), whatever S was before
+      if (code.letter == 'M' && code.tenths == 1060 && !words_.has('S')) power_off_ = false;
     } else if (is_shutter_code(close_code_, code)) {
       open_ = false;
       closes = true;
@@ -1265,8 +1272,9 @@ bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, 
     if (std::abs(radius) <
         half - std::max(kArcRadiusTolerance_mm, kArcRadiusTolerance_rel * std::abs(radius))) {
       std::ostringstream message;
-      message << "radius R" << words_.get('R') << " is shorter than half the chord (" << half
-              << " mm)";
+      message << "radius R" << words_.get('R');
+      if (unit_mm_ != 1.0) message << " (" << std::abs(radius) << " mm)";  // G20: in inches
+      message << " is shorter than half the chord (" << half << " mm)";
       problem(line_number, message.str());
       return false;
     }
@@ -1544,17 +1552,18 @@ GcodeProgram parse_gcode_program(const std::string& text, const std::string& fil
     throw InputError(file_label, 1, kKey, container);
   // at most one move per line: one reservation instead of a copy at every doubling (capped:
   // beyond 2^23 moves the vector grows as usual)
-  const auto n_newlines = static_cast<std::size_t>(std::count(p, end, '\n'));
-  // a file of classic Mac line ends (CR alone) has no LF at all
-  const char separator = n_newlines == 0 && std::memchr(p, '\r', end - p) ? '\r' : '\n';
-  const auto n_lines =
-      (separator == '\n' ? n_newlines : static_cast<std::size_t>(std::count(p, end, '\r'))) + 1;
-  parser.reserve_moves(std::min<std::size_t>(n_lines, std::size_t{1} << 23));
+  const auto n_line_ends = static_cast<std::size_t>(std::count(p, end, '\n')) +
+                           static_cast<std::size_t>(std::count(p, end, '\r'));
+  parser.reserve_moves(std::min<std::size_t>(n_line_ends + 1, std::size_t{1} << 23));
+  // every line ends at LF, CR LF or a CR alone (classic Mac), mixed as they may be in one file
+  // (a CR-only file with one LF added by another tool), as a firmware reads them: either byte
+  // ends a command
   int line_number = 0;
   while (p < end) {
-    const char* line_end = static_cast<const char*>(std::memchr(p, separator, end - p));
-    if (!line_end) line_end = end;
+    const char* line_end = std::find_if(p, end, [](char c) { return c == '\n' || c == '\r'; });
     parser.line(p, line_end, ++line_number);
+    if (line_end < end && *line_end == '\r' && line_end + 1 < end && line_end[1] == '\n')
+      ++line_end;  // CR LF: one line end
     p = line_end + 1;
   }
   return parser.finish(line_number);

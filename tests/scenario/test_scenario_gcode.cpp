@@ -265,6 +265,33 @@ toolpath: {gcode: {file: circle.gcode, feed: clamp}}
 }
 
 // describe shows the keys (the same tables the loader checks)
+// arcs whose chords a job cannot hold are counted, not cut: 100 circles of radius 1e9 mm (a
+// number a file may hold) would take 7 * 10^7 chords within 0.01 mm, minutes to cut before
+// each point is found out of reach; refused at once at the largest arc's line
+TEST_F(ScenarioGcode, ArcsTooLargeToChordAreRefusedBeforeAnyIsCut) {
+  std::string text = "G21 G90\nG1 X0 Y0 F6000\n";
+  for (int i = 0; i < 100; ++i) text += i == 40 ? "G2 I999999999 E1\n" : "G2 I990000000 E1\n";
+  write("huge.gcode", text);
+  const auto problems = problems_of(R"(
+toolpath: {gcode: {file: huge.gcode, rule: feed}}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, (dir_ / "huge.gcode").string(), "toolpath.gcode", 43,
+                 "points with their arcs cut into chords within chord_tolerance_mm 0.01 mm, more "
+                 "than a job holds (67108864); the arc on this line alone takes 702482 (radius "
+                 "1e+09 mm)");
+  // a circle of radius 40 mm is cut as before, its chords within 0.01 mm
+  write("circle.gcode", "G21 G90\nG1 X0 Y0 F600\nG2 I40 E1\n");
+  const Scenario circle = load_scenario(write("c.yaml", R"(
+limits: {v_max: 100, a_max: 1000}
+machine: cartesian
+toolpath: {gcode: {file: circle.gcode, rule: feed}}
+)"));
+  ASSERT_EQ(circle.toolpath.paths.size(), 1u);
+  EXPECT_EQ(circle.toolpath.paths[0].points.size(),
+            static_cast<std::size_t>(arc_chord_count(40.0, 2.0 * kPi, 0.01)) + 1);
+}
+
 TEST(ScenarioGcodeSchema, TheTablesHoldTheGcodeKeys) {
   const SchemaSection& section = schema_section("toolpath.gcode");
   EXPECT_EQ(section.key_names(),

@@ -253,6 +253,35 @@ TEST(Gcode, PowerZeroClosesTheShutter) {
   expect_points(imported.toolpath.paths[2], {Vec3(5, 0, 0), Vec3(0, 0, 0)});
 }
 
+TEST(Gcode, MarlinsLaserFlagAndFanSpeed) {
+  // Marlin's `M3 I` (the laser's inline mode) is a flag, not a malformed word; an M106 open
+  // code without S runs the fan at full speed (255) after an M106 S0, as Marlin does
+  GcodeOptions laser;
+  const GcodeImport inline_mode = import_gcode_program(
+      parse_gcode_program("G21 G90\nM3 I\nG1 X10 F600 S200\nM3 I S0\nG1 Y10\nM5\nG0 X0\n",
+                          "laser.gcode", laser),
+      laser);
+  ASSERT_EQ(inline_mode.toolpath.paths.size(), 1u);
+  expect_points(inline_mode.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+  GcodeOptions fan;
+  fan.open_code = "M106";
+  fan.close_code = "M107";
+  const GcodeImport full_speed = import_gcode_program(
+      parse_gcode_program("G21 G90\nM106 S0\nG0 X0 Y0 F3000\nM106\nG1 X10 F600\nM107\nG0 X20\n"
+                          "M106 S255\nG1 X30\nM107\n",
+                          "fan.gcode", fan),
+      fan);
+  ASSERT_EQ(full_speed.toolpath.paths.size(), 2u);
+  expect_points(full_speed.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+  // an R too short for its chord, in inches: the message gives R in the file's unit and in mm
+  const auto problems = problems_of("G20 G90\nG1 X0 Y0 F60\nG2 X2 Y0 R0.5\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_NE(problems[0].message.find("radius R0.5 (12.7 mm) is shorter than half the chord "
+                                     "(25.4 mm)"),
+            std::string::npos)
+      << problems[0].str();
+}
+
 TEST(Gcode, M3AndM4BothOpenTheShutter) {
   // a grbl laser file switches the laser on with M4 (dynamic power), a mill's spindle may turn
   // either way: under the default open code M3 (and under M4), both open, M5 closes
@@ -345,6 +374,40 @@ TEST(Gcode, ClassicMacLineEndsAreLines) {
     ASSERT_EQ(program.moves.size(), 2u);
     EXPECT_EQ(program.moves[1].to_mm, Vec3(10, 10, 0));
   }
+}
+
+TEST(Gcode, LineEndsMayBeMixedInOneFile) {
+  // a file of CR line ends that another tool gave one LF (at its end): every CR still ends a
+  // line, a CR LF is one line end; before, the CRs became spaces and the first comment hid
+  // the whole file (0 moves, exit 0)
+  const std::string text =
+      "G21\r; a header comment\rG90\rM83\rG0 X0 Y0 F3000\rG1 X10 E1 F1200\rG1 Y10 E1\r"
+      "G1 X0 E1\rG1 Y0 E1\r; end\r\n";
+  const GcodeProgram program = parse_gcode_program(text, "mixed.gcode", GcodeOptions{});
+  EXPECT_EQ(program.n_lines, 10);
+  ASSERT_EQ(program.moves.size(), 4u);  // (G0 X0 Y0 goes nowhere: no move)
+  EXPECT_EQ(program.moves[2].to_mm, Vec3(0, 10, 0));
+  EXPECT_EQ(program.moves[2].line, 8);
+  // a bad word is named at its own line whichever line ends come before it
+  const auto problems = problems_of("G21\r\nG90\rG1 X1 F600\nG1 Xq\r\nG1 X2\r");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 4) << problems[0].str();
+}
+
+TEST(Gcode, ALineOfManyCommentsIsReadOnce) {
+  // 10^5 parenthesised comments before the words of one line: read in a loop (before: a call
+  // per comment, each scanning the rest of the line again; 200 000 took 31 s)
+  std::string text = "G21\n";
+  for (int i = 0; i < 100000; ++i) text += "(a)";
+  text += " G1 X1 E1 F100\n(b)(c)G1 X2 E2\n";
+  const GcodeProgram program = parse_gcode_program(text, "comments.gcode", GcodeOptions{});
+  ASSERT_EQ(program.moves.size(), 2u);
+  EXPECT_EQ(program.moves[0].to_mm, Vec3(1, 0, 0));
+  EXPECT_EQ(program.moves[1].to_mm, Vec3(2, 0, 0));
+  // a comment left open after closed ones is refused at its line, as one alone is
+  const auto problems = problems_of("G21\n(b)(c)(unclosed G1 X3\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 2) << problems[0].str();
 }
 
 TEST(Gcode, InchesAndSetPosition) {

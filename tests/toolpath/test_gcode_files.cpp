@@ -291,6 +291,19 @@ TEST(GcodeFiles, EstimateStopsEveryMillionPieces) {
               (fine_length + 100.0) / 50.0 + 2.0 * 50.0 / a, 1e-6);
 }
 
+// an arc of radius above 34 m is cut into at most 4096 chords per turn for the estimate (at
+// 0.01 mm, a circle of radius 1e9 mm took 7 * 10^5 and 1000 of them minutes): nearly straight
+// chords, each at the feed rate, so a circle takes its length / feed plus one ramp
+TEST(GcodeFiles, EstimateCutsHugeArcsCoarser) {
+  std::string text = "G21 G90\nG1 X0 Y0 F6000\n";
+  for (int i = 0; i < 1000; ++i) text += "G2 I999999999\n";
+  const GcodeProgram program = parse_gcode_program(text, "huge.gcode", GcodeOptions{});
+  const double length_mm = 1000.0 * 2.0 * kPi * 999999999.0;
+  const GcodeFacts facts = gcode_facts(program, PrintRule::automatic);
+  EXPECT_NEAR(facts.estimated_time_s, length_mm / 100.0, 1e-6 * length_mm / 100.0);
+  EXPECT_NEAR(facts.feed_rate_time_s, length_mm / 100.0, 1e-9 * length_mm / 100.0);
+}
+
 TEST(GcodeFiles, InspectJsonKeys) {
   const nlohmann::json json = gcode_facts_json(facts_of("arcs.gcode"));
   for (const char* key :
