@@ -76,6 +76,15 @@ std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemLi
                  "more than one YAML document (---): a " + kind + " file holds one");
     return std::nullopt;
   }
+  // a tag would make text of a number (`!!str 3`) or null of a value (`!!null 3`), which the
+  // reader, going by the scalar's text, would not see: refused rather than read differently
+  if (documents.first_tag_line > 0) {
+    problems.add(documents.first_tag_line, "",
+                 "YAML tag '" + printable_text(documents.first_tag) + "': a " + kind +
+                     " file's values are plain (3 is a number, \"3\" text); write it without "
+                     "the tag");
+    return std::nullopt;
+  }
   if (aliased_positions != nullptr) *aliased_positions = std::move(documents.aliased_positions);
   return documents.first;
 }

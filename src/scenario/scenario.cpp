@@ -82,6 +82,16 @@ std::string folder_name_problem(const std::string& name) {
   return "";
 }
 
+// true for a name a run's folder cannot take: one starting with '.' (hidden; the output
+// folder's marker is .depotwin), or a file written beside the run folders (compare's
+// comparison.*, a sweep task's task.json)
+bool names_an_output_file(const std::string& label) {
+  static const char* const kBesideRuns[] = {"comparison.json", "comparison.csv", "comparison.md",
+                                            "comparison.png", "task.json"};
+  return label.front() == '.' || std::any_of(std::begin(kBesideRuns), std::end(kBesideRuns),
+                                             [&](const char* name) { return label == name; });
+}
+
 // "x -10 to 10, y -5 to 5, z 5": a box's extent per axis, one number where it is flat
 std::string box_text(const Vec3& lower, const Vec3& upper) {
   std::string text;
@@ -1606,6 +1616,14 @@ void Loader::read_arm(const Field& field) {
       target = read_number(*f, problems_, range_of("arm", key)).value_or(target);
   };
   read("roll_step_deg", arm.roll_step_deg);
+  // the ladder's rolls go round once: a step that does not divide 360 is named at its line
+  if (const Field* f = view.find("roll_step_deg");
+      f != nullptr && std::fmod(360.0, arm.roll_step_deg) > 1e-9) {
+    problems_.add(f->line, f->key,
+                  "must divide 360 into a whole number of steps (5, 7.5, 10, 15, 30, ...), got " +
+                      format_number(arm.roll_step_deg));
+    arm.roll_step_deg = ArmPostureSettings().roll_step_deg;
+  }
   read("sample_spacing_mm", arm.sample_spacing_mm);
   read("min_joint_margin_deg", arm.min_joint_margin_deg);
   read("min_wrist_alignment", arm.min_wrist_alignment);
@@ -1735,6 +1753,11 @@ void Loader::read_planners(const Field& field) {
         std::string problem = folder_name_problem(*label);
         if (problem.empty() && label->find(' ') != std::string::npos)
           problem = "'" + printable_text(*label) + "' cannot name a run (no spaces)";
+        if (problem.empty() && names_an_output_file(*label))
+          problem = "'" + printable_text(*label) +
+                    "' cannot name a run: the run folders sit beside the output folder's own "
+                    "files (.depotwin, comparison.json, .csv, .md, .png; a sweep task's "
+                    "task.json), and a name starting with '.' is hidden";
         if (!problem.empty())
           problems_.add(parameter->line, parameter->key, problem);
         else

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "core/input_ranges.hpp"
@@ -52,27 +53,37 @@ class DocumentCounter : public YAML::EventHandler {
     if (count == 1 && anchored != anchor_positions_.end())
       aliased_positions.push_back(anchored->second);
   }
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+  std::string first_tag;
+  int first_tag_line = 0;
+
+  void OnScalar(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
                 const std::string&) override {
-    node_at(mark, anchor);
+    node_at(mark, anchor, tag);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+  void OnSequenceStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
                        YAML::EmitterStyle::value) override {
-    node_at(mark, anchor);
+    node_at(mark, anchor, tag);
   }
   void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+  void OnMapStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
                   YAML::EmitterStyle::value) override {
-    node_at(mark, anchor);
+    node_at(mark, anchor, tag);
   }
   void OnMapEnd() override {}
 
  private:
   std::map<YAML::anchor_t, int> anchor_positions_;
 
-  void node_at(const YAML::Mark& mark, YAML::anchor_t anchor) {
+  void node_at(const YAML::Mark& mark, YAML::anchor_t anchor, const std::string& tag = "") {
     if (count == 2 && second_line == 0) second_line = mark.is_null() ? 0 : mark.line + 1;
     if (count == 1 && anchor != 0) anchor_positions_[anchor] = mark.pos;
+    // yaml-cpp tags a plain node "?" (or nothing) and a quoted one "!"; anything else was
+    // written (`!!str`, which it spells tag:yaml.org,2002:str, or `!custom`)
+    if (count == 1 && first_tag_line == 0 && !tag.empty() && tag != "?" && tag != "!") {
+      static const std::string kCoreTags = "tag:yaml.org,2002:";
+      first_tag = tag.rfind(kCoreTags, 0) == 0 ? "!!" + tag.substr(kCoreTags.size()) : tag;
+      first_tag_line = mark.is_null() ? 1 : mark.line + 1;
+    }
   }
 };
 
@@ -89,6 +100,8 @@ YamlDocuments load_documents(const std::string& text) {
   documents.count = counter.count;
   documents.second_line = counter.second_line;
   documents.aliased_positions = std::move(counter.aliased_positions);
+  documents.first_tag = counter.first_tag;
+  documents.first_tag_line = counter.first_tag_line;
   if (documents.count > 0) documents.first = YAML::Load(text);
   return documents;
 }
@@ -212,9 +225,15 @@ std::optional<double> read_number(const Field& field, ProblemList& problems, con
     return std::nullopt;
   }
   if (!range.contains(*value)) {
+    // a number nearer 0 than the doubles hold (3e-400) reads as 0: shown as written, which
+    // only a few digits can be once its mantissa is not 0
+    const std::string mantissa = text.substr(0, text.find_first_of("eE"));
+    const bool underflowed = std::abs(*value) < std::numeric_limits<double>::min() &&
+                             mantissa.find_first_of("123456789") != std::string::npos;
     problems.add(field.line, field.key,
                  "must be " + range.text() + ", got " +
-                     message_number_outside(*value, range.min, range.max));
+                     (underflowed ? printable_text(text) + " (nearer 0 than a double holds: 0)"
+                                  : message_number_outside(*value, range.min, range.max)));
     return std::nullopt;
   }
   return value;

@@ -32,6 +32,10 @@ struct YamlDocuments {
   // where (YAML::Mark::pos) each node of the first document that an alias repeats begins: the
   // tree holds it once, so an edit there changes every place that names it
   std::vector<int> aliased_positions;
+  // the first explicit tag in the first document (`!!str 3`, `!foo`), as written, and its
+  // line (0: none); a plain or quoted node has none
+  std::string first_tag;
+  int first_tag_line = 0;
 };
 YamlDocuments load_documents(const std::string& text);
 

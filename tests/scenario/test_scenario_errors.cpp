@@ -101,6 +101,37 @@ toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
   expect_problem(problems, scenario_path(), "limits.z.a_max", 5, "must be a finite number");
 }
 
+// a number nearer 0 than a double holds reads as 0: a range that refuses 0 shows it as written
+// (it said "got 0" of `v_max: 3e-400`); 0 written so is 0 (j_max 0: no jerk limit)
+TEST_F(ScenarioErrors, ANumberTooNearZeroIsShownAsWritten) {
+  const auto problems = problems_of(R"(
+limits: {v_max: 3e-400, a_max: -0.5e-330, j_max: 0e-999}
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 2u) << dump(problems);
+  expect_problem(problems, scenario_path(), "limits.v_max", 1,
+                 "must be in [1e-06, 1e+06], got 3e-400 (nearer 0 than a double holds: 0)");
+  expect_problem(problems, scenario_path(), "limits.a_max", 1,
+                 "must be in [1e-06, 1e+09], got -0.5e-330 (nearer 0 than a double holds: 0)");
+}
+
+// the arm's roll step divides 360: one that does not is named at its own line and key
+TEST_F(ScenarioErrors, ARollStepThatDoesNotDivide360IsNamedAtItsKey) {
+  const auto problems = problems_of(R"(
+machine: arm6
+arm:
+  roll: optimized
+  roll_step_deg: 7
+toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
+)");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  expect_problem(problems, scenario_path(), "arm.roll_step_deg", 4,
+                 "must divide 360 into a whole number of steps (5, 7.5, 10, 15, 30, ...), got 7");
+  EXPECT_TRUE(problems_of("machine: arm6\narm: {roll_step_deg: 7.5}\ntoolpath: {speed: 3, "
+                          "segments: [[[0, 0], [1, 0]]]}\n")
+                  .empty());
+}
+
 TEST_F(ScenarioErrors, JointLimitsNeedVelocityAndAcceleration) {
   const auto problems = problems_of(R"(
 limits: {joint: {v_max: 200}}
@@ -597,6 +628,28 @@ TEST_F(ScenarioErrors, HostileNamesAreRefused) {
   expect_problem(long_name, scenario_path(), "name", 1, "is 101 bytes long");
 }
 
+// a label names a run's folder beside the output folder's own files: the marker .depotwin (a
+// run labelled so replaced it, and a sweep then wrote into the run's folder), compare's
+// comparison.* (compare ran every simulation, then failed to move its table: exit 1) and a
+// sweep task's task.json; a name starting with '.' (hidden) is refused with them
+TEST_F(ScenarioErrors, ALabelCannotTakeTheNameOfAnOutputFile) {
+  const auto scenario_with_label = [](const std::string& label) {
+    return "toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\n"
+           "planners: [{name: lspb_mtt, label: \"" +
+           label + "\"}, stop_and_go]\n";
+  };
+  for (const std::string label : {".depotwin", "comparison.json", "comparison.csv", "comparison.md",
+                                  "comparison.png", "task.json", ".hidden"}) {
+    const auto problems = problems_of(scenario_with_label(label));
+    ASSERT_EQ(problems.size(), 1u) << dump(problems);
+    expect_problem(problems, scenario_path(), "planners[0].label", 2,
+                   "'" + label + "' cannot name a run: the run folders sit beside");
+  }
+  // names near them are labels like any other
+  for (const std::string label : {"comparison", "comparison.txt", "a.depotwin", "task.json2"})
+    EXPECT_TRUE(problems_of(scenario_with_label(label)).empty()) << label;
+}
+
 // process.flow_mm3_s on extrusion: a fixed nominal flow (a constant-rate extruder)
 TEST_F(ScenarioErrors, ExtrusionTakesAFixedFlow) {
   const auto problems = problems_of(R"(
@@ -860,6 +913,28 @@ name: second
   ASSERT_EQ(list.size(), 1u) << dump(list);
   EXPECT_EQ(list[0].line, 1);
   EXPECT_NE(list[0].message.find("expected a map, got a list"), std::string::npos);
+}
+
+// a YAML tag would make text of a number or null of a value the reader takes by its text:
+// `speed: !!str 3` was read as the number 3 (and `"3"` refused); every tag is refused at its
+// line, a quoted or plain value is read as before
+TEST_F(ScenarioErrors, YamlTagsAreRefusedAtTheirLine) {
+  for (const std::string tagged : {"!!str 3", "!!null 3", "!!int 3.5", "!!float \"3\"", "!foo 3"}) {
+    const auto problems = problems_of("name: tags\ntoolpath:\n  speed: " + tagged +
+                                      "\n  segments: [[[0, 0], [1, 0]]]\n");
+    ASSERT_EQ(problems.size(), 1u) << tagged << "\n" << dump(problems);
+    EXPECT_EQ(problems[0].line, 3) << problems[0].str();
+    const std::string tag = tagged.substr(0, tagged.find(' '));
+    EXPECT_EQ(
+        problems[0].message.rfind("YAML tag '" + tag + "': a scenario file's values are plain", 0),
+        0u)
+        << problems[0].str();
+  }
+  const auto on_a_map = problems_of("toolpath: !!map {speed: 3, segments: [[[0, 0], [1, 0]]]}\n");
+  ASSERT_EQ(on_a_map.size(), 1u) << dump(on_a_map);
+  EXPECT_EQ(on_a_map[0].line, 1);
+  EXPECT_TRUE(
+      problems_of("name: plain\ntoolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}\n").empty());
 }
 
 // three independent mistakes: all three reported, in line order, by one InputError
