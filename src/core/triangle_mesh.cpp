@@ -85,14 +85,84 @@ std::vector<std::array<Vec3, 3>> TriangleMesh::corner_normals(double crease_angl
     for (int corner = 0; corner < 3; ++corner)
       around[fill[triangles[t][corner]]++] = {static_cast<int>(t), corner};
 
+  // the triangles around a vertex form fans: two are in one fan where they share an edge
+  // from the vertex that no other triangle has (a manifold edge). A triangle sharing only a
+  // non-manifold edge (three or more triangles on it: a hidden facet hung on the top's
+  // diagonal) or only the vertex (two cones tip to tip) is another surface there, and its
+  // normal is not averaged in. A facet's duplicate (the same three vertices) stands for its
+  // original: it counts once on the edges and shares the original's fan.
+  std::vector<std::pair<std::array<int, 3>, int>> sorted_facets(n_triangles);
+  for (size_t t = 0; t < n_triangles; ++t) {
+    sorted_facets[t] = {triangles[t], static_cast<int>(t)};
+    std::sort(sorted_facets[t].first.begin(), sorted_facets[t].first.end());
+  }
+  std::sort(sorted_facets.begin(), sorted_facets.end());
+  std::vector<int> original(n_triangles);  // the first triangle with the same three vertices
+  for (size_t i = 0; i < n_triangles; ++i)
+    original[static_cast<size_t>(sorted_facets[i].second)] =
+        i > 0 && sorted_facets[i].first == sorted_facets[i - 1].first
+            ? original[static_cast<size_t>(sorted_facets[i - 1].second)]
+            : sorted_facets[i].second;
+
+  // fan[k]: the fan of the corner at around[k], as a row of its vertex's rows
+  std::vector<int> fan(around.size());
+  std::vector<int> parent;
+  std::vector<std::pair<int, int>> rows_by_original, rows_by_edge;  // (key, row)
+  const auto root_of = [&parent](int i) {
+    while (parent[static_cast<size_t>(i)] != i)
+      i = parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[i])];
+    return i;
+  };
+  const auto join = [&](int a, int b) { parent[static_cast<size_t>(root_of(a))] = root_of(b); };
+  for (size_t v = 0; v < vertices.size(); ++v) {
+    const int begin = first[v], count = first[v + 1] - first[v];
+    parent.resize(static_cast<size_t>(count));
+    rows_by_original.clear();
+    for (int i = 0; i < count; ++i) {
+      parent[static_cast<size_t>(i)] = i;
+      rows_by_original.emplace_back(original[static_cast<size_t>(around[begin + i].first)], i);
+    }
+    std::sort(rows_by_original.begin(), rows_by_original.end());
+    // a duplicate joins its original's fan; each original's two edges from v are counted
+    rows_by_edge.clear();
+    for (size_t i = 0; i < rows_by_original.size(); ++i) {
+      const int row = rows_by_original[i].second;
+      if (i > 0 && rows_by_original[i].first == rows_by_original[i - 1].first) {
+        join(row, rows_by_original[i - 1].second);
+        continue;
+      }
+      const auto [t, corner] = around[begin + row];
+      const std::array<int, 3>& f = triangles[static_cast<size_t>(t)];
+      if (f[0] == f[1] || f[1] == f[2] || f[2] == f[0]) continue;  // a vertex twice: no edges
+      for (int step = 1; step <= 2; ++step) rows_by_edge.emplace_back(f[(corner + step) % 3], row);
+    }
+    // an edge exactly two originals share joins their fans
+    std::sort(rows_by_edge.begin(), rows_by_edge.end());
+    for (size_t i = 0; i < rows_by_edge.size();) {
+      size_t j = i;
+      while (j < rows_by_edge.size() && rows_by_edge[j].first == rows_by_edge[i].first) ++j;
+      if (j - i == 2) join(rows_by_edge[i].second, rows_by_edge[i + 1].second);
+      i = j;
+    }
+    for (int i = 0; i < count; ++i) fan[static_cast<size_t>(begin + i)] = root_of(i);
+  }
+
   const double cos_crease = std::cos(crease_angle_rad);
   std::vector<std::array<Vec3, 3>> normals(n_triangles);
+  std::vector<int> row_of_corner(3 * n_triangles);  // around's row of each (t, corner)
+  for (size_t k = 0; k < around.size(); ++k)
+    row_of_corner[3 * around[k].first + around[k].second] = static_cast<int>(k);
   for (size_t t = 0; t < n_triangles; ++t) {
     for (int corner = 0; corner < 3; ++corner) {
       const int v = triangles[t][corner];
+      const int own_fan = fan[row_of_corner[3 * t + corner]];
       Vec3 sum = Vec3::Zero();
       for (int k = first[v]; k < first[v + 1]; ++k) {
         const auto [u, u_corner] = around[k];
+        // the fan's facets, each once: a duplicate facing as its original does adds nothing
+        const int first_copy = original[static_cast<size_t>(u)];
+        if (fan[k] != own_fan || (first_copy != u && facet[u].dot(facet[first_copy]) > 0.0))
+          continue;
         if (facet[u].isZero() || facet[u].dot(facet[t]) < cos_crease) continue;
         sum += angle[u][u_corner] * facet[u];
       }

@@ -29,10 +29,14 @@ struct TriangleMesh {
   std::vector<Vec3> vertex_normals() const;
   // unit normals per triangle corner, smooth across edges but not across creases: the normal
   // at corner c of triangle t is the angle-weighted mean (as vertex_normals) of the facet
-  // normals around that vertex that lie within crease_angle_rad of t's own facet normal. On a
-  // smooth surface this is vertex_normals(); at a sharp edge (a solid's rim, where the top
-  // meets a side wall) each side keeps its own normal instead of a 45-degree average. The
-  // facet normal for a corner of a degenerate triangle (zero: degenerate triangles only).
+  // normals around that vertex that lie within crease_angle_rad of t's own facet normal and in
+  // t's fan there: the triangles reached from t around the vertex across edges that exactly two
+  // facets share (a facet's duplicate counts once and shares its original's fan). On a smooth
+  // surface this is vertex_normals(); at a sharp edge (a solid's rim, where the top meets a
+  // side wall) each side keeps its own normal instead of a 45-degree average; a facet that
+  // meets t only at a non-manifold edge (three facets on it) or at the vertex alone is another
+  // surface and is left out. The facet normal for a corner of a degenerate triangle (zero:
+  // degenerate triangles only).
   std::vector<std::array<Vec3, 3>> corner_normals(double crease_angle_rad) const;
   // the enclosed volume by the divergence theorem (mm^3): positive when the triangles are wound
   // outward; taken about the bounds' centre so that a part far from the origin loses no digits

@@ -16,6 +16,10 @@ namespace depotwin {
 namespace {
 
 constexpr int kPacket = 16;
+// a hit this near an edge of its triangle (barycentric coordinate) may be on a neighbour's too
+constexpr double kOnEdge = 1e-6;
+// how far uncover's ray looks inside the hit triangle: this share of the way to its centroid
+constexpr double kInward = 1e-3;
 
 void check_device(RTCDevice device, const char* what) {
   const RTCError error = rtcGetDeviceError(device);
@@ -120,9 +124,59 @@ struct SurfaceProjector::Impl {
   // hit: the ray's own answer at (x, y), replaced by edge_hit's where it misses or meets a
   // wall's edge and edge_hit finds one (in place: most points keep theirs, uncopied)
   void settle(double x, double y, std::optional<SurfaceHit>& hit) const {
-    if (hit && hit->facet_normal.z() > 0.0) return;
+    if (hit && hit->facet_normal.z() > 0.0) {
+      if (hit->barycentric.minCoeff() < kOnEdge) uncover(x, y, *hit);
+      return;
+    }
     std::optional<SurfaceHit> beside = edge_hit(x, y);
     if (beside) hit = beside;
+  }
+
+  // A point on an edge is on every triangle that shares it, and Embree names any of them: a
+  // facet hung under the top on its diagonal (a non-manifold STL) is as near as the top, and
+  // its normal would tilt the layers offset there. A ray just inside the hit triangle (toward
+  // its centroid) tells: where it meets another triangle higher up, the hit one is hidden
+  // beside the edge, and the point is taken on the one seen instead (at the same height).
+  void uncover(double x, double y, SurfaceHit& hit) const {
+    const std::array<int, 3>& f = mesh.triangles[static_cast<std::size_t>(hit.triangle)];
+    const Vec3 centroid = (mesh.vertices[f[0]] + mesh.vertices[f[1]] + mesh.vertices[f[2]]) / 3.0;
+    const Vec2 inner = Vec2(x, y) + kInward * (centroid.head<2>() - Vec2(x, y));
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rayhit;
+    set_down_ray(rayhit, inner.x(), inner.y());
+    rtcIntersect1(scene, &context, &rayhit);
+    if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID ||
+        static_cast<int>(rayhit.hit.primID) == hit.triangle)
+      return;
+    const SurfaceHit own_inside =
+        exact_hit(inner.x(), inner.y(), hit.triangle, hit.point_mm.z() - center.z(), 0.0f, 0.0f);
+    const std::optional<SurfaceHit> seen_inside =
+        ray_hit(inner.x(), inner.y(), rayhit.hit.geomID, rayhit.hit.primID, rayhit.ray.tfar,
+                rayhit.hit.u, rayhit.hit.v);
+    if (!seen_inside || seen_inside->facet_normal.z() <= 0.0 ||
+        seen_inside->point_mm.z() <= own_inside.point_mm.z() + edge_offset_mm)
+      return;
+    const SurfaceHit seen =
+        exact_hit(x, y, seen_inside->triangle, hit.point_mm.z() - center.z(), 0.0f, 0.0f);
+    if (std::abs(seen.point_mm.z() - hit.point_mm.z()) <= edge_offset_mm) hit = seen;
+  }
+
+  // one ray straight down from above the mesh at (x, y)
+  void set_down_ray(RTCRayHit& rayhit, double x, double y) const {
+    rayhit.ray.org_x = static_cast<float>(x - center.x());
+    rayhit.ray.org_y = static_cast<float>(y - center.y());
+    rayhit.ray.org_z = ray_z;
+    rayhit.ray.dir_x = 0.0f;
+    rayhit.ray.dir_y = 0.0f;
+    rayhit.ray.dir_z = -1.0f;
+    rayhit.ray.tnear = 0.0f;
+    rayhit.ray.tfar = std::numeric_limits<float>::infinity();
+    rayhit.ray.mask = ~0u;
+    rayhit.ray.flags = 0;
+    rayhit.ray.time = 0.0f;
+    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   }
 
   // ray k of a packet: straight down from above the mesh at (x, y)
@@ -208,19 +262,7 @@ std::optional<SurfaceHit> SurfaceProjector::project_down(double x_mm, double y_m
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rayhit;
-  rayhit.ray.org_x = static_cast<float>(x_mm - im.center.x());
-  rayhit.ray.org_y = static_cast<float>(y_mm - im.center.y());
-  rayhit.ray.org_z = im.ray_z;
-  rayhit.ray.dir_x = 0.0f;
-  rayhit.ray.dir_y = 0.0f;
-  rayhit.ray.dir_z = -1.0f;
-  rayhit.ray.tnear = 0.0f;
-  rayhit.ray.tfar = std::numeric_limits<float>::infinity();
-  rayhit.ray.mask = ~0u;
-  rayhit.ray.flags = 0;
-  rayhit.ray.time = 0.0f;
-  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  im.set_down_ray(rayhit, x_mm, y_mm);
   rtcIntersect1(im.scene, &context, &rayhit);
   std::optional<SurfaceHit> hit = im.ray_hit(x_mm, y_mm, rayhit.hit.geomID, rayhit.hit.primID,
                                              rayhit.ray.tfar, rayhit.hit.u, rayhit.hit.v);

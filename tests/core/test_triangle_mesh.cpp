@@ -2,7 +2,9 @@
 // open surface facing down) is turned over, and one wound right is left alone, judged by the
 // closed form of its signed volume and its signed projected area. orient_consistently: facets
 // wound against their neighbours are turned to match the larger area around them; a surface
-// without an outside (a Moebius strip) faces up triangle by triangle.
+// without an outside (a Moebius strip) faces up triangle by triangle. corner_normals: smooth
+// within a fan of facets joined by manifold edges, closed form on a bent sheet, and another
+// surface met at a non-manifold edge or a lone vertex is not averaged in.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -157,6 +159,88 @@ TEST(TriangleMesh, TrianglesWoundAgainstTheirNeighboursAreTurnedToMatch) {
   // the fan and the consistent meshes have no such piece
   EXPECT_EQ(fan.orient_consistently().unorientable_pieces, 0u);
   EXPECT_EQ(box.orient_consistently().unorientable_pieces, 0u);
+}
+
+// a sheet folded along x = 0 by +-20 degrees (a roof, 2 x 2 quads), triangulated so that every
+// inner vertex sits on the fold: the corner normals there are the closed form (0, 0, 1) for
+// the fold's two sides, and the facet normal elsewhere
+TriangleMesh folded_sheet() {
+  TriangleMesh mesh;
+  const double slope = std::tan(20.0 * M_PI / 180.0);
+  for (int j = 0; j <= 2; ++j)
+    for (int i = 0; i <= 2; ++i)
+      mesh.vertices.emplace_back(i - 1.0, j - 1.0, -slope * std::abs(i - 1.0));
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const int a = 3 * j + i;
+      mesh.triangles.push_back({a, a + 1, a + 4});
+      mesh.triangles.push_back({a, a + 4, a + 3});
+    }
+  return mesh;
+}
+
+TEST(TriangleMesh, CornerNormalsAverageAFansFacetsByTheirAngles) {
+  const TriangleMesh sheet = folded_sheet();
+  const auto normals = sheet.corner_normals(60.0 * M_PI / 180.0);
+  ASSERT_EQ(normals.size(), sheet.triangle_count());
+  for (size_t t = 0; t < sheet.triangle_count(); ++t)
+    for (int corner = 0; corner < 3; ++corner) {
+      const Vec3& p = sheet.vertices[sheet.triangles[t][corner]];
+      // on the fold both sides weigh equally (the same angles on each side): straight up
+      const Vec3 expected = p.x() == 0.0 ? Vec3(0, 0, 1) : sheet.facet_normal(t);
+      EXPECT_LT((normals[t][corner] - expected).norm(), 1e-12)
+          << "triangle " << t << " corner " << corner;
+    }
+  // a crease angle below the fold's 40 degrees keeps each side's own normal
+  const auto creased = sheet.corner_normals(30.0 * M_PI / 180.0);
+  for (size_t t = 0; t < sheet.triangle_count(); ++t)
+    for (int corner = 0; corner < 3; ++corner)
+      EXPECT_LT((creased[t][corner] - sheet.facet_normal(t)).norm(), 1e-12);
+}
+
+// an STL may hang a hidden facet on the top's diagonal (three facets on one edge), or touch
+// another surface at one vertex; neither tilts the top's normals (it tilted the offset layers
+// of a flat top by 13 degrees at the diagonal's ends); a facet's duplicate changes nothing
+TEST(TriangleMesh, CornerNormalsLeaveOutFacetsMetAtANonManifoldEdgeOrAVertexAlone) {
+  TriangleMesh top;
+  top.vertices = {{-10, -10, 1}, {10, -10, 1}, {10, 10, 1}, {-10, 10, 1}};
+  top.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const double crease = 60.0 * M_PI / 180.0;
+  // a facet under the top on its diagonal, facing up 19.5 degrees from vertical
+  TriangleMesh hung = top;
+  hung.vertices.emplace_back(10, -10, -4);
+  hung.triangles.push_back({0, 4, 2});
+  ASSERT_GT(hung.facet_normal(2).z(), std::cos(crease));  // within the crease angle
+  // a facet tilted 26.6 degrees touching the top's corner 2 only
+  TriangleMesh touching = top;
+  touching.vertices.emplace_back(20, 10, 1);
+  touching.vertices.emplace_back(10, 20, 1 + 5);
+  touching.triangles.push_back({2, 4, 5});
+  ASSERT_GT(touching.facet_normal(2).z(), std::cos(crease));
+  for (const TriangleMesh* mesh : {&hung, &touching}) {
+    const auto normals = mesh->corner_normals(crease);
+    for (size_t t = 0; t < 2; ++t)
+      for (int corner = 0; corner < 3; ++corner)
+        EXPECT_LT((normals[t][corner] - Vec3(0, 0, 1)).norm(), 1e-12)
+            << "triangle " << t << " corner " << corner;
+    // the other surface keeps its own facet normal
+    for (int corner = 0; corner < 3; ++corner)
+      EXPECT_LT((normals[2][corner] - mesh->facet_normal(2)).norm(), 1e-12);
+  }
+  // the folded sheet with one facet twice, once turned over: the same normals as without
+  const TriangleMesh sheet = folded_sheet();
+  TriangleMesh doubled = sheet;
+  doubled.triangles.push_back(sheet.triangles[2]);
+  doubled.triangles.push_back(
+      {sheet.triangles[5][0], sheet.triangles[5][2], sheet.triangles[5][1]});
+  const auto expected = sheet.corner_normals(crease);
+  const auto normals = doubled.corner_normals(crease);
+  for (size_t t = 0; t < sheet.triangle_count(); ++t)
+    for (int corner = 0; corner < 3; ++corner)
+      EXPECT_LT((normals[t][corner] - expected[t][corner]).norm(), 1e-12)
+          << "triangle " << t << " corner " << corner;
+  for (int corner = 0; corner < 3; ++corner)
+    EXPECT_LT((normals[sheet.triangle_count()][corner] - expected[2][corner]).norm(), 1e-12);
 }
 
 }  // namespace

@@ -221,6 +221,42 @@ TEST(SurfaceProjection, SmoothNormalsStopAtTheRim) {
   EXPECT_LT(axis_angle_rad(hit->normal, field.normal(19.75, 0.25)), 0.03);
 }
 
+// a facet hung under a flat top on its diagonal (a non-manifold STL: three facets on one edge)
+// is as near as the top along the diagonal, where Embree may name it: the point is on the top,
+// which is what is seen beside it, with the top's normal (it tilted the offset layers 19 deg);
+// on a ridge, where both sides are seen, each point keeps the side it was found on
+TEST(SurfaceProjection, APointOnAnEdgeIsOnTheTriangleSeenBesideIt) {
+  TriangleMesh top;
+  top.vertices = {{-10, -10, 1}, {10, -10, 1}, {10, 10, 1}, {-10, 10, 1}, {10, -10, -4}};
+  top.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 4, 2}};  // the last one hangs under the diagonal
+  const SurfaceProjector projector(top);
+  std::vector<Vec2> diagonal;
+  for (int k = -40; k <= 40; ++k) diagonal.emplace_back(0.25 * k, 0.25 * k);
+  std::vector<std::optional<SurfaceHit>> hits;
+  projector.project_down(diagonal, hits);
+  for (std::size_t k = 0; k < diagonal.size(); ++k) {
+    const std::optional<SurfaceHit> single =
+        projector.project_down(diagonal[k].x(), diagonal[k].y());
+    for (const std::optional<SurfaceHit>& hit : {hits[k], single}) {
+      ASSERT_TRUE(hit) << diagonal[k].transpose();
+      EXPECT_NE(hit->triangle, 2) << diagonal[k].transpose();
+      EXPECT_NEAR(hit->point_mm.z(), 1.0, 1e-12);
+      EXPECT_LT((hit->normal - Vec3::UnitZ()).norm(), 1e-12) << diagonal[k].transpose();
+    }
+  }
+  // a roof (slopes of 0.2 either side of x = 0): a point on the ridge is on a slope, both seen
+  TriangleMesh roof;
+  roof.vertices = {{-5, -5, 0}, {0, -5, 1}, {0, 5, 1}, {-5, 5, 0}, {5, -5, 0}, {5, 5, 0}};
+  roof.triangles = {{0, 1, 2}, {0, 2, 3}, {1, 4, 5}, {1, 5, 2}};
+  const SurfaceProjector roof_projector(roof);
+  for (double y : {-2.5, 0.0, 3.25}) {
+    const std::optional<SurfaceHit> ridge = roof_projector.project_down(0.0, y);
+    ASSERT_TRUE(ridge);
+    EXPECT_NEAR(ridge->point_mm.z(), 1.0, 1e-12);
+    EXPECT_NEAR(std::abs(ridge->facet_normal.x()), 0.2 / std::sqrt(1.04), 1e-12);
+  }
+}
+
 TEST(SurfaceProjection, BatchEqualsSingleRays) {
   CylinderParams params;
   params.mesh.holes = {SurfaceHole::circle(Vec2(0, 0), 5.0)};
