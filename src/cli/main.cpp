@@ -64,6 +64,19 @@ void print_parse_error(CLI::App& app, const CLI::ParseError& error) {
     text = name + ": '" + value + "' is not " + (whole ? "a whole number" : "a number") +
            (positive ? " above 0" : "");
   }
+  // "--planner: At Most 1 required but received 2": an option given twice
+  static const std::string kAtMostOne = ": At Most 1 required but received ";
+  const std::size_t at_most = text.find(kAtMostOne);
+  if (at_most != std::string::npos) {
+    const std::string name = text.substr(0, at_most);
+    const CLI::Option* option = nullptr;
+    for (CLI::App* verb : app.get_subcommands())
+      if (const CLI::Option* found = verb->get_option_no_throw(name)) option = found;
+    const bool takes_a_list =
+        option != nullptr && option->get_description().find("comma-separated") != std::string::npos;
+    text = name + " is given " + text.substr(at_most + kAtMostOne.size()) + " times; give it once" +
+           (takes_a_list ? " (several names go comma-separated in one: " + name + " a,b)" : "");
+  }
   std::string verb_name;
   for (const CLI::App* verb : app.get_subcommands()) verb_name = " " + verb->get_name();
   std::cerr << "error: " << terminal_text(text) << "\n(depotwin" << verb_name
@@ -136,11 +149,14 @@ int run_command_line(int argc, char** argv) {
                 "exit (status 2) instead of waiting while another depotwin writes --out");
   run->add_option("--max-memory", run_options.max_memory, kMaxMemoryHelp);
   // ---- moving pictures (src/render/video.hpp) ----
-  run->add_flag("--video", run_options.video,
-                "also write run.mp4 in each run folder: the scene over time, the deposit growing");
+  CLI::Option* run_video =
+      run->add_flag("--video", run_options.video,
+                    "also write run.mp4 in each run folder: the scene over time, the deposit "
+                    "growing");
   run->add_option("--video-length", run_options.video_length_s,
                   "longest video, seconds: a longer run is sped up to fit (default 30)")
-      ->check(positive_number());
+      ->check(positive_number())
+      ->needs(run_video);
   // ---- end moving pictures ----
 
   CompareOptions compare_options;
@@ -164,11 +180,13 @@ int run_command_line(int argc, char** argv) {
                     "exit (status 2) instead of waiting while another depotwin writes --out");
   compare->add_option("--max-memory", compare_options.run.max_memory, kMaxMemoryHelp);
   // ---- moving pictures (src/render/video.hpp) ----
-  compare->add_flag("--video", compare_options.run.video, "also write run.mp4 in each run folder");
+  CLI::Option* compare_video = compare->add_flag("--video", compare_options.run.video,
+                                                 "also write run.mp4 in each run folder");
   compare
       ->add_option("--video-length", compare_options.run.video_length_s,
                    "longest video, seconds: a longer run is sped up to fit (default 30)")
-      ->check(positive_number());
+      ->check(positive_number())
+      ->needs(compare_video);
   // ---- end moving pictures ----
 
   RunOptions plan_options;

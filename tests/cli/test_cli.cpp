@@ -103,6 +103,23 @@ TEST(Cli, AValueThatIsNoNumberNamesTheOptionAndWhatWasExpected) {
   EXPECT_EQ(missing.output.rfind("error: scenario is required\n", 0), 0u) << missing.output;
 }
 
+// an option given twice is named with how to give several names (CLI11 said "--planner: At
+// Most 1 required but received 2"); one that takes a single value is only told once
+TEST(Cli, AnOptionGivenTwiceSaysHowToGiveItOnce) {
+  const Result planners = depotwin("plan x.yaml --planner lspb_mtt --planner bezier");
+  EXPECT_EQ(planners.status, 2);
+  EXPECT_EQ(planners.output.rfind("error: --planner is given 2 times; give it once (several "
+                                  "names go comma-separated in one: --planner a,b)\n",
+                                  0),
+            0u)
+      << planners.output;
+  const Result out = depotwin("run x.yaml --out a --out b --out c");
+  EXPECT_EQ(out.status, 2);
+  EXPECT_EQ(
+      out.output.rfind("error: --out is given 3 times; give it once\n(depotwin run --help", 0), 0u)
+      << out.output;
+}
+
 // a list option given empty is refused (exit 2), never read as "not given" (every planner)
 TEST(Cli, EmptyNameListsAreRefused) {
   const std::string scenario = scenario_path("thompson_fig7.yaml");

@@ -84,5 +84,19 @@ TEST(Video, WithoutFfmpegTheRunFailsAndWritesNothing) {
             2);
 }
 
+// a video length without --video would be ignored in silence: it is refused, naming both
+TEST(Video, ALengthWithoutTheVideoIsRefused) {
+  const std::string dir = fresh_directory("video_length_alone");
+  const std::string scenario = testing_support::write_small_scenario(dir);
+  for (const char* verb : {"run", "compare"}) {
+    const CliResult alone = depotwin(std::string(verb) + " " + scenario + " --out " + dir +
+                                     "/alone --quiet --video-length 5");
+    EXPECT_EQ(alone.status, 2) << alone.output;
+    EXPECT_NE(alone.output.find("--video-length requires --video"), std::string::npos)
+        << alone.output;
+    EXPECT_FALSE(fs::exists(dir + "/alone")) << verb;
+  }
+}
+
 }  // namespace
 }  // namespace depotwin
