@@ -2,6 +2,8 @@
 // (scenario/overrides.hpp).
 #include "scenario/overrides.hpp"
 
+#include <yaml-cpp/depthguard.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -39,6 +41,12 @@ std::optional<YAML::Node> parse_scenario_text(const std::string& text, ProblemLi
   YamlDocuments documents;
   try {
     documents = load_documents(text);
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp stops a parse hundreds of levels deep with the words "bad file"
+    problems.add(e.mark.is_null() ? 0 : e.mark.line + 1, "",
+                 "malformed YAML: lists or maps nested hundreds of levels deep (a " + kind +
+                     " nests a few)");
+    return std::nullopt;
   } catch (const YAML::ParserException& e) {
     const int line = e.mark.is_null() ? 0 : e.mark.line + 1;
     // the two slips the parser's words do not name: a tab in the indentation, CR line ends

@@ -233,6 +233,17 @@ order: as_given
   EXPECT_NE(problems[0].message.find("malformed YAML"), std::string::npos);
 }
 
+// yaml-cpp stops a parse nested hundreds of levels deep with "bad file": said as it is
+TEST_F(ScenarioErrors, YamlNestedTooDeepSaysSo) {
+  const auto problems = problems_of("name: deep\ntoolpath: " + std::string(1000, '[') +
+                                    std::string(1000, ']') + "\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 2) << problems[0].str();
+  EXPECT_EQ(problems[0].message,
+            "malformed YAML: lists or maps nested hundreds of levels deep (a "
+            "scenario nests a few)");
+}
+
 TEST_F(ScenarioErrors, UnknownPlanner) {
   const auto problems = problems_of(R"(
 toolpath: {speed: 3, segments: [[[0, 0], [1, 0]]]}
