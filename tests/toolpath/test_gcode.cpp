@@ -599,6 +599,11 @@ TEST(Gcode, G28AndG30GoToThePositionsG28p1AndG30p1Stored) {
   const GcodeImport plain = parse("G21 G90\nG0 X20 Y20 Z1\nG28\nG30 Z9\nG1 X5 E1 F600\n");
   ASSERT_EQ(plain.toolpath.paths.size(), 1u);
   expect_points(plain.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(5, 0, 0)});
+  // homing clears G92's offset on the homed axes, as Marlin does (X5 is then machine 5); the
+  // others keep theirs (Y15 is machine 8 after G92 Y10 at machine 3)
+  const GcodeImport homed = parse("G21 G90\nG0 X2 Y3\nG92 X10 Y10\nG28 X\nG1 X5 Y15 E1 F600\n");
+  ASSERT_EQ(homed.toolpath.paths.size(), 1u);
+  expect_points(homed.toolpath.paths[0], {Vec3(0, 3, 0), Vec3(5, 8, 0)});
 }
 
 // the open and close codes on one line (`S1000 M3 M5`): LinuxCNC refuses two spindle codes on
