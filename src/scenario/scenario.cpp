@@ -1365,6 +1365,13 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
          Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.y()), Vec3::UnitY()) *
          Eigen::AngleAxisd(deg_to_rad(surface->rotation_deg.x()), Vec3::UnitX()))
             .toRotationMatrix();
+    // whether the file as written faces up, where a rotation may turn it over
+    bool file_faced_down = true;
+    if (!surface->rotation_deg.isZero()) {
+      TriangleMesh as_written = part;
+      as_written.orient_consistently();
+      file_faced_down = as_written.face_outward_and_up();
+    }
     part.transform(rotation, surface->offset_mm);
     // facets wound against their neighbours turned to match them, then an STL wound the wrong
     // way (a surface patch facing down, a solid inside out) turned over; every run says so:
@@ -1384,9 +1391,16 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
                                 "' were wound against their neighbours; they were turned over "
                                 "to match them");
     if (part.face_outward_and_up())
-      scenario_.notes.push_back("toolpath.surface: '" + given_file +
-                                "' faced down or inside out (its triangles wound clockwise "
-                                "seen from outside); its triangles were turned over");
+      scenario_.notes.push_back(
+          "toolpath.surface: '" + given_file +
+          (file_faced_down
+               ? "' faced down or inside out (its triangles wound clockwise seen "
+                 "from outside); its triangles were turned over"
+               : "' faces down as rotation [" + format_number(surface->rotation_deg.x()) + ", " +
+                     format_number(surface->rotation_deg.y()) + ", " +
+                     format_number(surface->rotation_deg.z()) +
+                     "] places it (the file faces up); its triangles were turned "
+                     "over, so the side now on top is printed"));
     // the grid's size before it is built: every layer's points over the part's (x, y) bounds
     Vec3 lo, hi;
     part.bounds(lo, hi);

@@ -351,7 +351,8 @@ std::vector<SchemaSection> make_schema() {
           number("chord_tolerance_mm", "mm", ValueRange::closed(0.0, 10.0),
                  surface.chord_tolerance_mm,
                  "where the surface rises more than this above the chord between two points "
-                 "(a ridge), the point there is added; 0: the grid's points only (the paper)"),
+                 "(a ridge, a step's edge), the point there is added; 0: the grid's points only "
+                 "(the paper)"),
           speed}});
   }
 

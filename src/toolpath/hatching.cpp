@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "core/error.hpp"
@@ -58,73 +59,152 @@ struct AngleGrid {
   std::vector<Vec3> lone_points;           // between printed pieces, in none (see close())
 };
 
-// n points spaced h, centred on [lo, hi]: the i-th at centre + (i - (n - 1) / 2) h
+// n points spaced h, centred on [lo, hi]: the i-th at centre + (i - (n - 1) / 2) h. An STL
+// holds floats: a part 20 mm wide from x 0.3 is 19.99999923 mm wide as read, and the grid
+// would lose a point (every line half a spacing short at each end), so a width within a few
+// float roundings of the coordinates below a whole number of spacings counts as that number
+// (the outer points then lie that hair outside, where project_down still finds the rim).
 struct Axis {
   int n = 1;
   double first = 0.0;  // the first point
   Axis(double lo, double hi, double h) {
-    n = static_cast<int>(std::floor((hi - lo) / h + 1e-9)) + 1;
+    const double rounding = 4.0 * std::numeric_limits<float>::epsilon() *
+                            std::max({std::abs(lo), std::abs(hi), hi - lo});
+    n = static_cast<int>(std::floor((hi - lo + rounding) / h)) + 1;
     first = 0.5 * (lo + hi) - 0.5 * (n - 1) * h;
   }
 };
 
 // Chords that cut into the part refined (beyond the paper, whose points are the grid's): where
-// the surface halfway between two consecutive points of a piece rises more than
-// spec.chord_tolerance_mm above their chord (a ridge, or any stretch convex enough), that surface
-// point is inserted and both halves are checked again, down to kMaxChordHalvings. Heights are
-// compared vertically, as the points are projected. Without it a roof of slope 0.7 hatched at
-// 2 mm had the nozzle 0.7 mm inside the part on every line across its ridge.
+// the surface between two consecutive points of a piece rises more than
+// spec.chord_tolerance_mm above their chord, a surface point is inserted and both halves are
+// checked again, down to kMaxChordHalvings. The point is the surface halfway where that cuts
+// (a ridge, or any stretch convex enough); else, where the chord lifted by the tolerance first
+// meets the part going either way (a step between the two points, whose edge the halfway
+// point misses: a wall 0.7 of the way up from one to the next), the surface there, a hair
+// past on the side the chord meets, where that cuts more. Heights are compared vertically, as
+// the points are projected. Without it a roof of slope 0.7 hatched at 2 mm had the nozzle
+// 0.7 mm inside the part on every line across its ridge, and a 2 mm step 0.7 of a spacing
+// past a grid point had it 0.6 mm inside.
 constexpr int kMaxChordHalvings = 10;
+// a point found where a lifted chord meets the part is kept at least this share of the chord
+// from its ends, and a chord shorter than twice that share of hatch_mm is not refined (a wall
+// is met at its foot: the chord may climb it over a thousandth of a spacing)
+constexpr double kChordEndShare = 1e-3;
 
 void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& line_origin,
                   const Vec2& d, double first_u, double h, const SurfaceHatchSpec& spec) {
   const std::size_t n = piece.points.size();
   if (n < 2 || !(spec.chord_tolerance_mm > 0.0)) return;
   const auto along = [&](double u) -> Vec2 { return line_origin + u * d; };
-  // every chord's halfway point at once (one batch per piece)
+  const Vec3 lift = spec.chord_tolerance_mm * Vec3::UnitZ();
+  // a hair along the line: beside an edge Embree gives to one side only (as project_down's)
+  const double hair =
+      1e-5 *
+      std::max((projector.upper_bound() - projector.lower_bound()).head<2>().maxCoeff(), 1.0);
+  // the lifted chord a-b's crossings, forward (from a) and back (from b), each the first of
+  // two rays a hair either side of the line: one along the part's outline would meet a wall's
+  // edge there on one side only, as a ray down does
+  const Vec3 beside = hair * Vec3(-d.y(), d.x(), 0.0);
+  const auto add_lifted = [&](std::vector<std::pair<Vec3, Vec3>>& segments, const Vec3& a,
+                              const Vec3& b) {
+    for (const double side : {1.0, -1.0})  // forward
+      segments.emplace_back(a + lift + side * beside, b + lift + side * beside);
+    for (const double side : {1.0, -1.0})  // back
+      segments.emplace_back(b + lift + side * beside, a + lift + side * beside);
+  };
+  const auto first_of = [](const std::optional<double>& one, const std::optional<double>& other) {
+    return !one ? other : !other ? one : std::optional<double>(std::min(*one, *other));
+  };
+  // every chord's halfway point and lifted crossings at once (one batch per piece)
   std::vector<Vec2> halfway(n - 1);
-  for (std::size_t m = 0; m + 1 < n; ++m) halfway[m] = along(first_u + (piece.index[m] + 0.5) * h);
+  std::vector<std::pair<Vec3, Vec3>> lifted;
+  lifted.reserve(4 * (n - 1));
+  for (std::size_t m = 0; m + 1 < n; ++m) {
+    halfway[m] = along(first_u + (piece.index[m] + 0.5) * h);
+    add_lifted(lifted, piece.points[m], piece.points[m + 1]);
+  }
   std::vector<std::optional<SurfaceHit>> hits;
   projector.project_down(halfway, hits);
-  // the surface point halfway if it rises above the chord a-b by more than the tolerance, and
-  // is no step away from its ends (a shelf above the chord: a point there would be a spike,
-  // where the grid's own points break the line)
+  std::vector<std::optional<double>> crossings;
+  projector.first_crossings(lifted, crossings);
+  // the surface point at fraction t of the chord a-b if it rises above the chord by more than
+  // the tolerance (how much; else 0), and is no step away from its ends (a shelf above the
+  // chord: a point there would be a spike, where the grid's own points break the line)
   const double max_jump = spec.max_jump_ratio * h;
-  const auto cut_into = [&](const std::optional<SurfaceHit>& hit, const Vec3& a, const Vec3& b) {
+  const auto rise_above = [&](const std::optional<SurfaceHit>& hit, const Vec3& a, const Vec3& b,
+                              double t) {
     // (a chord up a steep slope is longer than the jump: a point on it lies within the chord)
     const double reach = std::max(max_jump, (b - a).norm());
-    return hit && hit->faces_up(spec.min_normal_z) &&
-           hit->point_mm.z() - 0.5 * (a.z() + b.z()) > spec.chord_tolerance_mm &&
-           (hit->point_mm - a).norm() <= reach && (hit->point_mm - b).norm() <= reach;
+    if (!hit || !hit->faces_up(spec.min_normal_z) || (hit->point_mm - a).norm() > reach ||
+        (hit->point_mm - b).norm() > reach)
+      return 0.0;
+    const double rise = hit->point_mm.z() - (a.z() + t * (b.z() - a.z()));
+    return rise > spec.chord_tolerance_mm ? rise : 0.0;
+  };
+  // the point to insert between (ua, a) and (ub, b), at u along the line, given the surface
+  // halfway and the lifted chord's crossings (fractions from a, and from b going back)
+  struct Cut {
+    double u = 0.0;
+    SurfaceHit hit;
+  };
+  const auto cut_between = [&](double ua, const Vec3& a, double ub, const Vec3& b,
+                               const std::optional<SurfaceHit>& middle,
+                               const std::optional<double>& forward,
+                               const std::optional<double>& backward) -> std::optional<Cut> {
+    if (rise_above(middle, a, b, 0.5) > 0.0) return Cut{0.5 * (ua + ub), *middle};
+    if (!(ub - ua > 2.0 * kChordEndShare * h) || (!forward && !backward)) return std::nullopt;
+    std::optional<Cut> deepest;
+    double deepest_rise = 0.0;
+    for (const auto& [crossing, side] : {std::pair{forward, 1.0}, std::pair{backward, -1.0}}) {
+      if (!crossing) continue;
+      const double t_met = side > 0.0 ? *crossing : 1.0 - *crossing;
+      const double u = std::clamp(ua + t_met * (ub - ua) + side * hair,
+                                  ua + kChordEndShare * (ub - ua), ub - kChordEndShare * (ub - ua));
+      const Vec2 xy = along(u);
+      const std::optional<SurfaceHit> hit = projector.project_down(xy.x(), xy.y());
+      const double rise = rise_above(hit, a, b, (u - ua) / (ub - ua));
+      if (rise > deepest_rise) {
+        deepest_rise = rise;
+        deepest = Cut{u, *hit};
+      }
+    }
+    return deepest;
+  };
+  // the same for a chord inside a refined one, one ray at a time
+  const auto check = [&](double ua, const Vec3& a, double ub, const Vec3& b) {
+    const Vec2 middle = along(0.5 * (ua + ub));
+    std::vector<std::pair<Vec3, Vec3>> segments;
+    add_lifted(segments, a, b);
+    std::vector<std::optional<double>> met;
+    projector.first_crossings(segments, met);
+    return cut_between(ua, a, ub, b, projector.project_down(middle.x(), middle.y()),
+                       first_of(met[0], met[1]), first_of(met[2], met[3]));
   };
   Piece refined;
-  // the points strictly between (ua, a) and (ub, b), in order, given the hit halfway
+  // the points strictly between (ua, a) and (ub, b), in order, given the cut between them
   const auto insert_between = [&](auto&& self, double ua, const Vec3& a, double ub, const Vec3& b,
-                                  const std::optional<SurfaceHit>& middle, int index,
-                                  int depth) -> void {
-    if (!cut_into(middle, a, b)) return;
-    const double um = 0.5 * (ua + ub);
-    const Vec3 m = middle->point_mm;
-    if (depth < kMaxChordHalvings) {
-      const Vec2 left = along(0.5 * (ua + um));
-      self(self, ua, a, um, m, projector.project_down(left.x(), left.y()), index, depth + 1);
-    }
+                                  const std::optional<Cut>& cut, int index, int depth) -> void {
+    if (!cut) return;
+    const double um = cut->u;
+    const Vec3 m = cut->hit.point_mm;
+    if (depth < kMaxChordHalvings) self(self, ua, a, um, m, check(ua, a, um, m), index, depth + 1);
     refined.index.push_back(index);
     refined.points.push_back(m);
-    refined.normals.push_back(middle->normal);
-    if (depth < kMaxChordHalvings) {
-      const Vec2 right = along(0.5 * (um + ub));
-      self(self, um, m, ub, b, projector.project_down(right.x(), right.y()), index, depth + 1);
-    }
+    refined.normals.push_back(cut->hit.normal);
+    if (depth < kMaxChordHalvings) self(self, um, m, ub, b, check(um, m, ub, b), index, depth + 1);
   };
   for (std::size_t m = 0; m < n; ++m) {
     refined.index.push_back(piece.index[m]);
     refined.points.push_back(piece.points[m]);
     refined.normals.push_back(piece.normals[m]);
     if (m + 1 == n) break;
-    insert_between(insert_between, first_u + piece.index[m] * h, piece.points[m],
-                   first_u + piece.index[m + 1] * h, piece.points[m + 1], hits[m], piece.index[m],
-                   1);
+    const double ua = first_u + piece.index[m] * h, ub = first_u + piece.index[m + 1] * h;
+    insert_between(insert_between, ua, piece.points[m], ub, piece.points[m + 1],
+                   cut_between(ua, piece.points[m], ub, piece.points[m + 1], hits[m],
+                               first_of(crossings[4 * m], crossings[4 * m + 1]),
+                               first_of(crossings[4 * m + 2], crossings[4 * m + 3])),
+                   piece.index[m], 1);
   }
   piece = std::move(refined);
 }

@@ -14,7 +14,9 @@
 //    points is a PrintPath (the planner joins pieces by travels);
 //  - beyond the paper, a chord between two points that the surface rises above by more than
 //    chord_tolerance_mm halfway (a ridge between grid points: the nozzle would cut into the
-//    part) gets the surface point there, and its halves are checked again;
+//    part) gets the surface point there, one that the chord lifted by chord_tolerance_mm
+//    still meets (a step's edge off the midpoint) the surface where it meets it, and its
+//    halves are checked again;
 //  - lines go in order across the part (increasing e), every other printed line reversed
 //    (zig-zag; the alternation counts lines that have a piece, so a line lost entirely to a
 //    hole does not break it); a reversed line's pieces come in reverse order, each reversed;
@@ -55,8 +57,9 @@ struct SurfaceHatchSpec {
   double speed_mm_s = 10.0;
   double min_normal_z = 0.1;    // a surface whose normal has n_z <= this is no surface
   double max_jump_ratio = 3.0;  // farther apart than this * hatch_mm, no slope between: a break
-  // a chord between consecutive points whose surface rises more than this above it halfway is
-  // refined by the surface point there (0: the grid's points only, as in the paper)
+  // a chord between consecutive points that the surface rises more than this above (halfway,
+  // or where the chord lifted by this meets it) is refined by the surface point there (0: the
+  // grid's points only, as in the paper)
   double chord_tolerance_mm = 0.05;
 };
 

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -20,6 +21,9 @@ constexpr int kPacket = 16;
 constexpr double kOnEdge = 1e-6;
 // how far uncover's ray looks inside the hit triangle: this share of the way to its centroid
 constexpr double kInward = 1e-3;
+// a triangle met on its edge this steep or steeper (n_z below cos 60 deg) gives way to a
+// flatter one beside it at the same height (flatten)
+constexpr double kSteepFacetZ = 0.5;
 
 void check_device(RTCDevice device, const char* what) {
   const RTCError error = rtcGetDeviceError(device);
@@ -96,12 +100,9 @@ struct SurfaceProjector::Impl {
     return length > 0.0 ? Vec3(sum / length) : mesh.facet_normal(static_cast<std::size_t>(t));
   }
 
-  // Embree decides a ray exactly on a boundary edge of the surface (the outline, a hole's
-  // edge) for one side only, so a part a whole number of grid cells wide is hit along one rim
-  // and missed along the other. A ray that misses, or meets the edge of a wall, is tried again
-  // at four points edge_offset_mm away (diagonally); the highest hit facing up among them is
-  // taken, recomputed exactly at (x, y) on its triangle's plane. Nothing if none.
-  std::optional<SurfaceHit> edge_hit(double x, double y) const {
+  // the hits of four rays edge_offset_mm beside (x, y) (diagonally), each recomputed exactly at
+  // (x, y) on its triangle's plane
+  std::array<std::optional<SurfaceHit>, 4> hits_beside(double x, double y) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     alignas(16) RTCRayHit4 packet;
@@ -112,12 +113,20 @@ struct SurfaceProjector::Impl {
       set_down_ray(packet, k, x + dx, y + dy);
     }
     rtcIntersect4(valid, scene, &context, &packet);
+    std::array<std::optional<SurfaceHit>, 4> hits;
+    for (int k = 0; k < 4; ++k) hits[static_cast<std::size_t>(k)] = lane_hit(packet, k, x, y);
+    return hits;
+  }
+
+  // Embree decides a ray exactly on a boundary edge of the surface (the outline, a hole's
+  // edge) for one side only, so a part a whole number of grid cells wide is hit along one rim
+  // and missed along the other. A ray that misses, or meets the edge of a wall, is tried again
+  // beside (hits_beside); the highest hit facing up among them is taken. Nothing if none.
+  std::optional<SurfaceHit> edge_hit(double x, double y) const {
     std::optional<SurfaceHit> best;
-    for (int k = 0; k < 4; ++k) {
-      const std::optional<SurfaceHit> hit = lane_hit(packet, k, x, y);
+    for (const std::optional<SurfaceHit>& hit : hits_beside(x, y))
       if (hit && hit->facet_normal.z() > 0.0 && (!best || hit->point_mm.z() > best->point_mm.z()))
         best = hit;
-    }
     return best;
   }
 
@@ -125,7 +134,10 @@ struct SurfaceProjector::Impl {
   // wall's edge and edge_hit finds one (in place: most points keep theirs, uncopied)
   void settle(double x, double y, std::optional<SurfaceHit>& hit) const {
     if (hit && hit->facet_normal.z() > 0.0) {
-      if (hit->barycentric.minCoeff() < kOnEdge) uncover(x, y, *hit);
+      if (hit->barycentric.minCoeff() < kOnEdge) {
+        uncover(x, y, *hit);
+        if (hit->facet_normal.z() < kSteepFacetZ) flatten(x, y, *hit);
+      }
       return;
     }
     std::optional<SurfaceHit> beside = edge_hit(x, y);
@@ -160,6 +172,16 @@ struct SurfaceProjector::Impl {
     const SurfaceHit seen =
         exact_hit(x, y, seen_inside->triangle, hit.point_mm.z() - center.z(), 0.0f, 0.0f);
     if (std::abs(seen.point_mm.z() - hit.point_mm.z()) <= edge_offset_mm) hit = seen;
+  }
+
+  // A steep triangle met on its edge (a sliver between two flat facets, mesh noise a few
+  // micrometres high) would leave the point without a printable surface or tilt its normal
+  // far over: the flattest triangle met beside it at the same height there is taken instead.
+  void flatten(double x, double y, SurfaceHit& hit) const {
+    for (const std::optional<SurfaceHit>& beside : hits_beside(x, y))
+      if (beside && beside->facet_normal.z() > hit.facet_normal.z() &&
+          std::abs(beside->point_mm.z() - hit.point_mm.z()) <= edge_offset_mm)
+        hit = *beside;
   }
 
   // one ray straight down from above the mesh at (x, y)
@@ -293,6 +315,42 @@ void SurfaceProjector::project_down(const std::vector<Vec2>& xy,
       hit = im.lane_hit(packet, k, p.x(), p.y());
       im.settle(p.x(), p.y(), hit);
     }
+  }
+}
+
+void SurfaceProjector::first_crossings(const std::vector<std::pair<Vec3, Vec3>>& segments,
+                                       std::vector<std::optional<double>>& fractions) const {
+  const Impl& im = *impl_;
+  fractions.assign(segments.size(), std::nullopt);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(64) RTCRayHit16 packet;
+  alignas(64) int valid[kPacket];
+  for (std::size_t start = 0; start < segments.size(); start += kPacket) {
+    const int count = static_cast<int>(std::min<std::size_t>(kPacket, segments.size() - start));
+    for (int k = 0; k < kPacket; ++k) {
+      const auto& [from, to] = segments[start + static_cast<std::size_t>(std::min(k, count - 1))];
+      valid[k] = k < count ? -1 : 0;
+      // from `from` along to - from: the segment is t in [0, 1]
+      packet.ray.org_x[k] = static_cast<float>(from.x() - im.center.x());
+      packet.ray.org_y[k] = static_cast<float>(from.y() - im.center.y());
+      packet.ray.org_z[k] = static_cast<float>(from.z() - im.center.z());
+      packet.ray.dir_x[k] = static_cast<float>(to.x() - from.x());
+      packet.ray.dir_y[k] = static_cast<float>(to.y() - from.y());
+      packet.ray.dir_z[k] = static_cast<float>(to.z() - from.z());
+      packet.ray.tnear[k] = 0.0f;
+      packet.ray.tfar[k] = 1.0f;
+      packet.ray.mask[k] = ~0u;
+      packet.ray.flags[k] = 0;
+      packet.ray.time[k] = 0.0f;
+      packet.ray.id[k] = static_cast<unsigned>(k);
+      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, im.scene, &context, &packet);
+    for (int k = 0; k < count; ++k)
+      if (packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID)
+        fractions[start + static_cast<std::size_t>(k)] = static_cast<double>(packet.ray.tfar[k]);
   }
 }
 

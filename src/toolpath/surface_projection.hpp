@@ -14,6 +14,7 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/triangle_mesh.hpp"
@@ -73,6 +74,11 @@ class SurfaceProjector {
                     std::vector<std::optional<SurfaceHit>>& hits) const;
   // the height of the top surface at (x, y), or nothing where it misses
   std::optional<double> height_at(double x_mm, double y_mm) const;
+  // Where each straight segment (from, to) first meets the surface, going from `from`: the
+  // fraction of the way, in [0, 1]; nothing where it meets none (packets of 16 rays).
+  // `fractions` is resized to segments.size().
+  void first_crossings(const std::vector<std::pair<Vec3, Vec3>>& segments,
+                       std::vector<std::optional<double>>& fractions) const;
 
   const TriangleMesh& mesh() const;
   // the smooth normal of triangle t at barycentric coordinates b (normalised)

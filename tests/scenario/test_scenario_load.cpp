@@ -362,6 +362,21 @@ TEST_F(ScenarioLoad, ASurfaceFacingDownIsTurnedUpAndSaysSo) {
   EXPECT_EQ(mixed_up.notes[0], "toolpath.surface: 1 of 2 triangles of 'mixed_up.stl" + against);
   ASSERT_EQ(mixed_down.notes.size(), 2u);
   EXPECT_EQ(mixed_down.notes[0], "toolpath.surface: 1 of 2 triangles of 'mixed_down.stl" + against);
+  // a file facing up that the scenario's rotation turns over: the note names the rotation,
+  // not the file; one facing down turned up by the rotation has no note
+  const Scenario rotated = load_scenario(
+      write("rotated.yaml", surface_scenario("up.stl",
+                                             ", rotation: [180, 0, 0], offset: [0, 10, "
+                                             "3]")));
+  ASSERT_EQ(rotated.notes.size(), 1u);
+  EXPECT_EQ(rotated.notes[0],
+            "toolpath.surface: 'up.stl' faces down as rotation [180, 0, 0] places it (the file "
+            "faces up); its triangles were turned over, so the side now on top is printed");
+  EXPECT_TRUE(
+      load_scenario(write("rotated_down.yaml", surface_scenario("down.stl",
+                                                                ", rotation: [180, 0, 0], offset: "
+                                                                "[0, 10, 3]")))
+          .notes.empty());
   ASSERT_GT(up.toolpath.paths.size(), 3u);
   const Vec3 normal = Vec3(-0.1, 0, 1).normalized();
   for (const Scenario* other : {&down, &mixed_up, &mixed_down}) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "core/pose.hpp"
@@ -134,6 +135,63 @@ TEST(Hatching, PartAWholeNumberOfSpacingsWideKeepsItsRim) {
       EXPECT_NEAR(y_lo, 0.0, 1e-9);
       EXPECT_NEAR(y_hi, 6.0, 1e-9);
     }
+  }
+}
+
+// an STL holds floats: a plate 20 mm wide from x 0.3 is 19.99999923 mm wide as read (0.3f,
+// 20.3f), and the grid lost a point: every line was 19 mm long, half a spacing short at each
+// end. Read as 20 mm wide, its lines run from rim to rim at 1 mm.
+TEST(Hatching, APartAsWideAsItsFloatsRoundIsHatchedRimToRim) {
+  const double lo = static_cast<float>(0.3), hi = static_cast<float>(20.3);
+  ASSERT_LT(hi - lo, 20.0);
+  TriangleMesh mesh;
+  mesh.vertices = {{lo, -3, 5}, {hi, -3, 5}, {hi, 3, 5}, {lo, 3, 5}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  SurfaceHatchSpec spec;
+  spec.hatch_mm = 1.0;
+  spec.angles_deg = {0};
+  const SurfaceHatch hatch = hatch_surface(mesh, spec);
+  expect_well_formed(hatch);
+  ASSERT_EQ(hatch.toolpath.paths.size(), 7u);
+  for (const PrintPath& path : hatch.toolpath.paths) {
+    ASSERT_EQ(path.points.size(), 21u);
+    EXPECT_NEAR(std::min(path.points.front().x(), path.points.back().x()), lo, 1e-5);
+    EXPECT_NEAR(std::max(path.points.front().x(), path.points.back().x()), hi, 1e-5);
+  }
+}
+
+// a 2 mm step between grid points, off their midpoint: the surface halfway lies below the
+// chord, which cut 0.6 mm into the step's upper side (a wall 0.7 of a spacing past a grid
+// point, up or down, and on the part's outline too); a point is put on the step's edge where
+// the chord lifted by the tolerance meets it, and no chord cuts deeper than the tolerance
+TEST(Hatching, AChordOverAStepBetweenGridPointsClimbsItsEdge) {
+  for (const auto& [step_x, z_before, z_after] :
+       {std::tuple{0.7, 5.0, 7.0}, std::tuple{0.3, 7.0, 5.0}, std::tuple{-2.85, 5.0, 7.0}}) {
+    SCOPED_TRACE("step at x " + std::to_string(step_x));
+    // two plates at their heights either side of x = step_x, joined by a vertical wall
+    TriangleMesh mesh;
+    mesh.vertices = {{-5, -3, z_before}, {step_x, -3, z_before}, {step_x, 3, z_before},
+                     {-5, 3, z_before},  {step_x, -3, z_after},  {5, -3, z_after},
+                     {5, 3, z_after},    {step_x, 3, z_after}};
+    mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}, {1, 4, 7}, {1, 7, 2}};
+    const SurfaceProjector projector(mesh);
+    SurfaceHatchSpec spec;
+    spec.hatch_mm = 1.0;
+    spec.angles_deg = {0};
+    const SurfaceHatch hatch = hatch_surface(projector, spec);
+    expect_well_formed(hatch);
+    ASSERT_EQ(hatch.toolpath.paths.size(), 7u);  // the step (2 spacings) breaks no line
+    double deepest = 0.0;
+    for (const PrintPath& path : hatch.toolpath.paths)
+      for (std::size_t i = 0; i + 1 < path.points.size(); ++i)
+        for (int k = 1; k < 400; ++k) {
+          const Vec3 p = path.points[i] + (k / 400.0) * (path.points[i + 1] - path.points[i]);
+          const double surface = p.x() < step_x   ? z_before
+                                 : p.x() > step_x ? z_after
+                                                  : std::max(z_before, z_after);
+          deepest = std::max(deepest, surface - p.z());
+        }
+    EXPECT_LE(deepest, spec.chord_tolerance_mm + 1e-9);
   }
 }
 

@@ -257,6 +257,28 @@ TEST(SurfaceProjection, APointOnAnEdgeIsOnTheTriangleSeenBesideIt) {
   }
 }
 
+// two plates 10 um apart in height joined by a sliver 0.1 um wide (mesh noise), its lower
+// edge on the line y = 0: a point there was taken on the sliver (n_z 0.01, no surface to
+// print) and the whole line was dropped; it is on the flat plate met beside it, at its height
+TEST(SurfaceProjection, APointOnASliversEdgeIsOnTheFlatFacetBesideIt) {
+  TriangleMesh mesh;
+  mesh.vertices = {{-10, -8, 5},     {10, -8, 5},       {10, 0, 5},    {-10, 0, 5},
+                   {10, 1e-4, 5.01}, {-10, 1e-4, 5.01}, {10, 8, 5.01}, {-10, 8, 5.01}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {3, 2, 4}, {3, 4, 5}, {5, 4, 6}, {5, 6, 7}};
+  ASSERT_LT(mesh.facet_normal(2).z(), 0.02);  // the sliver
+  const SurfaceProjector projector(mesh);
+  std::vector<Vec2> on_the_edge;
+  for (int k = -8; k <= 8; ++k) on_the_edge.emplace_back(k, 0.0);
+  std::vector<std::optional<SurfaceHit>> hits;
+  projector.project_down(on_the_edge, hits);
+  for (std::size_t k = 0; k < on_the_edge.size(); ++k) {
+    ASSERT_TRUE(hits[k]) << k;
+    EXPECT_TRUE(hits[k]->faces_up()) << on_the_edge[k].transpose();
+    EXPECT_LT((hits[k]->facet_normal - Vec3::UnitZ()).norm(), 1e-12);
+    EXPECT_NEAR(hits[k]->point_mm.z(), 5.0, 1e-12);
+  }
+}
+
 TEST(SurfaceProjection, BatchEqualsSingleRays) {
   CylinderParams params;
   params.mesh.holes = {SurfaceHole::circle(Vec2(0, 0), 5.0)};
