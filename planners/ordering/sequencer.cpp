@@ -87,17 +87,67 @@ const std::vector<std::string>& cost_models() {
   return names;
 }
 
-OrderResult sequence(const Toolpath& toolpath, const TcpLimits& limits, const OrderSpec& spec,
-                     const SequencerOptions& options) {
-  check_spec(spec);
-  const TransitionCost cost(toolpath, limits, parse_cost_model(spec.cost_model));
+namespace {
 
-  // construct, then refine over neighbour lists
+// construct, then refine over neighbour lists
+OrderResult search_order(const TransitionCost& cost, const OrderSpec& spec,
+                         const SequencerOptions& options) {
   OrderResult result = find_sequencer(spec.method)->construct(cost, spec);
   if (!spec.refine.empty()) {
     const NeighborLists neighbors(cost, options.neighbors);
     refine_order(result, cost, neighbors, parse_refinement(spec.refine));
   }
+  return result;
+}
+
+// A part in layers (a slicer's G-code, a hatch's layers) is printed layer on layer: the
+// order is searched within each layer, the layers taken in rising order (across them a
+// sequencer printed a layer before the one under it, which no machine can). Each layer's
+// search starts where the last one ended and ends where the next layer's first path as given
+// begins (a slicer starts each layer near where it ended the last); the last layer ends at the
+// toolpath's end.
+OrderResult search_layer_by_layer(const Toolpath& toolpath, const TcpLimits& limits,
+                                  const OrderSpec& spec, const SequencerOptions& options) {
+  std::vector<std::vector<int>> layers(static_cast<std::size_t>(toolpath.layer_count()));
+  for (std::size_t i = 0; i < toolpath.paths.size(); ++i)
+    layers[static_cast<std::size_t>(toolpath.paths[i].layer)].push_back(static_cast<int>(i));
+  layers.erase(std::remove_if(layers.begin(), layers.end(),
+                              [](const std::vector<int>& paths) { return paths.empty(); }),
+               layers.end());
+  OrderResult result;
+  Vec3 at = toolpath.start_mm;
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    Toolpath layer;
+    layer.start_mm = at;
+    layer.end_mm =
+        l + 1 == layers.size()
+            ? toolpath.end_mm
+            : toolpath.paths[static_cast<std::size_t>(layers[l + 1].front())].points.front();
+    for (const int i : layers[l])
+      layer.paths.push_back(toolpath.paths[static_cast<std::size_t>(i)]);
+    const TransitionCost cost(layer, limits, parse_cost_model(spec.cost_model));
+    const OrderResult within = search_order(cost, spec, options);
+    for (std::size_t k = 0; k < within.order.size(); ++k) {
+      result.order.push_back(layers[l][static_cast<std::size_t>(within.order[k])]);
+      result.reversed.push_back(within.reversed[k]);
+    }
+    const PrintPath& last = layer.paths[static_cast<std::size_t>(within.order.back())];
+    at = within.reversed.back() ? last.points.front() : last.points.back();
+  }
+  return result;
+}
+
+}  // namespace
+
+OrderResult sequence(const Toolpath& toolpath, const TcpLimits& limits, const OrderSpec& spec,
+                     const SequencerOptions& options) {
+  check_spec(spec);
+  const TransitionCost cost(toolpath, limits, parse_cost_model(spec.cost_model));
+  // (the given order, unrefined, is the file's, whatever its layers)
+  const bool searched = spec.method != "as_given" || !spec.refine.empty();
+  OrderResult result = toolpath.layer_count() > 1 && searched
+                           ? search_layer_by_layer(toolpath, limits, spec, options)
+                           : search_order(cost, spec, options);
 
   result.cost_s = cost.order_cost(result);
   result.print_time_s = cost.print_time_s();

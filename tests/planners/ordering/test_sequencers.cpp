@@ -53,6 +53,33 @@ TEST(Sequencers, NoMethodBeatsTheBruteForceOptimumAndTheBoundStaysBelow) {
   }
 }
 
+// a part in layers is printed layer on layer: every search keeps the layers in rising order
+// (a multi-layer G-code file searched whole had upper layers printed before the ones under
+// them); the given order, unrefined, stays the file's whatever its layers
+TEST(Sequencers, SearchesKeepTheLayersInRisingOrder) {
+  Toolpath toolpath = testing::paper_instance(12, 4242);
+  for (std::size_t i = 0; i < toolpath.paths.size(); ++i) {
+    PrintPath& path = toolpath.paths[i];
+    path.layer = static_cast<int>((i * 7) % 3);  // layers 0, 1, 2 mixed through the file
+    for (Vec3& p : path.points) p.z() = 0.2 * (path.layer + 1);
+  }
+  ASSERT_EQ(toolpath.layer_count(), 3);
+  const TransitionCost cost(toolpath, kPaperLimits, CostModel::machine);
+  for (const OrderSpec& spec : every_method("machine")) {
+    const OrderResult result = sequence(toolpath, kPaperLimits, spec);
+    expect_permutation(result, 12);
+    EXPECT_NEAR(result.cost_s, cost.order_cost(result), 1e-9);
+    if (spec.method == "as_given" && spec.refine.empty()) {
+      for (int k = 0; k < 12; ++k) EXPECT_EQ(result.order[static_cast<std::size_t>(k)], k);
+      continue;
+    }
+    for (std::size_t k = 1; k < result.order.size(); ++k)
+      EXPECT_LE(toolpath.paths[static_cast<std::size_t>(result.order[k - 1])].layer,
+                toolpath.paths[static_cast<std::size_t>(result.order[k])].layer)
+          << spec.label() << " at " << k;
+  }
+}
+
 TEST(Sequencers, ThreeOptReachesTheOptimumOnMostSeeds) {
   // N = 6 and 7, 15 seeds each, from nearest neighbour and from Christofides
   int runs = 0, optimal = 0;
