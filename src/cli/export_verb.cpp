@@ -18,6 +18,7 @@
 #include "metrics/polyline_distance.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/job_check.hpp"
+#include "pipeline/models_dir.hpp"
 #include "pipeline/step_heartbeat.hpp"
 #include "report/output_dir.hpp"
 #include "toolpath/gcode.hpp"
@@ -200,14 +201,20 @@ class GcodeWriter {
     body_ << text << '\n';
   }
 
-  // E with at least 3 significant digits (a slow ramp's moves carry very little), so a print
-  // move never reads as E0; F when it changes
+  // E as written: at least 3 significant digits (a slow ramp's moves carry very little), up
+  // to 10 decimals; "" where that shows no material (e_mm below 5e-11 mm: the move is written
+  // without E, a travel to a reader)
+  std::string e_text(double e_mm) const {
+    if (!extrusion_ || !(e_mm > 0.0)) return "";
+    int decimals = 5;
+    while (decimals < 10 && e_mm < std::pow(10.0, 2 - decimals)) ++decimals;
+    const std::string text = number_text(e_mm, decimals);
+    return text.find_first_of("123456789") == std::string::npos ? "" : text;
+  }
+
+  // E (e_text) and F when it changes
   void append_e_and_feed(std::string& text, double e_mm, double feed_mm_min) {
-    if (extrusion_ && e_mm > 0.0) {
-      int decimals = 5;
-      while (decimals < 10 && e_mm < std::pow(10.0, 2 - decimals)) ++decimals;
-      text += " E" + number_text(e_mm, decimals);
-    }
+    if (const std::string e = e_text(e_mm); !e.empty()) text += " E" + e;
     if (feed_mm_min > 0.0) {
       int decimals = 1;
       while (decimals < 4 && feed_mm_min < std::pow(10.0, 2 - decimals)) ++decimals;
@@ -264,6 +271,24 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
   size_t print_moves = 0, print_arcs = 0;
   double print_length_mm = 0.0, e_total_mm = 0.0;
   bool open = false;  // aerosol: the shutter code last written
+  // extrusion: a move whose E the written digits cannot show (the flow's last trickle at a
+  // path's end) is written without E, a travel to a reader, and counted as one; its E goes
+  // with the next move that shows E, so the header's counts and E total are the file's
+  double e_carried_mm = 0.0;
+  const auto deposits = [&](double e_mm) {
+    return !extrusion || !gcode.e_text(e_mm + e_carried_mm).empty();
+  };
+  const auto tally = [&](bool prints, double e_mm, double length_mm, bool arc) {
+    if (!prints) {
+      e_carried_mm += e_mm;
+      return;
+    }
+    e_total_mm += e_mm + e_carried_mm;
+    e_carried_mm = 0.0;
+    ++print_moves;
+    print_arcs += arc ? 1 : 0;
+    print_length_mm += length_mm;
+  };
 
   // the job's start, at rest
   if (!trajectory.pieces().empty()) {
@@ -344,14 +369,13 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
           pending_dwell_s = 0.0;
           const double e_mm =
               (samples.volume_mm3[arc_to] - samples.volume_mm3[written]) / filament_area_mm2;
+          const bool prints = deposits(e_mm);
           gcode.arc(arc->second > 0.0, samples.position_mm[written], samples.position_mm[arc_to],
-                    arc->first.centre_mm, 60.0 * length_mm / move_s, e_mm);
+                    arc->first.centre_mm, 60.0 * length_mm / move_s,
+                    prints ? e_mm + e_carried_mm : 0.0);
           written = arc_to;
           next = arc_end;
-          ++print_moves;
-          ++print_arcs;
-          print_length_mm += length_mm;
-          e_total_mm += e_mm;
+          tally(prints, e_mm, length_mm, true);
           continue;
         }
         const double length_mm = (samples.position_mm[to] - samples.position_mm[written]).norm();
@@ -368,11 +392,11 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
         pending_dwell_s = 0.0;
         const double e_mm =
             (samples.volume_mm3[to] - samples.volume_mm3[written]) / filament_area_mm2;
-        gcode.move("G1", samples.position_mm[to], 60.0 * length_mm / move_s, e_mm);
+        const bool prints = deposits(e_mm);
+        gcode.move("G1", samples.position_mm[to], 60.0 * length_mm / move_s,
+                   prints ? e_mm + e_carried_mm : 0.0);
         written = to;
-        ++print_moves;
-        print_length_mm += length_mm;
-        e_total_mm += e_mm;
+        tally(prints, e_mm, length_mm, false);
       }
       run_first = run_last;
     }
@@ -454,6 +478,13 @@ int export_verb(const ExportOptions& options) {
                                       (input == scenario.file ? "the scenario file"
                                                               : "a file the scenario reads") +
                                       "; name another file to write");
+    // nor in the folder of the shipped machine models, which every scenario may read (a
+    // built-in machine's MJCF is named by no key of the scenario)
+    const fs::path out_folder = fs::absolute(options.out).parent_path();
+    if (fs::equivalent(out_folder, models_directory(), error))
+      throw InputError("--out", "'" + options.out + "' is in the machine models' folder (" +
+                                    models_directory() +
+                                    "), which depotwin reads; name a file elsewhere");
   }
   // one writer of the file at a time (report/output_dir.hpp); what writers killed outright
   // left beside it goes

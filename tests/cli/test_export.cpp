@@ -189,6 +189,22 @@ TEST(ExportGcode, RoundTripOnEveryShippedPlanarScenario) {
       const GcodeImport import = parse_gcode(in, scenario.name + ".gcode", GcodeOptions{});
       EXPECT_EQ(import.rule,
                 scenario.process.type == "extrusion" ? PrintRule::e : PrintRule::shutter);
+      // the header's counts are the file's: a move whose E the digits cannot show (the flow's
+      // last trickle) is written without E and counted as the travel a reader takes it for
+      // (uniform's export said 657 print moves where the file had 654: three wrote no E, one
+      // wrote E0)
+      const std::string counts = "print moves (";
+      const std::size_t counts_at = gcode.find(counts);
+      ASSERT_NE(counts_at, std::string::npos);
+      const std::size_t count_begin = gcode.rfind(' ', gcode.rfind(' ', counts_at - 1) - 1) + 1;
+      std::size_t moves_in_file = 0;
+      for (const PrintPath& path : import.toolpath.paths) moves_in_file += path.points.size() - 1;
+      EXPECT_EQ(std::stoul(gcode.substr(count_begin)), moves_in_file);
+      const std::size_t length_at = gcode.find("print length ", counts_at) + 13;
+      EXPECT_NEAR(std::stod(gcode.substr(length_at)), import.toolpath.print_length_mm(),
+                  1e-3 + 1e-4 * import.toolpath.print_length_mm());
+      EXPECT_EQ(gcode.find(" E0 "), std::string::npos);
+      EXPECT_EQ(gcode.find(" E0\n"), std::string::npos);
       // arcs (G2/G3 written where the plan runs on a circle) as fine chords for the distances
       const Toolpath imported = import.toolpath.chorded(1e-5);
 
@@ -311,6 +327,28 @@ TEST(ExportVerb, RefusesBadOutputPlannerChoiceAndConformalScenarios) {
             std::string::npos)
       << r.output;
   EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+// a built-in machine's MJCF is named by no key of the scenario: export wrote G-code over
+// models/cartesian.xml, and every scenario on the machine then failed; the models' folder is
+// refused (on a copy of it, so that a failure cannot harm the shipped one)
+TEST(ExportVerb, NeverWritesInTheMachineModelsFolder) {
+  namespace fs = std::filesystem;
+  const std::string dir = fresh_directory("export_models");
+  fs::copy(std::string(DEPOTWIN_SOURCE_DIR) + "/models", dir + "/models",
+           fs::copy_options::recursive);
+  const std::string model = dir + "/models/cartesian.xml";
+  const std::string before = read_text(model);
+  const auto r = testing_support::shell("DEPOTWIN_MODELS_DIR=" + dir + "/models " +
+                                        std::string(DEPOTWIN_BINARY_DIR) + "/depotwin export " +
+                                        scenario_path("gcode_rounded_square.yaml") +
+                                        " --planner lspb_mtt --out " + model);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("error: --out: '" + model + "' is in the machine models' folder (" + dir +
+                          "/models), which depotwin reads; name a file elsewhere"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(read_text(model), before);
 }
 
 }  // namespace
