@@ -204,14 +204,23 @@ struct SurfaceProjector::Impl {
   // ray k of a packet: straight down from above the mesh at (x, y)
   template <typename Packet>
   void set_down_ray(Packet& packet, int k, double x, double y) const {
-    packet.ray.org_x[k] = static_cast<float>(x - center.x());
-    packet.ray.org_y[k] = static_cast<float>(y - center.y());
-    packet.ray.org_z[k] = ray_z;
-    packet.ray.dir_x[k] = 0.0f;
-    packet.ray.dir_y[k] = 0.0f;
-    packet.ray.dir_z[k] = -1.0f;
+    set_ray(packet, k,
+            {static_cast<float>(x - center.x()), static_cast<float>(y - center.y()), ray_z},
+            {0.0f, 0.0f, -1.0f}, std::numeric_limits<float>::infinity());
+  }
+
+  // ray k of a packet from `origin` (centred frame) along `direction` up to tfar times it
+  template <typename Packet>
+  static void set_ray(Packet& packet, int k, const std::array<float, 3>& origin,
+                      const std::array<float, 3>& direction, float tfar) {
+    packet.ray.org_x[k] = origin[0];
+    packet.ray.org_y[k] = origin[1];
+    packet.ray.org_z[k] = origin[2];
+    packet.ray.dir_x[k] = direction[0];
+    packet.ray.dir_y[k] = direction[1];
+    packet.ray.dir_z[k] = direction[2];
     packet.ray.tnear[k] = 0.0f;
-    packet.ray.tfar[k] = std::numeric_limits<float>::infinity();
+    packet.ray.tfar[k] = tfar;
     packet.ray.mask[k] = ~0u;
     packet.ray.flags[k] = 0;
     packet.ray.time[k] = 0.0f;
@@ -332,20 +341,13 @@ void SurfaceProjector::first_crossings(const std::vector<std::pair<Vec3, Vec3>>&
       const auto& [from, to] = segments[start + static_cast<std::size_t>(std::min(k, count - 1))];
       valid[k] = k < count ? -1 : 0;
       // from `from` along to - from: the segment is t in [0, 1]
-      packet.ray.org_x[k] = static_cast<float>(from.x() - im.center.x());
-      packet.ray.org_y[k] = static_cast<float>(from.y() - im.center.y());
-      packet.ray.org_z[k] = static_cast<float>(from.z() - im.center.z());
-      packet.ray.dir_x[k] = static_cast<float>(to.x() - from.x());
-      packet.ray.dir_y[k] = static_cast<float>(to.y() - from.y());
-      packet.ray.dir_z[k] = static_cast<float>(to.z() - from.z());
-      packet.ray.tnear[k] = 0.0f;
-      packet.ray.tfar[k] = 1.0f;
-      packet.ray.mask[k] = ~0u;
-      packet.ray.flags[k] = 0;
-      packet.ray.time[k] = 0.0f;
-      packet.ray.id[k] = static_cast<unsigned>(k);
-      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+      const Vec3 origin = from - im.center, direction = to - from;
+      Impl::set_ray(packet, k,
+                    {static_cast<float>(origin.x()), static_cast<float>(origin.y()),
+                     static_cast<float>(origin.z())},
+                    {static_cast<float>(direction.x()), static_cast<float>(direction.y()),
+                     static_cast<float>(direction.z())},
+                    1.0f);
     }
     rtcIntersect16(valid, im.scene, &context, &packet);
     for (int k = 0; k < count; ++k)
