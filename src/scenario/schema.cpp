@@ -226,7 +226,9 @@ std::vector<SchemaSection> make_schema() {
                "the line's width for the target region; 0: 4 sigma (aerosol) or the bead width "
                "(extrusion)"),
         number("bead_width_mm", "mm", ValueRange::closed(0.01, 100.0), process.bead_width_mm,
-               "bead width; the flow is speed * bead width * layer height", "extrusion"),
+               "bead width; the nominal flow is the path's print speed * bead width * layer "
+               "height",
+               "extrusion"),
         number("layer_height_mm", "mm", ValueRange::closed(0.001, 100.0), process.layer_height_mm,
                "bead height", "extrusion"),
         number("tau_s", "s", positive_up_to(100.0), process.tau_s,
