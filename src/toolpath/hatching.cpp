@@ -102,24 +102,29 @@ void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& l
   const double hair =
       1e-5 *
       std::max((projector.upper_bound() - projector.lower_bound()).head<2>().maxCoeff(), 1.0);
-  // the lifted chord a-b's crossings, forward (from a) and back (from b), each the first of
-  // two rays a hair either side of the line: one along the part's outline would meet a wall's
-  // edge there on one side only, as a ray down does
+  // the lifted chord a-b's crossings, forward (from a) and back (from b): each that of the
+  // ray along the line, or where it misses, the first of two rays a hair either side (one
+  // along the part's outline meets a wall's edge there on one side only, as a ray down does;
+  // beside the line an oblique wall is met early, so the line's own crossing comes first)
   const Vec3 beside = hair * Vec3(-d.y(), d.x(), 0.0);
+  constexpr std::size_t kRaysPerChord = 6;
   const auto add_lifted = [&](std::vector<std::pair<Vec3, Vec3>>& segments, const Vec3& a,
                               const Vec3& b) {
-    for (const double side : {1.0, -1.0})  // forward
+    for (const double side : {0.0, 1.0, -1.0})  // forward
       segments.emplace_back(a + lift + side * beside, b + lift + side * beside);
-    for (const double side : {1.0, -1.0})  // back
+    for (const double side : {0.0, 1.0, -1.0})  // back
       segments.emplace_back(b + lift + side * beside, a + lift + side * beside);
   };
-  const auto first_of = [](const std::optional<double>& one, const std::optional<double>& other) {
+  // the crossing of rays [first, first + 3): the line's own, else the earlier beside it
+  const auto crossing_of = [](const std::vector<std::optional<double>>& met, std::size_t first) {
+    if (met[first]) return met[first];
+    const std::optional<double>&one = met[first + 1], &other = met[first + 2];
     return !one ? other : !other ? one : std::optional<double>(std::min(*one, *other));
   };
   // every chord's halfway point and lifted crossings at once (one batch per piece)
   std::vector<Vec2> halfway(n - 1);
   std::vector<std::pair<Vec3, Vec3>> lifted;
-  lifted.reserve(4 * (n - 1));
+  lifted.reserve(kRaysPerChord * (n - 1));
   for (std::size_t m = 0; m + 1 < n; ++m) {
     halfway[m] = along(first_u + (piece.index[m] + 0.5) * h);
     add_lifted(lifted, piece.points[m], piece.points[m + 1]);
@@ -129,18 +134,18 @@ void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& l
   std::vector<std::optional<double>> crossings;
   projector.first_crossings(lifted, crossings);
   // the surface point at fraction t of the chord a-b if it rises above the chord by more than
-  // the tolerance (how much; else 0), and is no step away from its ends (a shelf above the
-  // chord: a point there would be a spike, where the grid's own points break the line)
+  // `least` (how much; else 0), and is no step away from its ends (a shelf above the chord: a
+  // point there would be a spike, where the grid's own points break the line)
   const double max_jump = spec.max_jump_ratio * h;
   const auto rise_above = [&](const std::optional<SurfaceHit>& hit, const Vec3& a, const Vec3& b,
-                              double t) {
+                              double t, double least) {
     // (a chord up a steep slope is longer than the jump: a point on it lies within the chord)
     const double reach = std::max(max_jump, (b - a).norm());
     if (!hit || !hit->faces_up(spec.min_normal_z) || (hit->point_mm - a).norm() > reach ||
         (hit->point_mm - b).norm() > reach)
       return 0.0;
     const double rise = hit->point_mm.z() - (a.z() + t * (b.z() - a.z()));
-    return rise > spec.chord_tolerance_mm ? rise : 0.0;
+    return rise > least ? rise : 0.0;
   };
   // the point to insert between (ua, a) and (ub, b), at u along the line, given the surface
   // halfway and the lifted chord's crossings (fractions from a, and from b going back)
@@ -152,18 +157,27 @@ void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& l
                                const std::optional<SurfaceHit>& middle,
                                const std::optional<double>& forward,
                                const std::optional<double>& backward) -> std::optional<Cut> {
-    if (rise_above(middle, a, b, 0.5) > 0.0) return Cut{0.5 * (ua + ub), *middle};
+    if (rise_above(middle, a, b, 0.5, spec.chord_tolerance_mm) > 0.0)
+      return Cut{0.5 * (ua + ub), *middle};
     if (!(ub - ua > 2.0 * kChordEndShare * h) || (!forward && !backward)) return std::nullopt;
+    // where the lifted chord enters the part, a hair on (a wall's top, beyond its foot), where
+    // it leaves it, a hair back, and halfway between: the deepest. At the crossing itself the
+    // surface is the tolerance above the chord, a hair on by the chord's slope times the hair
+    // more: a point must rise more than that allows (else a point beside a descending chord's
+    // start would be refined again and again, each a hair on)
+    const double t_in = forward ? *forward : 0.0;
+    const double t_out = backward ? 1.0 - *backward : 1.0;
+    const double slope = std::abs(b.z() - a.z()) / (ub - ua);
+    const double least = spec.chord_tolerance_mm + 4.0 * hair * (1.0 + slope);
     std::optional<Cut> deepest;
     double deepest_rise = 0.0;
-    for (const auto& [crossing, side] : {std::pair{forward, 1.0}, std::pair{backward, -1.0}}) {
-      if (!crossing) continue;
-      const double t_met = side > 0.0 ? *crossing : 1.0 - *crossing;
-      const double u = std::clamp(ua + t_met * (ub - ua) + side * hair,
-                                  ua + kChordEndShare * (ub - ua), ub - kChordEndShare * (ub - ua));
+    for (const double u_raw : {ua + t_in * (ub - ua) + hair, ua + t_out * (ub - ua) - hair,
+                               ua + 0.5 * (t_in + t_out) * (ub - ua)}) {
+      const double u =
+          std::clamp(u_raw, ua + kChordEndShare * (ub - ua), ub - kChordEndShare * (ub - ua));
       const Vec2 xy = along(u);
       const std::optional<SurfaceHit> hit = projector.project_down(xy.x(), xy.y());
-      const double rise = rise_above(hit, a, b, (u - ua) / (ub - ua));
+      const double rise = rise_above(hit, a, b, (u - ua) / (ub - ua), least);
       if (rise > deepest_rise) {
         deepest_rise = rise;
         deepest = Cut{u, *hit};
@@ -179,7 +193,7 @@ void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& l
     std::vector<std::optional<double>> met;
     projector.first_crossings(segments, met);
     return cut_between(ua, a, ub, b, projector.project_down(middle.x(), middle.y()),
-                       first_of(met[0], met[1]), first_of(met[2], met[3]));
+                       crossing_of(met, 0), crossing_of(met, 3));
   };
   Piece refined;
   // the points strictly between (ua, a) and (ub, b), in order, given the cut between them
@@ -202,8 +216,8 @@ void refine_piece(const SurfaceProjector& projector, Piece& piece, const Vec2& l
     const double ua = first_u + piece.index[m] * h, ub = first_u + piece.index[m + 1] * h;
     insert_between(insert_between, ua, piece.points[m], ub, piece.points[m + 1],
                    cut_between(ua, piece.points[m], ub, piece.points[m + 1], hits[m],
-                               first_of(crossings[4 * m], crossings[4 * m + 1]),
-                               first_of(crossings[4 * m + 2], crossings[4 * m + 3])),
+                               crossing_of(crossings, kRaysPerChord * m),
+                               crossing_of(crossings, kRaysPerChord * m + 3)),
                    piece.index[m], 1);
   }
   piece = std::move(refined);

@@ -163,35 +163,53 @@ TEST(Hatching, APartAsWideAsItsFloatsRoundIsHatchedRimToRim) {
 // a 2 mm step between grid points, off their midpoint: the surface halfway lies below the
 // chord, which cut 0.6 mm into the step's upper side (a wall 0.7 of a spacing past a grid
 // point, up or down, and on the part's outline too); a point is put on the step's edge where
-// the chord lifted by the tolerance meets it, and no chord cuts deeper than the tolerance
+// the chord lifted by the tolerance meets it, and no chord cuts deeper than the tolerance:
+// measured vertically along x, and as the distance into the part for lines that cross the
+// wall at 50 and 60 degrees (the point beside an oblique wall once fell on its foot: 0.14 mm)
 TEST(Hatching, AChordOverAStepBetweenGridPointsClimbsItsEdge) {
-  for (const auto& [step_x, z_before, z_after] :
-       {std::tuple{0.7, 5.0, 7.0}, std::tuple{0.3, 7.0, 5.0}, std::tuple{-2.85, 5.0, 7.0}}) {
-    SCOPED_TRACE("step at x " + std::to_string(step_x));
-    // two plates at their heights either side of x = step_x, joined by a vertical wall
-    TriangleMesh mesh;
-    mesh.vertices = {{-5, -3, z_before}, {step_x, -3, z_before}, {step_x, 3, z_before},
-                     {-5, 3, z_before},  {step_x, -3, z_after},  {5, -3, z_after},
-                     {5, 3, z_after},    {step_x, 3, z_after}};
-    mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}, {1, 4, 7}, {1, 7, 2}};
-    const SurfaceProjector projector(mesh);
-    SurfaceHatchSpec spec;
-    spec.hatch_mm = 1.0;
-    spec.angles_deg = {0};
-    const SurfaceHatch hatch = hatch_surface(projector, spec);
-    expect_well_formed(hatch);
-    ASSERT_EQ(hatch.toolpath.paths.size(), 7u);  // the step (2 spacings) breaks no line
-    double deepest = 0.0;
-    for (const PrintPath& path : hatch.toolpath.paths)
-      for (std::size_t i = 0; i + 1 < path.points.size(); ++i)
-        for (int k = 1; k < 400; ++k) {
-          const Vec3 p = path.points[i] + (k / 400.0) * (path.points[i + 1] - path.points[i]);
-          const double surface = p.x() < step_x   ? z_before
-                                 : p.x() > step_x ? z_after
-                                                  : std::max(z_before, z_after);
-          deepest = std::max(deepest, surface - p.z());
-        }
-    EXPECT_LE(deepest, spec.chord_tolerance_mm + 1e-9);
+  for (const double angle : {0.0, 50.0, 60.0}) {
+    for (const auto& [step_x, z_before, z_after] :
+         {std::tuple{0.7, 5.0, 7.0}, std::tuple{0.3, 7.0, 5.0}, std::tuple{-2.85, 5.0, 7.0},
+          std::tuple{0.9, 7.0, 5.0}}) {
+      SCOPED_TRACE("step at x " + std::to_string(step_x) + ", lines at " + std::to_string(angle) +
+                   " deg");
+      // two plates at their heights either side of x = step_x, joined by a vertical wall
+      TriangleMesh mesh;
+      mesh.vertices = {{-5, -3, z_before}, {step_x, -3, z_before}, {step_x, 3, z_before},
+                       {-5, 3, z_before},  {step_x, -3, z_after},  {5, -3, z_after},
+                       {5, 3, z_after},    {step_x, 3, z_after}};
+      mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}, {1, 4, 7}, {1, 7, 2}};
+      const SurfaceProjector projector(mesh);
+      SurfaceHatchSpec spec;
+      spec.hatch_mm = 1.0;
+      spec.angles_deg = {angle};
+      const SurfaceHatch hatch = hatch_surface(projector, spec);
+      expect_well_formed(hatch);
+      if (angle == 0.0) {
+        ASSERT_EQ(hatch.toolpath.paths.size(), 7u);  // the step breaks no line
+      }
+      // how far p lies inside the part: below the low plate, or below the high one and past
+      // the wall (the nearer of the high top and the wall's upper edge)
+      const double low = std::min(z_before, z_after), high = std::max(z_before, z_after);
+      const auto depth = [&](const Vec3& p) {
+        const double past_wall = z_after > z_before ? p.x() - step_x : step_x - p.x();
+        if (past_wall <= 0.0) return low - p.z();
+        return std::min(high - p.z(), std::hypot(past_wall, std::max(0.0, low - p.z())));
+      };
+      double deepest = 0.0, deepest_vertically = 0.0;
+      for (const PrintPath& path : hatch.toolpath.paths)
+        for (std::size_t i = 0; i + 1 < path.points.size(); ++i)
+          for (int k = 1; k < 400; ++k) {
+            const Vec3 p = path.points[i] + (k / 400.0) * (path.points[i + 1] - path.points[i]);
+            deepest = std::max(deepest, depth(p));
+            const double surface = p.x() < step_x ? z_before : p.x() > step_x ? z_after : high;
+            deepest_vertically = std::max(deepest_vertically, surface - p.z());
+          }
+      EXPECT_LE(deepest, spec.chord_tolerance_mm + 1e-9);
+      if (angle == 0.0) {
+        EXPECT_LE(deepest_vertically, spec.chord_tolerance_mm + 1e-9);
+      }
+    }
   }
 }
 
