@@ -168,9 +168,11 @@ TEST(Hatching, APartAsWideAsItsFloatsRoundIsHatchedRimToRim) {
 // wall at 50 and 60 degrees (the point beside an oblique wall once fell on its foot: 0.14 mm)
 TEST(Hatching, AChordOverAStepBetweenGridPointsClimbsItsEdge) {
   for (const double angle : {0.0, 50.0, 60.0}) {
-    for (const auto& [step_x, z_before, z_after] :
+    for (const auto& [step_at, before, after] :
          {std::tuple{0.7, 5.0, 7.0}, std::tuple{0.3, 7.0, 5.0}, std::tuple{-2.85, 5.0, 7.0},
           std::tuple{0.9, 7.0, 5.0}}) {
+      // (copies: a lambda cannot capture a structured binding in C++17)
+      const double step_x = step_at, z_before = before, z_after = after;
       SCOPED_TRACE("step at x " + std::to_string(step_x) + ", lines at " + std::to_string(angle) +
                    " deg");
       // two plates at their heights either side of x = step_x, joined by a vertical wall
