@@ -79,13 +79,13 @@ struct Axis {
 // the surface between two consecutive points of a piece rises more than
 // spec.chord_tolerance_mm above their chord, a surface point is inserted and both halves are
 // checked again, down to kMaxChordHalvings. The point is the surface halfway where that cuts
-// (a ridge, or any stretch convex enough); else, where the chord lifted by the tolerance first
-// meets the part going either way (a step between the two points, whose edge the halfway
-// point misses: a wall 0.7 of the way up from one to the next), the surface there, a hair
-// past on the side the chord meets, where that cuts more. Heights are compared vertically, as
-// the points are projected. Without it a roof of slope 0.7 hatched at 2 mm had the nozzle
-// 0.7 mm inside the part on every line across its ridge, and a 2 mm step 0.7 of a spacing
-// past a grid point had it 0.6 mm inside.
+// (a ridge, or any stretch convex enough); else, where the chord lifted by the tolerance
+// still meets the part (a step between the two points, whose edge the halfway point misses:
+// a wall 0.7 of the way up from one to the next), the deepest of the surface where it enters
+// the part (a hair on), where it leaves it (a hair back) and midway between. Heights are
+// compared vertically, as the points are projected. Without it a roof of slope 0.7 hatched at 2 mm
+// had the nozzle 0.7 mm inside the part on every line across its ridge, and a 2 mm step 0.7 of a
+// spacing past a grid point had it 0.6 mm inside.
 constexpr int kMaxChordHalvings = 10;
 // a point found where a lifted chord meets the part is kept at least this share of the chord
 // from its ends, and a chord shorter than twice that share of hatch_mm is not refined (a wall
