@@ -44,6 +44,14 @@ void print_problems(const InputError& error) {
   for (const Problem& problem : error.problems()) std::cerr << "error: " << problem.str() << '\n';
 }
 
+// the option of that name, in the verb given (parsed) or the app itself; nullptr if none
+const CLI::Option* option_named(CLI::App& app, const std::string& name) {
+  const CLI::Option* option = app.get_option_no_throw(name);
+  for (CLI::App* verb : app.get_subcommands())
+    if (const CLI::Option* found = verb->get_option_no_throw(name)) option = found;
+  return option;
+}
+
 // CLI11's refusal of the command line, as every other error reads: "error: ...", a value that
 // is no number named with what was expected ("Could not convert: --jobs = 1.5" alone does not
 // say), then where the options are listed
@@ -54,10 +62,7 @@ void print_parse_error(CLI::App& app, const CLI::ParseError& error) {
   if (text.rfind(kConvert, 0) == 0 && equals != std::string::npos) {
     const std::string name = text.substr(kConvert.size(), equals - kConvert.size());
     const std::string value = text.substr(equals + 3);
-    // the option, in the verb given (parsed) or the app itself
-    const CLI::Option* option = app.get_option_no_throw(name);
-    for (CLI::App* verb : app.get_subcommands())
-      if (const CLI::Option* found = verb->get_option_no_throw(name)) option = found;
+    const CLI::Option* option = option_named(app, name);
     const std::string type = option ? option->get_type_name() : std::string();
     const bool whole = type.rfind("INT", 0) == 0;
     const bool positive = type.find("POSITIVE") != std::string::npos;
@@ -69,9 +74,7 @@ void print_parse_error(CLI::App& app, const CLI::ParseError& error) {
   const std::size_t at_most = text.find(kAtMostOne);
   if (at_most != std::string::npos) {
     const std::string name = text.substr(0, at_most);
-    const CLI::Option* option = nullptr;
-    for (CLI::App* verb : app.get_subcommands())
-      if (const CLI::Option* found = verb->get_option_no_throw(name)) option = found;
+    const CLI::Option* option = option_named(app, name);
     const bool takes_a_list =
         option != nullptr && option->get_description().find("comma-separated") != std::string::npos;
     text = name + " is given " + text.substr(at_most + kAtMostOne.size()) + " times; give it once" +
