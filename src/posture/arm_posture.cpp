@@ -307,8 +307,12 @@ double path_cost(const Ladder& ladder, const std::vector<int>& path) {
 
 }  // namespace
 
+bool roll_step_divides_a_turn(double roll_step_deg) {
+  return std::fmod(360.0, roll_step_deg) < 1e-9;
+}
+
 std::string ArmPostureSettings::validate() const {
-  if (!(roll_step_deg >= 1.0 && roll_step_deg <= 90.0 && std::fmod(360.0, roll_step_deg) < 1e-9))
+  if (!(roll_step_deg >= 1.0 && roll_step_deg <= 90.0 && roll_step_divides_a_turn(roll_step_deg)))
     return "roll_step_deg must divide 360 and lie in [1, 90]";
   if (!(sample_spacing_mm > 0.0) || !std::isfinite(sample_spacing_mm))
     return "sample_spacing_mm must be > 0";

@@ -61,6 +61,9 @@ struct ArmPostureSettings {
   std::string validate() const;
 };
 
+// whether a roll step goes round a whole turn in whole steps (360 / step a whole number)
+bool roll_step_divides_a_turn(double roll_step_deg);
+
 // names point `point` of print path `path` for messages ("layer 3, line 12, point 40")
 using PointNamer = std::function<std::string(size_t path, size_t point)>;
 

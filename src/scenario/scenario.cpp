@@ -1632,7 +1632,7 @@ void Loader::read_arm(const Field& field) {
   read("roll_step_deg", arm.roll_step_deg);
   // the ladder's rolls go round once: a step that does not divide 360 is named at its line
   if (const Field* f = view.find("roll_step_deg");
-      f != nullptr && std::fmod(360.0, arm.roll_step_deg) > 1e-9) {
+      f != nullptr && !roll_step_divides_a_turn(arm.roll_step_deg)) {
     problems_.add(f->line, f->key,
                   "must divide 360 into a whole number of steps (5, 7.5, 10, 15, 30, ...), got " +
                       format_number(arm.roll_step_deg));
