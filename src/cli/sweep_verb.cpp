@@ -84,7 +84,7 @@ std::string absolute(const std::string& path) {
 // "done" (up to date), "failed", "stale" (a result of other inputs), "missing" (its
 // metrics.json gone or cut short: run again) or "-" (not run)
 std::string task_state(const Sweep& sweep, std::uint64_t index) {
-  const std::optional<TaskRecord> record = read_task_record(sweep.task_folder(index));
+  const std::optional<TaskRecord> record = read_task_record(sweep.found_task_folder(index));
   if (!record) return "-";
   std::string hash;
   try {
@@ -112,7 +112,7 @@ int list_tasks(const Sweep& sweep, const SweepOptions& options) {
     const SweepTask task = sweep.task(i);
     std::vector<std::string> row{std::to_string(i)};
     for (const auto& parameter : task.parameters) row.push_back(parameter.second.text);
-    row.push_back(sweep.task_folder(i));
+    row.push_back(sweep.found_task_folder(i));
     row.push_back(task_state(sweep, i));
     done += row.back() == "done";
     rows.push_back(std::move(row));
@@ -175,8 +175,12 @@ void check_merge_folder(const Sweep& sweep) {
 // them again. The folder is checked and made first: the lock file sits beside it.
 std::unique_ptr<OutputLock> lock_results_folder(const Sweep& sweep, const SweepOptions& options) {
   sweep.prepare_out_directory();
-  return std::make_unique<OutputLock>(absolute(sweep.out_directory()), sweep.out_directory(),
-                                      "sweep", !options.no_wait);
+  auto lock = std::make_unique<OutputLock>(absolute(sweep.out_directory()), sweep.out_directory(),
+                                           "sweep", !options.no_wait);
+  // a sweep grown past 9,999 tasks (or shrunk below): its finished tasks' folders renamed to
+  // the current width, so they are found up to date and the merge reads them
+  sweep.rename_task_folders_to_current_width();
+  return lock;
 }
 
 // called holding the folder's lock (lock_results_folder, which checked and prepared it)
@@ -232,7 +236,7 @@ int run_one_task(const Sweep& sweep, const SweepOptions& options) {
   const std::string hash = sweep.input_hash(task);
   if (!options.force && task_up_to_date(sweep, index, hash)) {
     std::cout << "task " << index << " (" << task.parameters_text() << "): up to date in "
-              << sweep.task_folder(index) << " (--force reruns it)\n";
+              << sweep.found_task_folder(index) << " (--force reruns it)\n";
     return kExitOk;
   }
   const TaskRecord record = run_task(sweep, task, hash);

@@ -46,6 +46,8 @@ struct MetricValue {
 // what one task contributes to the table
 struct TaskRow {
   std::string status, error, input_hash;
+  // the folder its result is read from, relative to the results folder ("tasks/0007")
+  std::string folder;
   double wall_s = NAN;
   std::vector<MetricValue> metrics;
 };
@@ -166,6 +168,7 @@ std::string read_file(const std::string& path, bool& found) {
 TaskRow read_task_row(const Sweep& sweep, std::uint64_t index) {
   TaskRow row;
   row.status = "missing";
+  row.folder = sweep.task_folder_name(index);
   const SweepTask task = sweep.task(index);
   try {
     row.input_hash = sweep.input_hash(task);
@@ -173,7 +176,8 @@ TaskRow read_task_row(const Sweep& sweep, std::uint64_t index) {
     row.error = std::string("its overrides do not fit the scenario: ") + error.what();
     return row;
   }
-  const std::string folder = sweep.task_folder(index);
+  const std::string folder = sweep.found_task_folder(index);
+  row.folder = "tasks/" + fs::path(folder).filename().string();
   const std::optional<TaskRecord> record = read_task_record(folder);
   std::error_code ignored;
   const std::string log = sweep.task_log(index);
@@ -262,10 +266,11 @@ ResultsTable collect_results(const Sweep& sweep, int threads) {
   std::map<std::string, std::string> units;
   for (std::uint64_t i = 0; i < count && units.empty(); ++i) {
     if (rows[static_cast<std::size_t>(i)].status != "ok") continue;
-    const std::optional<TaskRecord> record = read_task_record(sweep.task_folder(i));
+    const std::string folder = sweep.found_task_folder(i);
+    const std::optional<TaskRecord> record = read_task_record(folder);
     bool found = false;
-    const std::string text = read_file(
-        sweep.task_folder(i) + "/" + (record ? record->run : "") + "/metrics.json", found);
+    const std::string text =
+        read_file(folder + "/" + (record ? record->run : "") + "/metrics.json", found);
     try {
       const Json metrics = Json::parse(text);
       if (metrics.contains("units")) collect_units(metrics["units"], "", units);
@@ -310,7 +315,7 @@ ResultsTable collect_results(const Sweep& sweep, int threads) {
     if (!source.error.empty()) cells[status_at + 1] = source.error;
     if (std::isfinite(source.wall_s)) cells[status_at + 2] = source.wall_s;
     cells[status_at + 3] = source.input_hash;
-    cells[status_at + 4] = sweep.task_folder_name(i);
+    cells[status_at + 4] = source.folder;
     for (const MetricValue& metric : source.metrics) {
       const std::size_t at = metric_column[metric.name];
       if (at != 0) cells[at] = metric.value;

@@ -112,6 +112,49 @@ std::string Sweep::task_folder(std::uint64_t index) const {
   return (fs::path(out_) / task_folder_name(index)).string();
 }
 
+namespace {
+
+// the task index a folder name under tasks/ stands for: digits only, zero-padded to at least
+// four (a staging folder, tasks/<i>.partial-<pid>, is not one)
+std::optional<std::uint64_t> task_index_of_folder(const std::string& name) {
+  if (name.size() < 4 || name.size() > 19) return std::nullopt;
+  if (!std::all_of(name.begin(), name.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return std::nullopt;
+  return std::stoull(name);
+}
+
+}  // namespace
+
+std::string Sweep::found_task_folder(std::uint64_t index) const {
+  const std::string current = task_folder(index);
+  std::error_code error;
+  if (fs::exists(current, error)) return current;
+  const std::string digits = std::to_string(index);
+  for (std::size_t width = std::max<std::size_t>(4, digits.size()); width <= 19; ++width) {
+    if (static_cast<int>(width) == folder_digits_) continue;
+    const fs::path other =
+        fs::path(out_) / "tasks" / (std::string(width - digits.size(), '0') + digits);
+    if (fs::is_directory(other, error)) return other.string();
+  }
+  return current;
+}
+
+void Sweep::rename_task_folders_to_current_width() const {
+  std::error_code error;
+  std::vector<std::pair<fs::path, fs::path>> renames;
+  for (const fs::directory_entry& entry : fs::directory_iterator(fs::path(out_) / "tasks", error)) {
+    const std::string name = entry.path().filename().string();
+    const std::optional<std::uint64_t> index = task_index_of_folder(name);
+    if (!index || *index >= size() || static_cast<int>(name.size()) == folder_digits_) continue;
+    if (!entry.is_directory(error)) continue;
+    renames.emplace_back(entry.path(), fs::path(task_folder(*index)));
+  }
+  for (const auto& [from, to] : renames) {
+    std::error_code ignored;
+    if (!fs::exists(to, ignored)) fs::rename(from, to, ignored);
+  }
+}
+
 std::string Sweep::task_log(std::uint64_t index) const {
   return (fs::path(out_) / "logs" / ("task-" + std::to_string(index) + ".log")).string();
 }

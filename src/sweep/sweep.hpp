@@ -56,6 +56,15 @@ class Sweep {
   // "tasks/0007": its folder relative to the results folder, and the full path
   std::string task_folder_name(std::uint64_t index) const;
   std::string task_folder(std::uint64_t index) const;
+  // The folder holding task `index`'s result: task_folder(index), or, when that is absent, the
+  // same index under another zero-padding (a sweep grown past 9,999 tasks, or shrunk below
+  // 10,000, names its folders with more or fewer digits than the run that wrote them).
+  std::string found_task_folder(std::uint64_t index) const;
+  // Renames the task folders written under another zero-padding to task_folder(), where that
+  // name is free; folders beyond the last task are left as they are. Called by a local run or
+  // merge holding the folder's lock; errors leave a folder where it is (found_task_folder still
+  // finds it).
+  void rename_task_folders_to_current_width() const;
   // the log of a task run by -j or GNU parallel: DIR/logs/task-<i>.log
   std::string task_log(std::uint64_t index) const;
 

@@ -55,7 +55,7 @@ std::optional<TaskRecord> read_task_record(const std::string& folder) {
 }
 
 bool task_up_to_date(const Sweep& sweep, std::uint64_t index, const std::string& input_hash) {
-  const std::string folder = sweep.task_folder(index);
+  const std::string folder = sweep.found_task_folder(index);
   const std::optional<TaskRecord> record = read_task_record(folder);
   if (!record || record->status != "ok" || record->input_hash != input_hash) return false;
   // its metrics.json whole: one cut short (a full disk, a copy interrupted) is run again, as

@@ -229,6 +229,58 @@ TEST(SweepMerge, AMetricsFileCutShortIsMissingAndRunAgain) {
   EXPECT_EQ(std::get<double>(table.rows[1][total]), 23.5);
 }
 
+// a sweep grown past 9,999 tasks names its folders with five digits: the tasks the smaller
+// sweep finished (tasks/0000) are still up to date and merged, and a local run or merge renames
+// them to the new width (before, every one of them was run again under tasks/00000)
+TEST(SweepMerge, ASweepGrownPastTenThousandTasksFindsItsFinishedTasks) {
+  const std::string dir = fresh_directory("sweep_grown");
+  const auto sweep_file = [&](const std::string& name, const std::string& speeds) {
+    return write_text(dir, name,
+                      "name: merged\nbase: " + scenario_path("thompson_fig7.yaml") +
+                          "\ngrid:\n  toolpath.speed: " + speeds +
+                          "\n  planner: [lspb_mtt, stop_and_go]\n");
+  };
+  // 4 tasks, then the speeds extended to 5001 values: the planner is the fastest key, so
+  // tasks 0-3 keep their index and their inputs
+  const Sweep small(sweep_file("small.yaml", "[2, 2.5]"), dir + "/out");
+  const Sweep grown(sweep_file("grown.yaml", "{from: 2, to: 2502, step: 0.5}"), dir + "/out");
+  ASSERT_EQ(grown.size(), 10002u);
+  EXPECT_EQ(small.task_folder_name(3), "tasks/0003");
+  EXPECT_EQ(grown.task_folder_name(3), "tasks/00003");
+  for (std::uint64_t index = 0; index < 4; ++index) {
+    ASSERT_EQ(grown.input_hash(grown.task(index)), small.input_hash(small.task(index)));
+    write_task(small, index, "ok", metrics_of(20 + static_cast<double>(index), 0.1, false));
+  }
+  // the grown sweep finds them up to date where the small one left them
+  for (std::uint64_t index = 0; index < 4; ++index) {
+    EXPECT_TRUE(task_up_to_date(grown, index, grown.input_hash(grown.task(index)))) << index;
+    EXPECT_EQ(grown.found_task_folder(index), small.task_folder(index));
+  }
+  EXPECT_FALSE(task_up_to_date(grown, 4, grown.input_hash(grown.task(4))));
+  // renamed to five digits; a folder beyond the last task and a staging folder stay
+  fs::create_directories(dir + "/out/tasks/99999");
+  fs::create_directories(dir + "/out/tasks/0002.partial-7");
+  grown.rename_task_folders_to_current_width();
+  for (std::uint64_t index = 0; index < 4; ++index) {
+    EXPECT_TRUE(fs::is_directory(grown.task_folder(index))) << index;
+    EXPECT_FALSE(fs::exists(small.task_folder(index))) << index;
+    EXPECT_TRUE(task_up_to_date(grown, index, grown.input_hash(grown.task(index)))) << index;
+  }
+  EXPECT_TRUE(fs::is_directory(dir + "/out/tasks/99999"));
+  EXPECT_TRUE(fs::is_directory(dir + "/out/tasks/0002.partial-7"));
+  // the small sweep again: found under five digits, merged with the folder it is read from,
+  // then renamed back to four
+  EXPECT_TRUE(task_up_to_date(small, 3, small.input_hash(small.task(3))));
+  const ResultsTable table = collect_results(small, 1);
+  const int folder = table.column("folder");
+  ASSERT_GE(folder, 0);
+  EXPECT_EQ(std::get<std::string>(table.rows[3][static_cast<std::size_t>(folder)]), "tasks/00003");
+  EXPECT_EQ(table.ok, 4u);
+  small.rename_task_folders_to_current_width();
+  EXPECT_TRUE(fs::is_directory(dir + "/out/tasks/0003"));
+  EXPECT_FALSE(fs::exists(dir + "/out/tasks/00003"));
+}
+
 TEST(SweepMerge, AResultOfOtherInputsIsMissing) {
   const std::string dir = fresh_directory("sweep_stale");
   const Sweep sweep(write_sweep(dir), dir + "/out");
