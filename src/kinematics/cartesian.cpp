@@ -16,6 +16,9 @@ namespace {
 constexpr double kTravelXY_mm = 100.0;
 constexpr double kTravelZMin_mm = -10.0;
 constexpr double kTravelZMax_mm = 150.0;
+// the bed's top is z = 0: the nozzle may go no deeper into it than this (as the delta's
+// min_tcp_z); the z travel below it is the bed's, for the MJCF's hard stop and homing
+constexpr double kMinTcpZ_mm = -1.0;
 constexpr double kVelocityXY_mm_s = 300.0;
 constexpr double kAccelerationXY_mm_s2 = 3000.0;
 constexpr double kVelocityZ_mm_s = 15.0;
@@ -57,6 +60,12 @@ class Cartesian : public Machine {
                  message_number(std::max(limit.min - joints[i], joints[i] - limit.max), 4) + " mm";
         return false;
       }
+    }
+    if (tcp_mm.z() < kMinTcpZ_mm) {
+      if (why)
+        *why = "z = " + message_number(tcp_mm.z(), 4) + " mm puts the nozzle more than " +
+               message_number(-kMinTcpZ_mm, 4) + " mm into the bed (its top is z = 0)";
+      return false;
     }
     return true;
   }

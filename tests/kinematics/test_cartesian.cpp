@@ -33,7 +33,7 @@ TEST(Cartesian, DescribesItselfAndIsRegistered) {
 TEST(Cartesian, InverseIsTheIdentityAndForwardUndoesIt) {
   const auto machine = make_cartesian();
   for (const Vec3& tcp :
-       {Vec3(0, 0, 0), Vec3(12.5, -3.25, 0.2), Vec3(-100, 100, 150), Vec3(99.999, -99.999, -10)}) {
+       {Vec3(0, 0, 0), Vec3(12.5, -3.25, 0.2), Vec3(-100, 100, 150), Vec3(99.999, -99.999, -1)}) {
     JointVector joints;
     std::string why;
     ASSERT_TRUE(machine->inverse(Pose(tcp), joints, &why)) << why;
@@ -57,6 +57,12 @@ TEST(Cartesian, RejectsPointsOutsideTheTravelNamingTheAxis) {
   EXPECT_EQ(why,
             "the cartesian machine's x axis at -100.2 mm is outside its travel [-100, 100] mm, by "
             "0.25 mm");
+  // within the z travel but in the bed: a CNC file zeroed on its stock's top, a slicer's
+  // negative z offset (before, z = -8 printed as if on the bed)
+  EXPECT_FALSE(machine->inverse(Pose(Vec3(0, 0, -8)), joints, &why));
+  EXPECT_EQ(why, "z = -8 mm puts the nozzle more than 1 mm into the bed (its top is z = 0)");
+  EXPECT_TRUE(machine->inverse(Pose(Vec3(0, 0, -1)), joints, &why));
+  EXPECT_FALSE(machine->inverse(Pose(Vec3(0, 0, -1.001)), joints, &why));
 }
 
 TEST(Cartesian, TcpLimitsAreTheTighterOfTheRequestedAndTheJoints) {
