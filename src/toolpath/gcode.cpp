@@ -578,6 +578,11 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   }
   // grbl's system commands ($H homing, $X unlock, $$ settings): not G-code
   if (*p == '$') return;
+  // Prusa's MMU `T?` (its firmware asks which filament to load; `Tx` and `Tc`, the same in two
+  // steps, read as named commands below): a tool choice, no geometry, as T0 is
+  if (upper(*p) == 'T' && p + 1 < end && p[1] == '?' &&
+      (p + 2 == end || is_space(p[2]) || p[2] == ';' || p[2] == '('))
+    return;
   // Klipper's extended commands (a name, not a letter and a number; a macro's may start with
   // `_`, as `_CLIENT_RETRACT`): not motion, unless the name is another controller's geometry
   if (*p == '_' || (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_'))) {

@@ -282,6 +282,25 @@ TEST(Gcode, MarlinsLaserFlagAndFanSpeed) {
       << problems[0].str();
 }
 
+// Prusa's MMU tool choices, `T?` (its firmware asks which filament to load), `Tx` and `Tc`, are
+// read as T0 is: no geometry (before, `T?` refused the whole file as a malformed word)
+TEST(Gcode, PrusasMmuToolChoicesAreNoGeometry) {
+  GcodeOptions options;
+  for (const char* choice : {"T?", "t? ; menu", "Tx\nTc", "T0"}) {
+    const GcodeImport imported = import_gcode_program(
+        parse_gcode_program(std::string("M83\nG1 X0 Y0 F600\n") + choice + "\nG1 X10 E1\n",
+                            "mmu.gcode", options),
+        options);
+    ASSERT_EQ(imported.toolpath.paths.size(), 1u) << choice;
+    expect_points(imported.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
+  }
+  // a T with anything else after it is still malformed
+  const auto problems = problems_of("G1 X0 Y0 F600\nT?1\nG1 X10 E1\n");
+  ASSERT_EQ(problems.size(), 1u) << dump(problems);
+  EXPECT_NE(problems[0].message.find("malformed word 'T?1'"), std::string::npos)
+      << problems[0].str();
+}
+
 TEST(Gcode, M3AndM4BothOpenTheShutter) {
   // a grbl laser file switches the laser on with M4 (dynamic power), a mill's spindle may turn
   // either way: under the default open code M3 (and under M4), both open, M5 closes
