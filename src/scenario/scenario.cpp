@@ -307,6 +307,18 @@ ScenarioReading Loader::read() {
   // workspace (the arm's reach depends on the roll its posture chooses: prepare_job)
   // (the keys' lines first: the reach check names them)
   scenario_.key_lines = problems_.key_lines();
+  // a G-code file's default end, above its start, out of the machine's reach (the top of a
+  // delta's workspace is narrower than its bed): the file's last print point instead
+  Toolpath& toolpath = scenario_.toolpath;
+  if (machine_ && scenario_.gcode && scenario_.end_line <= 0 && !toolpath.paths.empty() &&
+      toolpath.end_mm != toolpath.start_mm) {
+    JointVector joints;
+    if (!machine_->inverse(Pose(toolpath.end_mm), joints, nullptr)) {
+      toolpath.end_mm = toolpath.paths.back().points.back();
+      if (!scenario_.exact_toolpath.paths.empty())
+        scenario_.exact_toolpath.end_mm = toolpath.end_mm;
+    }
+  }
   if (machine_ && scenario_.machine != "arm6")
     for (Problem& problem : unreachable_points(scenario_, *machine_))
       problems_.add_problem(std::move(problem));
@@ -995,11 +1007,17 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
     if (keeps_arcs) scenario_.exact_toolpath.paths.push_back(std::move(exact));
   }
 
-  // the start (and so the end) defaults to the file's first print point; `offset` then moves
-  // start and paths together
+  // the start defaults to the file's first print point, the end to the start raised to the
+  // file's highest print point (a file of several layers does not end by moving down through
+  // them); `offset` then moves start, end and paths together
   Toolpath& toolpath = scenario_.toolpath;
   if (!start_given) toolpath.start_mm = toolpath.paths.front().points.front();
-  if (!end_given) toolpath.end_mm = toolpath.start_mm;
+  if (!end_given) {
+    toolpath.end_mm = toolpath.start_mm;
+    for (const PrintPath& path : toolpath.paths)
+      for (const Vec3& point : path.points)
+        toolpath.end_mm.z() = std::max(toolpath.end_mm.z(), point.z());
+  }
   scenario_.exact_toolpath.start_mm = toolpath.start_mm;
   scenario_.exact_toolpath.end_mm = toolpath.end_mm;
   scenario_.exact_toolpath.chord_tolerance_mm = tolerance_mm;
