@@ -78,29 +78,23 @@ toolpath:
   EXPECT_TRUE(s.notes.empty());  // no auto, nothing clamped
 }
 
-// several z levels on the XY stage: one problem, at the first move off the first level
 // a file of several layers ends above its start at its highest print point, not by moving
 // down through its layers to its first point; where that point is out of the machine's reach
 // (the delta's carriages bottom out under (130, 0, 190)), at the file's last print point
 TEST_F(ScenarioGcode, TheEndDefaultsToTheStartRaisedToTheTopLayer) {
   write("layers.gcode", kThreeLayers);
-  const Scenario layered = load_scenario(write("s.yaml", R"(
-machine: cartesian
-limits: {v_max: 20, a_max: 300}
-toolpath:
-  gcode: layers.gcode
-  offset: [5, 0, 1]
-)"));
+  // the three layers on the cartesian printer, with one more toolpath key
+  const auto layers_with = [&](const std::string& name, const std::string& key) {
+    return load_scenario(write(name,
+                               "machine: cartesian\nlimits: {v_max: 20, a_max: 300}\n"
+                               "toolpath:\n  gcode: layers.gcode\n  " +
+                                   key + "\n"));
+  };
+  const Scenario layered = layers_with("s.yaml", "offset: [5, 0, 1]");
   EXPECT_EQ(layered.toolpath.start_mm, Vec3(5, 0, 1));
   EXPECT_EQ(layered.toolpath.end_mm, Vec3(5, 0, 1.4));
   // the start given: the end is it raised
-  const Scenario given = load_scenario(write("given.yaml", R"(
-machine: cartesian
-limits: {v_max: 20, a_max: 300}
-toolpath:
-  gcode: layers.gcode
-  start: [2, 3, 0]
-)"));
+  const Scenario given = layers_with("given.yaml", "start: [2, 3, 0]");
   EXPECT_EQ(given.toolpath.end_mm, Vec3(2, 3, 0.4));
   write("tall.gcode", "G1 X130 Y0 Z0 F600\nG1 X131 Y0 E1\nG0 X0 Y0 Z190\nG1 X1 Y0 E2\n");
   const Scenario tall = load_scenario(write("tall.yaml", R"(
@@ -113,6 +107,7 @@ toolpath: {gcode: tall.gcode}
   EXPECT_EQ(tall.toolpath.end_mm, Vec3(1, 0, 190));
 }
 
+// several z levels on the XY stage: one problem, at the first move off the first level
 TEST_F(ScenarioGcode, SeveralZLevelsWithoutZIsOneError) {
   write("layers.gcode", kThreeLayers);
   const auto problems = problems_of(R"(
