@@ -61,6 +61,24 @@ Interval capsule_row(double ax, double ay, double bx, double by, double ex, doub
   return row;
 }
 
+// the cell centred on (x, y), side h: a bit per sub-point of its 8 x 8 grid (centres of
+// h/8 squares) that lies within r of the segment from (ax, ay) along the unit (ex, ey)
+uint64_t sub_points_within(double x, double y, double ax, double ay, double ex, double ey,
+                           double length, double r, double h) {
+  uint64_t mask = 0;
+  const double r2 = r * r * (1.0 + 1e-9);
+  for (int j = 0; j < 8; ++j) {
+    const double py = y + (j - 3.5) * h / 8.0 - ay;
+    for (int i = 0; i < 8; ++i) {
+      const double px = x + (i - 3.5) * h / 8.0 - ax;
+      const double t = std::min(length, std::max(0.0, px * ex + py * ey));
+      const double dx = px - t * ex, dy = py - t * ey;
+      if (dx * dx + dy * dy <= r2) mask |= uint64_t{1} << (8 * j + i);
+    }
+  }
+  return mask;
+}
+
 // point at arc length s along a polyline (xy), advancing a segment cursor (s increasing)
 void point_at_arc(const PrintPath& path, double s, size_t& segment, double& segment_start,
                   double& x, double& y) {
@@ -96,6 +114,14 @@ TargetRegion::TargetRegion(const Toolpath& toolpath, double line_width_mm, doubl
   const double r = half_width_mm_;
   // "within r": a relative tolerance keeps cells exactly at r in, whatever the rounding
   const double r2 = r * r * (1.0 + 1e-9);
+  // a cell's share of the band: which of its 8 x 8 sub-points lie within r of a centreline
+  // (a mask, or-ed over every segment of every path: the band's union, each cell once).
+  // Cells whose centre lies within r - h/sqrt(2) are whole, those beyond r + h/sqrt(2) out.
+  const double half_diagonal = h * std::sqrt(0.5);
+  const double reach = r + half_diagonal;
+  const double reach2 = reach * reach;
+  const double whole = r - half_diagonal;
+  const double whole2 = whole > 0.0 ? whole * whole : -1.0;
 
   for (size_t p = 0; p < toolpath.paths.size(); ++p) {
     const PrintPath& path = toolpath.paths[p];
@@ -115,7 +141,7 @@ TargetRegion::TargetRegion(const Toolpath& toolpath, double line_width_mm, doubl
         const double y = iy * h;
         // (the row's interval with the same tolerance as the test below: a row exactly r
         // from the centreline, rounded a hair beyond it, keeps its cells)
-        const Interval row = capsule_row(ax, ay, bx, by, ex, ey, length, std::sqrt(r2), y);
+        const Interval row = capsule_row(ax, ay, bx, by, ex, ey, length, reach, y);
         if (row.empty()) continue;
         const int ix_lo = static_cast<int>(std::floor(row.lo / h)) - 1;
         const int ix_hi = static_cast<int>(std::ceil(row.hi / h)) + 1;
@@ -124,10 +150,16 @@ TargetRegion::TargetRegion(const Toolpath& toolpath, double line_width_mm, doubl
           const double t = std::min(length, std::max(0.0, (x - ax) * ex + (y - ay) * ey));
           const double dx = x - (ax + t * ex), dy = y - (ay + t * ey);
           const double d2 = dx * dx + dy * dy;
-          if (d2 > r2) continue;
+          if (d2 >= reach2) continue;
           // keep, per path, the nearest centreline point; settle the previous path's cell first
           Cell& cell = tiles_.get_or_create(Tiles::tile_of(ix),
                                             Tiles::tile_of(iy))[Tiles::local_index(ix, iy)];
+          if (d2 <= whole2) {
+            cell.inside_mask = kWholeCell;
+          } else if (cell.inside_mask != kWholeCell) {
+            cell.inside_mask |= sub_points_within(x, y, ax, ay, ex, ey, length, r, h);
+          }
+          if (d2 <= r2) cell.flags |= kCentreInside;
           if (cell.path != static_cast<int32_t>(p)) {
             finish_cell(cell);
             cell.path = static_cast<int32_t>(p);
@@ -143,12 +175,14 @@ TargetRegion::TargetRegion(const Toolpath& toolpath, double line_width_mm, doubl
       arc_start += length;
     }
   }
-  // settle the last path of every cell
+  // settle the last path of every cell, and its share of the band
   for (const auto& [tx, ty] : tiles_.sorted_tiles()) {
     Cell* tile = tiles_.find(tx, ty);
     for (int k = 0; k < Tiles::kCells; ++k) {
       finish_cell(tile[k]);
       tile[k].path = -1;
+      tile[k].weight = static_cast<float>(__builtin_popcountll(tile[k].inside_mask)) / 64.0f;
+      if (tile[k].inside_mask == 0) tile[k].flags &= static_cast<uint8_t>(~kTarget);
     }
   }
 }
@@ -168,11 +202,16 @@ uint8_t TargetRegion::flags(int ix, int iy) const {
   return tile ? tile[Tiles::local_index(ix, iy)].flags : 0;
 }
 
+double TargetRegion::weight(int ix, int iy) const {
+  const Cell* tile = tiles_.find(Tiles::tile_of(ix), Tiles::tile_of(iy));
+  return tile ? tile[Tiles::local_index(ix, iy)].weight : 0.0;
+}
+
 size_t TargetRegion::target_cells() const {
   size_t count = 0;
   for (const auto& [tx, ty] : tiles_.sorted_tiles()) {
     const Cell* tile = tiles_.find(tx, ty);
-    for (int k = 0; k < Tiles::kCells; ++k) count += (tile[k].flags & kTarget) ? 1 : 0;
+    for (int k = 0; k < Tiles::kCells; ++k) count += (tile[k].flags & kCentreInside) ? 1 : 0;
   }
   return count;
 }
@@ -184,8 +223,9 @@ ThicknessStats thickness_stats(const ThicknessField& field, const TargetRegion& 
   ThicknessStats stats;
   const auto region_tiles = region.tiles().sorted_tiles();
 
-  // cells of the stats region: two passes (mean, min, max; then the spread)
-  double sum = 0.0;
+  // cells of the stats region, each by its share of the band: two passes (mean, min, max;
+  // then the spread). min and max are over the cells whose centre lies within r.
+  double sum = 0.0, weights = 0.0;
   double min_value = std::numeric_limits<double>::infinity();
   double max_value = -std::numeric_limits<double>::infinity();
   auto for_each_stats_cell = [&](auto&& visit) {
@@ -193,22 +233,27 @@ ThicknessStats thickness_stats(const ThicknessField& field, const TargetRegion& 
       const TargetRegion::Cell* cells = region.tiles().find(tx, ty);
       const double* values = field.tiles().find(tx, ty);
       for (int k = 0; k < TargetRegion::Tiles::kCells; ++k)
-        if (cells[k].flags == TargetRegion::kTarget) visit(values ? values[k] : 0.0);
+        if ((cells[k].flags & TargetRegion::kTarget) && !(cells[k].flags & TargetRegion::kEndZone))
+          visit(values ? values[k] : 0.0, cells[k]);
     }
   };
-  for_each_stats_cell([&](double v) {
-    sum += v;
+  for_each_stats_cell([&](double v, const TargetRegion::Cell& cell) {
+    sum += cell.weight * v;
+    weights += cell.weight;
+    if (!(cell.flags & TargetRegion::kCentreInside)) return;
     min_value = std::min(min_value, v);
     max_value = std::max(max_value, v);
     ++stats.cells;
   });
   if (stats.cells > 0 && sum > 0.0) {
-    const double mean = sum / static_cast<double>(stats.cells);
+    const double mean = sum / weights;
     double squares = 0.0;
     // (relative to the mean: a tiny flow's squares would underflow to a cv of 0)
-    for_each_stats_cell([&](double v) { squares += ((v - mean) / mean) * ((v - mean) / mean); });
+    for_each_stats_cell([&](double v, const TargetRegion::Cell& cell) {
+      squares += cell.weight * ((v - mean) / mean) * ((v - mean) / mean);
+    });
     stats.mean_um = mean * kUmPerMm;
-    stats.cv = std::sqrt(squares / static_cast<double>(stats.cells));
+    stats.cv = std::sqrt(squares / weights);
     stats.min_rel = min_value / mean;
     stats.max_rel = max_value / mean;
   }
@@ -249,16 +294,16 @@ MaterialSplit split_material(const ThicknessField& field, const TargetRegion& re
                              const MaterialAccount& account) {
   if (field.cell_mm() != region.cell_mm())
     throw InternalError("split_material: region and field have different cells");
-  // every landed cell is on target or overspray, summed in sorted tile order
+  // every landed cell is on target by its share of the band, overspray by the rest, summed in
+  // sorted tile order
   double on_target_mm = 0.0, outside_mm = 0.0;
   for (const auto& [tx, ty] : field.tiles().sorted_tiles()) {
     const double* values = field.tiles().find(tx, ty);
     const TargetRegion::Cell* cells = region.tiles().find(tx, ty);
     for (int k = 0; k < ThicknessField::Tiles::kCells; ++k) {
-      if (cells && (cells[k].flags & TargetRegion::kTarget))
-        on_target_mm += values[k];
-      else
-        outside_mm += values[k];
+      const double share = cells ? cells[k].weight : 0.0;
+      on_target_mm += share * values[k];
+      outside_mm += (1.0 - share) * values[k];
     }
   }
   const double area_mm2 = field.cell_mm() * field.cell_mm();

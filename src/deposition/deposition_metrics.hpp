@@ -2,18 +2,22 @@
 // material account (ARCHITECTURE.md "Definitions"). Paths are taken in the substrate
 // plane (x, y); r = half the line width.
 //
-//  target region  cells (centres on the field's lattice) within r of any print path's
-//                 centreline (capsules: round caps at the path ends).
+//  target region  the band within r of any print path's centreline (capsules: round caps
+//                 at the path ends), on the field's cells (centres on its lattice): each
+//                 cell by its share w of the band, the fraction of its 8 x 8 sub-points
+//                 within r of some centreline (bands that touch or overlap count once), so
+//                 the metrics do not depend on where the lines fall between cell centres.
 //  end zones      cells of a path's band whose nearest centreline point lies within r
 //                 (arc length) of the path's start or end, caps included.
 //  stats region   target region minus every path's end zones.
-//  thickness      over the stats region, cell values: mean_um, cv = std / mean (population
-//                 std), min_rel = min / mean, max_rel = max / mean. line_cv = CV of the
-//                 field sampled bilinearly on each centreline every cell length, from
-//                 arc length r to length - r. Empty region or zero mean: all zeros.
-//  material       on_target = landed inside the target region, overspray = landed
-//                 outside, captured = blocked by the shutter; fraction = (overspray +
-//                 captured) / emitted.
+//  thickness      over the stats region, cell values weighted by w: mean_um, cv = std /
+//                 mean (population std); min_rel = min / mean, max_rel = max / mean over
+//                 its cells whose centre lies within r (`cells` counts those). line_cv = CV
+//                 of the field sampled bilinearly on each centreline every cell length,
+//                 from arc length r to length - r. Empty region or zero mean: all zeros.
+//  material       on_target = landed in the target region (each cell's material times w),
+//                 overspray = the rest that landed, captured = blocked by the shutter;
+//                 fraction = (overspray + captured) / emitted.
 #pragma once
 
 #include <cstddef>
@@ -57,20 +61,28 @@ class TargetRegion {
   struct Cell {
     double best_arc_mm = 0.0;         // arc length of the nearest point along `path`
     float best_distance2_mm2 = 0.0f;  // squared distance to that point
+    float weight = 0.0f;              // the cell's share of the band, in [0, 1]
+    uint64_t inside_mask = 0;         // its 8 x 8 sub-points within r of a centreline
     int32_t path = -1;                // path being resolved (construction scratch)
     uint8_t flags = 0;
   };
-  static constexpr uint8_t kTarget = 1;
-  static constexpr uint8_t kEndZone = 2;
+  static constexpr uint8_t kTarget = 1;        // a share of the band (weight > 0)
+  static constexpr uint8_t kEndZone = 2;       // in a path's end zone
+  static constexpr uint8_t kCentreInside = 4;  // its centre within r of a centreline
+  static constexpr uint64_t kWholeCell = ~uint64_t{0};
   using Tiles = SparseTiles<Cell>;
 
   TargetRegion(const Toolpath& toolpath, double line_width_mm, double cell_mm);
 
   double cell_mm() const { return cell_mm_; }
   double half_width_mm() const { return half_width_mm_; }
-  bool in_target(int ix, int iy) const { return flags(ix, iy) & kTarget; }
-  bool in_stats(int ix, int iy) const { return flags(ix, iy) == kTarget; }
+  // the cell's centre within r of a centreline; in the stats region (a share of the band,
+  // outside every end zone); its share of the band
+  bool in_target(int ix, int iy) const { return flags(ix, iy) & kCentreInside; }
+  bool in_stats(int ix, int iy) const { return (flags(ix, iy) & (kTarget | kEndZone)) == kTarget; }
   uint8_t flags(int ix, int iy) const;
+  double weight(int ix, int iy) const;
+  // cells whose centre lies within r of a centreline
   size_t target_cells() const;
   const Tiles& tiles() const { return tiles_; }
 

@@ -211,8 +211,8 @@ TEST(Aerosol, MaterialIsConservedThroughShutterTransitions) {
   EXPECT_GT(m.overspray_mm3, 0.0);  // the Gaussian tail beyond +-2 sigma
 
   // the waste, from an account of its own: the material that landed farther than half a line
-  // width from both centrelines, summed over the deposit's cells themselves, plus Q x the
-  // closed time above, over Q x 5 s
+  // width from both centrelines (each cell by the share of its 8 x 8 sub-points that are),
+  // summed over the deposit's cells themselves, plus Q x the closed time above, over Q x 5 s
   const double r = 0.5 * process.line_width_mm();
   const double area = kCell * kCell;
   const FieldBounds bounds = process.field().bounds();
@@ -223,19 +223,23 @@ TEST(Aerosol, MaterialIsConservedThroughShutterTransitions) {
     for (long ix = std::lround(bounds.x_lo_mm / kCell); ix <= std::lround(bounds.x_hi_mm / kCell);
          ++ix) {
       const double volume = process.field().cell_thickness_mm(ix, iy) * area;
-      const double x = ix * kCell, y = iy * kCell;
-      // distance to the segments (0, 0)-(6, 0) and (0, 1)-(6, 1)
-      const double along = std::max(0.0, std::max(x - 6.0, -x));
-      const double d = std::min(std::hypot(along, y), std::hypot(along, y - 1.0));
+      int outside = 0;
+      for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+          const double x = (ix + (i - 3.5) / 8.0) * kCell, y = (iy + (j - 3.5) / 8.0) * kCell;
+          // distance to the segments (0, 0)-(6, 0) and (0, 1)-(6, 1)
+          const double along = std::max(0.0, std::max(x - 6.0, -x));
+          const double d = std::min(std::hypot(along, y), std::hypot(along, y - 1.0));
+          outside += d > r * (1.0 + 1e-9) ? 1 : 0;
+        }
       landed_mm3 += volume;
-      if (d > r + 1e-9) outside_mm3 += volume;
+      outside_mm3 += volume * outside / 64.0;
     }
   EXPECT_NEAR(landed_mm3, emitted - q * closed_time, 1e-6 * emitted);
-  // the Gaussian tails on both sides of 12 mm of line: the cells within r = 2 sigma are on
-  // target, so on the lattice the band ends half a cell beyond r, erfc((r + h / 2) / (sigma
-  // sqrt 2)) = 3.4 % (the line's ends add little)
-  EXPECT_NEAR(outside_mm3 / landed_mm3, std::erfc((r + 0.5 * kCell) / (kSigma * std::sqrt(2.0))),
-              0.002);
+  // the Gaussian tails on both sides of 12 mm of line beyond r = 2 sigma, erfc(r / (sigma
+  // sqrt 2)) = 4.6 % (the line's ends add little). Before each cell was counted by its
+  // centre alone, the rows exactly r away whole: the band ended half a cell beyond r (3.4 %)
+  EXPECT_NEAR(outside_mm3 / landed_mm3, std::erfc(r / (kSigma * std::sqrt(2.0))), 0.002);
   EXPECT_NEAR(m.fraction, (outside_mm3 + q * closed_time) / emitted, 1e-9);
   EXPECT_NEAR(m.overspray_mm3, outside_mm3, 1e-9 * emitted);
 }
