@@ -63,8 +63,9 @@ class Cartesian : public Machine {
     }
     if (tcp_mm.z() < kMinTcpZ_mm) {
       if (why)
-        *why = "z = " + message_number(tcp_mm.z(), 4) + " mm puts the nozzle more than " +
-               message_number(-kMinTcpZ_mm, 4) + " mm into the bed (its top is z = 0)";
+        *why = "z = " + message_number_outside(tcp_mm.z(), kMinTcpZ_mm, kTravelZMax_mm, 4) +
+               " mm puts the nozzle more than " + message_number(-kMinTcpZ_mm, 4) +
+               " mm into the bed (its top is z = 0)";
       return false;
     }
     return true;

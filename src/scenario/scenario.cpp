@@ -2050,12 +2050,15 @@ std::string reach_summary(const Toolpath& toolpath, const Machine& machine, bool
   const Vec3 to_centre = centre - 0.5 * (lo + hi);
   const Vec3 in_plane = rounded(Vec3(to_centre.x(), to_centre.y(), 0.0));
   const Vec3 in_space = rounded(to_centre);
+  // a print below z = 0 (a CNC file zeroed on its stock's top, a negative z offset): centred
+  // in x and y and its lowest point lifted onto the bed, before the workspace's centre
+  const Vec3 on_bed = in_plane + Vec3(0.0, 0.0, std::max(0.0, std::ceil(-lo.z() * 10.0) / 10.0));
   const auto range = [](double from, double to) {
     return from == to ? format_number(from) : format_number(from) + " to " + format_number(to);
   };
   const std::string message = "the print paths span x " + range(lo.x(), hi.x()) + ", y " +
                               range(lo.y(), hi.y()) + ", z " + range(lo.z(), hi.z()) + " mm; ";
-  const Vec3 shifts[2] = {in_plane, in_space};
+  const Vec3 shifts[3] = {in_plane, on_bed, in_space};
   for (const Vec3& shift : shifts)
     if (all_reachable(shift))
       return message + "moved by " + format_point(shift) + " mm every point is within " +

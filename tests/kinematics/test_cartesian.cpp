@@ -62,7 +62,8 @@ TEST(Cartesian, RejectsPointsOutsideTheTravelNamingTheAxis) {
   EXPECT_FALSE(machine->inverse(Pose(Vec3(0, 0, -8)), joints, &why));
   EXPECT_EQ(why, "z = -8 mm puts the nozzle more than 1 mm into the bed (its top is z = 0)");
   EXPECT_TRUE(machine->inverse(Pose(Vec3(0, 0, -1)), joints, &why));
-  EXPECT_FALSE(machine->inverse(Pose(Vec3(0, 0, -1.001)), joints, &why));
+  EXPECT_FALSE(machine->inverse(Pose(Vec3(0, 0, -1.0001)), joints, &why));
+  EXPECT_EQ(why, "z = -1.0001 mm puts the nozzle more than 1 mm into the bed (its top is z = 0)");
 }
 
 TEST(Cartesian, TcpLimitsAreTheTighterOfTheRequestedAndTheJoints) {

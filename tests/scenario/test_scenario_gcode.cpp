@@ -3,6 +3,7 @@
 // one error for several z levels on a machine without z, layer selection, arcs chorded.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "scenario/scenario_test_util.hpp"
@@ -105,6 +106,24 @@ toolpath: {gcode: tall.gcode}
 )"));
   EXPECT_EQ(tall.toolpath.start_mm, Vec3(130, 0, 0));
   EXPECT_EQ(tall.toolpath.end_mm, Vec3(1, 0, 190));
+}
+
+// a file below the cartesian's bed (zeroed on a stock's top): refused at its points, and the
+// offset that lifts it onto the bed suggested (before: one that centred it at z = 70)
+TEST_F(ScenarioGcode, AFileBelowTheBedIsLiftedOntoIt) {
+  write("below.gcode", "G1 X10 Y0 Z-1.5 F600\nG1 X13 Y0 E1\n");
+  const auto problems = problems_of(R"(
+machine: cartesian
+limits: {v_max: 20, a_max: 300}
+toolpath: {gcode: below.gcode}
+)");
+  const auto offset = std::find_if(problems.begin(), problems.end(),
+                                   [](const Problem& p) { return p.key == "toolpath.offset"; });
+  ASSERT_NE(offset, problems.end()) << dump(problems);
+  EXPECT_NE(offset->message.find("moved by (-11.5, 0, 1.5) mm every point is within cartesian's "
+                                 "reach"),
+            std::string::npos)
+      << offset->message;
 }
 
 // several z levels on the XY stage: one problem, at the first move off the first level
