@@ -79,6 +79,47 @@ uint64_t sub_points_within(double x, double y, double ax, double ay, double ex, 
   return mask;
 }
 
+// A cell the band's edge crosses (0 < share < 1), read at its 8 x 8 sub-points from the field
+// interpolated between cell centres: the mean thickness of its part inside the band, and the
+// share of its material there (a cell's inner side holds more than its outer one where the
+// deposit falls off across the edge). A cell with nothing around it: its value, by area.
+struct EdgeCell {
+  double inside_mean_mm = 0.0;
+  double material_share = 0.0;
+};
+EdgeCell read_edge_cell(const ThicknessField& field, int ix, int iy, uint64_t inside_mask,
+                        double value_mm) {
+  const double h = field.cell_mm();
+  double inside = 0.0, all = 0.0;
+  int inside_count = 0;
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i) {
+      const double t =
+          field.thickness_mm_at((ix + (i - 3.5) / 8.0) * h, (iy + (j - 3.5) / 8.0) * h);
+      all += t;
+      if (inside_mask >> (8 * j + i) & 1) {
+        inside += t;
+        ++inside_count;
+      }
+    }
+  EdgeCell cell;
+  if (all > 0.0 && inside_count > 0) {
+    cell.inside_mean_mm = inside / inside_count;
+    cell.material_share = inside / all;
+  } else {
+    cell.inside_mean_mm = value_mm;
+    cell.material_share = inside_count / 64.0;
+  }
+  return cell;
+}
+
+// the cell of tile (tx, ty) at local index k: its lattice indices
+void cell_indices(int tx, int ty, int k, int& ix, int& iy) {
+  using Tiles = TargetRegion::Tiles;
+  ix = tx * Tiles::kSize + k % Tiles::kSize;
+  iy = ty * Tiles::kSize + k / Tiles::kSize;
+}
+
 // point at arc length s along a polyline (xy), advancing a segment cursor (s increasing)
 void point_at_arc(const PrintPath& path, double s, size_t& segment, double& segment_start,
                   double& x, double& y) {
@@ -223,28 +264,45 @@ ThicknessStats thickness_stats(const ThicknessField& field, const TargetRegion& 
   ThicknessStats stats;
   const auto region_tiles = region.tiles().sorted_tiles();
 
-  // cells of the stats region, each by its share of the band: two passes (mean, min, max;
-  // then the spread). min and max are over the cells whose centre lies within r.
+  // cells of the stats region, each by its share of the band (a cell the band's edge crosses
+  // by the mean thickness of its part inside): two passes (mean, min, max; then the spread).
+  // min and max are over the cells whose centre lies within r (every cell with a share when
+  // no centre does: a line narrower than a cell)
   double sum = 0.0, weights = 0.0;
   double min_value = std::numeric_limits<double>::infinity();
   double max_value = -std::numeric_limits<double>::infinity();
+  double min_any = min_value, max_any = max_value;
+  bool any_centre = false;
   auto for_each_stats_cell = [&](auto&& visit) {
     for (const auto& [tx, ty] : region_tiles) {
       const TargetRegion::Cell* cells = region.tiles().find(tx, ty);
       const double* values = field.tiles().find(tx, ty);
-      for (int k = 0; k < TargetRegion::Tiles::kCells; ++k)
-        if ((cells[k].flags & TargetRegion::kTarget) && !(cells[k].flags & TargetRegion::kEndZone))
-          visit(values ? values[k] : 0.0, cells[k]);
+      for (int k = 0; k < TargetRegion::Tiles::kCells; ++k) {
+        const TargetRegion::Cell& cell = cells[k];
+        if (!(cell.flags & TargetRegion::kTarget) || (cell.flags & TargetRegion::kEndZone))
+          continue;
+        double value = values ? values[k] : 0.0;
+        if (cell.inside_mask != TargetRegion::kWholeCell) {
+          int ix = 0, iy = 0;
+          cell_indices(tx, ty, k, ix, iy);
+          value = read_edge_cell(field, ix, iy, cell.inside_mask, value).inside_mean_mm;
+        }
+        visit(value, cell);
+      }
     }
   };
   for_each_stats_cell([&](double v, const TargetRegion::Cell& cell) {
     sum += cell.weight * v;
     weights += cell.weight;
+    ++stats.cells;
+    min_any = std::min(min_any, v);
+    max_any = std::max(max_any, v);
     if (!(cell.flags & TargetRegion::kCentreInside)) return;
+    any_centre = true;
     min_value = std::min(min_value, v);
     max_value = std::max(max_value, v);
-    ++stats.cells;
   });
+  if (!any_centre) min_value = min_any, max_value = max_any;
   if (stats.cells > 0 && sum > 0.0) {
     const double mean = sum / weights;
     double squares = 0.0;
@@ -294,14 +352,22 @@ MaterialSplit split_material(const ThicknessField& field, const TargetRegion& re
                              const MaterialAccount& account) {
   if (field.cell_mm() != region.cell_mm())
     throw InternalError("split_material: region and field have different cells");
-  // every landed cell is on target by its share of the band, overspray by the rest, summed in
-  // sorted tile order
+  // every landed cell is on target by the share of its material inside the band (a whole
+  // cell: all of it; one the band's edge crosses: read at its sub-points), overspray by the
+  // rest, summed in sorted tile order
   double on_target_mm = 0.0, outside_mm = 0.0;
   for (const auto& [tx, ty] : field.tiles().sorted_tiles()) {
     const double* values = field.tiles().find(tx, ty);
     const TargetRegion::Cell* cells = region.tiles().find(tx, ty);
     for (int k = 0; k < ThicknessField::Tiles::kCells; ++k) {
-      const double share = cells ? cells[k].weight : 0.0;
+      double share = 0.0;
+      if (cells && cells[k].inside_mask == TargetRegion::kWholeCell) {
+        share = 1.0;
+      } else if (cells && cells[k].inside_mask != 0 && values[k] != 0.0) {
+        int ix = 0, iy = 0;
+        cell_indices(tx, ty, k, ix, iy);
+        share = read_edge_cell(field, ix, iy, cells[k].inside_mask, values[k]).material_share;
+      }
       on_target_mm += share * values[k];
       outside_mm += (1.0 - share) * values[k];
     }

@@ -5,19 +5,23 @@
 //  target region  the band within r of any print path's centreline (capsules: round caps
 //                 at the path ends), on the field's cells (centres on its lattice): each
 //                 cell by its share w of the band, the fraction of its 8 x 8 sub-points
-//                 within r of some centreline (bands that touch or overlap count once), so
-//                 the metrics do not depend on where the lines fall between cell centres.
+//                 within r of some centreline (bands that touch or overlap count once); a
+//                 cell the band's edge crosses is read at those sub-points from the field
+//                 interpolated between cell centres (its inside part's thickness, the share
+//                 of its material inside), so the metrics hardly depend on where the lines
+//                 fall between cell centres.
 //  end zones      cells of a path's band whose nearest centreline point lies within r
 //                 (arc length) of the path's start or end, caps included.
 //  stats region   target region minus every path's end zones.
 //  thickness      over the stats region, cell values weighted by w: mean_um, cv = std /
 //                 mean (population std); min_rel = min / mean, max_rel = max / mean over
-//                 its cells whose centre lies within r (`cells` counts those). line_cv = CV
-//                 of the field sampled bilinearly on each centreline every cell length,
-//                 from arc length r to length - r. Empty region or zero mean: all zeros.
-//  material       on_target = landed in the target region (each cell's material times w),
-//                 overspray = the rest that landed, captured = blocked by the shutter;
-//                 fraction = (overspray + captured) / emitted.
+//                 its cells whose centre lies within r (all of them when none does);
+//                 `cells` counts the cells with a share. line_cv = CV of the field sampled
+//                 bilinearly on each centreline every cell length, from arc length r to
+//                 length - r. Empty region or zero mean: all zeros.
+//  material       on_target = landed in the target region (each cell's material inside
+//                 the band), overspray = the rest that landed, captured = blocked by the
+//                 shutter; fraction = (overspray + captured) / emitted.
 #pragma once
 
 #include <cstddef>

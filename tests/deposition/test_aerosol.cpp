@@ -211,7 +211,8 @@ TEST(Aerosol, MaterialIsConservedThroughShutterTransitions) {
   EXPECT_GT(m.overspray_mm3, 0.0);  // the Gaussian tail beyond +-2 sigma
 
   // the waste, from an account of its own: the material that landed farther than half a line
-  // width from both centrelines (each cell by the share of its 8 x 8 sub-points that are),
+  // width from both centrelines (a cell the band's edge crosses by the share of the field read
+  // at its 8 x 8 sub-points that lies beyond),
   // summed over the deposit's cells themselves, plus Q x the closed time above, over Q x 5 s
   const double r = 0.5 * process.line_width_mm();
   const double area = kCell * kCell;
@@ -223,17 +224,27 @@ TEST(Aerosol, MaterialIsConservedThroughShutterTransitions) {
     for (long ix = std::lround(bounds.x_lo_mm / kCell); ix <= std::lround(bounds.x_hi_mm / kCell);
          ++ix) {
       const double volume = process.field().cell_thickness_mm(ix, iy) * area;
+      // its sub-points, each by the field read there; the share of what they read outside
       int outside = 0;
+      double read_outside = 0.0, read_all = 0.0;
       for (int j = 0; j < 8; ++j)
         for (int i = 0; i < 8; ++i) {
           const double x = (ix + (i - 3.5) / 8.0) * kCell, y = (iy + (j - 3.5) / 8.0) * kCell;
           // distance to the segments (0, 0)-(6, 0) and (0, 1)-(6, 1)
           const double along = std::max(0.0, std::max(x - 6.0, -x));
           const double d = std::min(std::hypot(along, y), std::hypot(along, y - 1.0));
-          outside += d > r * (1.0 + 1e-9) ? 1 : 0;
+          const double t = process.field().thickness_mm_at(x, y);
+          read_all += t;
+          if (d > r * (1.0 + 1e-9)) {
+            ++outside;
+            read_outside += t;
+          }
         }
       landed_mm3 += volume;
-      outside_mm3 += volume * outside / 64.0;
+      if (outside == 64)
+        outside_mm3 += volume;
+      else if (outside > 0 && volume != 0.0)
+        outside_mm3 += volume * (read_all > 0.0 ? read_outside / read_all : outside / 64.0);
     }
   EXPECT_NEAR(landed_mm3, emitted - q * closed_time, 1e-6 * emitted);
   // the Gaussian tails on both sides of 12 mm of line beyond r = 2 sigma, erfc(r / (sigma

@@ -68,21 +68,24 @@ TEST(TargetRegion, EndZonesRemoveOneHalfWidthAtEachEnd) {
   EXPECT_EQ(region.target_cells(), 17u * 401u + 2 * cap);
 }
 
-// known field: 1 um below the centreline, 2 um on and above it, a gap of zero cells
+// known field: 1 um below the centreline, 2 um on and above it, a gap of zero cells inside
+// the band (its two outer rows on either side kept)
 TEST(ThicknessStats, MeanCvMinMaxOfAKnownField) {
   const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, 10.0, 0.0, 3.0);
   ThicknessField field(kCell);
   for (int iy = -8; iy <= 8; ++iy)
     for (int ix = -8; ix <= 408; ++ix)
-      if (!(ix >= 100 && ix < 105)) field.add_to_cell(ix, iy, iy < 0 ? 1e-3 : 2e-3);
+      if (!(ix >= 100 && ix < 105 && std::abs(iy) < 7))
+        field.add_to_cell(ix, iy, iy < 0 ? 1e-3 : 2e-3);
   const TargetRegion region(toolpath, 0.4, kCell);
   const ThicknessStats stats = thickness_stats(field, region, toolpath);
   ASSERT_EQ(stats.cells, 17u * 385u);
   // per stats column: 8 cells of 1 um, 9 of 2 um, the two exactly r from the centreline (rows
-  // -8 and 8) half in the band: weights 7.5 of 1 um and 8.5 of 2 um; 5 columns are empty
+  // -8 and 8) half in the band: weights 7.5 of 1 um and 8.5 of 2 um (their inner halves read
+  // between rows of the same value); 5 columns empty but for rows -8, -7, 7 and 8
   const double n = 16.0 * 385.0;
-  const double sum = 380.0 * (7.5 * 1.0 + 8.5 * 2.0);
-  const double squares = 380.0 * (7.5 * 1.0 + 8.5 * 4.0);
+  const double sum = 380.0 * (7.5 * 1.0 + 8.5 * 2.0) + 5.0 * (1.5 * 1.0 + 1.5 * 2.0);
+  const double squares = 380.0 * (7.5 * 1.0 + 8.5 * 4.0) + 5.0 * (1.5 * 1.0 + 1.5 * 4.0);
   const double mean = sum / n;
   EXPECT_NEAR(stats.mean_um, mean, 1e-9);
   EXPECT_NEAR(stats.cv, std::sqrt(squares / n - mean * mean) / mean, 1e-9);
@@ -108,6 +111,7 @@ TEST(ThicknessStats, AGaussianLineScoresAlikeWhereverItFallsOnTheLattice) {
   const double mean_t2 = sigma * std::sqrt(M_PI) * std::erf(r / sigma) / (2.0 * r);
   const double cv = std::sqrt(mean_t2 / (mean_t * mean_t) - 1.0);
   const double overspray = 1.0 - std::erf(r / (sigma * std::sqrt(2.0)));
+  std::vector<double> means, cvs, oversprays;
   for (const double offset : {0.0, 0.25 * kCell, 0.5 * kCell, 0.75 * kCell}) {
     SCOPED_TRACE(offset);
     const Toolpath toolpath = test::straight_toolpath(0.0, offset, 10.0, offset, 3.0);
@@ -122,12 +126,20 @@ TEST(ThicknessStats, AGaussianLineScoresAlikeWhereverItFallsOnTheLattice) {
     MaterialAccount account;
     account.emitted_mm3 = account.landed_mm3 = landed * kCell * kCell;
     const DepositionMetrics metrics = evaluate_deposition(field, toolpath, 2.0 * r, account);
-    // (cell-centre samples of a smooth profile: the mean within 0.3 % of the integral, the cv
-    // within 1 %; the overspray within 3 %, 0.14 points: a cell the band's edge halves
-    // holds more on its inner side than its even split counts)
-    EXPECT_NEAR(metrics.thickness.mean_um, mean_t, 3e-3 * mean_t);
-    EXPECT_NEAR(metrics.thickness.cv, cv, 1e-2 * cv);
-    EXPECT_NEAR(metrics.material.overspray_mm3 / account.emitted_mm3, overspray, 3e-2 * overspray);
+    // (cell-centre samples of a smooth profile: the mean within 0.2 % of the integral, the cv
+    // within 0.5 %, the overspray within 1.5 %)
+    EXPECT_NEAR(metrics.thickness.mean_um, mean_t, 2e-3 * mean_t);
+    EXPECT_NEAR(metrics.thickness.cv, cv, 5e-3 * cv);
+    EXPECT_NEAR(metrics.material.overspray_mm3 / account.emitted_mm3, overspray,
+                1.5e-2 * overspray);
+    means.push_back(metrics.thickness.mean_um);
+    cvs.push_back(metrics.thickness.cv);
+    oversprays.push_back(metrics.material.overspray_mm3 / account.emitted_mm3);
+  }
+  // and alike wherever the line falls: within 0.2 % of one another
+  for (const std::vector<double>* scores : {&means, &cvs, &oversprays}) {
+    const auto [lo, hi] = std::minmax_element(scores->begin(), scores->end());
+    EXPECT_LT(*hi - *lo, 2e-3 * *hi);
   }
 }
 
@@ -142,28 +154,40 @@ TEST(ThicknessStats, UniformFieldHasZeroSpread) {
   EXPECT_NEAR(metrics.thickness.line_cv, 0.0, 1e-12);
   EXPECT_NEAR(metrics.thickness.min_rel, 1.0, 1e-12);
   EXPECT_NEAR(metrics.thickness.max_rel, 1.0, 1e-12);
+  // a line narrower than a cell, between two rows of cell centres (line width 0.8 h): no cell
+  // centre lies in its band, yet cells share in it (before: every score 0)
+  const Toolpath narrow = test::straight_toolpath(0.0, 0.5 * kCell, 5.0, 0.5 * kCell, 3.0);
+  const DepositionMetrics between = evaluate_deposition(field, narrow, 0.8 * kCell, {});
+  EXPECT_GT(between.thickness.cells, 0u);
+  EXPECT_NEAR(between.thickness.mean_um, 1.5, 1e-12);
+  EXPECT_NEAR(between.thickness.cv, 0.0, 1e-12);
+  EXPECT_NEAR(between.thickness.min_rel, 1.0, 1e-12);
+  EXPECT_NEAR(between.thickness.max_rel, 1.0, 1e-12);
 }
 
 // on_target / overspray by cell, captured and emitted from the account
 TEST(MaterialSplit, SplitsLandedMaterialByTargetRegion) {
   const Toolpath toolpath = test::straight_toolpath(0.0, 0.0, 5.0, 0.0, 3.0);
   ThicknessField field(kCell);
-  field.add_to_cell(40, 0, 2.0);    // on the centreline
-  field.add_to_cell(40, 8, 3.0);    // exactly half a width away: half the cell in the band
-  field.add_to_cell(40, 9, 5.0);    // a cell beyond: outside
+  field.add_to_cell(40, 0, 2.0);  // on the centreline
+  // a 3 x 3 block of 3 across the band's edge: row 7 inside, row 8 exactly half a width away
+  // (half of each cell in the band, and half its material: the field is even across it),
+  // row 9 outside
+  for (int ix = 39; ix <= 41; ++ix)
+    for (int iy = 7; iy <= 9; ++iy) field.add_to_cell(ix, iy, 3.0);
   field.add_to_cell(-300, 0, 7.0);  // far away
   const double area = kCell * kCell;
   MaterialAccount account;
-  account.landed_mm3 = 17.0 * area;
+  account.landed_mm3 = 36.0 * area;
   account.captured_mm3 = 3.0 * area;
-  account.emitted_mm3 = 20.0 * area;
+  account.emitted_mm3 = 39.0 * area;
   account.closed_time_s = 0.25;
   const MaterialSplit split = evaluate_deposition(field, toolpath, 0.4, account).material;
-  EXPECT_DOUBLE_EQ(split.on_target_mm3, 3.5 * area);
-  EXPECT_DOUBLE_EQ(split.overspray_mm3, 13.5 * area);
+  EXPECT_NEAR(split.on_target_mm3, (2.0 + 9.0 + 4.5) * area, 1e-12);
+  EXPECT_NEAR(split.overspray_mm3, (4.5 + 9.0 + 7.0) * area, 1e-12);
   EXPECT_DOUBLE_EQ(split.captured_mm3, 3.0 * area);
-  EXPECT_DOUBLE_EQ(split.emitted_mm3, 20.0 * area);
-  EXPECT_DOUBLE_EQ(split.fraction, 16.5 / 20.0);
+  EXPECT_DOUBLE_EQ(split.emitted_mm3, 39.0 * area);
+  EXPECT_NEAR(split.fraction, 23.5 / 39.0, 1e-12);
   EXPECT_DOUBLE_EQ(split.closed_time_s, 0.25);
 }
 
