@@ -89,13 +89,30 @@ struct EdgeCell {
 };
 EdgeCell read_edge_cell(const ThicknessField& field, int ix, int iy, uint64_t inside_mask,
                         double value_mm) {
-  const double h = field.cell_mm();
+  // the cell and its eight neighbours, read once: every sub-point lies between their centres
+  double around[3][3];
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      around[dy + 1][dx + 1] =
+          dx == 0 && dy == 0 ? value_mm : field.cell_thickness_mm(ix + dx, iy + dy);
+  // a sub-point's offset from the centre, in cells: the neighbour it leans to and its weight
+  // (bilinear_between_cells' rule, thickness_mm_at's, at (ix + offset) h)
+  BilinearPoint at[8];
+  for (int i = 0; i < 8; ++i) {
+    const double offset = (i - 3.5) / 8.0;
+    at[i].ix0 = offset < 0.0 ? 0 : 1;  // index into around: the lower of the two
+    at[i].wx = offset < 0.0 ? 1.0 + offset : offset;
+  }
   double inside = 0.0, all = 0.0;
   int inside_count = 0;
   for (int j = 0; j < 8; ++j)
     for (int i = 0; i < 8; ++i) {
-      const double t =
-          field.thickness_mm_at((ix + (i - 3.5) / 8.0) * h, (iy + (j - 3.5) / 8.0) * h);
+      BilinearPoint p;
+      p.ix0 = at[i].ix0;
+      p.wx = at[i].wx;
+      p.iy0 = at[j].ix0;
+      p.wy = at[j].wx;
+      const double t = bilinear_between_cells(p, [&](int cx, int cy) { return around[cy][cx]; });
       all += t;
       if (inside_mask >> (8 * j + i) & 1) {
         inside += t;
