@@ -68,6 +68,31 @@ TEST(TargetRegion, EndZonesRemoveOneHalfWidthAtEachEnd) {
   EXPECT_EQ(region.target_cells(), 17u * 401u + 2 * cap);
 }
 
+// a cell's share of the band: its 8 x 8 sub-points within r (a row exactly r from the line:
+// half); two bands that touch fill their shared row, two that overlap count once
+TEST(TargetRegion, ACellSharesInTheBandByItsSubPointsAndBandsCountOnce) {
+  const TargetRegion one(test::straight_toolpath(0.0, 0.0, 10.0, 0.0, 3.0), 0.4, kCell);
+  EXPECT_EQ(one.weight(40, 0), 1.0);
+  EXPECT_EQ(one.weight(40, 7), 1.0);
+  EXPECT_EQ(one.weight(40, 8), 0.5);
+  EXPECT_EQ(one.weight(40, 9), 0.0);
+  EXPECT_EQ(one.weight(40, -8), 0.5);
+  // half a cell off: the band covers 16 rows whole
+  const TargetRegion off(test::straight_toolpath(0.0, 0.5 * kCell, 10.0, 0.5 * kCell, 3.0), 0.4,
+                         kCell);
+  EXPECT_EQ(off.weight(40, 8), 1.0);
+  EXPECT_EQ(off.weight(40, 9), 0.0);
+  EXPECT_EQ(off.weight(40, -7), 1.0);
+  EXPECT_EQ(off.weight(40, -8), 0.0);
+  for (const double second_y : {0.4, 0.1}) {
+    Toolpath two = test::straight_toolpath(0.0, 0.0, 10.0, 0.0, 3.0);
+    two.paths.push_back(test::straight_toolpath(0.0, second_y, 10.0, second_y, 3.0).paths[0]);
+    const TargetRegion both(two, 0.4, kCell);
+    EXPECT_EQ(both.weight(40, 8), 1.0) << second_y;
+    EXPECT_EQ(both.weight(40, -8), 0.5) << second_y;
+  }
+}
+
 // known field: 1 um below the centreline, 2 um on and above it, a gap of zero cells inside
 // the band (its two outer rows on either side kept)
 TEST(ThicknessStats, MeanCvMinMaxOfAKnownField) {
