@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "core/toolpath.hpp"
 #include "core/types.hpp"
@@ -109,7 +110,8 @@ BENCHMARK(BM_ExtrusionStep1msUnbatched);
 // Scoring a slicer-like deposit (deposition_metrics.hpp: the band's cells by their share, the
 // thickness figures, the material split) against laying it down: an extrusion spiral of 0.5 mm
 // chords, 2 mm apart, 600 mm at 30 mm/s in 1 ms steps, scored whole each iteration.
-// `score_over_deposit`: one scoring's time over the deposit's, measured once in the same run.
+// `score_over_deposit`: one scoring's time over the deposit's (the quickest of three), in the
+// same run.
 void BM_ScoreSpiralAgainstItsDeposit(benchmark::State& state) {
   depotwin::Toolpath toolpath;
   depotwin::PrintPath path;
@@ -120,28 +122,42 @@ void BM_ScoreSpiralAgainstItsDeposit(benchmark::State& state) {
     angle += 0.5 / radius;
   }
   toolpath.paths.push_back(path);
-  depotwin::ExtrusionProcess process(extrusion(1.0), 0.0);
-  // the deposit: the nozzle along the chords at the print speed, 1 ms steps
-  const auto deposit_start = std::chrono::steady_clock::now();
-  DepositionStep step;
-  step.open0 = step.open1 = 1.0;
-  step.flow_command = 1.0;
-  step.desired_speed_mm_s = path.speed_mm_s;
-  double t_s = 0.0;
-  for (std::size_t k = 0; k + 1 < path.points.size(); ++k) {
-    const Vec3 a = path.points[k], b = path.points[k + 1];
-    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.03)));
-    for (int i = 0; i < steps; ++i) {
-      step.t0_s = t_s;
-      step.t1_s = t_s += (b - a).norm() / steps / path.speed_mm_s;
-      step.p0_mm = a + (b - a) * (static_cast<double>(i) / steps);
-      step.p1_mm = a + (b - a) * (static_cast<double>(i + 1) / steps);
-      process.advance(step);
+  // the deposit: the nozzle along the chords at the print speed, 1 ms steps; laid down three
+  // times in fresh processes, the quickest kept as the baseline
+  const auto lay_down = [&](depotwin::Process& process) {
+    DepositionStep step;
+    step.open0 = step.open1 = 1.0;
+    step.flow_command = 1.0;
+    step.desired_speed_mm_s = path.speed_mm_s;
+    double t_s = 0.0;
+    for (std::size_t k = 0; k + 1 < path.points.size(); ++k) {
+      const Vec3 a = path.points[k], b = path.points[k + 1];
+      const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.03)));
+      for (int i = 0; i < steps; ++i) {
+        step.t0_s = t_s;
+        step.t1_s = t_s += (b - a).norm() / steps / path.speed_mm_s;
+        step.p0_mm = a + (b - a) * (static_cast<double>(i) / steps);
+        step.p1_mm = a + (b - a) * (static_cast<double>(i + 1) / steps);
+        process.advance(step);
+      }
     }
+    process.flush();
+  };
+  double deposit_s = std::numeric_limits<double>::infinity();
+  for (int round = 0; round < 2; ++round) {
+    depotwin::ExtrusionProcess scratch(extrusion(1.0), 0.0);
+    const auto start = std::chrono::steady_clock::now();
+    lay_down(scratch);
+    deposit_s = std::min(
+        deposit_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
-  process.flush();
-  const double deposit_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - deposit_start).count();
+  depotwin::ExtrusionProcess process(extrusion(1.0), 0.0);
+  {
+    const auto start = std::chrono::steady_clock::now();
+    lay_down(process);
+    deposit_s = std::min(
+        deposit_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
   double scored_s = 0.0;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
