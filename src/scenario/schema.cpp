@@ -255,8 +255,8 @@ std::vector<SchemaSection> make_schema() {
               "where the machine starts, at rest (surface: 20 mm above the part; gcode: the "
               "file's first print point, before offset)"),
         other("end", "point [x, y] or [x, y, z], each in [-1e+06, 1e+06]", "mm", "start",
-              "where the machine ends, at rest (gcode: the start raised to the file's highest "
-              "print point, or its last print point where that is out of reach)"),
+              "where the machine ends, at rest (gcode: the start raised to the highest print "
+              "point read, or the last one where that is out of reach)"),
         other("offset", "point [dx, dy] or [dx, dy, dz], each in [-1e+06, 1e+06]", "mm", "none",
               "added to every point, start and end (not with surface)"),
         other("segments", "list of [[x, y], [x, y]]", "mm", "-",
