@@ -233,13 +233,12 @@ TargetRegion::TargetRegion(const Toolpath& toolpath, double line_width_mm, doubl
       arc_start += length;
     }
   }
-  // settle the last path of every cell, and its share of the band
+  // settle the last path of every cell; one with no sub-point in the band is not a target
   for (const auto& [tx, ty] : tiles_.sorted_tiles()) {
     Cell* tile = tiles_.find(tx, ty);
     for (int k = 0; k < Tiles::kCells; ++k) {
       finish_cell(tile[k]);
       tile[k].path = -1;
-      tile[k].weight = static_cast<float>(__builtin_popcountll(tile[k].inside_mask)) / 64.0f;
       if (tile[k].inside_mask == 0) tile[k].flags &= static_cast<uint8_t>(~kTarget);
     }
   }
@@ -262,7 +261,7 @@ uint8_t TargetRegion::flags(int ix, int iy) const {
 
 double TargetRegion::weight(int ix, int iy) const {
   const Cell* tile = tiles_.find(Tiles::tile_of(ix), Tiles::tile_of(iy));
-  return tile ? tile[Tiles::local_index(ix, iy)].weight : 0.0;
+  return tile ? tile[Tiles::local_index(ix, iy)].weight() : 0.0;
 }
 
 size_t TargetRegion::target_cells() const {
@@ -309,8 +308,8 @@ ThicknessStats thickness_stats(const ThicknessField& field, const TargetRegion& 
     }
   };
   for_each_stats_cell([&](double v, const TargetRegion::Cell& cell) {
-    sum += cell.weight * v;
-    weights += cell.weight;
+    sum += cell.weight() * v;
+    weights += cell.weight();
     ++stats.cells;
     min_any = std::min(min_any, v);
     max_any = std::max(max_any, v);
@@ -325,7 +324,7 @@ ThicknessStats thickness_stats(const ThicknessField& field, const TargetRegion& 
     double squares = 0.0;
     // (relative to the mean: a tiny flow's squares would underflow to a cv of 0)
     for_each_stats_cell([&](double v, const TargetRegion::Cell& cell) {
-      squares += cell.weight * ((v - mean) / mean) * ((v - mean) / mean);
+      squares += cell.weight() * ((v - mean) / mean) * ((v - mean) / mean);
     });
     stats.mean_um = mean * kUmPerMm;
     stats.cv = std::sqrt(squares / weights);

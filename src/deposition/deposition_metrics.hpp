@@ -65,10 +65,11 @@ class TargetRegion {
   struct Cell {
     double best_arc_mm = 0.0;         // arc length of the nearest point along `path`
     float best_distance2_mm2 = 0.0f;  // squared distance to that point
-    float weight = 0.0f;              // the cell's share of the band, in [0, 1]
     uint64_t inside_mask = 0;         // its 8 x 8 sub-points within r of a centreline
     int32_t path = -1;                // path being resolved (construction scratch)
     uint8_t flags = 0;
+    // the cell's share of the band, in [0, 1]
+    double weight() const { return __builtin_popcountll(inside_mask) / 64.0; }
   };
   static constexpr uint8_t kTarget = 1;        // a share of the band (weight > 0)
   static constexpr uint8_t kEndZone = 2;       // in a path's end zone
