@@ -61,11 +61,10 @@ class Cartesian : public Machine {
         return false;
       }
     }
-    if (tcp_mm.z() < kMinTcpZ_mm) {
-      if (why)
-        *why = "z = " + message_number_outside(tcp_mm.z(), kMinTcpZ_mm, kTravelZMax_mm, 4) +
-               " mm puts the nozzle more than " + message_number(-kMinTcpZ_mm, 4) +
-               " mm into the bed (its top is z = 0)";
+    if (const std::string deep =
+            below_surface_problem(tcp_mm.z(), kMinTcpZ_mm, "bed (its top is z = 0)");
+        !deep.empty()) {
+      if (why) *why = deep;
       return false;
     }
     return true;

@@ -214,13 +214,10 @@ bool LinearDelta::inverse(const Pose& pose, JointVector& joints, std::string* wh
   if (!tcp_mm.allFinite()) return fail("the point is not finite");
   if (const std::string tilted = vertical_axis_problem(name(), pose); !tilted.empty())
     return fail(tilted);
-  if (tcp_mm.z() < geometry_.min_tcp_z_mm) {
-    return fail("z = " +
-                message_number_outside(tcp_mm.z(), geometry_.min_tcp_z_mm,
-                                       std::numeric_limits<double>::infinity(), 4) +
-                " mm puts the nozzle more than " + message_number(-geometry_.min_tcp_z_mm, 4) +
-                " mm into the substrate");
-  }
+  if (const std::string deep =
+          below_surface_problem(tcp_mm.z(), geometry_.min_tcp_z_mm, "substrate");
+      !deep.empty())
+    return fail(deep);
 
   // each arm: q_i = p_z - sqrt(L^2 - |p_xy - D u_i|^2) - H
   const Vec3 platform_mm = linear_delta_platform_position(geometry_, tcp_mm);

@@ -83,6 +83,11 @@ class Machine {
 // is vertical, else why not. For the translational machines' inverse().
 std::string vertical_axis_problem(const std::string& machine, const Pose& pose);
 
+// A machine whose nozzle may go at most -min_z_mm below the work surface (z = 0): "" when the
+// TCP's z is at or above min_z_mm, else "z = ... mm puts the nozzle more than ... mm into the
+// <surface>". For the translational machines' inverse().
+std::string below_surface_problem(double z_mm, double min_z_mm, const std::string& surface);
+
 // One registered machine: its name (the scenario's `machine:` and an MJCF's `kinematics:`),
 // a line of description, and a factory with default geometry and limits.
 struct MachineInfo {

@@ -2,7 +2,9 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
+#include "core/number_text.hpp"
 #include "kinematics/arm6.hpp"
 #include "kinematics/cartesian.hpp"
 #include "kinematics/linear_delta.hpp"
@@ -92,6 +94,15 @@ std::string vertical_axis_problem(const std::string& machine, const Pose& pose) 
                 machine.c_str(), pose.tool_axis.x(), pose.tool_axis.y(), pose.tool_axis.z(),
                 tilt_deg);
   return text;
+}
+
+std::string below_surface_problem(double z_mm, double min_z_mm, const std::string& surface) {
+  if (z_mm >= min_z_mm) return "";
+  // (z to the digits that tell it from the limit: -1.0001, not -1)
+  return "z = " +
+         message_number_outside(z_mm, min_z_mm, std::numeric_limits<double>::infinity(), 4) +
+         " mm puts the nozzle more than " + message_number(-min_z_mm, 4) + " mm into the " +
+         surface;
 }
 
 }  // namespace depotwin
