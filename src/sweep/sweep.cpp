@@ -101,18 +101,14 @@ SweepTask Sweep::task(std::uint64_t index) const {
   return task;
 }
 
-std::string Sweep::task_folder_name(std::uint64_t index) const {
-  std::string digits = std::to_string(index);
-  if (static_cast<int>(digits.size()) < folder_digits_)
-    digits.insert(0, static_cast<std::size_t>(folder_digits_) - digits.size(), '0');
-  return "tasks/" + digits;
-}
-
-std::string Sweep::task_folder(std::uint64_t index) const {
-  return (fs::path(out_) / task_folder_name(index)).string();
-}
-
 namespace {
+
+// a task folder's name under tasks/: its index zero-padded to `width` digits
+std::string zero_padded(std::uint64_t index, std::size_t width) {
+  std::string digits = std::to_string(index);
+  if (digits.size() < width) digits.insert(0, width - digits.size(), '0');
+  return digits;
+}
 
 // the task index a folder name under tasks/ stands for: digits only, zero-padded to at least
 // four (a staging folder, tasks/<i>.partial-<pid>, is not one)
@@ -125,15 +121,22 @@ std::optional<std::uint64_t> task_index_of_folder(const std::string& name) {
 
 }  // namespace
 
+std::string Sweep::task_folder_name(std::uint64_t index) const {
+  return "tasks/" + zero_padded(index, static_cast<std::size_t>(folder_digits_));
+}
+
+std::string Sweep::task_folder(std::uint64_t index) const {
+  return (fs::path(out_) / task_folder_name(index)).string();
+}
+
 std::string Sweep::found_task_folder(std::uint64_t index) const {
   const std::string current = task_folder(index);
   std::error_code error;
   if (fs::exists(current, error)) return current;
-  const std::string digits = std::to_string(index);
-  for (std::size_t width = std::max<std::size_t>(4, digits.size()); width <= 19; ++width) {
+  for (std::size_t width = std::max<std::size_t>(4, std::to_string(index).size()); width <= 19;
+       ++width) {
     if (static_cast<int>(width) == folder_digits_) continue;
-    const fs::path other =
-        fs::path(out_) / "tasks" / (std::string(width - digits.size(), '0') + digits);
+    const fs::path other = fs::path(out_) / "tasks" / zero_padded(index, width);
     if (fs::is_directory(other, error)) return other.string();
   }
   return current;
