@@ -315,8 +315,7 @@ ScenarioReading Loader::read() {
     JointVector joints;
     if (!machine_->inverse(Pose(toolpath.end_mm), joints, nullptr)) {
       toolpath.end_mm = toolpath.paths.back().points.back();
-      if (!scenario_.exact_toolpath.paths.empty())
-        scenario_.exact_toolpath.end_mm = toolpath.end_mm;
+      scenario_.exact_toolpath.end_mm = toolpath.end_mm;
     }
   }
   if (machine_ && scenario_.machine != "arm6")
