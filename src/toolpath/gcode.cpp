@@ -192,8 +192,7 @@ bool has_g_word(const char* p, const char* end) {
 // line's axis words beside them are a move in the modal motion (RS274/NGC), `G90 X5`
 bool is_modal_setting(int tenths) {
   switch (tenths) {
-    case 70:  // G7, G8: lathe diameter or radius mode
-    case 80:
+    case 80:   // G8: a lathe's radius mode, X words are radii (G7, diameters: refused)
     case 150:  // G15 polar coordinates off
     case 400:  // G40 cutter compensation off
     case 430:  // G43 tool length offset (H), G49 off
@@ -497,6 +496,9 @@ const char* unsupported_g_code_reason(int tenths) {
     case 421:
       return " is not supported: cutter radius compensation offsets the path by a tool radius "
              "the file does not give (export the toolpath without it, G40)";
+    case 70:  // G7: LinuxCNC's lathe diameter mode
+      return " is not supported: a lathe's diameter mode reads every X that follows as a "
+             "diameter, twice the distance moved (write the program in radius mode, G8)";
     case 121:  // G12.1, G13.1: Fanuc's polar interpolation
     case 131:
     case 160:  // G16 polar coordinates

@@ -888,25 +888,27 @@ TEST(Gcode, AnAnalogChannelIsNoExtrusion) {
 
 // other controllers' codes that cut what the file does not write out, or whose meaning
 // depends on the controller, are refused at their line (before, each was skipped and its
-// geometry lost, or G70's inch read as mm); Marlin's G12 nozzle clean passes
+// geometry lost, or G70's inch read as mm; G7's X as diameters read as radii, twice the
+// part); Marlin's G12 nozzle clean passes, and G8, the lathe's radius mode
 TEST(Gcode, PocketsCyclesAndAmbiguousUnitCodesAreRefused) {
   const auto problems = problems_of(
       "G21 G90\nG1 X0 Y0 F600\nG12 I10\nG13 I5\nG74 X1 Y1 Z-0.5 R0.1 F25\nG70\nG71\n"
-      "G12.1\nG75 X1\nG1 X10 E1\n");
-  ASSERT_EQ(problems.size(), 7u) << dump(problems);
-  const char* codes[7] = {"G12 I: circular pockets",
+      "G12.1\nG75 X1\nG18 G7\nG1 X10 E1\n");
+  ASSERT_EQ(problems.size(), 8u) << dump(problems);
+  const char* codes[8] = {"G12 I: circular pockets",
                           "G13 I: circular pockets",
                           "G74 is not supported: a canned cycle",
                           "G70 is not supported: it "
                           "means inch or mm",
                           "G71 is not supported: it means inch or mm",
                           "G12.1 is not supported: polar",
-                          "G75 is not supported: a canned"};
+                          "G75 is not supported: a canned",
+                          "G7 is not supported: a lathe's diameter mode"};
   for (std::size_t i = 0; i < problems.size(); ++i) {
     EXPECT_EQ(problems[i].line, static_cast<int>(i) + 3);
     EXPECT_EQ(problems[i].message.rfind(codes[i], 0), 0u) << problems[i].str();
   }
-  const GcodeImport clean = parse("G21 G90\nG12 P1 S3 T2\nG1 X0 Y0 F600\nG1 X10 E1\n");
+  const GcodeImport clean = parse("G21 G90\nG12 P1 S3 T2\nG8\nG1 X0 Y0 F600\nG1 X10 E1\n");
   ASSERT_EQ(clean.toolpath.paths.size(), 1u);
   expect_points(clean.toolpath.paths[0], {Vec3(0, 0, 0), Vec3(10, 0, 0)});
 }
