@@ -1075,34 +1075,47 @@ bool Loader::machine_moves_z(const Machine& machine) {
 
 bool Loader::multi_level_problem(const GcodeImport& imported, const std::string& file,
                                  const std::string& key) {
-  const double first_z_mm = imported.toolpath.paths.front().points.front().z();
-  std::vector<double> levels{first_z_mm};
-  int first_off_line = 0;
-  double first_off_z_mm = first_z_mm;
-  for (std::size_t i = 0; i < imported.toolpath.paths.size(); ++i) {
-    const std::vector<Vec3>& points = imported.toolpath.paths[i].points;
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      const double z_mm = points[k].z();
-      if (std::none_of(levels.begin(), levels.end(),
-                       [&](double level) { return std::abs(level - z_mm) <= 1e-6; }))
-        levels.push_back(z_mm);
-      if (first_off_line == 0 && std::abs(z_mm - first_z_mm) > 1e-6) {
-        first_off_line = imported.point_lines[i].at(k);
-        first_off_z_mm = z_mm;
-      }
+  // the first move, in the file's order, that leaves the first print point's z: within a print
+  // run (a plunge or ramp with the shutter open: no layer choice helps) or at a run of its own
+  // at another height (a layer)
+  const std::vector<PrintPath>& paths = imported.toolpath.paths;
+  const double first_z_mm = paths.front().points.front().z();
+  const auto off_level = [](double a_mm, double b_mm) { return std::abs(a_mm - b_mm) > 1e-6; };
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const std::vector<Vec3>& points = paths[i].points;
+    const double run_z_mm = points.front().z();
+    for (std::size_t k = 1; k < points.size(); ++k) {
+      if (!off_level(points[k].z(), run_z_mm)) continue;
+      problems_.add_problem(Problem{
+          file, imported.point_lines[i].at(k), key,
+          "this print move changes z from " + format_number(run_z_mm) + " to " +
+              format_number(points[k].z()) + " mm while printing (a plunge or ramp with the " +
+              "shutter open or the material flowing) but " + scenario_.machine +
+              " has no z axis (start printing at the working height, or use a machine with z " +
+              "such as cartesian)"});
+      return true;
     }
+    if (!off_level(run_z_mm, first_z_mm)) continue;
+    // a layer at another height: how many heights the file's runs print at
+    std::vector<double> levels;
+    for (const PrintPath& path : paths) {
+      const double z_mm = path.points.front().z();
+      if (std::none_of(levels.begin(), levels.end(),
+                       [&](double level) { return !off_level(level, z_mm); }))
+        levels.push_back(z_mm);
+    }
+    std::sort(levels.begin(), levels.end());
+    problems_.add_problem(Problem{
+        file, imported.point_lines[i].front(), key,
+        "the file prints at " + std::to_string(levels.size()) + " z levels (" +
+            format_number(levels.front()) + " to " + format_number(levels.back()) + " mm) but " +
+            scenario_.machine + " has no z axis: this move leaves z = " +
+            format_number(first_z_mm) + " mm for z = " + format_number(run_z_mm) +
+            " mm (select one layer with gcode: {file: ..., layers: [k, k]}, or use a machine "
+            "with z such as cartesian)"});
+    return true;
   }
-  if (levels.size() < 2) return false;
-  std::sort(levels.begin(), levels.end());
-  problems_.add_problem(Problem{
-      file, first_off_line, key,
-      "the file prints at " + std::to_string(levels.size()) + " z levels (" +
-          format_number(levels.front()) + " to " + format_number(levels.back()) + " mm) but " +
-          scenario_.machine + " has no z axis: this move leaves z = " + format_number(first_z_mm) +
-          " mm for z = " + format_number(first_off_z_mm) +
-          " mm (select one layer with gcode: {file: ..., layers: [k, k]}, or use a machine "
-          "with z such as cartesian)"});
-  return true;
+  return false;
 }
 
 void Loader::clamp_feed_rates(std::vector<PrintPath>& paths, std::vector<std::vector<int>>& lines,

@@ -138,6 +138,22 @@ toolpath: {gcode: layers.gcode}
                  "the file prints at 3 z levels (0 to 0.4 mm) but xy_stage has no z axis");
 }
 
+// a CAM pass that plunges with the shutter already open changes z within its print run: no
+// layer choice helps (before, the message counted its points' heights as "2 z levels" and
+// suggested `layers: [k, k]`, though the file has one layer and [0, 0] was refused alike)
+TEST_F(ScenarioGcode, APlungeWhilePrintingWithoutZIsNotCalledLayers) {
+  write("plunge.gcode", "G21 G90\nG0 X0 Y0 Z5\nM3\nG1 Z0 F300\nG1 X10 F600\nG1 Y10\nM5\nG0 Z5\n");
+  for (const char* toolpath : {"{gcode: {file: plunge.gcode, rule: shutter}}",
+                               "{gcode: {file: plunge.gcode, rule: shutter, layers: [0, 0]}}"}) {
+    const auto problems =
+        problems_of(std::string("limits: {v_max: 20, a_max: 300}\ntoolpath: ") + toolpath + "\n");
+    ASSERT_EQ(problems.size(), 1u) << dump(problems);
+    expect_problem(problems, (dir_ / "plunge.gcode").string(), "toolpath.gcode", 4,
+                   "this print move changes z from 5 to 0 mm while printing");
+    EXPECT_EQ(problems[0].message.find("layers: [k, k]"), std::string::npos) << problems[0].str();
+  }
+}
+
 // on the cartesian machine every layer loads; `layers: [from, to]` selects some
 TEST_F(ScenarioGcode, CartesianLoadsLayersAndSelectsThem) {
   write("layers.gcode", kThreeLayers);
