@@ -2,11 +2,11 @@
 // view`): the RecordedRun holds the machine's actuated joints only, but a replay must also
 // place the passive ones (a delta's rods and free platform, the shutter's flap).
 //
-// Simulation::run hands its states to on_step in chunks of 64 steps, between physics steps:
-// the last state of a chunk is the simulation's current state, so its qpos is read there
-// exactly (every 64 ms at 1 ms steps). In between, the samples are interpolated linearly
-// (quaternions renormalised), and the machine's joints are taken from the record at the
-// time itself (linear between its 1 ms steps), so the nozzle is where the run put it.
+// Simulation::run hands its states to on_step in chunks of 64 steps (the first of one step),
+// between physics steps: the last state of a chunk is the simulation's current state, so its
+// qpos is read there exactly (1 ms in, then every 64 ms at 1 ms steps). In between, the samples are
+// interpolated linearly (quaternions renormalised), and the machine's joints are taken from the
+// record at the time itself (linear between its 1 ms steps), so the nozzle is where the run put it.
 #pragma once
 
 #include <vector>

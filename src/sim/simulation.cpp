@@ -359,7 +359,9 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
   // them); callbacks run in the caller's floating-point mode
   FlushSubnormalsScope flush_subnormals;
   // on_step runs on chunks of buffered states (the first is the last chunk's end), so the
-  // floating-point mode switches once per chunk rather than twice a step
+  // floating-point mode switches once per chunk rather than twice a step; the first chunk is
+  // one step, so a caller sees the simulation's own state (its passive joints: a delta's
+  // platform) 1 ms in rather than only a chunk in
   std::vector<StepState> pending_states;
   if (on_step) pending_states.reserve(kCallbackChunkSteps + 1);
   const auto deliver_pending_states = [&]() {
@@ -385,7 +387,8 @@ RecordedRun Simulation::run(const Trajectory& trajectory, const StepCallback& on
       max_violation_mm = std::max(max_violation_mm, constraint_violation_mm(*d));
     if (on_step) {
       pending_states.push_back(after);  // capacity reserved: no allocation
-      if (pending_states.size() == kCallbackChunkSteps + 1 || k == steps) deliver_pending_states();
+      if (pending_states.size() == kCallbackChunkSteps + 1 || k == steps || k == 1)
+        deliver_pending_states();
     }
 
     // servo controls at the controller rate, held in between

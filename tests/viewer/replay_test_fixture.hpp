@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <limits>
 #include <string>
 
 #include "pipeline/job.hpp"
@@ -30,15 +31,16 @@ struct ReplayFixture {
 
   // the largest distance (mm) between the nozzle site placed by a frame's qpos and the
   // recorded nozzle of that frame (both in the substrate frame); its frame in `worst_frame`
-  // (from frame `first` on)
-  double worst_nozzle_error_mm(size_t* worst_frame = nullptr, size_t first = 0) const {
+  // (frames `first` to `end`, exclusive, at most the last)
+  double worst_nozzle_error_mm(size_t* worst_frame = nullptr, size_t first = 0,
+                               size_t end = std::numeric_limits<size_t>::max()) const {
     install_mujoco_handlers();
     const ModelPtr model = load_model_from_string(replay.model_text, replay.model_source);
     const DataPtr data = make_data(*model);
     const int nozzle = mj_name2id(model.get(), mjOBJ_SITE, "nozzle");
     const int substrate = mj_name2id(model.get(), mjOBJ_BODY, "substrate");
     double worst_mm = 0.0;
-    for (size_t frame = first; frame < replay.frame_count(); ++frame) {
+    for (size_t frame = first; frame < std::min(end, replay.frame_count()); ++frame) {
       std::copy(replay.qpos_of(frame), replay.qpos_of(frame) + replay.nq, data->qpos);
       mj_kinematics(model.get(), data.get());
       const mjtNum* site = data->site_xpos + 3 * nozzle;

@@ -228,20 +228,23 @@ TEST(Replay, TheMachineIsWhereTheRunHadIt) {
   // the nozzle site placed by each frame's qpos against the record's nozzle. The XY stage's
   // joints come from the record at the frame's time, whose nearest step is up to half a step
   // away (0.5 ms at <= 4 mm/s: 2 um). The delta's rods and free platform are interpolated
-  // between states sampled every 64 ms (0.019 mm at worst here); its first frame holds the
-  // first sample, 64 ms in, over which the platform settles on its rods (< 0.1 mm).
+  // between states sampled every 64 ms (0.019 mm at worst on thompson_fig7_delta; 0.21 mm on
+  // giberti_circle, where linear interpolation misses up to a T^2 / 8 = 0.26 mm of the move
+  // from the centre, accelerating at 500 mm/s^2). The
+  // first frame holds the first sample, 1 ms in (before, 64 ms in: the platform, settling on
+  // its rods and moving at once on giberti_circle, showed 1.4 mm off at frame 0).
   struct Case {
     const char* scenario;
-    double bound_mm, first_frame_bound_mm;
+    double bound_mm;
   };
-  for (const Case& c :
-       {Case{"thompson_fig7.yaml", 0.005, 0.005}, Case{"thompson_fig7_delta.yaml", 0.05, 0.1}}) {
+  for (const Case& c : {Case{"thompson_fig7.yaml", 0.005}, Case{"thompson_fig7_delta.yaml", 0.05},
+                        Case{"giberti_circle.yaml", 0.25}}) {
     testing_support::ReplayFixture fixture(scenario_path(c.scenario));
     size_t frame = 0;
     const double worst_mm = fixture.worst_nozzle_error_mm(&frame, 1);
     EXPECT_LT(worst_mm, c.bound_mm)
         << c.scenario << ": frame " << frame << " at t = " << fixture.replay.t_s[frame] << " s";
-    EXPECT_LT(fixture.worst_nozzle_error_mm(nullptr, 0), c.first_frame_bound_mm) << c.scenario;
+    EXPECT_LT(fixture.worst_nozzle_error_mm(nullptr, 0, 1), 0.01) << c.scenario;
   }
 }
 
