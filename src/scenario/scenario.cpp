@@ -1364,10 +1364,19 @@ void Loader::read_surface(const Field& field, const std::optional<double>& defau
                         "' (expected normal: along the surface normal, or z: vertical, as in "
                         "the paper)");
   }
-  if (const Field* f = view.find("chord_tolerance_mm"))
+  if (const Field* f = view.find("chord_tolerance_mm")) {
     surface->chord_tolerance_mm =
         read_number(*f, problems_, range_of(section, "chord_tolerance_mm"))
             .value_or(surface->chord_tolerance_mm);
+    // (a tolerance of atoms refines every chord of a curved surface to its limit and cuts each
+    // crease's arc into millions of chords: gigabytes, then out of memory)
+    if (surface->chord_tolerance_mm > 0.0 &&
+        surface->chord_tolerance_mm < SurfaceHatchSpec::kLeastChordTolerance_mm)
+      problems_.add(f->line, f->key,
+                    "is " + format_number(surface->chord_tolerance_mm) + " mm: give 0 (the " +
+                        "grid's points only) or at least " +
+                        format_number(SurfaceHatchSpec::kLeastChordTolerance_mm) + " mm");
+  }
   std::optional<double> speed = default_speed;
   // where the hatch's speed is given, for the segments it is too fast on
   std::string speed_key = "toolpath.speed";

@@ -355,7 +355,7 @@ std::vector<SchemaSection> make_schema() {
                  surface.chord_tolerance_mm,
                  "where the surface rises more than this above the chord between two points "
                  "(a ridge, a step's edge), the point there is added; 0: the grid's points only "
-                 "(the paper)"),
+                 "(the paper), else at least 1e-4"),
           speed}});
   }
 

@@ -38,8 +38,10 @@ void validate(const SurfaceHatchSpec& spec) {
         "min_normal_z", "the least normal z must be in [0, 1)");
   check(std::isfinite(spec.max_jump_ratio) && spec.max_jump_ratio >= 1.0, "max_jump_ratio",
         "the jump ratio must be at least 1");
-  check(std::isfinite(spec.chord_tolerance_mm) && spec.chord_tolerance_mm >= 0.0,
-        "chord_tolerance_mm", "the chord tolerance must be finite and not negative");
+  check(std::isfinite(spec.chord_tolerance_mm) &&
+            (spec.chord_tolerance_mm == 0.0 ||
+             spec.chord_tolerance_mm >= SurfaceHatchSpec::kLeastChordTolerance_mm),
+        "chord_tolerance_mm", "the chord tolerance must be 0 or at least 1e-4 mm");
   if (!problems.empty()) throw InputError(std::move(problems));
 }
 
@@ -389,7 +391,8 @@ std::size_t round_convex_creases(PrintPath& path, HatchPathInfo& info, double of
     if (!(-a / b > -c / d)) continue;
     const Vec3 crease = s0 + u * along + w * Vec3::UnitZ();
     // the arc from n0 to n1 about the crease (the normals' slerp), its ends included
-    const int pieces = static_cast<int>(std::ceil(turn / largest_turn));
+    const int pieces = static_cast<int>(
+        std::min(std::ceil(turn / largest_turn), double{SurfaceHatchSpec::kMaxCreaseChords}));
     std::vector<Vec3> normals;
     for (int k = 0; k <= pieces; ++k) {
       const double f = static_cast<double>(k) / pieces;

@@ -59,8 +59,12 @@ struct SurfaceHatchSpec {
   double max_jump_ratio = 3.0;  // farther apart than this * hatch_mm, no slope between: a break
   // a chord between consecutive points that the surface rises more than this above (halfway,
   // or where the chord lifted by this meets it) is refined by the surface point there (0: the
-  // grid's points only, as in the paper)
+  // grid's points only, as in the paper; else at least kLeastChordTolerance_mm)
   double chord_tolerance_mm = 0.05;
+  static constexpr double kLeastChordTolerance_mm = 1e-4;
+  // a convex crease's offset arc takes at most this many chords (finer than the tolerance
+  // where the offset is large: 2^10 chords of a 90 deg arc keep within 1.2e-6 of its radius)
+  static constexpr int kMaxCreaseChords = 1024;
 };
 
 // Where each path came from and what the surface is like under it.

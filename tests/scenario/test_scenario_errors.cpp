@@ -794,8 +794,9 @@ toolpath:
     angles: []
     layers: 0
     layer_offset: sideways
+    chord_tolerance_mm: 1e-12
 )");
-  ASSERT_EQ(problems.size(), 7u) << dump(problems);
+  ASSERT_EQ(problems.size(), 8u) << dump(problems);
   expect_problem(problems, scenario_path(), "toolpath.surface", 3, "missing file");
   expect_problem(problems, scenario_path(), "toolpath.surface.mesh", 4, "unknown key");
   expect_problem(problems, scenario_path(), "toolpath.surface.units", 5, "unknown units 'furlong'");
@@ -804,6 +805,9 @@ toolpath:
   expect_problem(problems, scenario_path(), "toolpath.surface.layers", 8, "whole number");
   expect_problem(problems, scenario_path(), "toolpath.surface.layer_offset", 9,
                  "unknown layer offset 'sideways'");
+  // (a tolerance of atoms ran shembekar_beam out of memory: bad_alloc after 5 GB)
+  expect_problem(problems, scenario_path(), "toolpath.surface.chord_tolerance_mm", 10,
+                 "is 1e-12 mm: give 0 (the grid's points only) or at least 0.0001 mm");
 }
 
 // a missing STL names the path looked for; an offset outside surface: is refused

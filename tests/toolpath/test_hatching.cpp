@@ -588,6 +588,36 @@ TEST(Hatching, OffsetLayersKeepTheirOffsetOverAConvexCrease) {
   }
 }
 
+// The arc about a convex crease takes at most kMaxCreaseChords chords: far out (layer 7 at
+// 100 mm a layer: 700 mm from the roof) at the least tolerance, the 70 deg turn of the V would
+// take 1 143 chords; a tolerance of atoms took millions a crease (out of memory on
+// shembekar_beam). Every layer's arc within its tolerance where the cap leaves it.
+TEST(Hatching, AConvexCreasesArcHasAtMostItsCapOfChords) {
+  const TriangleMesh mesh = v_shaped(20.0, -0.7, 9.6);
+  SurfaceHatchSpec spec;
+  spec.hatch_mm = 2.0;
+  spec.angles_deg = {0};
+  spec.layers = 8;
+  spec.layer_height_mm = 100.0;
+  spec.chord_tolerance_mm = SurfaceHatchSpec::kLeastChordTolerance_mm;
+  const SurfaceHatch hatch = hatch_surface(mesh, spec);
+  const std::size_t grid_points = hatch.toolpath.paths.front().points.size();
+  const double turn = 2.0 * std::atan(0.7);
+  for (const PrintPath& path : hatch.toolpath.paths) {
+    const double offset = path.layer * spec.layer_height_mm;
+    const double wanted =
+        offset > 0.0 ? std::ceil(turn / (2.0 * std::acos(1.0 - spec.chord_tolerance_mm / offset)))
+                     : 0.0;
+    const double chords = std::min(wanted, double{SurfaceHatchSpec::kMaxCreaseChords});
+    SCOPED_TRACE("layer " + std::to_string(path.layer) + ", arc of " + std::to_string(wanted));
+    // the arc's points (its ends among them) beside the grid's, one each side of the crease
+    EXPECT_LE(path.points.size(), grid_points + static_cast<std::size_t>(chords) + 1);
+    if (path.layer == 7) {
+      EXPECT_GT(wanted, SurfaceHatchSpec::kMaxCreaseChords);
+    }
+  }
+}
+
 // A band around the z axis (radius 30 mm, 20 mm wide, centred 20 mm up) turning over by half
 // a turn along its length and cut open where its ends would meet: wound consistently, it faces
 // up on one half and down on the other, and both halves are seen from above.
