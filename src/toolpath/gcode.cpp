@@ -34,6 +34,8 @@ constexpr std::size_t kMaxListedProblems = 20;
 constexpr double kMinMove_mm = kJoinTolerance_mm;
 // the largest magnitude a number may have (beyond: a typo or garbage)
 constexpr double kMaxMagnitude = 1e9;
+// the least feed rate read (per minute, in the file's unit)
+constexpr double kLeastFeedPerMinute = 1e-6;
 // the largest G or M code number (Marlin's and RepRapFirmware's run to a few thousand); its
 // tenths must fit an int
 constexpr int kMaxCodeNumber = 99999;
@@ -817,8 +819,12 @@ bool GcodeParser::split_words(const char* p, const char* end, int line_number) {
 void GcodeParser::execute(int line_number) {
   // feed rate first (RS274/NGC order): per minute, in the current unit
   if (words_.has('F')) {
-    if (words_.get('F') <= 0.0) {
-      problem(line_number, "feed rate F must be > 0 (per minute)");
+    // (a feed of 1e-200 per minute underflowed the time estimates' squared speeds to 0)
+    if (!(words_.get('F') >= kLeastFeedPerMinute)) {
+      problem(line_number, words_.get('F') <= 0.0
+                               ? "feed rate F must be > 0 (per minute)"
+                               : "feed rate F must be at least 1e-6 (per minute): F" +
+                                     message_number(words_.get('F')) + " is no speed to print at");
       return;
     }
   }

@@ -515,6 +515,13 @@ TEST(Gcode, EveryMalformedLineIsReported) {
   EXPECT_NE(problems[4].message.find("X given twice"), std::string::npos);
   EXPECT_NE(problems[5].message.find("two motion commands"), std::string::npos);
   EXPECT_EQ(problems[6].message, "number out of range in 'X1e308' (at most 1e9 in magnitude)");
+  // a feed rate too slow to print at (F1e-200 was estimated at 0 s by inspect: its squared
+  // speed underflowed)
+  const auto crawl = problems_of("G1 X0 Y0 F600\nG1 X10 E1 F1e-200\n");
+  ASSERT_EQ(crawl.size(), 1u) << dump(crawl);
+  EXPECT_EQ(crawl[0].line, 2);
+  EXPECT_EQ(crawl[0].message,
+            "feed rate F must be at least 1e-6 (per minute): F1e-200 is no speed to print at");
   // a number too close to 0 for a double is said as such
   const auto tiny = problems_of("G1 X1e-400 F600\n");
   ASSERT_EQ(tiny.size(), 1u) << dump(tiny);
