@@ -142,7 +142,7 @@ int run_command_line(int argc, char** argv) {
   RunOptions run_options;
   CLI::App* run = app.add_subcommand("run", "plan, simulate, deposit and score a scenario");
   run->add_option("scenario", run_options.scenario, "scenario YAML file")->required();
-  run->add_option("--planner", run_options.planners,
+  run->add_option("--planner,--planners", run_options.planners,
                   "planner(s) to run, comma-separated (default: all of the scenario's)")
       ->check(kNamesGiven);
   run->add_option("--out", run_options.out, "output directory (default: results/<scenario name>)");
@@ -167,7 +167,7 @@ int run_command_line(int argc, char** argv) {
       app.add_subcommand("compare", "run several planners on the same toolpath and compare them");
   compare->add_option("scenario", compare_options.run.scenario, "scenario YAML file")->required();
   compare
-      ->add_option("--planners", compare_options.run.planners,
+      ->add_option("--planners,--planner", compare_options.run.planners,
                    "planners to compare, comma-separated (default: all of the scenario's)")
       ->check(kNamesGiven);
   compare
@@ -196,7 +196,7 @@ int run_command_line(int argc, char** argv) {
   CLI::App* plan =
       app.add_subcommand("plan", "plan only (no simulation): trajectory and planned metrics");
   plan->add_option("scenario", plan_options.scenario, "scenario YAML file")->required();
-  plan->add_option("--planner", plan_options.planners,
+  plan->add_option("--planner,--planners", plan_options.planners,
                    "planner(s), comma-separated (default: all of the scenario's)")
       ->check(kNamesGiven);
   plan->add_option("--out", plan_options.out,

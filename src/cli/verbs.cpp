@@ -55,6 +55,14 @@ void print_warnings(const std::vector<MetricsReport>& reports) {
   }
 }
 
+// the run folders a verb wrote, for its last line: DIR/a/, or DIR/{a,b}/ for several
+std::string run_folders_text(const std::string& directory, const std::vector<PlannerSpec>& runs) {
+  std::string labels;
+  for (const PlannerSpec& spec : runs) labels += (labels.empty() ? "" : ",") + spec.run_label();
+  if (runs.size() > 1) labels = "{" + labels + "}";
+  return terminal_text(directory + "/" + labels + "/");
+}
+
 }  // namespace
 
 int plan_verb(const RunOptions& options) {
@@ -78,8 +86,8 @@ int plan_verb(const RunOptions& options) {
             << job.toolpath.paths.size() << " print paths\n\n"
             << summary_table(reports) << '\n';
   print_warnings(reports);
-  std::cout << "plans written to " << terminal_text(directory)
-            << "/<planner>/{metrics.json,trajectory.csv}\n";
+  std::cout << "plans written to " << run_folders_text(directory, planners)
+            << " (metrics.json, trajectory.csv)\n";
   return kExitOk;
 }
 
@@ -175,8 +183,8 @@ int run_verb(const RunOptions& options) {
             << scenario.order.label() << "\n\n"
             << summary_table(reports) << '\n';
   print_warnings(reports);
-  std::cout << "results written to " << terminal_text(directory)
-            << "/<planner>/ (metrics.json, trajectory.csv, "
+  std::cout << "results written to " << run_folders_text(directory, planners)
+            << " (metrics.json, trajectory.csv, "
             << "thickness.csv" << (settings.render ? ", images" : "") << ")\n";
   return kExitOk;
 }

@@ -265,6 +265,18 @@ TEST(Cli, PlanWritesMetricsAndTrajectory) {
   const double total = metrics["time_s"]["total"].get<double>();
   EXPECT_NEAR(std::count(csv.begin(), csv.end(), '\n') - 1, std::floor(total * 1000) + 2, 1.0);
   EXPECT_FALSE(fs::exists(dir + "/stop_and_go"));
+  // the last line names the folder written (it said DIR/<planner>/ literally)
+  EXPECT_NE(r.output.find("plans written to " + dir + "/lspb_mtt/ (metrics.json, trajectory.csv)"),
+            std::string::npos)
+      << r.output;
+  // --planners, as compare spells it, is the same option; several folders in braces
+  const Result both = depotwin("plan " + scenario_path("thompson_fig7.yaml") +
+                               " --planners lspb_mtt,stop_and_go --out " + dir);
+  ASSERT_EQ(both.status, 0) << both.output;
+  EXPECT_TRUE(fs::exists(dir + "/stop_and_go/metrics.json"));
+  EXPECT_NE(both.output.find("plans written to " + dir + "/{lspb_mtt,stop_and_go}/"),
+            std::string::npos)
+      << both.output;
 }
 
 // a scenario with a broken piece, run end to end: exit 2, a clear message, no output folder
