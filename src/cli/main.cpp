@@ -339,8 +339,8 @@ int run_command_line(int argc, char** argv) {
             if (value.empty())
               throw InputError(option->get_name(),
                                "an empty value (give one, or leave the option out)");
-    // the verbs that write: SIGINT, SIGTERM and SIGHUP stop them with their staging folder
-    // removed, their children ended, the output as it was, exit 130, 143 or 129
+    // the verbs that write: SIGINT, SIGTERM, SIGHUP and SIGPIPE stop them with their staging
+    // folder removed, their children ended, the output as it was, exit 130, 143, 129 or 141
     // (core/interrupt.hpp); set before any thread starts (a local sweep's runner then takes the
     // signals itself, to end its workers). The others (validate, view, ...) write nothing and
     // keep the signals' default: they end at once.

@@ -42,12 +42,15 @@ Interrupted::Interrupted(int signal_number)
                (signal_number == SIGINT    ? "SIGINT"
                 : signal_number == SIGTERM ? "SIGTERM"
                 : signal_number == SIGHUP  ? "SIGHUP"
+                : signal_number == SIGPIPE ? "SIGPIPE (the standard output or error was closed)"
                                            : "signal " + std::to_string(signal_number))) {}
 
 void install_interrupt_handlers() {
-  // SIGHUP too: what a closed terminal or a dropped ssh session sends (SIGQUIT keeps its core
-  // dump, for a hang to be looked into)
-  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+  // SIGHUP too: what a closed terminal or a dropped ssh session sends; SIGPIPE: a reader of
+  // the output that went away (`depotwin run ... 2>&1 | head`), which killed the run with its
+  // staging folder and lock left behind (SIGQUIT keeps its core dump, for a hang to be looked
+  // into)
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) {
     struct sigaction previous {};
     ::sigaction(signal_number, nullptr, &previous);
     if (previous.sa_handler == SIG_IGN) continue;  // ignored by whoever started us: stays so

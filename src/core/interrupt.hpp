@@ -1,9 +1,9 @@
-// Stopping on SIGINT, SIGTERM and SIGHUP. The handler only records the signal and ends the child
-// processes registered with it (gnuplot, ffmpeg), both async-signal-safe; the long loops (the
+// Stopping on SIGINT, SIGTERM, SIGHUP and SIGPIPE. The handler only records the signal and ends the
+// child processes registered with it (gnuplot, ffmpeg), both async-signal-safe; the long loops (the
 // step loop, the posture search, the planners, the writers, the wait for an output lock) call
 // throw_if_interrupted(), and the Interrupted exception unwinds through the owners of the
 // staging folders and the child processes, which clean up. main() turns it into exit status
-// 128 + the signal (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP).
+// 128 + the signal (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP, 141 for SIGPIPE).
 #pragma once
 
 #include <sys/types.h>
@@ -28,7 +28,8 @@ class Interrupted : public std::exception {
   std::string message_;  // "interrupted by SIGINT"
 };
 
-// Installs the handler for SIGINT, SIGTERM and SIGHUP (SA_RESTART, so no other call sees EINTR). A
+// Installs the handler for SIGINT, SIGTERM, SIGHUP and SIGPIPE (SA_RESTART, so no other call sees
+// EINTR; a write to a closed pipe then fails with EPIPE, and the run stops at its next check). A
 // signal ignored when the process started (a shell's background job, nohup) stays ignored.
 // Call once, early in main, before any thread starts.
 void install_interrupt_handlers();

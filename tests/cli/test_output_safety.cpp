@@ -442,6 +442,23 @@ TEST(OutputSafety, NoWaitExitsTwoWhileAnotherWriterHoldsTheLock) {
   EXPECT_EQ(names_in(dir), std::vector<std::string>{"results"});
 }
 
+// ---- a reader of the output that goes away
+
+// `depotwin run ... 2>&1 | head -n 1`: the first write after head is gone raises SIGPIPE,
+// which stops the run as SIGINT does (exit 141, nothing left behind); it used to kill the run
+// outright and leave DIR.partial-<pid> and DIR.lock behind
+TEST(OutputSafety, AReaderThatGoesAwayStopsTheRunAndLeavesNothing) {
+  const std::string dir = fresh_directory("safety_sigpipe");
+  const std::string out = dir + "/results";
+  const auto r = testing_support::shell(
+      "bash -c 'DEPOTWIN_PROGRESS_PERIOD_S=0 " + std::string(DEPOTWIN_BINARY_DIR) +
+      "/depotwin run " + scenario_path("thompson_fig7.yaml") +
+      " --planner lspb_mtt --no-render --out " + out +
+      " 2>&1 | head -n 1 > /dev/null; echo \"status ${PIPESTATUS[0]}\"'");
+  EXPECT_NE(r.output.find("status 141"), std::string::npos) << r.output;
+  EXPECT_EQ(names_in(dir), std::vector<std::string>{}) << r.output;
+}
+
 // ---- a planner named twice
 
 // refused before any work, every time (it once raced two writers of one folder)
