@@ -27,8 +27,11 @@ constexpr double kMapBottom = 0.585, kMapHeight = 0.29;
 constexpr double kZoomBottom = 0.335, kZoomHeight = 0.215;
 constexpr double kSpeedBottom = 0.165, kSpeedTop = 0.295;
 constexpr double kMetricsTop = 0.115, kMetricsLine = 0.017;
-// an orders comparison: the travel panel takes the map's and the zoom's place
-constexpr double kTravelBottom = 0.36, kTravelHeight = 0.55;
+// an orders comparison: the travel panel takes the map's and the zoom's place on a shorter sheet
+// (kOrdersHeight_px: a travel panel about as tall as its column is wide, no blank bands above
+// and below it), the panels under it as many pixels up as on the full sheet
+constexpr int kOrdersHeight_px = 1000;
+constexpr double kTravelBottom = 0.43, kTravelHeight = 0.53;
 // at most this many points per x-y curve, and this many path numbers
 constexpr size_t kMaxPathPoints = 1200;
 constexpr size_t kMaxPathLabels = 40;
@@ -225,9 +228,15 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
 
   const size_t columns = input.columns.size();
   const int width_px = static_cast<int>(columns) * style::kComparisonColumnWidth_px;
-  job.begin_png(png_path, width_px, style::kComparisonHeight_px);
-  std::string& s = job.script();
   const bool orders = is_orders_comparison(input.columns);
+  const int height_px = orders ? kOrdersHeight_px : style::kComparisonHeight_px;
+  job.begin_png(png_path, width_px, height_px);
+  std::string& s = job.script();
+  // the panels under the maps (speed error, metrics, the footnote) keep their pixels from the
+  // sheet's bottom: their screen fractions grow as the sheet gets shorter
+  const double bottom_scale = static_cast<double>(style::kComparisonHeight_px) / height_px;
+  const double speed_bottom = kSpeedBottom * bottom_scale, speed_top = kSpeedTop * bottom_scale;
+  const double metrics_top = kMetricsTop * bottom_scale, metrics_line = kMetricsLine * bottom_scale;
 
   // shared scales: colour range, map extent, zoom window, time and error axes
   std::vector<HeightMap> display_maps(columns), zoom_maps(columns);
@@ -281,7 +290,7 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
                            : "grey bands: transitions (nothing deposited); white box: the zoom "
                              "below each map, on the thickest spot of all runs")
           .c_str(),
-      0.012);
+      0.012 * bottom_scale);
   const std::string shared_map_ranges = maps.empty() ? "" : map_ranges(maps, input.toolpath);
   const std::string shared_travel_ranges = orders ? travel_ranges(input.columns) : "";
   bool colour_bar_drawn = false;
@@ -347,7 +356,7 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
     s += format(
         "set lmargin at screen %.4f\nset rmargin at screen %.4f\n"
         "set bmargin at screen %.4f\nset tmargin at screen %.4f\n",
-        left + 0.16 * width, left + 0.95 * width, kSpeedBottom, kSpeedTop);
+        left + 0.16 * width, left + 0.95 * width, speed_bottom, speed_top);
     s += format("set xrange [0:%.9g]\n", std::max(duration_s, 1e-6));
     s += format("set yrange [0:%.9g]\n", error_max_pct > 0.0 ? 1.08 * error_max_pct : 1.0);
     s += "set xlabel " + style::quoted(style::axis_label("time", "s")) + "\n";
@@ -367,7 +376,7 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
     for (int i = 0; i < 6; ++i)
       s += format("set label %d %s at screen %.4f,%.4f left font \"%s\"\n", 910 + i,
                   style::quoted(lines[i]).c_str(), left + 0.10 * width,
-                  kMetricsTop - i * kMetricsLine, style::mono_font().c_str());
+                  metrics_top - i * metrics_line, style::mono_font().c_str());
 
     const Curve& curve = speed_curves[c];
     if (curve.point_count() > 0)
