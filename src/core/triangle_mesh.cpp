@@ -15,6 +15,99 @@ namespace {
 // surface that is a height field has the ratio 1
 constexpr double kClosedAreaRatio = 0.1;
 
+// A mesh's T-junctions (see corner_normals): for each vertex, the facets whose edge it lies on
+// without being their corner (empty when the mesh has none); and at each end of such an edge,
+// the facet and the one whose boundary edge runs along it from there, which share a fan.
+// Only facets with a normal, each once (a duplicate: original[t] != t), have edges here; an
+// edge of one of them is a boundary edge.
+struct TJunctions {
+  std::vector<std::vector<int>> across;
+  std::vector<std::array<int, 3>> joins;  // (vertex, facet, facet), sorted
+};
+TJunctions find_t_junctions(const TriangleMesh& mesh, const std::vector<int>& original,
+                            const std::vector<Vec3>& facet) {
+  const auto& vertices = mesh.vertices;
+  struct Edge {
+    int low, high, triangle;
+  };
+  std::vector<Edge> edges;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (original[t] != static_cast<int>(t) || facet[t].isZero()) continue;
+    for (int c = 0; c < 3; ++c) {
+      const int a = mesh.triangles[t][c], b = mesh.triangles[t][(c + 1) % 3];
+      edges.push_back({std::min(a, b), std::max(a, b), static_cast<int>(t)});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return x.low != y.low ? x.low < y.low : x.high < y.high;
+  });
+  // the boundary edges, and each vertex's neighbours along them (pairs sorted by vertex)
+  std::vector<Edge> boundary;
+  std::vector<std::array<int, 3>> along;  // (vertex, neighbour, the edge's facet)
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].low == edges[i].low && edges[j].high == edges[i].high) ++j;
+    if (j - i == 1) {
+      boundary.push_back(edges[i]);
+      along.push_back({edges[i].low, edges[i].high, edges[i].triangle});
+      along.push_back({edges[i].high, edges[i].low, edges[i].triangle});
+    }
+    i = j;
+  }
+  std::sort(along.begin(), along.end());
+  TJunctions found;
+  // from a to b along boundary edges, each step to the next vertex on the segment a-b (within
+  // a float STL's rounding of it); the vertices passed are the facet's T-junctions
+  constexpr int kMaxJunctionsPerEdge = 64;
+  std::vector<int> chain;
+  for (const Edge& edge : boundary) {
+    const Vec3 a = vertices[edge.low], b = vertices[edge.high];
+    const Vec3 ab = b - a;
+    const double length_squared = ab.squaredNorm();
+    if (!(length_squared > 0.0)) continue;
+    const double tolerance = 1e-6 * (std::sqrt(length_squared) +
+                                     std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()));
+    chain.clear();
+    int at = edge.low, first_facet = -1, last_facet = -1;
+    double at_fraction = 0.0;
+    bool reached = false;
+    for (int step = 0; step <= kMaxJunctionsPerEdge && !reached; ++step) {
+      int next = -1, next_facet = -1;
+      double next_fraction = 1.0;
+      for (auto it = std::lower_bound(along.begin(), along.end(), std::array<int, 3>{at, -1, -1});
+           it != along.end() && (*it)[0] == at; ++it) {
+        const int w = (*it)[1];
+        if (w == edge.high) {
+          if (at != edge.low) {
+            reached = true;
+            last_facet = (*it)[2];
+          }
+          continue;
+        }
+        const Vec3 aw = vertices[w] - a;
+        const double fraction = aw.dot(ab) / length_squared;
+        if (!(fraction > at_fraction && fraction < next_fraction)) continue;
+        if ((aw - fraction * ab).norm() > tolerance) continue;
+        next = w;
+        next_facet = (*it)[2];
+        next_fraction = fraction;
+      }
+      if (reached || next < 0) break;
+      if (chain.empty()) first_facet = next_facet;
+      chain.push_back(next);
+      at = next;
+      at_fraction = next_fraction;
+    }
+    if (!reached || chain.empty()) continue;
+    if (found.across.empty()) found.across.resize(vertices.size());
+    for (const int v : chain) found.across[static_cast<size_t>(v)].push_back(edge.triangle);
+    found.joins.push_back({edge.low, edge.triangle, first_facet});
+    found.joins.push_back({edge.high, edge.triangle, last_facet});
+  }
+  std::sort(found.joins.begin(), found.joins.end());
+  return found;
+}
+
 }  // namespace
 
 Vec3 TriangleMesh::facet_normal(size_t t) const {
@@ -104,6 +197,17 @@ std::vector<std::array<Vec3, 3>> TriangleMesh::corner_normals(double crease_angl
             ? original[static_cast<size_t>(sorted_facets[i - 1].second)]
             : sorted_facets[i].second;
 
+  // T-junctions: a vertex v that lies on another facet's edge (a, b) without being its corner
+  // (a facet split on one side of an edge only, as CAD exporters and mesh repairs leave them)
+  // has the facets of that side only around it, a half fan; and at a and b the edge, held by
+  // one facet on each side, splits the fan in two. Each leaned the normals by half the turn
+  // between the two sides (4 deg on a 0.5 mm sine sheet: the offset layer bent 0.03 mm and
+  // the tool turned at every such vertex). The facet across counts as a corner of angle pi at
+  // v, as it would had it been split there too, and at a and b it joins the fan of the facet
+  // along its edge. Found along boundary edges (one original facet): the facet's edge (a, b)
+  // and a chain of boundary edges from a to b through vertices on the segment a-b.
+  const TJunctions t_junctions = find_t_junctions(*this, original, facet);
+
   // fan[k]: the fan of the corner at around[k], as a row of its vertex's rows
   std::vector<int> fan(around.size());
   std::vector<int> parent;
@@ -144,6 +248,18 @@ std::vector<std::array<Vec3, 3>> TriangleMesh::corner_normals(double crease_angl
       if (j - i == 2) join(rows_by_edge[i].second, rows_by_edge[i + 1].second);
       i = j;
     }
+    // the facets on either side of a T-junction's edge, at its ends
+    for (auto it = std::lower_bound(t_junctions.joins.begin(), t_junctions.joins.end(),
+                                    std::array<int, 3>{static_cast<int>(v), -1, -1});
+         it != t_junctions.joins.end() && (*it)[0] == static_cast<int>(v); ++it) {
+      int one = -1, other = -1;
+      for (int i = 0; i < count; ++i) {
+        const int t = around[begin + i].first;
+        if (t == (*it)[1]) one = i;
+        if (t == (*it)[2]) other = i;
+      }
+      if (one >= 0 && other >= 0) join(one, other);
+    }
     for (int i = 0; i < count; ++i) fan[static_cast<size_t>(begin + i)] = root_of(i);
   }
 
@@ -166,6 +282,9 @@ std::vector<std::array<Vec3, 3>> TriangleMesh::corner_normals(double crease_angl
         if (facet[u].isZero() || facet[u].dot(facet[t]) < cos_crease) continue;
         sum += angle[u][u_corner] * facet[u];
       }
+      if (!t_junctions.across.empty())
+        for (const int across : t_junctions.across[static_cast<size_t>(v)])
+          if (facet[across].dot(facet[t]) >= cos_crease) sum += M_PI * facet[across];
       const double length = sum.norm();
       normals[t][corner] = length > 0.0 ? Vec3(sum / length) : facet[t];
     }

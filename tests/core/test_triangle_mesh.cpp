@@ -179,6 +179,29 @@ TriangleMesh folded_sheet() {
   return mesh;
 }
 
+// A roof folded along x = 1, its right side split at m = (1, 0.5) on the fold while the left
+// side's facet keeps the whole edge (1, 0)-(1, 1): a T-junction. m has only the right side's
+// facets around it, and the edge, one facet on each side, used to split the fans at (1, 0)
+// and (1, 1): every normal on the fold leaned to its own side, by half the fold's 22 deg (a
+// wavy sheet with such splits had its offset layer bent 0.03 mm and the arm slowed to 0.03
+// mm/s). The facet across counts at m as a corner of angle pi and joins the fans at the
+// edge's ends: on the fold every normal is straight up, as on the same roof unsplit.
+TEST(TriangleMesh, ATJunctionOnAFoldWeighsBothSides) {
+  const double slope = 0.2;
+  TriangleMesh roof;
+  roof.vertices = {{0, 0, 0}, {1, 0, slope}, {1, 1, slope},  {0, 1, 0},
+                   {2, 0, 0}, {2, 1, 0},     {1, 0.5, slope}};
+  roof.triangles = {{0, 1, 2}, {0, 2, 3}, {1, 4, 6}, {6, 4, 5}, {6, 5, 2}};
+  const auto normals = roof.corner_normals(60.0 * M_PI / 180.0);
+  for (size_t t = 0; t < roof.triangle_count(); ++t)
+    for (int corner = 0; corner < 3; ++corner) {
+      const Vec3& p = roof.vertices[roof.triangles[t][corner]];
+      const Vec3 expected = p.x() == 1.0 ? Vec3(0, 0, 1) : roof.facet_normal(t);
+      EXPECT_LT((normals[t][corner] - expected).norm(), 1e-12)
+          << "triangle " << t << " corner " << corner << " at (" << p.transpose() << ")";
+    }
+}
+
 TEST(TriangleMesh, CornerNormalsAverageAFansFacetsByTheirAngles) {
   const TriangleMesh sheet = folded_sheet();
   const auto normals = sheet.corner_normals(60.0 * M_PI / 180.0);
