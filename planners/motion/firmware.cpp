@@ -529,6 +529,12 @@ Trajectory FirmwarePlanner::plan(const Toolpath& toolpath, const TcpLimits& limi
                                                         : std::min(requested.axes[0].a_max_mm_s2,
                                                                    requested.axes[1].a_max_mm_s2);
   FirmwareSettings settings = settings_;
+  // Klipper's max_accel is the toolhead's, the same in every direction of the xy plane (its
+  // cartesian kinematics caps z alone): a diagonal move is not allowed the per-axis limit
+  // scaled by its direction, as Marlin's is (a 90 deg corner turned 30 deg off the axes was
+  // taken at 5.37 mm/s where square_corner_velocity says 5)
+  if (settings.mode == FirmwareMode::klipper && !(settings.max_accel > 0.0))
+    settings.max_accel = config_accel;
   if (settings.mode == FirmwareMode::klipper && settings.max_accel_to_decel > 0.0)
     settings.minimum_cruise_ratio = 1.0 - std::min(1.0, settings.max_accel_to_decel / config_accel);
   const double junction_deviation =

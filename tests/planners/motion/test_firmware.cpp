@@ -161,6 +161,12 @@ TEST(Firmware, SingleTrapezoidTime) {
   EXPECT_NEAR(
       plan_with({"firmware", {}, 0}, polyline_job({{0, 0, 0}, {3, 4, 0}}, 50), limits).duration_s(),
       5.0 / 50 + 50.0 / (1000 / 0.8), 1e-12);
+  // Klipper's max_accel is the same in every direction (default: the x and y axes' smaller
+  // a_max): the diagonal takes a, not a / |u_y|
+  EXPECT_NEAR(plan_with({"firmware", {}, 0, {{"mode", "klipper"}}},
+                        polyline_job({{0, 0, 0}, {3, 4, 0}}, 50), limits)
+                  .duration_s(),
+              5.0 / 50 + 50.0 / 1000, 1e-12);
   // Klipper's minimum_cruise_ratio 0.5: a 1.5 mm move cruises 0.75 mm (its docs' example) at
   // sqrt(a d / 2)
   const Trajectory klipper = plan_with({"firmware", {}, 0, {{"mode", "klipper"}}},
