@@ -147,6 +147,9 @@ std::optional<GridProfile> exact_end_profile(double distance, double v_in, doubl
 
 }  // namespace
 
+// the peak speeds tried below the scan's lowest (each half the one before): down to 2^-60 of it
+constexpr int kScanBelow = 60;
+
 std::optional<GridProfile> plan_grid_profile(double distance_mm, double v_in_mm_s,
                                              double v_out_mm_s, double v_cap_mm_s,
                                              double a_max_mm_s2, double period_s, bool exact_end) {
@@ -168,8 +171,11 @@ std::optional<GridProfile> plan_grid_profile(double distance_mm, double v_in_mm_
   // candidate peaks from the cap down, plus the boundary speeds themselves
   constexpr int kScan = 256;
   std::vector<double> candidates;
-  candidates.reserve(kScan + 3);
+  candidates.reserve(kScan + kScanBelow + 3);
   for (int i = 0; i < kScan; ++i) candidates.push_back(v_cap_mm_s * (1.0 - double(i) / kScan));
+  // and halving below the scan's lowest, for a line too short for a 256th of the cap (1e-5 mm at
+  // 3 mm/s: one period at 3/256 mm/s is 1.2e-5 mm; it had no profile, an internal error)
+  for (int k = 1; k <= kScanBelow; ++k) candidates.push_back(std::ldexp(v_cap_mm_s / kScan, -k));
   for (double v : {v_in_mm_s, v_out_mm_s, std::max(v_in_mm_s, v_out_mm_s)})
     if (v > 0.0 && v <= v_cap_mm_s) candidates.push_back(v);
   std::sort(candidates.begin(), candidates.end(), std::greater<double>());
@@ -360,8 +366,11 @@ std::optional<JerkGridProfile> plan_jerk_grid_profile(double distance_mm, double
   // towards the infeasible one above the first that fits
   constexpr int kScan = 256;
   std::vector<double> candidates;
-  candidates.reserve(kScan + 3);
+  candidates.reserve(kScan + kScanBelow + 3);
   for (int i = 0; i < kScan; ++i) candidates.push_back(v_cap_mm_s * (1.0 - double(i) / kScan));
+  // and halving below the scan's lowest, for a line too short for a 256th of the cap (1e-5 mm at
+  // 3 mm/s: one period at 3/256 mm/s is 1.2e-5 mm; it had no profile, an internal error)
+  for (int k = 1; k <= kScanBelow; ++k) candidates.push_back(std::ldexp(v_cap_mm_s / kScan, -k));
   for (double v : {v_in, v_out, std::max(v_in, v_out)})
     if (v > 0.0 && v <= v_cap_mm_s) candidates.push_back(v);
   std::sort(candidates.begin(), candidates.end(), std::greater<double>());

@@ -57,6 +57,24 @@ TEST(BezierProfile, ExactEndLandsOnTheLineEndAtRest) {
   }
 }
 
+// a line shorter than one period at a 256th of the cap, from rest to rest: 1e-5 mm at a 3 mm/s
+// cap (one step at 3/256 mm/s is 1.2e-5 mm) had no profile, and the planner an internal error;
+// down to 1e-9 mm, and up to the caps of a fast printer
+TEST(BezierProfile, ALineShorterThanTheScansLowestPeakStillLandsAtRest) {
+  for (const double distance : {1e-5, 1e-7, 1e-9})
+    for (const double cap : {3.0, 300.0}) {
+      const ProfileCase c{distance, 0.0, 0.0, cap, 30.0, 0.001};
+      const auto profile = plan_grid_profile(c.distance, 0.0, 0.0, c.v_cap, c.a, c.period, true);
+      ASSERT_TRUE(profile) << distance << " mm at cap " << cap;
+      // (the knee's rounding: 1e-12 mm, which the planner's last sample snaps to the line's end)
+      EXPECT_NEAR(profile->distance_mm(c.period), distance, 2e-12);
+      double v = 0, a = 0;
+      profile->at_step(profile->total_steps(), c.period, v, a);
+      EXPECT_EQ(v, 0.0);
+      expect_within_limits(*profile, c);
+    }
+}
+
 TEST(BezierProfile, OpenEndStopsLessThanOneCruiseStepBeforeTheJoint) {
   std::mt19937_64 rng(11);
   for (int i = 0; i < 400; ++i) {
