@@ -45,6 +45,9 @@ constexpr double kCrossJerkShare = 0.3;      // of the jerk share for 3 p'' sdot
 constexpr double kJerkAccelShare = 0.98;     // of a_max for the law (the rest: interpolation)
 constexpr int kJerkRepairRounds = 12;
 constexpr double kJerkRepairScale = 0.85;
+// a period whose jerk is r times its limit lowers the shares around it to kJerkRepairMargin / r
+// where that is lower
+constexpr double kJerkRepairMargin = 0.95;
 
 // The jerk-limited law and its samples; law is the TOPP-RA ceiling's, repair_rounds the rounds
 // of lowered shares, tcp_accel_scale the TOPP-RA factors (options' times kSampledAccelMargin).
