@@ -897,18 +897,21 @@ Trajectory ConformalPlanner::plan(const Toolpath& toolpath, const TcpLimits& lim
   const PathHeights heights(toolpath);
   // transitions lift; where the machine cannot reach the lifted poses (a machine without a z
   // axis) they go straight instead, and one warning says how often
+  // (a machine that holds the TCP at z = 0, the XY stage, lifts nothing: every transition
+  // used to try, and the job warned that all of them went straight)
   int unlifted = 0;
   std::string unlifted_first;
+  const double lift_mm = joints && !joints->moves_z ? 0.0 : settings.lift_mm;
   const auto add_transition = [&](const Vec3& p0, const ToolOrientation& o0, const Vec3& p1,
                                   const ToolOrientation& o1, const std::string& name) {
-    PathGrid grid = transition_grid(p0, o0, p1, o1, settings.lift_mm, settings.ds_mm, name,
-                                    &heights, jerk_limited);
+    PathGrid grid =
+        transition_grid(p0, o0, p1, o1, lift_mm, settings.ds_mm, name, &heights, jerk_limited);
     if (grid.points.empty()) return;
     if (joints) {
       try {
         attach_joints_with_headroom(grid, *joints);
       } catch (const InputError& error) {
-        if (settings.lift_mm <= 0.0) throw;
+        if (lift_mm <= 0.0) throw;
         PathGrid straight =
             transition_grid(p0, o0, p1, o1, 0.0, settings.ds_mm, name, nullptr, jerk_limited);
         attach_joints_with_headroom(straight, *joints);

@@ -64,6 +64,8 @@ struct JointMap {
   // TCP limits over a box bound the translation only: a planner that moves the tool axis must
   // time the path on the joints themselves
   bool turns_tool = false;
+  // false: the TCP is held at z = 0 (the XY stage), so a planner's travel lifts nothing
+  bool moves_z = true;
 };
 
 // The TCP limits a planner must honour, which may depend on where the move is.

@@ -61,6 +61,9 @@ class Machine {
   // true when cartesian_limits ignores its box (each TCP axis driven by one joint): the TCP
   // limits are then the same everywhere (TcpLimits::same_everywhere)
   virtual bool limits_ignore_position() const { return false; }
+  // false for a machine that cannot move the TCP in z (the XY stage): the TCP's z row of the
+  // Jacobian at the work frame's origin is zero
+  bool moves_tcp_z() const;
   // the user's TCP limits, refined per move by cartesian_limits, with the machine's joint map
   // (joint positions along a path by inverse_near; the machine must outlive it)
   TcpLimits tcp_limits(const MachineLimits& requested) const;

@@ -55,10 +55,18 @@ bool Machine::inverse_near(const Pose& pose, const JointVector& /*seed*/, JointV
   return inverse(pose, joints, why);
 }
 
+bool Machine::moves_tcp_z() const {
+  // the TCP's z row of the Jacobian at the work frame's origin: zero for a machine without z
+  JointVector joints;
+  if (!inverse(Pose(Vec3::Zero()), joints)) return true;
+  return jacobian(joints).row(2).norm() > 0.0;
+}
+
 TcpLimits Machine::tcp_limits(const MachineLimits& requested) const {
   auto joint_map = std::make_shared<JointMap>();
   joint_map->limits = joint_limits();
   joint_map->turns_tool = joint_count() > 3;
+  joint_map->moves_z = moves_tcp_z();
   joint_map->solve = [this](const std::vector<Pose>& poses, std::vector<JointVector>& joints,
                             std::string* why) {
     joints.resize(poses.size());

@@ -203,8 +203,6 @@ class Loader {
                                   const GcodeToolpath& settings);
   // the moves (distinct lines) among a path's points from `from` on
   static std::size_t distinct_moves(const std::vector<int>& point_lines, std::size_t from);
-  // false for a machine that cannot move the TCP in z (the XY stage)
-  static bool machine_moves_z(const Machine& machine);
   // one problem when the imported paths lie at several z levels, at the first move off the
   // first level; false (nothing added) for a single level
   bool multi_level_problem(const GcodeImport& imported, const std::string& file,
@@ -967,7 +965,7 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
 
   // a machine without a z axis cannot print several z levels: one problem, at the first move
   // that leaves the first level (never one per point)
-  if (machine_ && !machine_moves_z(*machine_) &&
+  if (machine_ && !machine_->moves_tcp_z() &&
       multi_level_problem(imported, resolved.string(), field.key))
     return;
 
@@ -1064,13 +1062,6 @@ std::size_t Loader::distinct_moves(const std::vector<int>& point_lines, std::siz
     previous = point_lines[k];
   }
   return count;
-}
-
-bool Loader::machine_moves_z(const Machine& machine) {
-  // the TCP's z row of the Jacobian at the work frame's origin: zero for a machine without z
-  JointVector joints;
-  if (!machine.inverse(Pose(Vec3::Zero()), joints)) return true;
-  return machine.jacobian(joints).row(2).norm() > 0.0;
 }
 
 bool Loader::multi_level_problem(const GcodeImport& imported, const std::string& file,

@@ -209,5 +209,31 @@ TEST(MachineRegistry, NamesAreUniqueAndUnknownNamesGiveNothing) {
   EXPECT_EQ(make_machine("scara"), nullptr);
 }
 
+// Only the XY stage holds the TCP at z = 0; there `conformal`'s travels do not lift (every one
+// used to try, fail and go straight, and every job warned "4 transition(s) could not lift by
+// 1 mm" on thompson_fig7's paths)
+TEST(MachineRegistry, OnlyTheXyStageCannotLiftAndItsTravelsDoNotTry) {
+  for (const std::string& name : machine_names())
+    EXPECT_EQ(make_machine(name)->moves_tcp_z(), name != "xy_stage") << name;
+  const std::unique_ptr<Machine> stage = make_machine("xy_stage");
+  const TcpLimits limits = stage->tcp_limits(MachineLimits::uniform(4.0, 30.0));
+  ASSERT_NE(limits.joint_map(), nullptr);
+  EXPECT_FALSE(limits.joint_map()->moves_z);
+  Toolpath toolpath;
+  toolpath.start_mm = Vec3(-5, -5, 0);
+  toolpath.end_mm = Vec3(5, 5, 0);
+  for (const double y : {-2.0, 0.0, 2.0}) {
+    PrintPath path;
+    path.points = {Vec3(-4, y, 0), Vec3(4, y, 0)};
+    path.speed_mm_s = 3.0;
+    path.source_index = static_cast<int>(toolpath.paths.size());
+    toolpath.paths.push_back(path);
+  }
+  const Trajectory plan = make_planner(PlannerSpec{"conformal", {}, 0})->plan(toolpath, limits);
+  EXPECT_TRUE(plan.warnings().empty()) << plan.warnings().front();
+  for (double t = 0.0; t <= plan.duration_s(); t += 0.01)
+    EXPECT_EQ(plan.at(t).position_mm.z(), 0.0) << "t " << t;
+}
+
 }  // namespace
 }  // namespace depotwin
