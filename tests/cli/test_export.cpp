@@ -205,6 +205,22 @@ TEST(ExportGcode, RoundTripOnEveryShippedPlanarScenario) {
                   1e-3 + 1e-4 * import.toolpath.print_length_mm());
       EXPECT_EQ(gcode.find(" E0 "), std::string::npos);
       EXPECT_EQ(gcode.find(" E0\n"), std::string::npos);
+      // the file as a firmware reads it: every move at its F, and its dwells, take the plan's
+      // time (one straight G0 per transition, at the planned path's length over its time, made
+      // thompson_fig11's uniform file 16.25 s of its 17.79; a corner's loop was a pause); its E
+      // adds up to the header's E total (each written E's rounding carried to the next: a
+      // stop_and_go ramp's E0.00124735 written E0.00125 put 0.12 % more E in the file)
+      const GcodeProgram program = parse_gcode_program(gcode, "exported.gcode", GcodeOptions{});
+      double file_time_s = program.dwell_s;
+      for (const GcodeMove& move : program.moves)  // (the first, to the job's start, has no F)
+        if (&move != &program.moves.front() || move.feed_mm_s > 0.0)
+          file_time_s += move.length_mm / move.feed_mm_s;
+      EXPECT_NEAR(file_time_s, trajectory.duration_s(), 2e-3 * trajectory.duration_s());
+      if (export_job.process == "extrusion") {
+        const std::size_t e_at = gcode.find("E total ");
+        ASSERT_NE(e_at, std::string::npos);
+        EXPECT_NEAR(program.extrusion_e_total, std::stod(gcode.substr(e_at + 8)), 5e-4);
+      }
       // arcs (G2/G3 written where the plan runs on a circle) as fine chords for the distances
       const Toolpath imported = import.toolpath.chorded(1e-5);
 
