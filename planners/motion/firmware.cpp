@@ -17,20 +17,6 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // the share of a move each junction blend may take at most (two blends: half of the move)
 constexpr double kBlendShare = 0.25;
 
-// The largest move speed and acceleration along unit direction u under per-axis limits and
-// the firmware's own caps (0: none): a firmware scales a move so that no axis exceeds its
-// max feed rate or acceleration (Marlin's max_feedrate / max_acceleration per axis).
-void move_caps(const Vec3& u, const MachineLimits& limits, double max_velocity, double max_accel,
-               double& speed_cap, double& accel_cap) {
-  speed_cap = max_velocity > 0.0 ? max_velocity : kInfinity;
-  accel_cap = max_accel > 0.0 ? max_accel : kInfinity;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (std::abs(u[axis]) < 1e-15) continue;
-    speed_cap = std::min(speed_cap, limits.axes[axis].v_max_mm_s / std::abs(u[axis]));
-    accel_cap = std::min(accel_cap, limits.axes[axis].a_max_mm_s2 / std::abs(u[axis]));
-  }
-}
-
 // S-curve mode: the axes' speed caps keep this share (the cubic interpolation between samples
 // rounds a ramp's approach to its cruise by about 1e-6 of the speed)
 constexpr double kSCurveSpeedShare = 1.0 - 1e-5;
@@ -310,6 +296,17 @@ TrajectoryPiece travel_piece(double t_begin_s, const Vec3& from, const Vec3& to,
 }
 
 }  // namespace
+
+void move_caps(const Vec3& u, const MachineLimits& limits, double max_velocity, double max_accel,
+               double& speed_cap, double& accel_cap) {
+  speed_cap = max_velocity > 0.0 ? max_velocity : kInfinity;
+  accel_cap = max_accel > 0.0 ? max_accel : kInfinity;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(u[axis]) < 1e-15) continue;
+    speed_cap = std::min(speed_cap, limits.axes[axis].v_max_mm_s / std::abs(u[axis]));
+    accel_cap = std::min(accel_cap, limits.axes[axis].a_max_mm_s2 / std::abs(u[axis]));
+  }
+}
 
 double junction_speed_squared(const Vec3& u_prev, const Vec3& u_next, double accel_mm_s2,
                               double junction_deviation_mm) {

@@ -82,6 +82,12 @@ struct FirmwareProfile {
 // Infinite for collinear moves, 0 for a reversal.
 double junction_speed_squared(const Vec3& u_prev, const Vec3& u_next, double accel_mm_s2,
                               double junction_deviation_mm);
+// The largest move speed and acceleration along unit direction u under per-axis limits and
+// the firmware's own caps (0: none): a firmware scales a move so that no axis exceeds its
+// max feed rate or acceleration (Marlin's max_feedrate / max_acceleration per axis; Klipper's
+// max_accel, the same in every xy direction, is such a cap).
+void move_caps(const Vec3& u, const MachineLimits& limits, double max_velocity, double max_accel,
+               double& speed_cap, double& accel_cap);
 // Klipper's conversion of square_corner_velocity to a junction deviation (Klipper
 // docs/Kinematics.md, "Look-ahead"; toolhead.py): jd = scv^2 (sqrt(2) - 1) / max_accel, so a
 // 90 deg corner is taken at exactly scv.

@@ -67,8 +67,10 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       settings.mode == FirmwareMode::klipper
           ? klipper_junction_deviation(settings.square_corner_velocity, config_accel)
           : settings.junction_deviation_mm;
-  const Vec3 axis_accel(limits.axes[0].a_max_mm_s2, limits.axes[1].a_max_mm_s2,
-                        limits.axes[2].a_max_mm_s2);
+  const double max_accel = settings.mode == FirmwareMode::klipper ? config_accel : 0.0;
+  const Vec3 axis_accel =
+      Vec3(limits.axes[0].a_max_mm_s2, limits.axes[1].a_max_mm_s2, limits.axes[2].a_max_mm_s2)
+          .cwiseMin(max_accel > 0.0 ? max_accel : kUnbounded);
 
   double total_s = 0.0;
   std::vector<FirmwareMove> chain;
@@ -109,16 +111,12 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       FirmwareMove piece;
       piece.length_mm = length_mm;
       piece.direction = step / length_mm;
-      // no axis beyond its own speed and acceleration (Marlin's max_feedrate, max_acceleration)
-      piece.cruise_speed_mm_s = move.feed_mm_s > 0.0 ? move.feed_mm_s : kUnbounded;
-      piece.accel_mm_s2 = kUnbounded;
-      for (int axis = 0; axis < 3; ++axis) {
-        const double share = std::abs(piece.direction[axis]);
-        if (share < 1e-15) continue;
-        piece.cruise_speed_mm_s =
-            std::min(piece.cruise_speed_mm_s, limits.axes[axis].v_max_mm_s / share);
-        piece.accel_mm_s2 = std::min(piece.accel_mm_s2, limits.axes[axis].a_max_mm_s2 / share);
-      }
+      // no axis beyond its own speed and acceleration (Marlin's max_feedrate, max_acceleration),
+      // and Klipper's max_accel the same in every direction, as the firmware planner has them
+      double speed_cap = 0.0;
+      move_caps(piece.direction, limits, 0.0, max_accel, speed_cap, piece.accel_mm_s2);
+      piece.cruise_speed_mm_s =
+          std::min(move.feed_mm_s > 0.0 ? move.feed_mm_s : kUnbounded, speed_cap);
       piece.blend_accel_mm_s2 = axis_accel;
       chain.push_back(piece);
       if (chain.size() >= kMaxChainPieces) flush();

@@ -258,6 +258,10 @@ TEST(GcodeFiles, EstimatedTimeIsTheFirmwaresTrapezoids) {
   const double a = 3000.0;
   EXPECT_NEAR(estimate("G21 G90\nG1 X100 F3000\n"), 100.0 / 50.0 + 50.0 / a, 1e-9);
   EXPECT_NEAR(estimate("G21 G90\nG1 X100 F3000\n", "klipper"), 100.0 / 50.0 + 50.0 / a, 1e-9);
+  // on a diagonal (3-4-5) Marlin's acceleration is a / |u_y|; Klipper's max_accel is the same
+  // in every direction, as the firmware planner has it (inspect once gave Klipper Marlin's)
+  EXPECT_NEAR(estimate("G21 G90\nG1 X60 Y80 F3000\n"), 100.0 / 50.0 + 50.0 / (a / 0.8), 1e-9);
+  EXPECT_NEAR(estimate("G21 G90\nG1 X60 Y80 F3000\n", "klipper"), 100.0 / 50.0 + 50.0 / a, 1e-9);
   // two collinear moves are one queue: no stop between them
   EXPECT_NEAR(estimate("G1 X40 F3000\nG1 X100\n"), 100.0 / 50.0 + 50.0 / a, 1e-9);
   // a dwell, and a retraction at 30 mm/s, each empty the queue: two stops and their own times
