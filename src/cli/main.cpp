@@ -3,6 +3,7 @@
 // when SIGINT or SIGTERM stopped it (the output is then as it was before).
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <functional>
 #include <iostream>
@@ -404,6 +405,9 @@ int main(int argc, char** argv) {
   const bool flushed = std::fflush(stdout) == 0;
   if (!std::cout || !flushed || std::ferror(stdout) != 0) {
     const int reason = errno;
+    // a writing verb's reader gone after its result was swapped in (`run ... | head`): the
+    // result is whole; 128 + SIGPIPE, as the signal ends a verb that does not catch it
+    if (interrupt_signal() == SIGPIPE) return Interrupted(SIGPIPE).exit_status();
     std::cerr << "error: the standard output could not be written whole" << system_reason(reason)
               << "\n";
     return status == kExitOk ? kExitInternal : status;

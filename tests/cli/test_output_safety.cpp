@@ -457,6 +457,17 @@ TEST(OutputSafety, AReaderThatGoesAwayStopsTheRunAndLeavesNothing) {
       " 2>&1 | head -n 1 > /dev/null; echo \"status ${PIPESTATUS[0]}\"'");
   EXPECT_NE(r.output.find("status 141"), std::string::npos) << r.output;
   EXPECT_EQ(names_in(dir), std::vector<std::string>{}) << r.output;
+  // gone before the last lines, printed after the result was swapped in: the result is whole,
+  // the status 141 as a verb ended by the signal reports it, and no error is said (it was
+  // exit 1, "the standard output could not be written whole")
+  const auto after = testing_support::shell(
+      "bash -c '" + std::string(DEPOTWIN_BINARY_DIR) + "/depotwin plan " +
+      scenario_path("thompson_fig7.yaml") + " --planner lspb_mtt --quiet --out " + out + " 2> " +
+      dir + "/stderr.txt | true; echo \"status ${PIPESTATUS[0]}\"'");
+  EXPECT_NE(after.output.find("status 141"), std::string::npos) << after.output;
+  EXPECT_EQ(read_text(dir + "/stderr.txt"), "");
+  EXPECT_EQ(names_in(dir), (std::vector<std::string>{"results", "stderr.txt"}));
+  EXPECT_TRUE(fs::exists(out + "/lspb_mtt/metrics.json"));
 }
 
 // ---- a planner named twice
