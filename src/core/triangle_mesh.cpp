@@ -59,6 +59,9 @@ TJunctions find_t_junctions(const TriangleMesh& mesh, const std::vector<int>& or
   // from a to b along boundary edges, each step to the next vertex on the segment a-b (within
   // a float STL's rounding of it); the vertices passed are the facet's T-junctions
   constexpr int kMaxJunctionsPerEdge = 64;
+  // a vertex with more boundary edges than this is no T-junction's (the hub of facets that
+  // meet only there): a walk stops at it, so that walks from it do not scan all of them each
+  constexpr std::ptrdiff_t kMaxBoundaryEdgesAtVertex = 16;
   std::vector<int> chain;
   for (const Edge& edge : boundary) {
     const Vec3 a = vertices[edge.low], b = vertices[edge.high];
@@ -74,8 +77,11 @@ TJunctions find_t_junctions(const TriangleMesh& mesh, const std::vector<int>& or
     for (int step = 0; step <= kMaxJunctionsPerEdge && !reached; ++step) {
       int next = -1, next_facet = -1;
       double next_fraction = 1.0;
-      for (auto it = std::lower_bound(along.begin(), along.end(), std::array<int, 3>{at, -1, -1});
-           it != along.end() && (*it)[0] == at; ++it) {
+      const auto from =
+          std::lower_bound(along.begin(), along.end(), std::array<int, 3>{at, -1, -1});
+      const auto to = std::upper_bound(from, along.end(), std::array<int, 3>{at + 1, -1, -1});
+      if (to - from > kMaxBoundaryEdgesAtVertex) break;
+      for (auto it = from; it != to; ++it) {
         const int w = (*it)[1];
         if (w == edge.high) {
           if (at != edge.low) {
