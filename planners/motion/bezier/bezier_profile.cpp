@@ -145,10 +145,23 @@ std::optional<GridProfile> exact_end_profile(double distance, double v_in, doubl
   return profile;
 }
 
-}  // namespace
+// The peak speeds a profile tries, highest first: 256 from the cap down, halvings below the
+// lowest of those down to 2^-60 of it (a line too short for a 256th of the cap: 1e-5 mm at
+// 3 mm/s, where one period at 3/256 mm/s is 1.2e-5 mm, had no profile, an internal error), and
+// the boundary speeds themselves
+std::vector<double> peak_candidates(double v_cap_mm_s, double v_in_mm_s, double v_out_mm_s) {
+  constexpr int kScan = 256, kScanBelow = 60;
+  std::vector<double> candidates;
+  candidates.reserve(kScan + kScanBelow + 3);
+  for (int i = 0; i < kScan; ++i) candidates.push_back(v_cap_mm_s * (1.0 - double(i) / kScan));
+  for (int k = 1; k <= kScanBelow; ++k) candidates.push_back(std::ldexp(v_cap_mm_s / kScan, -k));
+  for (double v : {v_in_mm_s, v_out_mm_s, std::max(v_in_mm_s, v_out_mm_s)})
+    if (v > 0.0 && v <= v_cap_mm_s) candidates.push_back(v);
+  std::sort(candidates.begin(), candidates.end(), std::greater<double>());
+  return candidates;
+}
 
-// the peak speeds tried below the scan's lowest (each half the one before): down to 2^-60 of it
-constexpr int kScanBelow = 60;
+}  // namespace
 
 std::optional<GridProfile> plan_grid_profile(double distance_mm, double v_in_mm_s,
                                              double v_out_mm_s, double v_cap_mm_s,
@@ -168,17 +181,7 @@ std::optional<GridProfile> plan_grid_profile(double distance_mm, double v_in_mm_
                      : open_end_profile(distance_mm, v_in_mm_s, v_out_mm_s, v_peak, a_max_mm_s2,
                                         period_s);
   };
-  // candidate peaks from the cap down, plus the boundary speeds themselves
-  constexpr int kScan = 256;
-  std::vector<double> candidates;
-  candidates.reserve(kScan + kScanBelow + 3);
-  for (int i = 0; i < kScan; ++i) candidates.push_back(v_cap_mm_s * (1.0 - double(i) / kScan));
-  // and halving below the scan's lowest, for a line too short for a 256th of the cap (1e-5 mm at
-  // 3 mm/s: one period at 3/256 mm/s is 1.2e-5 mm; it had no profile, an internal error)
-  for (int k = 1; k <= kScanBelow; ++k) candidates.push_back(std::ldexp(v_cap_mm_s / kScan, -k));
-  for (double v : {v_in_mm_s, v_out_mm_s, std::max(v_in_mm_s, v_out_mm_s)})
-    if (v > 0.0 && v <= v_cap_mm_s) candidates.push_back(v);
-  std::sort(candidates.begin(), candidates.end(), std::greater<double>());
+  const std::vector<double> candidates = peak_candidates(v_cap_mm_s, v_in_mm_s, v_out_mm_s);
   // the first feasible one, then bisect towards the infeasible one above it
   for (size_t i = 0; i < candidates.size(); ++i) {
     std::optional<GridProfile> found = attempt(candidates[i]);
@@ -364,16 +367,7 @@ std::optional<JerkGridProfile> plan_jerk_grid_profile(double distance_mm, double
 
   // the highest peak whose two S-curves fit: candidates from the cap down, then bisection
   // towards the infeasible one above the first that fits
-  constexpr int kScan = 256;
-  std::vector<double> candidates;
-  candidates.reserve(kScan + kScanBelow + 3);
-  for (int i = 0; i < kScan; ++i) candidates.push_back(v_cap_mm_s * (1.0 - double(i) / kScan));
-  // and halving below the scan's lowest, for a line too short for a 256th of the cap (1e-5 mm at
-  // 3 mm/s: one period at 3/256 mm/s is 1.2e-5 mm; it had no profile, an internal error)
-  for (int k = 1; k <= kScanBelow; ++k) candidates.push_back(std::ldexp(v_cap_mm_s / kScan, -k));
-  for (double v : {v_in, v_out, std::max(v_in, v_out)})
-    if (v > 0.0 && v <= v_cap_mm_s) candidates.push_back(v);
-  std::sort(candidates.begin(), candidates.end(), std::greater<double>());
+  const std::vector<double> candidates = peak_candidates(v_cap_mm_s, v_in, v_out);
   double v_peak = -1.0;
   for (size_t i = 0; i < candidates.size(); ++i) {
     if (!fits(candidates[i])) continue;
