@@ -317,6 +317,31 @@ double junction_speed_squared(const Vec3& u_prev, const Vec3& u_next, double acc
   return accel_mm_s2 * junction_deviation_mm * sin_half / (1.0 - sin_half);
 }
 
+FirmwareSettings resolved_firmware_settings(const FirmwareSettings& given,
+                                            const MachineLimits& limits,
+                                            double& junction_deviation_mm) {
+  // the configured acceleration: max_accel, else the x and y axes' smaller a_max
+  const double config_accel =
+      given.max_accel > 0.0 ? given.max_accel
+                            : std::min(limits.axes[0].a_max_mm_s2, limits.axes[1].a_max_mm_s2);
+  FirmwareSettings settings = given;
+  // Klipper's max_accel is the toolhead's, the same in every direction of the xy plane (its
+  // cartesian kinematics caps z alone): a diagonal move is not allowed the per-axis limit
+  // scaled by its direction, as Marlin's is (a 90 deg corner turned 30 deg off the axes was
+  // taken at 5.37 mm/s where square_corner_velocity says 5)
+  if (settings.mode == FirmwareMode::klipper && !(settings.max_accel > 0.0))
+    settings.max_accel = config_accel;
+  if (settings.mode == FirmwareMode::klipper && settings.max_accel_to_decel > 0.0)
+    settings.minimum_cruise_ratio = 1.0 - std::min(1.0, settings.max_accel_to_decel / config_accel);
+  // the junction deviation: Marlin's own, or Klipper's from the square-corner velocity at the
+  // configured acceleration
+  junction_deviation_mm =
+      settings.mode == FirmwareMode::klipper
+          ? klipper_junction_deviation(settings.square_corner_velocity, config_accel)
+          : settings.junction_deviation_mm;
+  return settings;
+}
+
 double klipper_junction_deviation(double square_corner_velocity, double max_accel_mm_s2) {
   return square_corner_velocity * square_corner_velocity * (std::sqrt(2.0) - 1.0) / max_accel_mm_s2;
 }
@@ -520,24 +545,9 @@ void append_s_curve_chain(const std::vector<PrintSegment>& segments, size_t firs
 Trajectory FirmwarePlanner::plan(const Toolpath& toolpath, const TcpLimits& limits) const {
   const std::vector<PrintSegment> segments = split_into_segments(toolpath, limits);
   const MachineLimits& requested = limits.requested();
-  // the junction deviation: Marlin's own, or Klipper's from the square-corner velocity at the
-  // configured acceleration (max_accel, else the x and y axes' smaller a_max)
-  const double config_accel = settings_.max_accel > 0.0 ? settings_.max_accel
-                                                        : std::min(requested.axes[0].a_max_mm_s2,
-                                                                   requested.axes[1].a_max_mm_s2);
-  FirmwareSettings settings = settings_;
-  // Klipper's max_accel is the toolhead's, the same in every direction of the xy plane (its
-  // cartesian kinematics caps z alone): a diagonal move is not allowed the per-axis limit
-  // scaled by its direction, as Marlin's is (a 90 deg corner turned 30 deg off the axes was
-  // taken at 5.37 mm/s where square_corner_velocity says 5)
-  if (settings.mode == FirmwareMode::klipper && !(settings.max_accel > 0.0))
-    settings.max_accel = config_accel;
-  if (settings.mode == FirmwareMode::klipper && settings.max_accel_to_decel > 0.0)
-    settings.minimum_cruise_ratio = 1.0 - std::min(1.0, settings.max_accel_to_decel / config_accel);
-  const double junction_deviation =
-      settings.mode == FirmwareMode::klipper
-          ? klipper_junction_deviation(settings.square_corner_velocity, config_accel)
-          : settings.junction_deviation_mm;
+  double junction_deviation = 0.0;
+  const FirmwareSettings settings =
+      resolved_firmware_settings(settings_, requested, junction_deviation);
 
   // a jerk limit in force anywhere on the job: Marlin's S_CURVE_ACCELERATION (see the header)
   Vec3 job_lo = toolpath.start_mm.cwiseMin(toolpath.end_mm);

@@ -88,6 +88,14 @@ double junction_speed_squared(const Vec3& u_prev, const Vec3& u_next, double acc
 // max_accel, the same in every xy direction, is such a cap).
 void move_caps(const Vec3& u, const MachineLimits& limits, double max_velocity, double max_accel,
                double& speed_cap, double& accel_cap);
+// The settings as the firmware applies them over the machine's limits, and its junction
+// deviation: Klipper's max_accel (when not given, the x and y axes' smaller a_max) the same in
+// every xy direction, its older max_accel_to_decel as minimum_cruise_ratio, and the junction
+// deviation Marlin's own or Klipper's from square_corner_velocity at that acceleration (the
+// planner and `inspect`'s estimate both take them from here)
+FirmwareSettings resolved_firmware_settings(const FirmwareSettings& given,
+                                            const MachineLimits& limits,
+                                            double& junction_deviation_mm);
 // Klipper's conversion of square_corner_velocity to a junction deviation (Klipper
 // docs/Kinematics.md, "Look-ahead"; toolhead.py): jd = scv^2 (sqrt(2) - 1) / max_accel, so a
 // 90 deg corner is taken at exactly scv.

@@ -58,16 +58,14 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
   }
   const MachineLimits limits = machine.cartesian_limits(
       MachineLimits::uniform(kUnbounded, kUnbounded), all_moves_bbox.lo, all_moves_bbox.hi);
-  // the firmware's configuration: Marlin's junction deviation, or Klipper's square-corner
-  // velocity at the x and y axes' acceleration
-  FirmwareSettings settings;
-  settings.mode = mode == "klipper" ? FirmwareMode::klipper : FirmwareMode::marlin;
-  const double config_accel = std::min(limits.axes[0].a_max_mm_s2, limits.axes[1].a_max_mm_s2);
-  const double junction_deviation_mm =
-      settings.mode == FirmwareMode::klipper
-          ? klipper_junction_deviation(settings.square_corner_velocity, config_accel)
-          : settings.junction_deviation_mm;
-  const double max_accel = settings.mode == FirmwareMode::klipper ? config_accel : 0.0;
+  // the firmware's configuration as the planner applies it: Marlin's junction deviation, or
+  // Klipper's square-corner velocity and its max_accel, both at the x and y axes' acceleration
+  FirmwareSettings given;
+  given.mode = mode == "klipper" ? FirmwareMode::klipper : FirmwareMode::marlin;
+  double junction_deviation_mm = 0.0;
+  const FirmwareSettings settings =
+      resolved_firmware_settings(given, limits, junction_deviation_mm);
+  const double max_accel = settings.max_accel;
   const Vec3 axis_accel =
       Vec3(limits.axes[0].a_max_mm_s2, limits.axes[1].a_max_mm_s2, limits.axes[2].a_max_mm_s2)
           .cwiseMin(max_accel > 0.0 ? max_accel : kUnbounded);
