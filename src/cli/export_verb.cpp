@@ -189,6 +189,11 @@ class GcodeWriter {
 
   void line(const std::string& text) { body_ << text << '\n'; }
 
+  // G4 for `seconds` (whole milliseconds), with a comment: "planned pause" or "planned dwell"
+  void dwell(double seconds, const char* what) {
+    line("G4 P" + number_text(1000.0 * seconds, 0) + " ; planned " + what);
+  }
+
   // G0 or G1 to `to` at `feed_mm_min` (<= 0: no F), with an E increment when e_mm > 0
   void move(const char* code, const Vec3& to, double feed_mm_min, double e_mm) {
     std::string text = code;
@@ -327,7 +332,7 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
       for (size_t k = 1; k <= last; ++k)
         travel_mm += (samples.position_mm[k] - samples.position_mm[k - 1]).norm();
       if (!(travel_mm > kMinMove_mm)) {
-        gcode.line("G4 P" + number_text(1000.0 * duration_s, 0) + " ; planned pause");
+        gcode.dwell(duration_s, "pause");
         continue;
       }
       size_t from = 0;
@@ -341,8 +346,7 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
       if (from != last) {
         // (the last points the written digits do not tell apart: the time stands still)
         const double rest_s = samples.t_s[last] - samples.t_s[from];
-        if (rest_s >= 0.0005)
-          gcode.line("G4 P" + number_text(1000.0 * rest_s, 0) + " ; planned pause");
+        if (rest_s >= 0.0005) gcode.dwell(rest_s, "pause");
       }
       continue;
     }
@@ -392,8 +396,7 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
           const size_t arc_to = kept[arc_end];
           const double length_mm = arc->first.radius_mm * std::abs(arc->second);
           const double move_s = samples.t_s[arc_to] - samples.t_s[written];
-          if (pending_dwell_s >= 0.0005)
-            gcode.line("G4 P" + number_text(1000.0 * pending_dwell_s, 0) + " ; planned dwell");
+          if (pending_dwell_s >= 0.0005) gcode.dwell(pending_dwell_s, "dwell");
           pending_dwell_s = 0.0;
           const double e_mm =
               (samples.volume_mm3[arc_to] - samples.volume_mm3[written]) / filament_area_mm2;
@@ -415,8 +418,7 @@ std::string trajectory_gcode(const Trajectory& trajectory, const GcodeExportJob&
         }
         // a move the written digits cannot show waits for the next point
         if (!gcode.changes_position(samples.position_mm[to])) continue;
-        if (pending_dwell_s >= 0.0005)
-          gcode.line("G4 P" + number_text(1000.0 * pending_dwell_s, 0) + " ; planned dwell");
+        if (pending_dwell_s >= 0.0005) gcode.dwell(pending_dwell_s, "dwell");
         pending_dwell_s = 0.0;
         const double e_mm =
             (samples.volume_mm3[to] - samples.volume_mm3[written]) / filament_area_mm2;
