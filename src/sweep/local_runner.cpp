@@ -85,6 +85,18 @@ std::string duration_text(double seconds) {
   return text;
 }
 
+// A worker that ended by a stop request (exit 128 + SIGINT, SIGTERM or SIGHUP: its task's
+// staging folder removed) was stopped, not failed: its task is not recorded
+int stop_signal_of(int status) {
+  if (!WIFEXITED(status)) return 0;
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP})
+    if (WEXITSTATUS(status) == 128 + signal_number) return signal_number;
+  return 0;
+}
+
+// how long stopped workers get to remove their staging folders before SIGKILL
+constexpr double kWorkerStopGrace_s = 20.0;
+
 struct Worker {
   pid_t pid = -1;
   int command_fd = -1;  // task indices to the worker's stdin
@@ -231,6 +243,11 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
       worker.command_fd = -1;
       int status = 0;
       ::waitpid(worker.pid, &status, 0);
+      if (const int stopped = stop_signal_of(status); stopped != 0 && worker.task) {
+        // a signal to the process group reached the worker first: the run stops
+        if (g_stop_signal == 0) g_stop_signal = stopped;
+        worker.task.reset();
+      }
       if (worker.task) {
         const std::uint64_t index = *worker.task;
         const SweepTask task = sweep.task(index);
@@ -267,19 +284,34 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
   ::sigaction(SIGTERM, &previous_term, nullptr);
   ::sigaction(SIGHUP, &previous_hup, nullptr);
   if (const int signal_number = g_stop_signal; signal_number != 0) {
-    // stopped: the workers end at once (their tasks' folders stay as they were: an unfinished
-    // task is not recorded and runs again next time), then this process by the signal
-    for (Worker& worker : workers)
-      if (worker.report_fd >= 0) {
-        ::kill(worker.pid, SIGKILL);
-        ::waitpid(worker.pid, nullptr, 0);
+    // stopped: each running worker is asked to stop (SIGTERM: its task's staging folder and
+    // lock are removed as the exception unwinds; an unfinished task is not recorded and runs
+    // again next time), ended outright if it has not within the grace; then this process
+    // stops as every writing verb does, its lock on DIR released (Interrupted)
+    // (a worker waiting for its next task ends at the end of its input)
+    for (Worker& worker : workers) {
+      if (worker.command_fd >= 0) ::close(worker.command_fd);
+      worker.command_fd = -1;
+      if (worker.report_fd >= 0) ::kill(worker.pid, SIGTERM);
+    }
+    const double deadline_s = now_s() + kWorkerStopGrace_s;
+    for (Worker& worker : workers) {
+      if (worker.report_fd < 0) continue;
+      while (::waitpid(worker.pid, nullptr, WNOHANG) == 0) {
+        if (now_s() > deadline_s) {
+          ::kill(worker.pid, SIGKILL);
+          ::waitpid(worker.pid, nullptr, 0);
+          break;
+        }
+        ::usleep(10000);
       }
+      ::close(worker.report_fd);
+    }
     std::fprintf(stderr, "\nsweep %s: stopped by %s after %llu of %llu tasks\n",
                  sweep.spec().name.c_str(), strsignal(signal_number),
                  static_cast<unsigned long long>(summary.ran),
                  static_cast<unsigned long long>(total));
-    ::signal(signal_number, SIG_DFL);
-    ::raise(signal_number);
+    throw Interrupted(signal_number);
   }
   summary.wall_s = now_s() - start_s;
   return summary;

@@ -245,8 +245,9 @@ int processes_with(const std::string& text) {
   return count;
 }
 
-// depotwin started with `arguments`, standard output to /dev/null
-pid_t spawn_depotwin(std::vector<std::string> arguments) {
+// depotwin started with `arguments`, standard output to /dev/null; with `own_group`, in a
+// process group of its own (as a shell starts a job), which kill(-pid, ...) signals whole
+pid_t spawn_depotwin(std::vector<std::string> arguments, bool own_group = false) {
   arguments.insert(arguments.begin(), DEPOTWIN_BINARY_DIR "/depotwin");
   std::vector<char*> argv;
   for (std::string& argument : arguments) argv.push_back(argument.data());
@@ -254,9 +255,16 @@ pid_t spawn_depotwin(std::vector<std::string> arguments) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  if (own_group) {
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attributes, 0);
+  }
   pid_t pid = 0;
-  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0) pid = 0;
+  if (posix_spawn(&pid, argv[0], &actions, &attributes, argv.data(), environ) != 0) pid = 0;
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
   return pid;
 }
 
@@ -288,9 +296,13 @@ grid:
   ::kill(pid, SIGINT);
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-  // ended by the signal, its workers with it, the unfinished tasks not recorded
-  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
+  // stopped as every writing verb (130), its workers with it, the unfinished tasks not
+  // recorded, nothing half-written left: no staging folder, no task's or DIR's lock
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 130) << status;
   EXPECT_EQ(processes_with(out), 0);
+  EXPECT_EQ(names_holding(out, ".partial"), std::vector<std::string>{});
+  EXPECT_EQ(names_holding(out, ".lock"), std::vector<std::string>{});
+  EXPECT_FALSE(fs::exists(out + ".lock"));
   int recorded = 0;
   for (int i = 0; i < 8; ++i)
     recorded += fs::exists(out + "/tasks/000" + std::to_string(i) + "/task.json");
@@ -336,8 +348,42 @@ TEST_F(SweepRoutes, ATaskStoppedBySIGTERMOrSIGHUPLeavesNothingHalfWritten) {
   ::kill(pid, SIGHUP);
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGHUP) << status;
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGHUP) << status;
   EXPECT_EQ(processes_with(out), 0);
+  EXPECT_EQ(names_holding(out, ".partial"), std::vector<std::string>{});
+  EXPECT_FALSE(fs::exists(out + ".lock"));
+}
+
+// SIGTERM to the whole process group (`kill -TERM -<pgid>`, a terminal's or a job
+// control's stop), so that the workers have it too, mid-task: each removes its staging
+// folder and task lock, the unfinished tasks are not recorded as failed, DIR's lock goes
+TEST_F(SweepRoutes, ALocalRunSignalledAsAGroupLeavesNothingHalfWritten) {
+  const std::string sweep = write_text(dir_, "group.yaml", kTwoTasks);
+  const std::string out = dir_ + "/group";
+  const pid_t pid =
+      spawn_depotwin({"sweep", sweep, "-j", "2", "--out", out, "--quiet"}, /*own_group=*/true);
+  ASSERT_GT(pid, 0);
+  // once a task's staging folder is there (the workers are mid-task), the signal
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (names_holding(out, ".partial").empty() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ::kill(-pid, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << status;
+  EXPECT_EQ(processes_with(out), 0);
+  EXPECT_EQ(names_holding(out, ".partial"), std::vector<std::string>{});
+  EXPECT_EQ(names_holding(out, ".lock"), std::vector<std::string>{});
+  EXPECT_FALSE(fs::exists(out + ".lock"));
+  // a task stopped mid-way has no record (not a failure): it runs again next time
+  for (const char* task : {"/tasks/0000/task.json", "/tasks/0001/task.json"}) {
+    if (fs::exists(out + task)) {
+      EXPECT_EQ(read_text(out + task).find("\"failed\""), std::string::npos) << task;
+    }
+  }
+  const CliResult resumed = depotwin("sweep " + sweep + " --quiet --no-render --out " + out);
+  EXPECT_EQ(resumed.status, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("(0 failed)"), std::string::npos) << resumed.output;
 }
 
 TEST_F(SweepRoutes, KeepAllKeepsWhatRunNoRenderWrites) {
