@@ -401,6 +401,8 @@ ResolvedScenario resolve_scenario(const std::string& path, const std::string& te
   const YAML::Node& tree = *root;
   if (tree.IsMap()) {
     if (tree["machine"] && tree["machine"].IsMap()) add_file(tree["machine"]["model"]);
+    if (tree["machine"] && tree["machine"].IsScalar())
+      resolved.shipped_machine = tree["machine"].Scalar();
     const YAML::Node toolpath = tree["toolpath"];
     if (toolpath && toolpath.IsMap()) {
       const YAML::Node gcode = toolpath["gcode"];

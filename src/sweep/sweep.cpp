@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -15,6 +16,8 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "core/number_text.hpp"
+#include "kinematics/machine.hpp"
+#include "pipeline/models_dir.hpp"
 #include "pipeline/progress_line.hpp"
 #include "report/output_dir.hpp"
 #include "scenario/overrides.hpp"
@@ -192,8 +195,11 @@ std::string file_hash(const std::string& path) {
 std::vector<std::string> Sweep::input_file_hashes(
     const std::vector<ScenarioOverride>& overrides) const {
   std::vector<std::string> hashes;
-  for (const std::string& file : resolve_scenario(spec_.base, base_text_, overrides).input_files)
-    hashes.push_back(file_hash(file));
+  const ResolvedScenario resolved = resolve_scenario(spec_.base, base_text_, overrides);
+  for (const std::string& file : resolved.input_files) hashes.push_back(file_hash(file));
+  // a shipped machine's MJCF, from the models folder the task's run reads it from
+  if (const std::unique_ptr<Machine> machine = make_machine(resolved.shipped_machine))
+    hashes.push_back(file_hash((fs::path(models_directory()) / machine->model_file()).string()));
   return hashes;
 }
 

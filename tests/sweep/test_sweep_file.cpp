@@ -382,6 +382,40 @@ TEST(ScenarioOverrides, HashesFollowTheInputsNotTheWorkingDirectory) {
   EXPECT_NE(Sweep(file, "").input_hash(Sweep(file, "").task(0)), model_one);
 }
 
+// A shipped machine (`machine: xy_stage`) reads its MJCF from the models folder: those bytes
+// count too, so a retuned model makes every task stale (and another folder of the same
+// models gives the same hash)
+TEST(ScenarioOverrides, HashesFollowTheShippedMachinesModel) {
+  const std::string dir = fresh_directory("sweep_hash_model");
+  const std::string models = dir + "/models";
+  std::filesystem::create_directories(models);
+  const std::string shipped = read_text(std::string(DEPOTWIN_SOURCE_DIR) + "/models/xy_stage.xml");
+  write_text(models, "xy_stage.xml", shipped);
+  write_text(dir, "base.yaml", read_text(scenario_path("thompson_fig7.yaml")));
+  const std::string file =
+      write_text(dir, "s.yaml", "base: base.yaml\ngrid:\n  planner: [lspb_mtt, stop_and_go]\n");
+  const char* previous = std::getenv("DEPOTWIN_MODELS_DIR");
+  const std::string previous_models = previous ? previous : "";
+  ::setenv("DEPOTWIN_MODELS_DIR", models.c_str(), 1);
+  const std::string as_shipped = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+  // a body heavier (a digit put before its first mass)
+  std::string heavier = shipped;
+  const std::size_t mass = heavier.find("mass=\"");
+  ASSERT_NE(mass, std::string::npos);
+  heavier.insert(mass + 6, "1");
+  write_text(models, "xy_stage.xml", heavier);
+  const std::string retuned = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+  write_text(models, "xy_stage.xml", shipped);
+  const std::string restored = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+  if (previous)
+    ::setenv("DEPOTWIN_MODELS_DIR", previous_models.c_str(), 1);
+  else
+    ::unsetenv("DEPOTWIN_MODELS_DIR");
+  EXPECT_NE(retuned, as_shipped);
+  EXPECT_EQ(restored, as_shipped);
+  EXPECT_EQ(Sweep(file, "").input_hash(Sweep(file, "").task(0)), as_shipped);
+}
+
 TEST(SweepTasks, ValidateAllListsEachProblemOnceWithTheTasksItConcerns) {
   const std::string dir = fresh_directory("sweep_validate");
   const std::string file =
