@@ -460,9 +460,11 @@ TEST(OutputSafety, AReaderThatGoesAwayStopsTheRunAndLeavesNothing) {
   // gone before the last lines, printed after the result was swapped in: the result is whole,
   // the status 141 as a verb ended by the signal reports it, and no error is said (it was
   // exit 1, "the standard output could not be written whole")
+  // (the plan starts a second after `true`, which has surely gone by then even on a loaded
+  // machine: started together, a plan that printed before `true` ended exited 0)
   const auto after = testing_support::shell(
-      "bash -c '" + std::string(DEPOTWIN_BINARY_DIR) + "/depotwin plan " +
-      scenario_path("thompson_fig7.yaml") + " --planner lspb_mtt --quiet --out " + out + " 2> " +
+      "bash -c '{ sleep 1; exec " + std::string(DEPOTWIN_BINARY_DIR) + "/depotwin plan " +
+      scenario_path("thompson_fig7.yaml") + " --planner lspb_mtt --quiet --out " + out + "; } 2> " +
       dir + "/stderr.txt | true; echo \"status ${PIPESTATUS[0]}\"'");
   EXPECT_NE(after.output.find("status 141"), std::string::npos) << after.output;
   EXPECT_EQ(read_text(dir + "/stderr.txt"), "");
