@@ -106,6 +106,7 @@ VelocityErrorStats velocity_error(const MotionSamples& samples,
     weighted.push_back({error[k], w});
   }
   if (total_time <= 0.0) return stats;
+  stats.counted_s = total_time;
   stats.rms_rel = std::sqrt(sum_sq / total_time);
   stats.frac_len_over_1pct = length > 0.0 ? length_over / length : 0.0;
   // time-weighted 95th percentile: the smallest error with >= 95 % of the time at or below it
@@ -126,9 +127,10 @@ std::vector<TimeSpan> speed_ramps(const MotionSamples& planned) {
   const size_t n = planned.size();
   // a ramp's span reaches half a sample period beyond its outer samples
   const auto half_gap = [&](size_t a, size_t b) { return 0.5 * (planned.t_s[b] - planned.t_s[a]); };
-  const auto reached = [&](size_t k) {
+  // at speed: within the tolerance of the desired speed, or of `ceiling` where that is lower
+  const auto reached = [&](size_t k, double ceiling) {
     return planned.velocity_mm_s[k].norm() >=
-           (1.0 - kRampTolerance_rel) * planned.desired_speed_mm_s[k];
+           (1.0 - kRampTolerance_rel) * std::min(planned.desired_speed_mm_s[k], ceiling);
   };
   size_t k = 0;
   while (k < n) {
@@ -144,14 +146,27 @@ std::vector<TimeSpan> speed_ramps(const MotionSamples& planned) {
     const double inner = last > first ? half_gap(first, first + 1) : 1e-9;
     const double before = first > 0 ? half_gap(first - 1, first) : inner;
     const double after = last + 1 < n ? half_gap(last, last + 1) : inner;
+    // A stretch that never reaches its desired speed is at speed where it reaches its own
+    // top speed: a line held below the speed on purpose (the limits, or conformal's
+    // constant scale-down) has a steady part, whose error is that shortfall.
+    // A peak (no sample between the first and last at that speed) is ramp throughout.
+    double ceiling = std::numeric_limits<double>::infinity();
     size_t steady_first = first;
-    while (steady_first <= last && !reached(steady_first)) ++steady_first;
-    if (steady_first > last) {  // never at speed: ramp throughout
-      ramps.push_back({planned.t_s[first] - before, planned.t_s[last] + after});
-      continue;
-    }
+    while (steady_first <= last && !reached(steady_first, ceiling)) ++steady_first;
     size_t steady_last = last;
-    while (!reached(steady_last)) --steady_last;
+    if (steady_first > last) {
+      ceiling = 0.0;
+      for (size_t i = first; i <= last; ++i)
+        ceiling = std::max(ceiling, planned.velocity_mm_s[i].norm());
+      steady_first = first;
+      while (steady_first < last && !reached(steady_first, ceiling)) ++steady_first;
+      while (steady_last > steady_first && !reached(steady_last, ceiling)) --steady_last;
+      if (ceiling <= 0.0 || steady_last <= steady_first + 1) {
+        ramps.push_back({planned.t_s[first] - before, planned.t_s[last] + after});
+        continue;
+      }
+    }
+    while (!reached(steady_last, ceiling)) --steady_last;
     // each ramp takes in the first (last) sample at speed: the servo follows a period late
     if (steady_first > first)
       ramps.push_back(

@@ -34,6 +34,8 @@ struct VelocityErrorStats {
   double rms_rel = 0.0;             // time-weighted
   double p95_rel = 0.0;             // time-weighted 95th percentile
   double frac_len_over_1pct = 0.0;  // fraction of deposited path length with e > 0.01
+  double counted_s = 0.0;           // the time the figures cover: 0 where no sample counts
+                                    // (the steady error of a run that is all ramps: n/a)
 };
 VelocityErrorStats velocity_error(const MotionSamples& samples);
 
@@ -56,7 +58,11 @@ constexpr double kRampTolerance_rel = 1e-4;
 // such sample (included) to its end. The sample at speed is part of the ramp because the
 // servo follows its setpoints a control period late: on the delta the simulated nozzle is
 // still 11 % short of 5 mm/s there, and within 0.4 % one period later. A stretch that never
-// reaches the desired speed is ramp throughout. The spans reach half a sample period beyond
+// reaches the desired speed is at speed where it reaches its own top planned speed (within
+// the same margin): a line held below its speed on purpose (by the limits, or conformal's
+// constant scale-down) has a steady part whose error is that shortfall. Where no sample
+// lies between its first and last at that speed (a peak, not a cruise), it is ramp
+// throughout. The spans reach half a sample period beyond
 // their outer samples (open ends), so that the samples of another run at other times (the
 // simulation's) fall in them as the plan's would.
 std::vector<TimeSpan> speed_ramps(const MotionSamples& planned);

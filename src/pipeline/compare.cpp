@@ -87,7 +87,8 @@ plots::ComparisonColumn sheet_column(const std::string& label, const SimulatedRu
     column.max_speed_error_rel = r.velocity_error->max_rel;
     column.rms_speed_error_rel = r.velocity_error->rms_rel;
   }
-  if (r.velocity_error_steady) column.steady_speed_error_rel = r.velocity_error_steady->max_rel;
+  if (r.velocity_error_steady && r.velocity_error_steady->counted_s > 0.0)  // else n/a: all ramps
+    column.steady_speed_error_rel = r.velocity_error_steady->max_rel;
   if (r.thickness) column.thickness_cv = r.thickness->cv;
   if (r.waste) column.waste_fraction = r.waste->fraction;
   column.total_time_s = r.time.total_s;

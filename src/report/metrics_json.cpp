@@ -72,6 +72,15 @@ Section velocity_section(const VelocityErrorStats& v) {
   return s;
 }
 
+// a steady error: its keys null where every printed sample is in a ramp (n/a, not 0)
+Section steady_velocity_section(const VelocityErrorStats& v) {
+  if (v.counted_s > 0.0) return velocity_section(v);
+  Section s;
+  for (const char* key : {"max_rel", "rms_rel", "p95_rel", "frac_len_over_1pct"})
+    s.optional_number(key, std::nullopt, unit::fraction);
+  return s;
+}
+
 Section path_section(const PathErrorStats& p) {
   Section s;
   s.number("max", p.max_mm, unit::mm).number("rms", p.rms_mm, unit::mm);
@@ -122,9 +131,10 @@ void add_motion_errors(Section& j, const std::optional<VelocityErrorStats>& simu
                        const std::optional<PathErrorStats>& simulated_path,
                        const PathErrorStats& planned_path) {
   if (simulated) j.section("velocity_error", velocity_section(*simulated));
-  if (simulated_steady) j.section("velocity_error_steady", velocity_section(*simulated_steady));
+  if (simulated_steady)
+    j.section("velocity_error_steady", steady_velocity_section(*simulated_steady));
   j.section("planned_velocity_error", velocity_section(planned));
-  j.section("planned_velocity_error_steady", velocity_section(planned_steady));
+  j.section("planned_velocity_error_steady", steady_velocity_section(planned_steady));
   if (simulated_path) j.section("path_error_mm", path_section(*simulated_path));
   j.section("planned_path_error_mm", path_section(planned_path));
 }

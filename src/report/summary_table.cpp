@@ -28,6 +28,16 @@ std::optional<double> simulated(const std::optional<Stats>& stats, Field field) 
   return stats ? std::optional<double>((*stats).*field) : std::nullopt;
 }
 
+// a steady statistic, when any sample lies outside the ramps (none: n/a, not 0)
+template <typename Field>
+std::optional<double> steady(const VelocityErrorStats& stats, Field field) {
+  return stats.counted_s > 0.0 ? std::optional<double>(stats.*field) : std::nullopt;
+}
+template <typename Field>
+std::optional<double> steady(const std::optional<VelocityErrorStats>& stats, Field field) {
+  return stats ? steady(*stats, field) : std::nullopt;
+}
+
 std::string fixed(double value, int digits) {
   char text[48];
   std::snprintf(text, sizeof text, "%.*f", digits, value);
@@ -70,9 +80,15 @@ const std::vector<SummaryColumn>& summary_columns() {
       {"planned_vel_err_rms_pct", false, 2,
        [](const R& r) { return number(100.0 * r.planned_velocity_error.rms_rel); }},
       {"planned_vel_err_steady_max_pct", false, 2,
-       [](const R& r) { return number(100.0 * r.planned_velocity_error_steady.max_rel); }},
+       [](const R& r) {
+         return number(
+             percent(steady(r.planned_velocity_error_steady, &VelocityErrorStats::max_rel)));
+       }},
       {"planned_vel_err_steady_rms_pct", false, 2,
-       [](const R& r) { return number(100.0 * r.planned_velocity_error_steady.rms_rel); }},
+       [](const R& r) {
+         return number(
+             percent(steady(r.planned_velocity_error_steady, &VelocityErrorStats::rms_rel)));
+       }},
       {"planned_path_err_max_mm", false, 4,
        [](const R& r) { return number(r.planned_path_error.max_mm); }},
       // simulated (the nozzle read back from MuJoCo)
@@ -86,11 +102,11 @@ const std::vector<SummaryColumn>& summary_columns() {
        }},
       {"sim_vel_err_steady_max_pct", true, 2,
        [](const R& r) {
-         return number(percent(simulated(r.velocity_error_steady, &VelocityErrorStats::max_rel)));
+         return number(percent(steady(r.velocity_error_steady, &VelocityErrorStats::max_rel)));
        }},
       {"sim_vel_err_steady_rms_pct", true, 2,
        [](const R& r) {
-         return number(percent(simulated(r.velocity_error_steady, &VelocityErrorStats::rms_rel)));
+         return number(percent(steady(r.velocity_error_steady, &VelocityErrorStats::rms_rel)));
        }},
       {"sim_path_err_max_mm", true, 4,
        [](const R& r) { return number(simulated(r.path_error, &PathErrorStats::max_mm)); }},

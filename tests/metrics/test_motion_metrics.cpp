@@ -84,7 +84,26 @@ TEST(SpeedRamps, SpansApplyToSamplesAtOtherTimes) {
   EXPECT_NEAR(velocity_error(finer).max_rel, 1.0, 1e-9);
 }
 
-// A stretch that never reaches its desired speed is ramp throughout: nothing steady is left.
+// A stretch held below its desired speed on purpose (a cruise at 3 mm/s against 4 mm/s: the
+// limits, or conformal's constant scale-down) has a steady part, the cruise at its own top
+// speed, and its steady error is the shortfall 1 - 3/4 throughout, not 0 over no length.
+TEST(SpeedRamps, ACruiseBelowTheDesiredSpeedIsSteadyAtItsShortfall) {
+  Trapezoid trap;
+  trap.dip_depth = 0.0;
+  MotionSamples planned = trap.sample(1e-3);
+  for (double& v : planned.desired_speed_mm_s) v = v > 0 ? 4.0 : 0.0;
+  const std::vector<TimeSpan> ramps = speed_ramps(planned);
+  ASSERT_EQ(ramps.size(), 2u);  // the same ramps as against 3 mm/s
+  EXPECT_NEAR(ramps[0].end_s, trap.rest_s + trap.ramp_s + 1e-3, 1e-3);
+  EXPECT_NEAR(total_time_s(ramps), 2 * trap.ramp_s + 2e-3, 3e-3);
+  const VelocityErrorStats steady = velocity_error(planned, ramps);
+  EXPECT_NEAR(steady.max_rel, 0.25, 1e-9);
+  EXPECT_NEAR(steady.rms_rel, 0.25, 1e-9);
+  EXPECT_NEAR(steady.counted_s, trap.cruise_s, 3e-3);
+}
+
+// A stretch that only peaks below its desired speed is ramp throughout: nothing steady is
+// left, and the steady figures cover no time (n/a, not 0).
 TEST(SpeedRamps, AStretchNeverAtSpeedIsAllRamp) {
   Trapezoid trap;
   trap.cruise_s = 0.0;  // a triangle: up to v at one instant only ...
@@ -97,6 +116,8 @@ TEST(SpeedRamps, AStretchNeverAtSpeedIsAllRamp) {
   const VelocityErrorStats steady = velocity_error(planned, ramps);
   EXPECT_EQ(steady.max_rel, 0.0);
   EXPECT_EQ(steady.rms_rel, 0.0);
+  EXPECT_EQ(steady.counted_s, 0.0);
+  EXPECT_GT(velocity_error(planned).counted_s, trap.printing_s() - 1e-3);
 }
 
 // A cruise exactly at speed from the first sample (LSPB entering at print speed): no ramp.

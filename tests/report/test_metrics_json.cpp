@@ -23,7 +23,7 @@ MetricsReport planned_report() {
   r.planner = "lspb_mtt";
   r.time = {19.0, 11.0, 8.0};
   r.planned_velocity_error = {0.6, 0.05, 0.1, 0.02};
-  r.planned_velocity_error_steady = {0.3, 0.01, 0.02, 0.01};
+  r.planned_velocity_error_steady = {0.3, 0.01, 0.02, 0.01, 7.6};
   r.planned_path_error = {0.04, 0.01};
   r.speed_ramps = {{1.0, 1.1}, {2.0, 2.3}};
   OrderStats order;
@@ -36,7 +36,7 @@ MetricsReport planned_report() {
 MetricsReport simulated_report() {
   MetricsReport r = planned_report();
   r.velocity_error = VelocityErrorStats{0.61, 0.05, 0.1, 0.02};
-  r.velocity_error_steady = VelocityErrorStats{0.31, 0.01, 0.02, 0.01};
+  r.velocity_error_steady = VelocityErrorStats{0.31, 0.01, 0.02, 0.01, 7.6};
   r.path_error = PathErrorStats{0.05, 0.01};
   r.thickness = ThicknessSummary{1.2, 0.5, 0.08, 0.1, 1.9};
   r.waste = WasteStats{0.45, 0.4, 0.05, 8.0};
@@ -56,7 +56,8 @@ MetricsReport simulated_report() {
     LayerReport layer;
     layer.layer = k;
     layer.velocity_error = VelocityErrorStats{};
-    layer.velocity_error_steady = VelocityErrorStats{};
+    layer.velocity_error_steady = VelocityErrorStats{0, 0, 0, 0, 1.0};
+    layer.planned_velocity_error_steady = VelocityErrorStats{0, 0, 0, 0, 1.0};
     layer.path_error = PathErrorStats{};
     layer.thickness = ThicknessSummary{};
     layer.waste = WasteStats{};
@@ -143,6 +144,21 @@ TEST(MetricsJson, PlannedAndSimulatedFiguresHaveTheirOwnNames) {
     EXPECT_TRUE(run["velocity_error_steady"].contains(key)) << key;
   EXPECT_TRUE(run["layers"][0].contains("planned_path_error_mm"));
   EXPECT_TRUE(run["layers"][0].contains("velocity_error_steady"));
+}
+
+// a run that is all ramps has no steady figures: the keys are there, null (n/a), not 0
+TEST(MetricsJson, SteadyErrorsOverNoTimeAreNull) {
+  MetricsReport report = simulated_report();
+  report.velocity_error_steady = VelocityErrorStats{};
+  report.planned_velocity_error_steady = VelocityErrorStats{};
+  const Json j = Json::parse(metrics_json_text(report));
+  for (const char* section : {"velocity_error_steady", "planned_velocity_error_steady"})
+    for (const char* key : {"max_rel", "rms_rel", "p95_rel", "frac_len_over_1pct"}) {
+      ASSERT_TRUE(j[section].contains(key)) << section << "." << key;
+      EXPECT_TRUE(j[section][key].is_null()) << section << "." << key;
+      EXPECT_EQ(j["units"][section][key], "fraction");
+    }
+  EXPECT_EQ(j["velocity_error"]["max_rel"], 0.61);  // the whole-length figures stay
 }
 
 // the contract of docs/ARCHITECTURE.md ("metrics.json"): every key under its name, holding the

@@ -20,11 +20,11 @@ MetricsReport report(const std::string& label, bool simulated) {
   r.sequencer = "as_given";
   r.time = {19.355, 11.011, 8.344};
   r.planned_velocity_error.max_rel = 0.6183;
-  r.planned_velocity_error_steady.max_rel = 0.0038;
+  r.planned_velocity_error_steady = {0.0038, 0.001, 0.002, 0.0, 7.6};
   r.planned_path_error.max_mm = 0.0409;
   if (simulated) {
     r.velocity_error = VelocityErrorStats{0.6182, 0.05, 0.1, 0.02};
-    r.velocity_error_steady = VelocityErrorStats{0.004, 0.001, 0.002, 0.0};
+    r.velocity_error_steady = VelocityErrorStats{0.004, 0.001, 0.002, 0.0, 7.6};
     r.path_error = PathErrorStats{0.05, 0.01};
     r.thickness = ThicknessSummary{1.2, 0.5098, 0.0771, 0.1, 1.9};
     r.waste = WasteStats{0.457, 0.4, 0.057, 8.0};
@@ -110,6 +110,17 @@ TEST(SummaryTable, PlannedAndSimulatedColumnsAreNamedApart) {
   EXPECT_NE(summary_console(run).find("planned_vel_err_steady_max_pct      0.38\n"),
             std::string::npos)
       << summary_console(run);
+  // a run that is all ramps: its steady columns are n/a (a dash, null), not 0.00
+  std::vector<MetricsReport> all_ramps{report("lspb_mtt", true)};
+  all_ramps[0].velocity_error_steady = VelocityErrorStats{};
+  all_ramps[0].planned_velocity_error_steady = VelocityErrorStats{};
+  const nlohmann::ordered_json ramps_json = summary_json(all_ramps);
+  for (const char* column : {"planned_vel_err_steady_max_pct", "planned_vel_err_steady_rms_pct",
+                             "sim_vel_err_steady_max_pct", "sim_vel_err_steady_rms_pct"})
+    EXPECT_TRUE(ramps_json["rows"][0][column].is_null()) << column;
+  EXPECT_NE(summary_console(all_ramps).find("sim_vel_err_steady_max_pct             -\n"),
+            std::string::npos)
+      << summary_console(all_ramps);
 }
 
 // ... and the same values: every cell of every row reads the same in comparison.csv (full
