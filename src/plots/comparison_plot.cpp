@@ -180,13 +180,13 @@ HeightMap crop_map(const HeightMap& map, const ZoomWindow& window) {
   return out;
 }
 
-SharedThicknessScale shared_thickness_scale(const ComparisonInput& input) {
+SharedThicknessScale capped_thickness_scale(const std::vector<const HeightMap*>& all_maps) {
   SharedThicknessScale scale;
   std::vector<const HeightMap*> maps;
-  for (const ComparisonColumn& column : input.columns)
-    if (has_map(column.thickness)) {
-      maps.push_back(column.thickness);
-      scale.peak_um = std::max(scale.peak_um, static_cast<double>(column.thickness->max_value()));
+  for (const HeightMap* map : all_maps)
+    if (has_map(map)) {
+      maps.push_back(map);
+      scale.peak_um = std::max(scale.peak_um, static_cast<double>(map->max_value()));
     }
   if (!(scale.peak_um > 0.0)) return scale;
   // each map's deposit cells' 95th percentile, from a histogram over [0, peak] (its bins a
@@ -218,6 +218,20 @@ SharedThicknessScale shared_thickness_scale(const ComparisonInput& input) {
   scale.top_um = std::min(scale.peak_um, kSharedScaleCap * median_um);
   scale.capped = scale.top_um < scale.peak_um;
   return scale;
+}
+
+SharedThicknessScale shared_thickness_scale(const ComparisonInput& input) {
+  std::vector<const HeightMap*> maps;
+  for (const ComparisonColumn& column : input.columns) maps.push_back(column.thickness);
+  return capped_thickness_scale(maps);
+}
+
+std::string capped_scale_note(const SharedThicknessScale& scale, const std::string& map_noun) {
+  if (!scale.capped) return "";
+  return format(
+      "topped at %g × the median %s's 95th percentile (thicker: the top colour); "
+      "peak %s µm",
+      kSharedScaleCap, map_noun.c_str(), fixed_text(scale.peak_um, scale.peak_um).c_str());
 }
 
 PlotResult render_comparison(const ComparisonInput& input, const std::string& png_path,
@@ -276,10 +290,7 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   // (capped: a second line says so; gnuplot's double quotes take the \n)
   const std::string scale_text =
       style::axis_label("thickness, one colour scale for all runs", "µm") +
-      (scale.capped ? format("\\ntopped at %g × the median run's 95th percentile (thicker: the "
-                             "top colour); peak %.3g µm",
-                             kSharedScaleCap, scale.peak_um)
-                    : std::string());
+      (scale.capped ? "\\n" + capped_scale_note(scale, "run") : std::string());
   s += "set cblabel \"" + scale_text + "\" offset 0,0.4\n";
   s += format("set colorbox horizontal user origin screen 0.2,%.4f size screen 0.6,%.4f\n",
               kColourBarY, kColourBarHeight);

@@ -143,7 +143,7 @@ void prepare_layer_panels(const RunPlotInput& input, const PlotOptions& options,
 
   const int cells = std::min(options.max_map_cells_per_side, kLayerMapCellsPerSide);
   Range x, y;
-  double peak_um = 0.0;
+  std::vector<const HeightMap*> shown_maps;
   for (int k : shown) {
     LayerPanel panel;
     panel.layer = k;
@@ -157,7 +157,7 @@ void prepare_layer_panels(const RunPlotInput& input, const PlotOptions& options,
       require(map->thickness_um.size() == static_cast<size_t>(map->nx) * map->ny,
               "a layer's height map size does not match nx * ny");
       panel.map = downsample_for_display(*map, cells);
-      peak_um = std::max(peak_um, static_cast<double>(panel.map.max_value()));
+      shown_maps.push_back(map);
       const HeightMap& m = panel.map;
       x.add(m.origin_x_mm - 0.5 * m.cell_mm);
       x.add(m.origin_x_mm + (m.nx - 0.5) * m.cell_mm);
@@ -176,7 +176,10 @@ void prepare_layer_panels(const RunPlotInput& input, const PlotOptions& options,
       }
     data.layer_panels.push_back(std::move(panel));
   }
-  data.layer_max_um = peak_um > 0.0 ? peak_um : 1e-3;
+  // one colour scale, topped near the beads' height when a blob (where the layers start)
+  // stands far above them; a layer of nothing still gets a scale
+  data.layer_scale = capped_thickness_scale(shown_maps);
+  if (!(data.layer_scale.peak_um > 0.0)) data.layer_scale.top_um = 1e-3;
   // every panel shows the same extent: all shown maps and paths (at least 1 mm)
   auto span = [](const Range& r, double& lo, double& hi) {
     lo = r.empty() ? 0.0 : r.lo;
@@ -381,7 +384,7 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
     title += format(" (%zu of %d layers, evenly chosen)", n, data.layer_count);
   s += "set multiplot title " + style::quoted(title) + " font \"" + style::title_font() + "\"\n";
   s += style::thickness_palette();
-  s += format("set cbrange [0:%.9g]\n", data.layer_max_um);
+  s += format("set cbrange [0:%.9g]\n", data.layer_scale.top_um);
   s += "set cblabel " + style::quoted(style::axis_label("thickness", "µm")) + " offset 0.5,0\n";
   s += "unset grid\nset tics front\nunset key\n";
 
@@ -425,6 +428,12 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
   s += format("set label 902 %s at screen %.4f, %.4f center rotate by 90\n",
               style::quoted(style::axis_label("y", "mm")).c_str(), (left0 + 4) / width_px,
               1.0 - 0.5 * (maps_top + maps_bottom) / height_px);
+  // a topped scale says so under the x label (the colour bar is too short for the sentence)
+  if (data.layer_scale.capped)
+    s += format(
+        "set label 904 %s at screen 0.5, %.4f center tc rgb \"#404040\"\n",
+        style::quoted("colour scale " + capped_scale_note(data.layer_scale, "layer")).c_str(),
+        1.0 - std::min(maps_bottom + kTicsBottom + 40, height_px - 12.0) / height_px);
   // the map's zero colour behind each panel, so that the extent a layer's grid does not
   // cover reads as "nothing there" like its empty cells
   s += "set object 1 rect from graph 0, graph 0 to graph 1, graph 1 behind fc rgb \"#440154\" "
@@ -464,10 +473,10 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
     if (panel.paths.point_count() > 0)
       elements.push_back(
           job.data_file(format("layer_%d_paths.dat", panel.layer), format_curve(panel.paths)) +
-          " " + line_style("#60ffffff", 0.7) + " notitle");
+          " " + line_style(style::kPathOverlayColour, style::kPathOverlayLineWidth) + " notitle");
     if (elements.empty()) elements.push_back(style::kEmptyFrame);
     s += plot_command(elements);
-    s += "unset label 901\nunset label 902\n";
+    s += "unset label 901\nunset label 902\nunset label 904\n";
   }
   job.end_png();
 }

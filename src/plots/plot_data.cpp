@@ -506,21 +506,25 @@ HeightMap downsample_for_display(const HeightMap& map, int max_cells_per_side) {
   out.origin_x_mm = map.origin_x_mm + 0.5 * (factor - 1) * map.cell_mm;
   out.origin_y_mm = map.origin_y_mm + 0.5 * (factor - 1) * map.cell_mm;
   out.thickness_um.assign(static_cast<size_t>(out.nx) * out.ny, 0.0f);
-  // block means (double sums: the order is fixed, so the result is deterministic)
+  // block maxima: a bead narrower than a block keeps its peak colour instead of being averaged
+  // into the empty cells around it
   for (int by = 0; by < out.ny; ++by) {
     for (int bx = 0; bx < out.nx; ++bx) {
-      double sum = 0.0;
-      int cells = 0;
+      float block_max = 0.0f;
       for (int iy = by * factor; iy < std::min(map.ny, (by + 1) * factor); ++iy)
-        for (int ix = bx * factor; ix < std::min(map.nx, (bx + 1) * factor); ++ix) {
-          sum += map.at(ix, iy);
-          ++cells;
-        }
-      out.thickness_um[static_cast<size_t>(by) * out.nx + bx] =
-          static_cast<float>(sum / std::max(cells, 1));
+        for (int ix = bx * factor; ix < std::min(map.nx, (bx + 1) * factor); ++ix)
+          block_max = std::max(block_max, map.at(ix, iy));
+      out.thickness_um[static_cast<size_t>(by) * out.nx + bx] = block_max;
     }
   }
   return out;
+}
+
+std::string fixed_text(double value, double largest) {
+  const double magnitude =
+      std::abs(largest) > 0.0 ? std::floor(std::log10(std::abs(largest))) : 0.0;
+  const int decimals = static_cast<int>(std::clamp(2.0 - magnitude, 0.0, 6.0));
+  return format("%.*f", decimals, value);
 }
 
 std::string format_curve(const Curve& curve) {

@@ -99,10 +99,15 @@ std::vector<double> speed_error_with_gaps(const MotionSamples& samples);
 std::vector<double> relative_position_error(const MotionSamples& samples, const Toolpath& toolpath,
                                             double feature_mm);
 
-// A thickness map reduced for display: each output cell is the mean of a block of
-// `factor` x `factor` input cells (cells beyond the edge ignored), centred on the block,
-// so that neither side has more than max_cells_per_side cells. factor 1 copies the map.
+// A thickness map reduced for display: each output cell is the largest of a block of
+// `factor` x `factor` input cells (cells beyond the edge ignored; max-pooling, so a line
+// narrower than a block keeps its peak and stays visible), centred on the block, so that
+// neither side has more than max_cells_per_side cells. factor 1 copies the map.
 HeightMap downsample_for_display(const HeightMap& map, int max_cells_per_side);
+
+// `value` with as many decimals as give `largest` three significant digits (none from 100 up):
+// one fixed format for numbers shown side by side ("2000" and "1034", not "2e+03" and "1.03e+03")
+std::string fixed_text(double value, double largest);
 
 // the text gnuplot reads: "x y" per line in fixed %.9g format, a blank line per break
 std::string format_curve(const Curve& curve);

@@ -44,6 +44,23 @@ struct JointSeries {
 JointSeries joint_series(const RecordedRun& run, const std::vector<JointLimit>& limits,
                          const std::vector<bool>& revolute);
 
+// The colour range maps drawn side by side share, [0, top_um]: the largest peak of all maps,
+// capped at kSharedScaleCap (2) x the median map's 95th percentile of its deposit cells (cells
+// above 1 % of its peak; the lower middle one of an even count), so one blob (a run's, or a
+// layer start's) does not wash the other maps' lines out (its cells above the top take the
+// top colour; the colour bar's label then gives the peak). 1 um when all are empty.
+struct SharedThicknessScale {
+  double top_um = 1.0;
+  double peak_um = 0.0;  // the largest cell of all maps
+  bool capped = false;   // top_um < peak_um
+};
+constexpr double kSharedScaleCap = 2.0;
+// null or empty maps are skipped
+SharedThicknessScale capped_thickness_scale(const std::vector<const HeightMap*>& maps);
+// what a capped scale's colour bar says under its title ("topped at 2 × the median <map_noun>'s
+// 95th percentile (thicker: the top colour); peak N µm"); empty when not capped
+std::string capped_scale_note(const SharedThicknessScale& scale, const std::string& map_noun);
+
 // Everything the run plots show. Pointers are borrowed for the call; the struct owns nothing.
 struct RunPlotInput {
   std::string title;                         // e.g. "two_segments / lspb_mtt", on every plot
@@ -154,11 +171,12 @@ struct RunPlotData {
   HeightMap display_map;
   // joints.png
   std::vector<JointPanel> joint_panels;
-  // layers.png: the shown layers, the layer count, the shared colour range [0, max] (um) and
+  // layers.png: the shown layers, the layer count, the shared colour range (the shown layers'
+  // capped_thickness_scale: a blob where the layers start does not wash the beads out) and
   // the x-y extent every panel shows
   std::vector<LayerPanel> layer_panels;
   int layer_count = 0;
-  double layer_max_um = 0.0;
+  SharedThicknessScale layer_scale;
   double layers_x_lo = 0.0, layers_x_hi = 0.0, layers_y_lo = 0.0, layers_y_hi = 0.0;
   // paths3d.png: print paths per layer (index = layer; the toolpath's points, thinned),
   // travels (the planned samples where not depositing), tool-axis segments (two points each:
@@ -229,17 +247,7 @@ struct ComparisonInput {
   std::vector<ComparisonColumn> columns;
 };
 
-// The colour range every map shares, [0, top_um]: the largest peak of all maps, capped at
-// kSharedScaleCap (2) x the median run's 95th percentile of its deposit cells (cells above 1 %
-// of its peak; the lower middle one of an even count), so one run's blob does not wash the
-// other runs' lines out (its cells above the top take the top colour; the colour bar's label
-// then gives the peak). 1 um when all are empty.
-struct SharedThicknessScale {
-  double top_um = 1.0;
-  double peak_um = 0.0;  // the largest cell of all maps
-  bool capped = false;   // top_um < peak_um
-};
-constexpr double kSharedScaleCap = 2.0;
+// the comparison sheet's scale: capped_thickness_scale over the columns' maps
 SharedThicknessScale shared_thickness_scale(const ComparisonInput& input);
 
 // comparison.png at png_path: one column per run: its thickness map on a shared colour scale

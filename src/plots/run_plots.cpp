@@ -461,7 +461,7 @@ std::string thickness_map_elements(PlotJob& job, const HeightMap& map, const Too
       paths.add_break();
     }
     elements.push_back(job.data_file(stem + "_paths.dat", format_curve(paths)) + " " +
-                       line_style(style::kPathOverlayColour, 1.2, 2) +
+                       line_style(style::kPathOverlayColour, style::kPathOverlayLineWidth, 2) +
                        (path_key ? " title 'print path'" : " notitle"));
   }
   return plot_command(elements);

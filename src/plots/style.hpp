@@ -32,7 +32,10 @@ constexpr const char* kStartColour = "#2ca02c";
 constexpr const char* kEndColour = "#d62728";
 constexpr const char* kTargetColour = "#000000";
 constexpr const char* kMeanColour = "#d62728";
-constexpr const char* kPathOverlayColour = "#ffffff";
+// the print paths over a thickness map: white, 60 % transparent (ARGB) and thin, so that a
+// bead only a few pixels wide still shows its colour under them
+constexpr const char* kPathOverlayColour = "#99ffffff";
+constexpr double kPathOverlayLineWidth = 0.8;
 constexpr const char* kMapKeyColour = "#440154";  // key box behind the white overlay sample
 constexpr const char* kAxisColours[3] = {"#1f77b4", "#ff7f0e", "#2ca02c"};  // x, y, z
 // the same, lightened (40 % of the colour on white): the wide band of the simulated axis,

@@ -89,6 +89,16 @@ TEST(ComparisonScale, TopIsThePeakUnlessABlobWouldWashTheLinesOut) {
   EXPECT_DOUBLE_EQ(scale.top_um, 1.0);
 }
 
+// The peaks shown side by side in one fixed format: three significant digits of the largest.
+TEST(ComparisonMaps, PeaksInOneFixedFormat) {
+  EXPECT_EQ(plots::fixed_text(2000.0, 2000.0), "2000");
+  EXPECT_EQ(plots::fixed_text(1034.4, 2000.0), "1034");
+  EXPECT_EQ(plots::fixed_text(360.2, 360.2), "360");
+  EXPECT_EQ(plots::fixed_text(12.345, 12.345), "12.3");
+  EXPECT_EQ(plots::fixed_text(9.8, 12.345), "9.8");
+  EXPECT_EQ(plots::fixed_text(1.5, 2.0), "1.50");
+}
+
 TEST(ComparisonTravels, PathsNumberedFromZeroInPrintOrder) {
   // print path 1 along y = 0, travel, print path 0 along y = 2 (printed second)
   MotionSamples s;

@@ -9,6 +9,7 @@
 
 #include "conformal_fixture.hpp"
 #include "core/error.hpp"
+#include "gnuplot_capture.hpp"
 #include "plots/plot_data.hpp"
 #include "plots/plots.hpp"
 #include "plots/style.hpp"
@@ -151,9 +152,13 @@ TEST(LayerPanels, OneMapPerLayerOnASharedScaleWithItsOwnPaths) {
     EXPECT_LE(std::max(panel.map.nx, panel.map.ny), 200);
     peak = std::max(peak, static_cast<double>(panel.map.max_value()));
   }
-  EXPECT_DOUBLE_EQ(data.layer_max_um, peak);
-  EXPECT_EQ(data.layer_max_um, data.layer_panels[1].map.max_value());
-  EXPECT_NEAR(data.layer_max_um, f.layer_maps[1].max_value(), 0.1);
+  // (the maps are max-pooled: the thickest cell survives the reduction exactly)
+  EXPECT_DOUBLE_EQ(data.layer_scale.peak_um, peak);
+  EXPECT_EQ(data.layer_scale.peak_um, data.layer_panels[1].map.max_value());
+  EXPECT_EQ(data.layer_scale.peak_um, f.layer_maps[1].max_value());
+  // even lines: the scale is not topped
+  EXPECT_FALSE(data.layer_scale.capped);
+  EXPECT_DOUBLE_EQ(data.layer_scale.top_um, peak);
   // each panel carries its own layer's paths only
   for (const auto& panel : data.layer_panels) {
     size_t points = 0;
@@ -169,6 +174,33 @@ TEST(LayerPanels, OneMapPerLayerOnASharedScaleWithItsOwnPaths) {
   input.layer_angles_deg = {0.0, NAN};
   const plots::RunPlotData no_angle = plots::prepare_run_plot_data(input);
   EXPECT_EQ(no_angle.layer_panels[1].title, "layer 1");
+}
+
+// A blob where the layers start (six times the beads' height, as a G-code job's first extrusion
+// leaves) tops the colour scale near the beads, not at the blob, and the plot says so; the
+// beads then take the middle of the scale instead of its dark end.
+TEST(LayerPanels, ABlobWhereTheLayersStartDoesNotWashTheBeadsOut) {
+  auto f = make_conformal_fixture(2);
+  HeightMap& first = f.layer_maps[0];
+  for (int iy = 0; iy < 4; ++iy)
+    for (int ix = 0; ix < 4; ++ix)
+      first.thickness_um[static_cast<size_t>(iy) * first.nx + ix] = 30.0f;
+  const plots::RunPlotData data = plots::prepare_run_plot_data(f.input());
+  EXPECT_TRUE(data.layer_scale.capped);
+  EXPECT_DOUBLE_EQ(data.layer_scale.peak_um, 30.0);
+  // 2 x the lower layer's 95th percentile (about its 4 um bead), far below the blob's 30 um
+  EXPECT_GE(data.layer_scale.top_um, 4.0);
+  EXPECT_LE(data.layer_scale.top_um, 2 * 5.0);
+  // the colour bar's range and the note under the panels
+  const auto capture = testing_support::capturing_gnuplot(output_directory("layers_blob_tool"));
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
+  plots::render_run_plots(f.input(), output_directory("layers_blob"), {RunPlot::layers}, options);
+  const std::string script = capture.script();
+  EXPECT_NE(script.find(plots::format("set cbrange [0:%.9g]", data.layer_scale.top_um)),
+            std::string::npos);
+  EXPECT_NE(script.find("colour scale topped at 2 × the median layer''s 95th percentile"),
+            std::string::npos);
 }
 
 TEST(LayerPanels, ManyLayersShowEightEvenlyChosen) {

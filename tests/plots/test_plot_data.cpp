@@ -152,7 +152,7 @@ TEST(ErrorSeries, FeatureSizeIsThePrintPatternsLargestExtent) {
   EXPECT_DOUBLE_EQ(plots::feature_size_mm(Toolpath{}), 1.0);
 }
 
-TEST(DisplayMap, BlockMeansCentredOnTheBlock) {
+TEST(DisplayMap, BlockMaximaCentredOnTheBlock) {
   HeightMap map;
   map.origin_x_mm = 1.0;
   map.origin_y_mm = 2.0;
@@ -166,17 +166,37 @@ TEST(DisplayMap, BlockMeansCentredOnTheBlock) {
   EXPECT_DOUBLE_EQ(out.cell_mm, 1.0);
   EXPECT_DOUBLE_EQ(out.origin_x_mm, 1.25);
   EXPECT_DOUBLE_EQ(out.origin_y_mm, 2.25);
-  EXPECT_FLOAT_EQ(out.thickness_um[0], (1 + 2 + 5 + 6) / 4.0f);
-  EXPECT_FLOAT_EQ(out.thickness_um[1], (3 + 4 + 7 + 8) / 4.0f);
+  EXPECT_FLOAT_EQ(out.thickness_um[0], 6.0f);
+  EXPECT_FLOAT_EQ(out.thickness_um[1], 8.0f);
   // small enough: unchanged
   EXPECT_EQ(plots::downsample_for_display(map, 4).thickness_um, map.thickness_um);
-  // 5 cells at most 2 per side: factor 3, the partial edge block is the mean of what is there
+  // 5 cells at most 2 per side: factor 3, the partial edge block is the largest of what is there
   map.nx = 5;
   map.ny = 1;
-  map.thickness_um = {3, 3, 3, 9, 9};
+  map.thickness_um = {3, 3, 3, 9, 7};
   const HeightMap edge = plots::downsample_for_display(map, 2);
   ASSERT_EQ(edge.nx, 2);
   EXPECT_FLOAT_EQ(edge.thickness_um[1], 9.0f);
+}
+
+// A bead one cell wide on a map reduced eightfold (a thin line on a large map) keeps its full
+// height: averaged, it would fade to an eighth and vanish into the zero colour.
+TEST(DisplayMap, AOneCellLineKeepsItsPeak) {
+  HeightMap map;
+  map.cell_mm = 0.05;
+  map.nx = 800;
+  map.ny = 16;
+  map.thickness_um.assign(static_cast<size_t>(map.nx) * map.ny, 0.0f);
+  for (int ix = 0; ix < map.nx; ++ix)
+    map.thickness_um[static_cast<size_t>(5) * map.nx + ix] = 320.0f;
+  const HeightMap out = plots::downsample_for_display(map, 100);
+  ASSERT_EQ(out.nx, 100);
+  ASSERT_EQ(out.ny, 2);
+  EXPECT_FLOAT_EQ(out.max_value(), 320.0f);
+  for (int ix = 0; ix < out.nx; ++ix) {
+    EXPECT_FLOAT_EQ(out.at(ix, 0), 320.0f);  // the block holding the line
+    EXPECT_FLOAT_EQ(out.at(ix, 1), 0.0f);    // nothing spills into the next
+  }
 }
 
 TEST(DataText, FixedFormatWithBlankLinesAtBreaks) {
