@@ -40,15 +40,6 @@ constexpr double kZoomFraction = 0.125;
 constexpr int kZoomMinCells = 24;
 constexpr int kZoomMaxCellsPerSide = 200;
 
-// a round tic spacing (1, 2 or 5 x 10^n) giving at most four intervals over `span`
-double tic_step(double span) {
-  const double rough = span / 4.0;
-  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
-  for (double m : {1.0, 2.0, 5.0})
-    if (m * decade >= rough) return m * decade;
-  return 10.0 * decade;
-}
-
 // the window's outline on a map (object 800), removed by `unset object 800`
 std::string window_outline(const ZoomWindow& w) {
   return format(
@@ -347,8 +338,11 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
              style::quoted(format("zoom at (%.2f, %.2f) mm: peak %.3g µm", zoom.centre_x_mm,
                                   zoom.centre_y_mm, column_peak_um)) +
              "\n" + xy_labels;
-        const double tic_mm = tic_step(zoom.x_hi - zoom.x_lo);
-        s += format("set xtics %.9g\nset ytics %.9g\n", tic_mm, tic_mm);
+        // about four intervals over the (square) window, at least three ticks on each axis
+        const double tic_mm = round_step_up((zoom.x_hi - zoom.x_lo) / 4.0);
+        s +=
+            format("set xtics %.9g\nset ytics %.9g\n", axis_tick_step(zoom.x_lo, zoom.x_hi, tic_mm),
+                   axis_tick_step(zoom.y_lo, zoom.y_hi, tic_mm));
         s +=
             thickness_map_elements(job, zoom_maps[c], input.toolpath, format("zoom_%zu", c), false);
         s += "unset title\nset xtics autofreq\nset ytics autofreq\n";

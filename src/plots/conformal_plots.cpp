@@ -520,9 +520,11 @@ void paths3d_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
   s += format("set xrange [%.9g:%.9g]\nset yrange [%.9g:%.9g]\nset zrange [%.9g:%.9g]\n", lo.x(),
               hi.x(), lo.y(), hi.y(), lo.z(), hi.z());
   const double horizontal = std::max(extent.x(), extent.y());
+  // one step on x and y, finer on a short horizontal axis it would leave with under 3 ticks
   const double step = nice_step(horizontal, 6);
   s += format("set xtics %.9g offset 0,-0.3\nset ytics %.9g offset 0.5,-0.3\nset ztics %.9g\n",
-              step, step, nice_step(extent.z(), 3));
+              axis_tick_step(lo.x(), hi.x(), step), axis_tick_step(lo.y(), hi.y(), step),
+              nice_step(extent.z(), 3));
   s += "set xlabel " + style::quoted(style::axis_label("x", "mm")) + " offset 0,-0.8\n";
   s += "set ylabel " + style::quoted(style::axis_label("y", "mm")) + " offset -2,-0.5\n";
   s += "set zlabel " + style::quoted(style::axis_label("z", "mm")) + " rotate by 90\n";

@@ -527,6 +527,40 @@ std::string fixed_text(double value, double largest) {
   return format("%.*f", decimals, value);
 }
 
+double round_step_up(double rough) {
+  if (!(rough > 0.0) || !std::isfinite(rough)) return 1.0;
+  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
+  for (double m : {1.0, 2.0, 5.0})
+    if (m * decade >= rough) return m * decade;
+  return 10.0 * decade;
+}
+
+int tick_count(double lo, double hi, double step) {
+  if (!(step > 0.0) || !(hi >= lo)) return 0;
+  // (a tick on an end, within rounding, counts)
+  const double first = std::ceil(lo / step - 1e-9), last = std::floor(hi / step + 1e-9);
+  return std::max(0, static_cast<int>(last - first) + 1);
+}
+
+double axis_tick_step(double lo, double hi, double preferred_step, int min_ticks) {
+  const double span = hi - lo;
+  if (!(span > 0.0) || !std::isfinite(span)) return 1.0;
+  double step = preferred_step > 0.0 ? preferred_step : span;
+  if (tick_count(lo, hi, step) >= min_ticks) return step;
+  // down the 1-2-5 ladder from the first rung below the preferred step
+  double decade = std::pow(10.0, std::floor(std::log10(step)));
+  const double mantissas[3] = {5.0, 2.0, 1.0};
+  for (int rung = 0; rung < 60; ++rung) {
+    for (double m : mantissas) {
+      const double candidate = m * decade;
+      if (candidate >= step * (1.0 - 1e-9)) continue;
+      if (tick_count(lo, hi, candidate) >= min_ticks) return candidate;
+    }
+    decade /= 10.0;
+  }
+  return step;
+}
+
 std::string format_curve(const Curve& curve) {
   std::string out;
   out.reserve(curve.size() * 24);

@@ -105,6 +105,15 @@ std::vector<double> relative_position_error(const MotionSamples& samples, const 
 // neither side has more than max_cells_per_side cells. factor 1 copies the map.
 HeightMap downsample_for_display(const HeightMap& map, int max_cells_per_side);
 
+// the smallest step of 1, 2 or 5 x 10^n at least `rough` (> 0)
+double round_step_up(double rough);
+// the number of ticks (multiples of step) inside [lo, hi]
+int tick_count(double lo, double hi, double step);
+// a tick step for an axis over [lo, hi]: preferred_step (e.g. one shared by both axes of a
+// map) when it puts at least min_ticks ticks on the axis, else the largest step of 1, 2 or 5 x
+// 10^n below it that does; a preferred_step <= 0 starts from the span. 1 for an empty span.
+double axis_tick_step(double lo, double hi, double preferred_step, int min_ticks = 3);
+
 // `value` with as many decimals as give `largest` three significant digits (none from 100 up):
 // one fixed format for numbers shown side by side ("2000" and "1034", not "2e+03" and "1.03e+03")
 std::string fixed_text(double value, double largest);

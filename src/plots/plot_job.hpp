@@ -57,7 +57,7 @@ struct Range {
   bool empty() const { return !(hi >= lo); }
   // [lo, hi] padded by a fraction of its width (at least min_half_width either side of a single
   // value)
-  std::string gnuplot(double pad_fraction, double min_half_width) const {
+  std::pair<double, double> padded(double pad_fraction, double min_half_width) const {
     double a = empty() ? 0.0 : lo, b = empty() ? 1.0 : hi;
     if (b - a < 2 * min_half_width) {
       const double mid = 0.5 * (a + b);
@@ -65,7 +65,12 @@ struct Range {
       b = mid + min_half_width;
     }
     const double pad = pad_fraction * (b - a);
-    return format("[%.9g:%.9g]", a - pad, b + pad);
+    return {a - pad, b + pad};
+  }
+  // the same as gnuplot's "[lo:hi]"
+  std::string gnuplot(double pad_fraction, double min_half_width) const {
+    const auto [a, b] = padded(pad_fraction, min_half_width);
+    return format("[%.9g:%.9g]", a, b);
   }
 };
 

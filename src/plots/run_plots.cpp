@@ -480,23 +480,14 @@ std::string map_ranges(const std::vector<const HeightMap*>& maps, const Toolpath
     for (const PrintPath& path : toolpath->paths)
       for (const Vec3& p : path.points) x.add(p.x()), y.add(p.y());
   // one tic step on both axes (the map is drawn at 1:1), about four over the longer side, so a
-  // tall narrow map does not crowd its x axis with the step its own width would get
-  const double span = std::max(x.empty() ? 0.0 : x.hi - x.lo, y.empty() ? 0.0 : y.hi - y.lo);
-  std::string tics;
-  if (span > 0.0) {
-    const double rough = span / 4.0;
-    const double decade = std::pow(10.0, std::floor(std::log10(rough)));
-    double step = 10.0 * decade;
-    for (double m : {1.0, 2.0, 5.0}) {
-      if (m * decade >= rough) {
-        step = m * decade;
-        break;
-      }
-    }
-    tics = format("set xtics %.9g\nset ytics %.9g\n", step, step);
-  }
-  return "set xrange " + x.gnuplot(0.0, 0.05) + "\nset yrange " + y.gnuplot(0.0, 0.05) + "\n" +
-         tics;
+  // tall narrow map does not crowd its x axis with the step its own width would get; an axis
+  // that step leaves with fewer than three ticks gets a finer one of its own
+  const auto [x_lo, x_hi] = x.padded(0.0, 0.05);
+  const auto [y_lo, y_hi] = y.padded(0.0, 0.05);
+  const double shared_step = round_step_up(std::max(x_hi - x_lo, y_hi - y_lo) / 4.0);
+  return format("set xrange [%.9g:%.9g]\nset yrange [%.9g:%.9g]\n", x_lo, x_hi, y_lo, y_hi) +
+         format("set xtics %.9g\nset ytics %.9g\n", axis_tick_step(x_lo, x_hi, shared_step),
+                axis_tick_step(y_lo, y_hi, shared_step));
 }
 
 namespace {

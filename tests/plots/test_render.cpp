@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <regex>
 #include <set>
 
 #include "gnuplot_capture.hpp"
@@ -202,6 +203,50 @@ TEST(RunPlots, ManyLinesShareOneProfileKeyEntry) {
   after_gap[0] = "paths 1-9";
   expect_profile_key(gap, gap.input("10 lines, the first empty"), "first_line_empty", after_gap,
                      true);
+}
+
+// the numbers of the section's `set <command> [a:b]` or `set <command> a`, in order
+std::vector<double> set_numbers(const std::string& section, const std::string& command) {
+  std::smatch match;
+  const std::regex pattern("set " + command + " \\[?([-0-9.e+]+)(?::([-0-9.e+]+)\\])?");
+  if (!std::regex_search(section, match, pattern)) return {};
+  std::vector<double> numbers = {std::stod(match[1])};
+  if (match[2].matched) numbers.push_back(std::stod(match[2]));
+  return numbers;
+}
+
+// A wide, short deposit (three 10 mm lines 1 mm apart): the one step the longer x axis gets
+// would leave y (about 3 mm) a single tick; every axis of the map gets at least three.
+TEST(RunPlots, EveryThicknessMapAxisHasAtLeastThreeTicks) {
+  const auto f = make_plot_fixture(testing_support::raster_toolpath(3), 0.3, false);
+  const std::string directory = output_directory("short_axis_ticks");
+  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
+  plots::render_run_plots(f.input(), directory + "/plot", {RunPlot::thickness}, options);
+  const std::string section = testing_support::png_section(capture.script(), "thickness.png");
+  for (const char* axis : {"x", "y"}) {
+    SCOPED_TRACE(axis);
+    const std::vector<double> range = set_numbers(section, axis + std::string("range"));
+    const std::vector<double> step = set_numbers(section, axis + std::string("tics"));
+    ASSERT_EQ(range.size(), 2u) << section;
+    ASSERT_EQ(step.size(), 1u) << section;
+    EXPECT_GE(plots::tick_count(range[0], range[1], step[0]), 3);
+  }
+}
+
+// The tick step: the shared one when it gives three ticks, else the largest finer 1-2-5 step
+// that does (giberti_fig3's 65 x 85 mm map: 20 mm, not 50 with only "0" on each axis)
+TEST(Ticks, AShortAxisGetsAFinerStepWithThreeTicks) {
+  EXPECT_DOUBLE_EQ(plots::round_step_up(85.0 / 4), 50.0);
+  EXPECT_EQ(plots::tick_count(-30, 35, 50), 1);
+  EXPECT_DOUBLE_EQ(plots::axis_tick_step(-30, 35, 50), 20.0);
+  EXPECT_DOUBLE_EQ(plots::axis_tick_step(-40, 45, 50), 20.0);
+  // an L's 3 mm leg beside its 10 mm one: 2 mm (0, 2, 4)
+  EXPECT_DOUBLE_EQ(plots::axis_tick_step(-0.8, 4.3, 5), 2.0);
+  // enough already: unchanged
+  EXPECT_DOUBLE_EQ(plots::axis_tick_step(0, 100, 20), 20.0);
+  EXPECT_EQ(plots::tick_count(-6, 7, plots::axis_tick_step(-6, 7, 10)), 3);
 }
 
 TEST(Comparison, OneColumnPerPlannerOnASharedScale) {
