@@ -20,6 +20,9 @@ std::string zero_based_range(double max_value) {
   return format("[0:%.9g]", max_value > 0.0 ? 1.08 * max_value : 1.0);
 }
 
+// thickness_profile.png: at most this many key entries go under the plot (two rows of three)
+constexpr size_t kProfileKeyEntriesBelow = 6;
+
 // an axis moves when its position range exceeds 1 um
 bool moves(const Curve& position) {
   Range r;
@@ -376,10 +379,35 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
            input.layer_count > 1 ? "centreline thickness, own layer" : "centreline thickness",
            "µm")) +
        "\n";
-  s += "set lmargin at screen 0.095\nset rmargin at screen 0.97\n";
-  s += "set tmargin at screen 0.90\nset bmargin at screen 0.36\n";
-  s += "set key at screen 0.5,0.235 center top horizontal maxrows 3 width 1 samplen 3\n";
   const double centreline_um = centreline_mean_um(input.profiles);
+
+  // one colour and key entry per line when few; one shared colour and entry when many, on the
+  // first line drawn, naming the paths' range
+  int first_path = std::numeric_limits<int>::max(), last_path = std::numeric_limits<int>::min();
+  size_t drawn = 0;
+  for (size_t i = 0; i < data.profiles.size(); ++i) {
+    if (data.profiles[i].point_count() == 0) continue;
+    ++drawn;
+    first_path = std::min(first_path, input.profiles[i].path_index);
+    last_path = std::max(last_path, input.profiles[i].path_index);
+  }
+  const bool few = drawn <= 8;
+
+  // the key under the plot, above the notes, while its entries fill at most two rows of three;
+  // more (up to eight lines and the two references) would reach down over the notes, so they
+  // go in one column right of the plot
+  const size_t key_entries = (input.target_thickness_um > 0.0 ? 1 : 0) +
+                             (centreline_um > 0.0 ? 1 : 0) +
+                             (few ? drawn : std::min<size_t>(drawn, 1));
+  if (key_entries <= kProfileKeyEntriesBelow) {
+    s += "set lmargin at screen 0.095\nset rmargin at screen 0.97\n";
+    s += "set tmargin at screen 0.90\nset bmargin at screen 0.36\n";
+    s += "set key at screen 0.5,0.235 center top horizontal maxrows 3 width 1 samplen 3\n";
+  } else {
+    s += "set lmargin at screen 0.095\nset rmargin at screen 0.63\n";
+    s += "set tmargin at screen 0.90\nset bmargin at screen 0.25\n";
+    s += "set key at screen 0.985,0.90 right top vertical width 1 samplen 3\n";
+  }
   Range x, y;
   for (const Curve& c : data.profiles) x.add_x(c), y.add_y(c);
   y.add(input.target_thickness_um), y.add(centreline_um);
@@ -405,17 +433,6 @@ void profile_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
     s += format("set label %zu %s at screen 0.5,%.4f center font \",10\" tc rgb \"#404040\"\n",
                 950 + i, style::quoted(notes[i]).c_str(), 0.075 - 0.04 * i);
 
-  // one colour and key entry per line when few; one shared colour and entry when many, on the
-  // first line drawn, naming the paths' range
-  int first_path = std::numeric_limits<int>::max(), last_path = std::numeric_limits<int>::min();
-  size_t drawn = 0;
-  for (size_t i = 0; i < data.profiles.size(); ++i) {
-    if (data.profiles[i].point_count() == 0) continue;
-    ++drawn;
-    first_path = std::min(first_path, input.profiles[i].path_index);
-    last_path = std::max(last_path, input.profiles[i].path_index);
-  }
-  const bool few = drawn <= 8;
   bool shared_entry_given = false;
   std::vector<std::string> elements;
   // the reference lines first, so the profiles are drawn over them

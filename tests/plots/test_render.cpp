@@ -205,6 +205,31 @@ TEST(RunPlots, ManyLinesShareOneProfileKeyEntry) {
                      true);
 }
 
+// The key under thickness_profile.png holds two rows of three entries above the notes; eight
+// lines and the two references (ten entries) would cover the notes there, so they go in one
+// column right of the plot, and the notes stay clear.
+TEST(RunPlots, AProfileKeyOfTenEntriesGoesBesideThePlotNotOverTheNotes) {
+  for (int lines : {3, 8}) {
+    SCOPED_TRACE(lines);
+    const auto f = make_plot_fixture(testing_support::raster_toolpath(lines), 0.3, false);
+    const std::string directory = output_directory("profile_key_" + std::to_string(lines));
+    const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+    plots::PlotOptions options;
+    options.gnuplot = capture.program;
+    const auto result = plots::render_run_plots(f.input(), directory + "/plot",
+                                                {RunPlot::thickness_profile}, options);
+    EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+    const std::string section =
+        testing_support::png_section(capture.script(), "thickness_profile.png");
+    const bool beside =
+        section.find("set key at screen 0.985,0.90 right top vertical") != std::string::npos;
+    const bool below =
+        section.find("set key at screen 0.5,0.235 center top horizontal") != std::string::npos;
+    EXPECT_EQ(beside, lines == 8) << section;
+    EXPECT_EQ(below, lines == 3) << section;
+  }
+}
+
 // the numbers of the section's `set <command> [a:b]` or `set <command> a`, in order
 std::vector<double> set_numbers(const std::string& section, const std::string& command) {
   std::smatch match;
