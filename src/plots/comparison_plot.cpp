@@ -39,6 +39,10 @@ constexpr size_t kMaxPathLabels = 40;
 constexpr double kZoomFraction = 0.125;
 constexpr int kZoomMinCells = 24;
 constexpr int kZoomMaxCellsPerSide = 200;
+// the footer caption: the width a character takes at most on average (px, the 11 pt font),
+// the room kept at either side and the height of each further line
+constexpr double kCaptionCharWidth_px = 7.6;
+constexpr int kCaptionSideMargin_px = 8, kCaptionLine_px = 17;
 
 // the window's outline on a map (object 800), removed by `unset object 800`
 std::string window_outline(const ZoomWindow& w) {
@@ -234,14 +238,28 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   const size_t columns = input.columns.size();
   const int width_px = static_cast<int>(columns) * style::kComparisonColumnWidth_px;
   const bool orders = is_orders_comparison(input.columns);
-  const int height_px = orders ? kOrdersHeight_px : style::kComparisonHeight_px;
+  // the footer caption, wrapped to the sheet's width (a one-run sheet is too narrow for one
+  // line); each line past the first makes the sheet that much taller
+  const std::vector<std::string> caption = wrap_text(
+      orders ? "top: print paths (dark, numbered in print order from 0) and travels; grey bands: "
+               "transitions"
+             : "grey bands: transitions (nothing deposited); white box: the zoom below each map, "
+               "on the thickest spot of all runs",
+      static_cast<size_t>((width_px - 2 * kCaptionSideMargin_px) / kCaptionCharWidth_px));
+  const int caption_extra_px = static_cast<int>(caption.size() - 1) * kCaptionLine_px;
+  const int height_px =
+      (orders ? kOrdersHeight_px : style::kComparisonHeight_px) + caption_extra_px;
   job.begin_png(png_path, width_px, height_px);
   std::string& s = job.script();
   // the panels under the maps (speed error, metrics, the footnote) keep their pixels from the
-  // sheet's bottom: their screen fractions grow as the sheet gets shorter
+  // sheet's bottom (raised by the caption's extra lines): their screen fractions grow as the
+  // sheet gets shorter
   const double bottom_scale = static_cast<double>(style::kComparisonHeight_px) / height_px;
-  const double speed_bottom = kSpeedBottom * bottom_scale, speed_top = kSpeedTop * bottom_scale;
-  const double metrics_top = kMetricsTop * bottom_scale, metrics_line = kMetricsLine * bottom_scale;
+  const double lift = static_cast<double>(caption_extra_px) / height_px;
+  const double speed_bottom = kSpeedBottom * bottom_scale + lift,
+               speed_top = kSpeedTop * bottom_scale + lift;
+  const double metrics_top = kMetricsTop * bottom_scale + lift,
+               metrics_line = kMetricsLine * bottom_scale;
 
   // shared scales: colour range, map extent, zoom window, time and error axes
   std::vector<HeightMap> display_maps(columns), zoom_maps(columns);
@@ -285,14 +303,9 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   s += "set cblabel \"" + scale_text + "\" offset 0,0.4\n";
   s += format("set colorbox horizontal user origin screen 0.2,%.4f size screen 0.6,%.4f\n",
               kColourBarY, kColourBarHeight);
-  s += format(
-      "set label 900 %s at screen 0.5,%.4f center tc rgb \"#606060\"\n",
-      style::quoted(orders ? "top: print paths (dark, numbered in print order from 0) and "
-                             "travels; grey bands: transitions"
-                           : "grey bands: transitions (nothing deposited); white box: the zoom "
-                             "below each map, on the thickest spot of all runs")
-          .c_str(),
-      0.012 * bottom_scale);
+  // (the label's position is its first line's; the others follow below)
+  s += format("set label 900 %s at screen 0.5,%.4f center tc rgb \"#606060\"\n",
+              style::double_quoted_lines(caption).c_str(), 0.012 * bottom_scale + lift);
   const std::string shared_map_ranges = maps.empty() ? "" : map_ranges(maps, input.toolpath);
   const std::string shared_travel_ranges = orders ? travel_ranges(input.columns) : "";
   bool colour_bar_drawn = false;

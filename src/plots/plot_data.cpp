@@ -527,6 +527,31 @@ std::string fixed_text(double value, double largest) {
   return format("%.*f", decimals, value);
 }
 
+std::vector<std::string> wrap_text(const std::string& text, size_t max_chars) {
+  // characters, not bytes: a UTF-8 continuation byte starts none
+  const auto length = [](const std::string& s) {
+    return static_cast<size_t>(
+        std::count_if(s.begin(), s.end(), [](char c) { return (c & 0xC0) != 0x80; }));
+  };
+  std::vector<std::string> lines;
+  std::string line;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find(' ', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string word = text.substr(start, end - start);
+    start = end + 1;
+    if (word.empty()) continue;
+    if (!line.empty() && length(line) + 1 + length(word) > max_chars) {
+      lines.push_back(line);
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+  }
+  if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
 double round_step_up(double rough) {
   if (!(rough > 0.0) || !std::isfinite(rough)) return 1.0;
   const double decade = std::pow(10.0, std::floor(std::log10(rough)));

@@ -105,6 +105,10 @@ std::vector<double> relative_position_error(const MotionSamples& samples, const 
 // neither side has more than max_cells_per_side cells. factor 1 copies the map.
 HeightMap downsample_for_display(const HeightMap& map, int max_cells_per_side);
 
+// `text` broken at spaces into lines of at most max_chars characters (UTF-8 code points; a
+// word longer than that stays whole on a line of its own)
+std::vector<std::string> wrap_text(const std::string& text, size_t max_chars);
+
 // the smallest step of 1, 2 or 5 x 10^n at least `rough` (> 0)
 double round_step_up(double rough);
 // the number of ticks (multiples of step) inside [lo, hi]

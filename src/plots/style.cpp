@@ -76,4 +76,16 @@ std::string quoted(const std::string& text) {
   return out;
 }
 
+std::string double_quoted_lines(const std::vector<std::string>& lines) {
+  std::string out = "\"";
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (i > 0) out += "\\n";
+    for (char c : lines[i]) {
+      if (c == '\\' || c == '"') out += '\\';
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
 }  // namespace depotwin::plots::style

@@ -90,5 +90,8 @@ std::string thickness_palette();
 
 // a string literal for gnuplot: single quotes, embedded quotes doubled (no escapes)
 std::string quoted(const std::string& text);
+// a string literal in double quotes, lines joined by gnuplot's "\n" (backslashes and quotes
+// escaped): a label of several lines
+std::string double_quoted_lines(const std::vector<std::string>& lines);
 
 }  // namespace depotwin::plots::style

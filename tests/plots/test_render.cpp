@@ -312,6 +312,51 @@ TEST(Comparison, OneColumnPerPlannerOnASharedScale) {
   EXPECT_EQ(entries(directory), std::vector<std::string>{"comparison.png"});
 }
 
+// A one-run sheet is one column (460 px) wide: the footer caption (about 120 characters,
+// some 900 px on one line) is wrapped to lines that fit it, not cut off at both sides, and the
+// sheet grows by the extra line.
+TEST(Comparison, OneRunSheetWrapsItsFooterCaption) {
+  EXPECT_EQ(plots::wrap_text("aa bb cc dd", 5), (std::vector<std::string>{"aa bb", "cc dd"}));
+  EXPECT_EQ(plots::wrap_text("µµµ µµ", 6), (std::vector<std::string>{"µµµ µµ"}));  // characters
+  EXPECT_EQ(plots::wrap_text("toolongword a", 4), (std::vector<std::string>{"toolongword", "a"}));
+
+  const auto f = make_plot_fixture(testing_support::thompson_like_toolpath(), 1.5);
+  plots::ComparisonInput input;
+  input.title = "one run";
+  input.toolpath = &f.toolpath;
+  plots::ComparisonColumn column;
+  column.planner = "bezier";
+  column.thickness = &f.thickness;
+  plots::set_speed_error(column, f.simulated);
+  input.columns.push_back(column);
+  const std::string directory = output_directory("comparison_one_run");
+  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
+  const auto result = plots::render_comparison(input, directory + "/comparison.png", options);
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  const std::string script = capture.script();
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(script, match, std::regex("set label 900 \"([^\"]*)\""))) << script;
+  const std::string caption = match[1];
+  EXPECT_NE(caption.find("grey bands: transitions"), std::string::npos);
+  EXPECT_NE(caption.find("thickest spot"), std::string::npos);
+  // lines split by gnuplot's \n, each at most the column's width at 8 px a character
+  size_t lines = 0, start = 0;
+  while (true) {
+    const size_t end = caption.find("\\n", start);
+    const std::string line = caption.substr(start, end == std::string::npos ? end : end - start);
+    EXPECT_LE(line.size() * 8, static_cast<size_t>(plots::style::kComparisonColumnWidth_px))
+        << line;
+    ++lines;
+    if (end == std::string::npos) break;
+    start = end + 2;
+  }
+  EXPECT_GE(lines, 2u);
+  expect_png(directory + "/comparison.png", plots::style::kComparisonColumnWidth_px,
+             plots::style::kComparisonHeight_px + 17 * (lines - 1));
+}
+
 TEST(Gnuplot, MissingToolIsANamedInternalError) {
   const auto f = make_plot_fixture(testing_support::single_line_toolpath(), 1.0, false, true);
   const std::string directory = output_directory("missing_gnuplot");
