@@ -560,6 +560,18 @@ double round_step_up(double rough) {
   return 10.0 * decade;
 }
 
+size_t widest_tick_label(double lo, double hi, double step) {
+  size_t widest = 0;
+  if (!(step > 0.0) || !(hi >= lo)) return widest;
+  const double first = std::ceil(lo / step - 1e-9), last = std::floor(hi / step + 1e-9);
+  for (double k = first; k <= last && k - first < 1000; k += 1.0) {
+    // a tick that should be 0 prints as 0, not as a rounding remainder
+    const double value = std::abs(k) < 0.5 ? 0.0 : k * step;
+    widest = std::max(widest, format("%g", value).size());
+  }
+  return widest;
+}
+
 int tick_count(double lo, double hi, double step) {
   if (!(step > 0.0) || !(hi >= lo)) return 0;
   // (a tick on an end, within rounding, counts)

@@ -111,6 +111,8 @@ std::vector<std::string> wrap_text(const std::string& text, size_t max_chars);
 
 // the smallest step of 1, 2 or 5 x 10^n at least `rough` (> 0)
 double round_step_up(double rough);
+// the characters of the widest "%g" label of the ticks (multiples of step) inside [lo, hi]
+size_t widest_tick_label(double lo, double hi, double step);
 // the number of ticks (multiples of step) inside [lo, hi]
 int tick_count(double lo, double hi, double step);
 // a tick step for an axis over [lo, hi]: preferred_step (e.g. one shared by both axes of a

@@ -242,11 +242,11 @@ struct Panel {
 };
 constexpr double kPanelLeft = 0.095, kPanelRight = 0.79;
 
-void begin_panel(std::string& s, const Panel& panel) {
+void begin_panel(std::string& s, const Panel& panel, double left = kPanelLeft) {
   s += format(
       "set lmargin at screen %.4f\nset rmargin at screen %.4f\n"
       "set bmargin at screen %.4f\nset tmargin at screen %.4f\n",
-      kPanelLeft, kPanelRight, panel.bottom, panel.top);
+      left, kPanelRight, panel.bottom, panel.top);
 }
 
 // axes.png: per-axis position and velocity against time, transitions shaded (Fig. 9)
@@ -302,24 +302,46 @@ void axes_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
   job.end_png();
 }
 
+// errors.png: the room left of a panel (px) for its y label (two lines) and tick labels of
+// `chars` characters, from the image's edge to the axis
+double error_panel_left_px(size_t chars) {
+  constexpr double kEdge_px = 6, kLabelLines_px = 2 * 17, kGap_px = 8, kChar_px = 7.5, kTick_px = 8;
+  return kEdge_px + kLabelLines_px + kGap_px + chars * kChar_px + kTick_px;
+}
+
 // errors.png: relative speed error and relative position error against time, transitions
 // shaded (Figs. 10 and 12)
 void errors_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
                  const std::string& png) {
   job.begin_png(png, style::kRunPlotWidth_px, style::kRunPlotHeight_px);
   std::string& s = job.script();
+  // each panel's y range [0, 1.08 max] and its tick step (about five intervals), so that the
+  // left margin can be made as wide as the widest tick label needs (tiny errors print as
+  // "0.025" or "4e-05"); one margin for both, so the time axes line up
+  const auto y_top = [](const Curve& planned, const Curve& simulated) {
+    Range y;
+    y.add_y(planned), y.add_y(simulated);
+    return !y.empty() && y.hi > 0.0 ? 1.08 * y.hi : 1.0;
+  };
+  const double speed_top = y_top(data.planned_speed_error_pct, data.simulated_speed_error_pct);
+  const double position_top =
+      y_top(data.planned_position_error_pct, data.simulated_position_error_pct);
+  const double speed_step = round_step_up(speed_top / 5.0);
+  const double position_step = round_step_up(position_top / 5.0);
+  const size_t widest = std::max(widest_tick_label(0.0, speed_top, speed_step),
+                                 widest_tick_label(0.0, position_top, position_step));
+  const double left = std::max(kPanelLeft, error_panel_left_px(widest) / style::kRunPlotWidth_px);
   s += "set multiplot title " + style::quoted(input.title + ": speed and position error") +
        " font \"" + style::title_font() + "\"\n";
   s += "set key outside right top vertical\n";
   s += format("set xrange [0:%.9g]\n", std::max(data.duration_s, 1e-6));
   s += style::transition_shading(data.transitions);
 
-  auto panel = [&](const Curve& planned, const Curve& simulated, const std::string& label,
+  auto panel = [&](const Curve& planned, const Curve& simulated,
+                   const std::vector<std::string>& label, double top, double step,
                    const std::string& stem, bool with_shading_key) {
-    Range y;
-    y.add_y(planned), y.add_y(simulated);
-    s += "set ylabel " + style::quoted(label) + "\n";
-    s += "set yrange " + zero_based_range(y.empty() ? 0.0 : y.hi) + "\n";
+    s += "set ylabel " + style::double_quoted_lines(label) + "\n";
+    s += format("set yrange [0:%.9g]\nset ytics %.9g\n", top, step);
     std::vector<std::string> elements;
     if (planned.point_count() > 0)
       elements.push_back(job.data_file(stem + "_planned.dat", format_curve(planned)) + " " +
@@ -339,15 +361,16 @@ void errors_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
     s += plot_command(elements);
   };
 
-  begin_panel(s, {0.55, 0.90});
+  begin_panel(s, {0.55, 0.90}, left);
   s += "set format x ''\nunset xlabel\n";
-  panel(data.planned_speed_error_pct, data.simulated_speed_error_pct, "(a) speed error (%)",
-        "speed_error", true);
-  begin_panel(s, {0.11, 0.51});
+  panel(data.planned_speed_error_pct, data.simulated_speed_error_pct, {"(a) speed error (%)"},
+        speed_top, speed_step, "speed_error", true);
+  begin_panel(s, {0.11, 0.51}, left);
   s += "set format x '%g'\nset xlabel " + style::quoted(style::axis_label("time", "s")) + "\n";
+  // (two lines: one would be taller than the panel)
   panel(data.planned_position_error_pct, data.simulated_position_error_pct,
-        format("(b) position error (%% of %.3g mm)", data.feature_size_mm), "position_error",
-        false);
+        {"(b) position error", format("(%% of %.3g mm)", data.feature_size_mm)}, position_top,
+        position_step, "position_error", false);
   job.end_png();
 }
 

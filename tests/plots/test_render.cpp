@@ -260,6 +260,44 @@ TEST(RunPlots, EveryThicknessMapAxisHasAtLeastThreeTicks) {
   }
 }
 
+// errors.png with tiny position errors (a fixture whose lines are followed to within
+// micrometres: ticks like "0.0002"): the left margin leaves room for the widest tick label and
+// the two-line y label beside it, so the label is not pushed past the image's edge.
+TEST(RunPlots, ErrorsMarginFitsTheWidestTickLabelAndTheLabel) {
+  EXPECT_EQ(plots::widest_tick_label(0, 0.027, 0.005), 5u);  // "0.005" .. "0.025"
+  EXPECT_EQ(plots::widest_tick_label(0, 7.5e-5, 2e-5), 5u);  // "2e-05"
+  EXPECT_EQ(plots::widest_tick_label(0, 0.3, 0.1), 3u);      // "0.1" (not 0.30000000000000004)
+  auto f = make_plot_fixture(testing_support::single_line_toolpath(), 1.5);
+  f.simulated = f.planned;  // the plan, 20 nm off the path: 2e-4 % of 10 mm
+  for (Vec3& p : f.simulated.position_mm) p.y() += 2e-5;
+  const std::string directory = output_directory("errors_tiny");
+  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
+  const auto result =
+      plots::render_run_plots(f.input(), directory + "/plot", {RunPlot::errors}, options);
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  const std::string section = testing_support::png_section(capture.script(), "errors.png");
+  // the lower panel: the last margin, range and step set
+  std::smatch match;
+  const std::regex panel(
+      "set lmargin at screen ([0-9.]+)\n[^]*?set yrange \\[0:([-0-9.e+]+)\\]"
+      "\nset ytics ([-0-9.e+]+)");
+  std::string rest = section;
+  double left = 0, top = 0, step = 0;
+  while (std::regex_search(rest, match, panel)) {
+    left = std::stod(match[1]), top = std::stod(match[2]), step = std::stod(match[3]);
+    rest = match.suffix();
+  }
+  ASSERT_GT(step, 0.0) << section;
+  const size_t widest = plots::widest_tick_label(0, top, step);
+  EXPECT_GE(widest, 5u);  // the case the margin must grow for
+  // 7.5 px a character, two label lines of 17 px and a few px of gaps
+  EXPECT_GE(left * plots::style::kRunPlotWidth_px, widest * 7.5 + 2 * 17 + 10);
+  EXPECT_NE(section.find("set ylabel \"(b) position error\\n(% of 10 mm)\""), std::string::npos)
+      << section;
+}
+
 // The tick step: the shared one when it gives three ticks, else the largest finer 1-2-5 step
 // that does (giberti_fig3's 65 x 85 mm map: 20 mm, not 50 with only "0" on each axis)
 TEST(Ticks, AShortAxisGetsAFinerStepWithThreeTicks) {
