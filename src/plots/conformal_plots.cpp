@@ -570,10 +570,12 @@ void paths3d_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
   s += format("$start3 << EOD\n%.9g %.9g %.9g\nEOD\n$end3 << EOD\n%.9g %.9g %.9g\nEOD\n",
               toolpath.start_mm.x(), toolpath.start_mm.y(), toolpath.start_mm.z(),
               toolpath.end_mm.x(), toolpath.end_mm.y(), toolpath.end_mm.z());
-  elements.push_back(
-      format("$start3 with points pt 7 ps 1.4 lc rgb \"%s\" title 'start'", style::kStartColour));
+  // the end, then the start as a ring over it: both show where they coincide (a job that
+  // returns to where it began)
   elements.push_back(
       format("$end3 with points pt 5 ps 1.3 lc rgb \"%s\" title 'end'", style::kEndColour));
+  elements.push_back(format("$start3 with points pt 6 ps 2.2 lw 2 lc rgb \"%s\" title 'start'",
+                            style::kStartColour));
   s += plot_command(elements, "splot");
   job.end_png();
 }

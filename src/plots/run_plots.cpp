@@ -228,10 +228,11 @@ void path_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
     elements.push_back(job.data_file("path_simulated.dat", format_curve(data.simulated_xy)) + " " +
                        line_style(style::kSimulatedPathColour, style::kThinLineWidth) +
                        " title 'simulated'");
-  elements.push_back(
-      format("$start with points pt 7 ps 1.8 lc rgb \"%s\" title 'start'", style::kStartColour));
+  // the end, then the start as a ring over it: both show where they coincide
   elements.push_back(
       format("$end with points pt 5 ps 1.6 lc rgb \"%s\" title 'end'", style::kEndColour));
+  elements.push_back(format("$start with points pt 6 ps 2.4 lw 2 lc rgb \"%s\" title 'start'",
+                            style::kStartColour));
   s += plot_command(elements);
   job.end_png();
 }

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <regex>
 #include <set>
 
 #include "conformal_fixture.hpp"
@@ -289,6 +290,42 @@ TEST(Paths3d, PathsByLayerTravelsAndToolAxesOfTheStatedLength) {
   EXPECT_LE(data.part_surface.triangle_count(), plots::PlotOptions{}.max_part_triangles);
   for (size_t t = 0; t < data.part_surface.triangle_count(); ++t)
     EXPECT_GT(data.part_surface.facet_normal(t).z(), 0.0);
+}
+
+// A job that ends where it started (the arm returns to its start): the end's square is drawn
+// first and the start's ring over it, so both markers show. And the shorter horizontal axis
+// (the arch's width beside its length) gets three ticks or more, not a lone "0".
+TEST(Paths3d, StartRingDrawnOverACoincidentEndAndThreeTicksOnEachAxis) {
+  auto f = make_conformal_fixture(2);
+  f.toolpath.end_mm = f.toolpath.start_mm;
+  const auto capture = testing_support::capturing_gnuplot(output_directory("paths3d_tool"));
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
+  const auto result = plots::render_run_plots(f.input(), output_directory("paths3d_same_ends"),
+                                              {RunPlot::paths3d}, options);
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  const std::string section = testing_support::png_section(capture.script(), "paths3d.png");
+  const std::vector<std::string> elements = testing_support::plot_elements(section);
+  size_t start = elements.size(), end = elements.size();
+  for (size_t e = 0; e < elements.size(); ++e) {
+    if (testing_support::key_title(elements[e]) == "start") start = e;
+    if (testing_support::key_title(elements[e]) == "end") end = e;
+  }
+  ASSERT_LT(start, elements.size()) << section;
+  ASSERT_LT(end, elements.size()) << section;
+  EXPECT_GT(start, end);                                        // drawn over it
+  EXPECT_NE(elements[start].find("pt 6 "), std::string::npos);  // an open ring
+  // the ticks on x and y
+  for (const char* axis : {"x", "y"}) {
+    SCOPED_TRACE(axis);
+    std::smatch range, tics;
+    ASSERT_TRUE(std::regex_search(
+        section, range,
+        std::regex(std::string("set ") + axis + "range \\[([-0-9.e+]+):([-0-9.e+]+)\\]")));
+    ASSERT_TRUE(std::regex_search(section, tics,
+                                  std::regex(std::string("set ") + axis + "tics ([-0-9.e+]+)")));
+    EXPECT_GE(plots::tick_count(std::stod(range[1]), std::stod(range[2]), std::stod(tics[1])), 3);
+  }
 }
 
 TEST(Curve3, BreaksAreTwoBlankLinesSoThatSplotDoesNotJoinLinesIntoAGrid) {
