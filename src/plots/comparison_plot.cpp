@@ -261,6 +261,23 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   const double metrics_top = kMetricsTop * bottom_scale + lift,
                metrics_line = kMetricsLine * bottom_scale;
 
+  // every run's map padded with zero cells to the extent of all of them, so that each fills
+  // the shared axes (map and zoom) instead of leaving a white strip where its grid ends
+  Range map_x, map_y;
+  for (const ComparisonColumn& column : input.columns)
+    if (has_map(column.thickness)) {
+      const HeightMap& m = *column.thickness;
+      map_x.add(m.origin_x_mm - 0.5 * m.cell_mm);
+      map_x.add(m.origin_x_mm + (m.nx - 0.5) * m.cell_mm);
+      map_y.add(m.origin_y_mm - 0.5 * m.cell_mm);
+      map_y.add(m.origin_y_mm + (m.ny - 0.5) * m.cell_mm);
+    }
+  std::vector<HeightMap> padded_maps(columns);
+  for (size_t c = 0; c < columns; ++c)
+    if (has_map(input.columns[c].thickness))
+      padded_maps[c] =
+          pad_to_extent(*input.columns[c].thickness, map_x.lo, map_x.hi, map_y.lo, map_y.hi);
+
   // shared scales: colour range, map extent, zoom window, time and error axes
   std::vector<HeightMap> display_maps(columns), zoom_maps(columns);
   std::vector<const HeightMap*> maps, full_maps;
@@ -271,9 +288,9 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
     if (column.t_s.size() != column.speed_error_rel.size())
       throw InternalError("plots: speed error and time differ in count for " + column.planner);
     if (has_map(column.thickness)) {
-      display_maps[c] = downsample_for_display(*column.thickness, options.max_map_cells_per_side);
+      display_maps[c] = downsample_for_display(padded_maps[c], options.max_map_cells_per_side);
       maps.push_back(&display_maps[c]);
-      full_maps.push_back(column.thickness);
+      full_maps.push_back(&padded_maps[c]);
     }
     std::vector<double> percent = column.speed_error_rel;
     for (double& e : percent) e *= 100.0;
@@ -288,8 +305,13 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   if (zoom.found)
     for (size_t c = 0; c < columns; ++c)
       if (has_map(input.columns[c].thickness))
-        zoom_maps[c] = downsample_for_display(crop_map(*input.columns[c].thickness, zoom),
-                                              kZoomMaxCellsPerSide);
+        zoom_maps[c] = downsample_for_display(crop_map(padded_maps[c], zoom), kZoomMaxCellsPerSide);
+  // the zooms' peaks in one fixed format, set by the largest of them
+  double largest_zoom_peak_um = 0.0;
+  for (const HeightMap& zoom_map : zoom_maps)
+    if (has_map(&zoom_map))
+      largest_zoom_peak_um =
+          std::max(largest_zoom_peak_um, static_cast<double>(zoom_map.max_value()));
 
   s += "set multiplot title " +
        style::quoted(input.title + (orders ? ": print order comparison" : ": planner comparison")) +
@@ -348,8 +370,9 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
         // own peak inside it
         const double column_peak_um = zoom_maps[c].max_value();
         s += "set title " +
-             style::quoted(format("zoom at (%.2f, %.2f) mm: peak %.3g µm", zoom.centre_x_mm,
-                                  zoom.centre_y_mm, column_peak_um)) +
+             style::quoted(format("zoom at (%.2f, %.2f) mm: peak %s µm", zoom.centre_x_mm,
+                                  zoom.centre_y_mm,
+                                  fixed_text(column_peak_um, largest_zoom_peak_um).c_str())) +
              "\n" + xy_labels;
         // about four intervals over the (square) window, at least three ticks on each axis
         const double tic_mm = round_step_up((zoom.x_hi - zoom.x_lo) / 4.0);

@@ -520,6 +520,30 @@ HeightMap downsample_for_display(const HeightMap& map, int max_cells_per_side) {
   return out;
 }
 
+HeightMap pad_to_extent(const HeightMap& map, double x_lo, double x_hi, double y_lo, double y_hi) {
+  if (map.nx <= 0 || map.ny <= 0 || !(map.cell_mm > 0.0)) return map;
+  // whole cells to add on each side (a hair's overlap of an edge adds none)
+  const auto cells_beyond = [&](double gap_mm) {
+    return std::max(0, static_cast<int>(std::ceil(gap_mm / map.cell_mm - 1e-6)));
+  };
+  const int left = cells_beyond(map.origin_x_mm - 0.5 * map.cell_mm - x_lo);
+  const int right = cells_beyond(x_hi - (map.origin_x_mm + (map.nx - 0.5) * map.cell_mm));
+  const int bottom = cells_beyond(map.origin_y_mm - 0.5 * map.cell_mm - y_lo);
+  const int top = cells_beyond(y_hi - (map.origin_y_mm + (map.ny - 0.5) * map.cell_mm));
+  if (left + right + bottom + top == 0) return map;
+  HeightMap out;
+  out.cell_mm = map.cell_mm;
+  out.nx = map.nx + left + right;
+  out.ny = map.ny + bottom + top;
+  out.origin_x_mm = map.origin_x_mm - left * map.cell_mm;
+  out.origin_y_mm = map.origin_y_mm - bottom * map.cell_mm;
+  out.thickness_um.assign(static_cast<size_t>(out.nx) * out.ny, 0.0f);
+  for (int iy = 0; iy < map.ny; ++iy)
+    std::copy_n(map.thickness_um.begin() + static_cast<size_t>(iy) * map.nx, map.nx,
+                out.thickness_um.begin() + static_cast<size_t>(iy + bottom) * out.nx + left);
+  return out;
+}
+
 std::string fixed_text(double value, double largest) {
   const double magnitude =
       std::abs(largest) > 0.0 ? std::floor(std::log10(std::abs(largest))) : 0.0;

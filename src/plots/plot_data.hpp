@@ -120,6 +120,11 @@ int tick_count(double lo, double hi, double step);
 // 10^n below it that does; a preferred_step <= 0 starts from the span. 1 for an empty span.
 double axis_tick_step(double lo, double hi, double preferred_step, int min_ticks = 3);
 
+// `map` on its own cell lattice, grown with zero cells to cover [x_lo, x_hi] x [y_lo, y_hi]
+// (cell edges; never shrunk): maps of several runs drawn on shared axes then all fill them,
+// with no white strip where one run's grid ends
+HeightMap pad_to_extent(const HeightMap& map, double x_lo, double x_hi, double y_lo, double y_hi);
+
 // `value` with as many decimals as give `largest` three significant digits (none from 100 up):
 // one fixed format for numbers shown side by side ("2000" and "1034", not "2e+03" and "1.03e+03")
 std::string fixed_text(double value, double largest);

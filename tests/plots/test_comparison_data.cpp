@@ -89,6 +89,24 @@ TEST(ComparisonScale, TopIsThePeakUnlessABlobWouldWashTheLinesOut) {
   EXPECT_DOUBLE_EQ(scale.top_um, 1.0);
 }
 
+// Two runs whose grids cover different extents, drawn on shared axes: each is padded with zero
+// cells to the joint extent, on its own lattice, so neither leaves a white strip.
+TEST(ComparisonMaps, PaddedWithZerosToTheSharedExtent) {
+  const HeightMap map = spotted_map(5.0f);  // cells -10 .. 9.5 (edges -10.25 .. 9.75), y 0 .. 9.5
+  const HeightMap padded = plots::pad_to_extent(map, -11.25, 9.75, -0.25, 10.75);
+  EXPECT_EQ(padded.nx, 42);  // two more cells on the left
+  EXPECT_EQ(padded.ny, 22);  // two more on top
+  EXPECT_DOUBLE_EQ(padded.origin_x_mm, -11.0);
+  EXPECT_DOUBLE_EQ(padded.origin_y_mm, 0.0);
+  EXPECT_DOUBLE_EQ(padded.cell_mm, 0.5);
+  EXPECT_EQ(padded.at(0, 0), 0.0f);  // new cells: nothing deposited
+  EXPECT_EQ(padded.at(41, 21), 0.0f);
+  EXPECT_EQ(padded.at(2 + 30, 15), 5.0f);  // the old cells where they were
+  EXPECT_EQ(padded.at(2, 0), 1.0f);
+  // already covering: unchanged
+  EXPECT_EQ(plots::pad_to_extent(map, -10.25, 9.75, -0.25, 9.75).thickness_um, map.thickness_um);
+}
+
 // The peaks shown side by side in one fixed format: three significant digits of the largest.
 TEST(ComparisonMaps, PeaksInOneFixedFormat) {
   EXPECT_EQ(plots::fixed_text(2000.0, 2000.0), "2000");
