@@ -606,7 +606,7 @@ int tick_count(double lo, double hi, double step) {
 double axis_tick_step(double lo, double hi, double preferred_step, int min_ticks) {
   const double span = hi - lo;
   if (!(span > 0.0) || !std::isfinite(span)) return 1.0;
-  double step = preferred_step > 0.0 ? preferred_step : span;
+  const double step = preferred_step > 0.0 ? preferred_step : span;
   if (tick_count(lo, hi, step) >= min_ticks) return step;
   // down the 1-2-5 ladder from the first rung below the preferred step
   double decade = std::pow(10.0, std::floor(std::log10(step)));
