@@ -94,7 +94,8 @@ void paths3d_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
                   const std::string& png);
 
 // the thickness map as an image (colours by the current cbrange) with the print paths
-// overlaid as dashed lines: a plot command; shared by thickness.png and the comparison sheet
+// overlaid as thin, translucent dashed lines: a plot command; shared by thickness.png and the
+// comparison sheet
 std::string thickness_map_elements(PlotJob& job, const HeightMap& map, const Toolpath* toolpath,
                                    const std::string& stem, bool path_key);
 // `set xrange/yrange` covering the maps' cells (to their edges) and the print paths

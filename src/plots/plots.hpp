@@ -117,7 +117,7 @@ std::vector<RunPlot> available_plots(const RunPlotInput& input);
 struct PlotOptions {
   std::string gnuplot = "gnuplot";  // program name (PATH) or path
   size_t max_points_per_curve = 1200;
-  int max_map_cells_per_side = 400;  // thickness maps are block-averaged down to this
+  int max_map_cells_per_side = 400;  // thickness maps are max-pooled down to this
   int max_layer_panels = 8;          // layers.png: more layers are shown evenly chosen
   size_t max_part_triangles = 3000;  // paths3d.png: the part's surface is decimated to this
   size_t max_tool_axes = 120;        // paths3d.png: at most this many tool-axis segments
