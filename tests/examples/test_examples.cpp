@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -139,6 +140,39 @@ std::vector<std::vector<double>> element_rows(const testing_support::GnuplotCapt
                                     testing_support::data_file_name(element));
 }
 
+// thickness.csv read back: its cell size, and the sum and peak of its cells (µm)
+struct ThicknessCsv {
+  double cell_mm = 0.0;
+  double sum_um = 0.0;
+  double peak_um = 0.0;
+};
+ThicknessCsv read_thickness_csv(const std::string& path) {
+  ThicknessCsv csv;
+  std::istringstream in(read_bytes(path));
+  std::string line;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (line.rfind("#", 0) == 0) {
+      const std::size_t at = line.find("cell_mm=");
+      if (at != std::string::npos) csv.cell_mm = std::stod(line.substr(at + 8));
+      continue;
+    }
+    if (header) {  // the columns' x
+      header = false;
+      continue;
+    }
+    std::istringstream row(line);
+    std::string cell;
+    std::getline(row, cell, ',');  // the row's y
+    while (std::getline(row, cell, ',')) {
+      const double value = std::stod(cell);
+      csv.sum_um += value;
+      csv.peak_um = std::max(csv.peak_um, value);
+    }
+  }
+  return csv;
+}
+
 // Every plot of a run shows this run's data, read from what gnuplot was given (the script and
 // its data files, captured) and from the pixels:
 // - path.png: the planned printing path, every point of it within the plan's path error
@@ -148,9 +182,10 @@ std::vector<std::vector<double>> element_rows(const testing_support::GnuplotCapt
 //   errors at least its print time; the planned speed error never exceeds metrics.json's
 //   planned maximum;
 // - thickness_profile.png: a profile of the deposit and the target line;
-// - thickness.png: the deposit map, whose volume is the material that landed (metrics.json
-//   on_target + overspray), under the scenario's print paths; the palette's top colour (the
-//   map's thickest cell) in the picture;
+// - thickness.png: the deposit map (thickness.csv's block maxima: its peak, at least its
+//   volume; thickness.csv's volume is the material that landed, metrics.json on_target +
+//   overspray), under the scenario's print paths; the palette's top colour (the map's
+//   thickest cell) in the picture;
 // - scene.png: the colour bar's bottom and top colours.
 void expect_every_plot(const std::string& run_directory,
                        const testing_support::GnuplotCapture& capture, const Scenario& scenario,
@@ -267,18 +302,28 @@ void expect_every_plot(const std::string& run_directory,
     const std::string map =
         read_bytes(capture.folder + "/" + testing_support::data_file_name(elements[0]));
     ASSERT_EQ(map.size(), 4 * nx * ny);
-    double sum_um = 0.0;
+    double shown_sum_um = 0.0, shown_peak_um = 0.0;
     for (size_t k = 0; k < nx * ny; ++k) {
       float value = 0.0f;
       std::memcpy(&value, map.data() + 4 * k, 4);
-      sum_um += value;
+      shown_sum_um += value;
+      shown_peak_um = std::max(shown_peak_um, static_cast<double>(value));
     }
+    // the deposit at full resolution (thickness.csv): its volume is what landed, and the map
+    // shown (block maxima, so that a thin bead keeps its colour) has its peak and at least
+    // its volume
+    const ThicknessCsv field = read_thickness_csv(run_directory + "/thickness.csv");
+    ASSERT_GT(field.cell_mm, 0.0);
     const double landed_mm3 = metrics["material_mm3"]["on_target"].get<double>() +
                               metrics["material_mm3"]["overspray"].get<double>();
     // (on a part the map is the thickness along the normal: not a vertical volume)
     if (scenario.toolpath.layer_count() == 1 && !scenario.surface) {
-      EXPECT_NEAR(1e-3 * sum_um * cell_mm * cell_mm, landed_mm3, 0.01 * landed_mm3);
+      EXPECT_NEAR(1e-3 * field.sum_um * field.cell_mm * field.cell_mm, landed_mm3,
+                  0.01 * landed_mm3);
     }
+    EXPECT_NEAR(shown_peak_um, field.peak_um, 1e-3 * field.peak_um + 1e-3);
+    EXPECT_GE(shown_sum_um * cell_mm * cell_mm,
+              (1.0 - 1e-4) * field.sum_um * field.cell_mm * field.cell_mm);
     // the overlay: on the scenario's paths, through both ends of every one
     const std::string* overlay = titled(elements, "print path");
     ASSERT_NE(overlay, nullptr);
