@@ -359,6 +359,97 @@ json sequencers_json() {
           {"order", section_json(schema_section("order"))}};
 }
 
+// ---- outputs: the files a verb writes and the keys of metrics.json ----
+
+// One thing a verb writes, and when: `written` names the verbs and conditions
+struct OutputEntry {
+  const char* name;
+  const char* written;
+  const char* meaning;
+};
+
+// the files of DIR/<run>/ (`run`, `plan`) and of DIR (`compare`), as README.md's Outputs
+// section lists them
+const std::vector<OutputEntry>& output_files() {
+  static const std::vector<OutputEntry> files{
+      {"metrics.json", "run, plan", "the figures (keys below; README.md, Metrics)"},
+      {"trajectory.csv", "run, plan", "the plan every 1 ms; after a run the simulated nozzle too"},
+      {"thickness.csv", "run", "the deposit map, µm per cell"},
+      {"thickness_field.png", "run", "the same map as 16-bit grey (µm per level in its text)"},
+      {"replay.json", "run", "for `view`: each frame's time and machine state"},
+      {"replay_model.xml", "run", "for `view`: the MJCF as simulated"},
+      {"replay_deposit.bin", "run", "for `view`: the deposit's growth, frame by frame"},
+      {"scene.png", "run, rendered", "the machine and the deposit, offscreen"},
+      {"path.png", "run, rendered", "planned and simulated path, print order"},
+      {"axes.png", "run, rendered", "axis position, speed and acceleration against time"},
+      {"errors.png", "run, rendered", "speed and position error against time"},
+      {"thickness_profile.png", "run, rendered", "thickness along each print line"},
+      {"thickness.png", "run, rendered", "the deposit map under the print paths"},
+      {"joints.png", "run, rendered", "each joint against time, its range marked"},
+      {"layers.png", "run, rendered, several layers or a part",
+       "each layer's map on one colour scale"},
+      {"paths3d.png", "run, rendered, several layers or a part", "the print paths in 3-D"},
+      {"run.mp4", "run --video", "the run as a film (ffmpeg)"},
+      {"comparison.json", "compare (in DIR)", "the summary table and each run's metrics"},
+      {"comparison.csv", "compare (in DIR)", "the summary table"},
+      {"comparison.md", "compare (in DIR)", "the summary table with links to the images"},
+      {"comparison.png", "compare (in DIR), rendered", "the deposit maps side by side"},
+  };
+  return files;
+}
+
+// metrics.json's top-level keys, in the order written
+const std::vector<OutputEntry>& metrics_keys() {
+  static const std::vector<OutputEntry> keys{
+      {"scenario", "run, plan", "the scenario's name"},
+      {"machine", "run, plan", "the machine's name"},
+      {"planner", "run, plan", "the planner's name"},
+      {"run", "run, plan", "the run's label (the planner's name when it has none)"},
+      {"sequencer", "run, plan", "the print order's method"},
+      {"time_s", "run, plan", "total, print and transition time"},
+      {"velocity_error", "run", "simulated speed error over the printed length"},
+      {"velocity_error_steady", "run", "the same outside the start and end ramps (null: none)"},
+      {"planned_velocity_error", "run, plan", "the plan's speed error over the printed length"},
+      {"planned_velocity_error_steady", "run, plan", "the same outside the ramps (null: none)"},
+      {"path_error_mm", "run", "simulated distance from the print path"},
+      {"planned_path_error_mm", "run, plan", "the plan's distance from the print path"},
+      {"speed_ramps", "run, plan", "the ramps the steady errors leave out: count, time"},
+      {"thickness", "run", "mean, cv, line_cv, min and max of the deposit on the target"},
+      {"waste", "run", "material off the target and caught by the shutter"},
+      {"material_mm3", "run", "emitted, on target, overspray, captured"},
+      {"actuators", "run", "each joint's peak speed, acceleration and force against limits"},
+      {"order", "run, plan", "the print order: cost, lower bound, refinement"},
+      {"warnings", "run, plan", "what the run warned of"},
+      {"sim", "run", "the simulation's steps, timestep and wall time"},
+      {"arm", "run, arm6", "postures: joint margins, branch, roll"},
+      {"layers", "run, several layers or a part", "the figures per layer"},
+      {"units", "run, plan", "every number's unit, in the same shape"},
+  };
+  return keys;
+}
+
+Rows output_rows(const std::vector<OutputEntry>& entries, const char* first) {
+  Rows rows{{first, "written", "meaning"}};
+  for (const OutputEntry& e : entries) rows.push_back({e.name, e.written, e.meaning});
+  return rows;
+}
+
+json output_json(const std::vector<OutputEntry>& entries) {
+  json list = json::array();
+  for (const OutputEntry& e : entries)
+    list.push_back({{"name", e.name}, {"written", e.written}, {"meaning", e.meaning}});
+  return list;
+}
+
+std::string outputs_text() {
+  return section_text(schema_section("outputs")) +
+         "\nfiles: DIR/<run>/ for each run (`compare`'s own in DIR); \"rendered\": unless "
+         "`render: false` or --no-render\n\n" +
+         table(output_rows(output_files(), "file")) +
+         "\nmetrics.json's keys (README.md, Metrics, defines each figure)\n\n" +
+         table(output_rows(metrics_keys(), "key"));
+}
+
 // ---- topics ----
 
 // the scenario sections a topic shows
@@ -369,7 +460,7 @@ std::vector<std::string> topic_sections(const std::string& topic) {
   if (topic == "toolpath")
     return {"toolpath", "toolpath.polylines[]", "toolpath.gcode", "toolpath.random_segments",
             "toolpath.surface"};
-  if (topic == "arm" || topic == "sim" || topic == "outputs") return {topic};
+  if (topic == "arm" || topic == "sim") return {topic};
   return {};
 }
 
@@ -422,6 +513,7 @@ std::string describe_text(const std::string& requested) {
   if (topic == "machines") return machines_text();
   if (topic == "planners") return planners_text();
   if (topic == "sequencers") return sequencers_text();
+  if (topic == "outputs") return outputs_text();
   std::string out;
   for (const std::string& path : topic_sections(topic))
     out += (out.empty() ? "" : "\n") + section_text(schema_section(path));
@@ -445,6 +537,10 @@ json describe_json(const std::string& requested) {
     out = planners_json();
   } else if (topic == "sequencers") {
     out = sequencers_json();
+  } else if (topic == "outputs") {
+    out = {{"sections", json::array({section_json(schema_section("outputs"))})},
+           {"files", output_json(output_files())},
+           {"metrics_keys", output_json(metrics_keys())}};
   } else {
     json sections = json::array();
     for (const std::string& path : topic_sections(topic))

@@ -465,7 +465,7 @@ std::vector<SchemaSection> make_schema() {
     render.type = "true | false";
     schema.push_back(
         {"outputs",
-         "what a run writes besides metrics and CSVs",
+         "whether a run draws its images, and the scene image's size",
          {render, whole("image_width", "px", 16, 2048, outputs.image_width, "scene image width"),
           whole("image_height", "px", 16, 2048, outputs.image_height, "scene image height")}});
   }

@@ -244,6 +244,48 @@ TEST(Cli, NamesWithControlBytesAreEchoedDisarmed) {
             std::string::npos);
 }
 
+// `describe outputs` lists the files and metrics.json keys that `plan` and `run` write, no
+// more and no fewer: a plan writes what is "run, plan"; a rendered run of one layer on the
+// XY stage that and what is "run" or "run, rendered"
+TEST(Cli, DescribeOutputsListsWhatPlanAndRunWrite) {
+  const Result described = depotwin("describe outputs --json");
+  ASSERT_EQ(described.status, 0) << described.output;
+  const auto outputs = nlohmann::json::parse(described.output);
+  const auto listed = [&](const char* list, const std::vector<std::string>& when) {
+    std::vector<std::string> names;
+    for (const auto& entry : outputs.at(list))
+      if (std::find(when.begin(), when.end(), entry.at("written")) != when.end())
+        names.push_back(entry.at("name"));
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  const auto written = [](const std::string& folder) {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(folder))
+      names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  const auto keys_of = [](const std::string& metrics_file) {
+    std::vector<std::string> keys;
+    const auto metrics = nlohmann::json::parse(testing_support::read_text(metrics_file));
+    for (const auto& [key, value] : metrics.items()) keys.push_back(key);
+    std::sort(keys.begin(), keys.end());
+    return keys;
+  };
+  const std::string dir = fresh_directory("cli_describe_outputs");
+  const std::string fig7 = scenario_path("thompson_fig7.yaml");
+  ASSERT_EQ(depotwin("plan " + fig7 + " --planner lspb_mtt --quiet --out " + dir + "/plan").status,
+            0);
+  EXPECT_EQ(written(dir + "/plan/lspb_mtt"), listed("files", {"run, plan"}));
+  EXPECT_EQ(keys_of(dir + "/plan/lspb_mtt/metrics.json"), listed("metrics_keys", {"run, plan"}));
+  ASSERT_EQ(depotwin("run " + fig7 + " --planner lspb_mtt --quiet --out " + dir + "/run").status,
+            0);
+  EXPECT_EQ(written(dir + "/run/lspb_mtt"), listed("files", {"run, plan", "run", "run, rendered"}));
+  EXPECT_EQ(keys_of(dir + "/run/lspb_mtt/metrics.json"),
+            listed("metrics_keys", {"run, plan", "run"}));
+}
+
 TEST(Cli, PlanWritesMetricsAndTrajectory) {
   const std::string dir = fresh_directory("cli_plan");
   const Result r =
