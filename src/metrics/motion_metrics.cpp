@@ -173,10 +173,17 @@ std::vector<TimeSpan> speed_ramps(const MotionSamples& planned) {
           {planned.t_s[first] - before,
            planned.t_s[steady_first] +
                (steady_first < last ? half_gap(steady_first, steady_first + 1) : after)});
-    if (steady_last < last)
-      ramps.push_back({planned.t_s[steady_last] -
-                           (steady_last > first ? half_gap(steady_last - 1, steady_last) : before),
-                       planned.t_s[last] + after});
+    if (steady_last < last) {
+      const TimeSpan end_ramp{
+          planned.t_s[steady_last] -
+              (steady_last > first ? half_gap(steady_last - 1, steady_last) : before),
+          planned.t_s[last] + after};
+      // at speed at one sample only: the two ramps share it, one span (its time counted once)
+      if (steady_first > first && ramps.back().end_s > end_ramp.begin_s)
+        ramps.back().end_s = end_ramp.end_s;
+      else
+        ramps.push_back(end_ramp);
+    }
   }
   return ramps;
 }

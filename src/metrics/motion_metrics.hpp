@@ -62,7 +62,8 @@ constexpr double kRampTolerance_rel = 1e-4;
 // the same margin): a line held below its speed on purpose (by the limits, or conformal's
 // constant scale-down) has a steady part whose error is that shortfall. Where no sample
 // lies between its first and last at that speed (a peak, not a cruise), it is ramp
-// throughout. The spans reach half a sample period beyond
+// throughout: one span, as is a stretch at speed at one sample only (its start and end
+// ramps share that sample, counted once). The spans reach half a sample period beyond
 // their outer samples (open ends), so that the samples of another run at other times (the
 // simulation's) fall in them as the plan's would.
 std::vector<TimeSpan> speed_ramps(const MotionSamples& planned);

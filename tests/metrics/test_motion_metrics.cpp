@@ -120,6 +120,19 @@ TEST(SpeedRamps, AStretchNeverAtSpeedIsAllRamp) {
   EXPECT_GT(velocity_error(planned).counted_s, trap.printing_s() - 1e-3);
 }
 
+// A stretch at its desired speed at one sample only (a triangle whose top sample is exactly
+// at speed): its start and end ramps share that sample, one span whose time counts it once,
+// not more than the stretch lasts (it was two spans, 1 ms over the print time)
+TEST(SpeedRamps, AStretchAtSpeedAtOneSampleIsOneRamp) {
+  Trapezoid trap;
+  trap.cruise_s = 0.0;
+  const MotionSamples planned = trap.sample(1e-3);
+  const std::vector<TimeSpan> ramps = speed_ramps(planned);
+  ASSERT_EQ(ramps.size(), 1u);
+  EXPECT_NEAR(total_time_s(ramps), trap.printing_s() + 1e-3, 1e-9);
+  EXPECT_EQ(velocity_error(planned, ramps).counted_s, 0.0);
+}
+
 // A cruise exactly at speed from the first sample (LSPB entering at print speed): no ramp.
 TEST(SpeedRamps, AStretchStartingAtSpeedHasNoStartRamp) {
   MotionSamples s;
