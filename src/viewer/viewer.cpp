@@ -235,12 +235,20 @@ void check_screenshot_path(const std::string& path) {
                      "cannot write in '" + parent.string() + "' (for '" + path + "')");
 }
 
+// the largest window side: OpenGL's usual largest framebuffer
+constexpr int kMaxWindowSide_px = 16384;
+
 }  // namespace
 
 int view_verb(const ViewOptions& options) {
-  if (options.width < 64) throw InputError("--width", "the window must be at least 64 pixels wide");
-  if (options.height < 64)
-    throw InputError("--height", "the window must be at least 64 pixels high");
+  // the window's size in [64, kMaxWindowSide_px] (a larger one wrapped round in the window
+  // system's 16-bit sizes: --width 65636 gave a 100-pixel window)
+  if (options.width < 64 || options.width > kMaxWindowSide_px)
+    throw InputError("--width", "the window must be 64 to " + std::to_string(kMaxWindowSide_px) +
+                                    " pixels wide, got " + std::to_string(options.width));
+  if (options.height < 64 || options.height > kMaxWindowSide_px)
+    throw InputError("--height", "the window must be 64 to " + std::to_string(kMaxWindowSide_px) +
+                                     " pixels high, got " + std::to_string(options.height));
   if (options.at_s && !(*options.at_s >= 0.0 && std::isfinite(*options.at_s)))
     throw InputError("--at", "a run time in seconds, 0 or more, is required, got " +
                                  message_number(*options.at_s));

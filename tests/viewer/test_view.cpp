@@ -72,9 +72,19 @@ TEST(View, ScreenshotPathsAndTimesAreChecked) {
   }
   const CliResult narrow = depotwin("view " + dir + " --width -1");
   EXPECT_EQ(narrow.status, 2) << narrow.output;
-  EXPECT_NE(narrow.output.find("error: --width: the window must be at least 64 pixels wide"),
-            std::string::npos)
+  EXPECT_NE(
+      narrow.output.find("error: --width: the window must be 64 to 16384 pixels wide, got -1"),
+      std::string::npos)
       << narrow.output;
+  // beyond the largest window (it wrapped round: 65636 made a 100-pixel window, exit 0)
+  for (const char* option : {"--width", "--height"}) {
+    const CliResult huge = depotwin("view " + dir + " " + option + " 65636");
+    EXPECT_EQ(huge.status, 2) << huge.output;
+    EXPECT_NE(huge.output.find(std::string("error: ") + option +
+                               ": the window must be 64 to 16384 pixels"),
+              std::string::npos)
+        << huge.output;
+  }
 }
 
 // pixels of a PNG as RGB
