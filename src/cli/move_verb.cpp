@@ -105,24 +105,27 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
     m.v_max = value_for_axis(request.v_max, i);
     m.a_max = value_for_axis(request.a_max, i);
     const std::string axis = " (axis " + std::to_string(i) + ")";
-    const auto got = [&](double value) { return ", got " + message_number(value) + axis; };
+    // a value outside [lo, hi] with the digits that tell it from the end it passes
+    const auto got = [&](double value, double lo, double hi) {
+      return ", got " + message_number_outside(value, lo, hi) + axis;
+    };
     for (const auto& [name, q] : {std::pair<const char*, double>{"--q0", m.boundary.q0},
                                   std::pair<const char*, double>{"--q1", m.boundary.q1}})
       if (!within(q, -ranges::kMaxCoordinate_mm, ranges::kMaxCoordinate_mm))
-        problems.push_back({"", 0, name,
-                            "must be " +
-                                range_text(-ranges::kMaxCoordinate_mm, ranges::kMaxCoordinate_mm) +
-                                " mm" + got(q)});
+        problems.push_back(
+            {"", 0, name,
+             "must be " + range_text(-ranges::kMaxCoordinate_mm, ranges::kMaxCoordinate_mm) +
+                 " mm" + got(q, -ranges::kMaxCoordinate_mm, ranges::kMaxCoordinate_mm)});
     const bool v_ok = within(m.v_max, ranges::kMinLimit, ranges::kMaxSpeed_mm_s);
     if (!v_ok)
       problems.push_back({"", 0, "--vmax",
                           "must be " + range_text(ranges::kMinLimit, ranges::kMaxSpeed_mm_s) +
-                              " mm/s" + got(m.v_max)});
+                              " mm/s" + got(m.v_max, ranges::kMinLimit, ranges::kMaxSpeed_mm_s)});
     if (!within(m.a_max, ranges::kMinLimit, ranges::kMaxAcceleration_mm_s2))
-      problems.push_back({"", 0, "--amax",
-                          "must be " +
-                              range_text(ranges::kMinLimit, ranges::kMaxAcceleration_mm_s2) +
-                              " mm/s^2" + got(m.a_max)});
+      problems.push_back(
+          {"", 0, "--amax",
+           "must be " + range_text(ranges::kMinLimit, ranges::kMaxAcceleration_mm_s2) + " mm/s^2" +
+               got(m.a_max, ranges::kMinLimit, ranges::kMaxAcceleration_mm_s2)});
     // a boundary speed over v_max, with the digits that tell them apart
     for (const auto& [name, v] : {std::pair<const char*, double>{"--v0", m.boundary.v0},
                                   std::pair<const char*, double>{"--v1", m.boundary.v1}})
@@ -137,7 +140,7 @@ nlohmann::ordered_json minimum_time_move_json(const MoveRequest& request) {
         problems.push_back({"", 0, "--jmax",
                             "must be 0 (no jerk limit) or " +
                                 range_text(ranges::kMinLimit, ranges::kMaxJerk_mm_s3) + " mm/s^3" +
-                                got(j_max)});
+                                got(j_max, ranges::kMinLimit, ranges::kMaxJerk_mm_s3)});
     }
   }
   if (!problems.empty()) throw InputError(problems);

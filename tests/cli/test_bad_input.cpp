@@ -502,6 +502,12 @@ std::vector<Row> rows() {
                       "error: --vmax: must be in \\[1e-06, 1e\\+06\\] mm/s, got 0"));
   r.push_back(command("MoveHugeTarget", "move --q0 0 --q1 1e300 --vmax 5 --amax 10",
                       "error: --q1: must be in \\[-1e\\+06, 1e\\+06\\] mm, got 1e\\+300"));
+  // just past a bound: the value's own digits, not the bound's (it read "got 1e+06")
+  r.push_back(command("MoveTargetJustPastTheTravel", "move --q0 0 --q1 1000001 --vmax 5 --amax 10",
+                      "error: --q1: must be in \\[-1e\\+06, 1e\\+06\\] mm, got 1000001"));
+  r.push_back(command("MoveSpeedLimitJustPastItsRange",
+                      "move --q0 0 --q1 1 --vmax 1000001 --amax 10",
+                      "error: --vmax: must be in \\[1e-06, 1e\\+06\\] mm/s, got 1000001"));
   r.push_back(command("MoveNotANumber", "move --q0 0 --q1 nan --vmax 5 --amax 10",
                       "error: --q1: 'nan' is not a finite number"));
   r.push_back(command("MoveListEndingInAComma", "move --q0 0,0 --q1 10, --vmax 5 --amax 10",
