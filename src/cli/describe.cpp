@@ -66,8 +66,9 @@ std::string joined(const std::vector<std::string>& names, const std::string& sep
 
 // ---- scenario sections (scenario/schema.hpp) ----
 
+// "`limits:` ", or nothing for the top level, whose summary says what it is
 std::string section_title(const SchemaSection& section) {
-  return section.path.empty() ? "the scenario file's top level" : "`" + section.path + ":`";
+  return section.path.empty() ? "" : "`" + section.path + ":` ";
 }
 
 std::string section_text(const SchemaSection& section) {
@@ -83,7 +84,7 @@ std::string section_text(const SchemaSection& section) {
     if (typed) row.insert(row.begin() + 1, k.applies_to.empty() ? "both" : k.applies_to);
     rows.push_back(row);
   }
-  return section_title(section) + " " + section.summary + "\n\n" + table(rows);
+  return section_title(section) + section.summary + "\n\n" + table(rows);
 }
 
 json key_json(const SchemaKey& k) {

@@ -201,8 +201,15 @@ std::vector<SchemaSection> make_schema() {
                       "never looser than these)",
                       keys});
   }
-  schema.push_back({"limits.x", "one TCP axis' overrides (also limits.y, limits.z)",
-                    axis_keys("of this TCP axis", false)});
+  {
+    // an axis' own limit defaults to the common one (limits.v_max, ...), whatever that is
+    std::vector<SchemaKey> keys = axis_keys("of this TCP axis", false);
+    for (SchemaKey& key : keys) {
+      key.default_text = "limits." + key.name;
+      key.default_value = std::nullopt;
+    }
+    schema.push_back({"limits.x", "one TCP axis' overrides (also limits.y, limits.z)", keys});
+  }
   schema.push_back({"limits.joint",
                     "every joint alike; a joint j_max is refused on linear_delta and arm6",
                     axis_keys("of every joint", true)});

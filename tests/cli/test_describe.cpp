@@ -171,6 +171,18 @@ TEST(Describe, ToolpathDefinesTheJointAngle) {
   EXPECT_EQ(describe_json("toolpath").at("joint_angle"), kJointAngleDefinition);
 }
 
+// the top level opens with its own summary (it had a title run into it), and an axis' own
+// limits default to the common ones, whatever those are set to (they read 4 and 30)
+TEST(Describe, ScenarioSummaryAndTheAxisLimitsDefaults) {
+  EXPECT_EQ(describe_text("scenario").rfind("a scenario file: one YAML map", 0), 0u);
+  const json limits = describe_json("limits").at("sections");
+  ASSERT_EQ(limits.at(1).at("path"), "limits.x");
+  for (const json& key : limits.at(1).at("keys")) {
+    EXPECT_EQ(key.at("default"), "limits." + key.at("name").get<std::string>());
+    EXPECT_FALSE(key.contains("default_value")) << key.at("name");
+  }
+}
+
 TEST(Describe, AnUnknownTopicIsBadInputNamingTheTopics) {
   try {
     describe_text("nozzles");
