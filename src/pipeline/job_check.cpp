@@ -258,11 +258,14 @@ double parse_memory_size(const std::string& text, const std::string& option) {
   } else {
     end = 0;
   }
-  if (end == 0 || !std::isfinite(value) || !(value > 0.0) || !(value * scale >= 1e6) ||
-      !(value * scale <= 1e18))
+  // between 1M and 1048576T (1 MiB and 1 EiB), in the powers of 1024 the units are
+  constexpr double kLeast_bytes = 1024.0 * 1024.0;
+  const double most_bytes = std::pow(1024.0, 6.0);
+  if (end == 0 || !std::isfinite(value) || !(value > 0.0) || !(value * scale >= kLeast_bytes) ||
+      !(value * scale <= most_bytes))
     throw InputError(option, "'" + printable_text(text) +
-                                 "' is not a memory size between 1 MB and 1 EB (e.g. 8G, 512M, "
-                                 "1.5GiB, or bytes)");
+                                 "' is not a memory size between 1M and 1048576T (1 MiB and 1 "
+                                 "EiB; e.g. 8G, 512M, 1.5GiB, or bytes)");
   return value * scale;
 }
 
@@ -273,8 +276,10 @@ std::string format_bytes(double bytes) {
     std::snprintf(text, sizeof text, "%.0f MB", mib);
   else if (mib < 1024.0 * 1024.0)
     std::snprintf(text, sizeof text, "%.3g GB", mib / 1024.0);
-  else
+  else if (mib < 1024.0 * 1024.0 * 1024.0)
     std::snprintf(text, sizeof text, "%.3g TB", mib / (1024.0 * 1024.0));
+  else  // TB in full (1048576 TB at most): the units the command line takes
+    std::snprintf(text, sizeof text, "%.0f TB", mib / (1024.0 * 1024.0));
   return text;
 }
 

@@ -27,6 +27,14 @@ TEST(MemorySize, UnitsArePowersOf1024) {
   EXPECT_EQ(kDefaultMaxMemoryBytes, 8 * gib);
   EXPECT_EQ(format_bytes(6.6 * gib), "6.6 GB");
   EXPECT_EQ(format_bytes(512 * 1024.0 * 1024.0), "512 MB");
+  // the bounds in the same units, 1 MiB and 1 EiB (they were 1e6 and 1e18 bytes: 1048575T,
+  // under 1 EiB, was refused and 1000000 bytes taken), and a size beyond a PiB read in TB
+  EXPECT_EQ(parse_memory_size("1M"), 1024.0 * 1024.0);
+  EXPECT_EQ(parse_memory_size("1048576T"), 1024.0 * 1024.0 * 1024 * gib);
+  EXPECT_EQ(parse_memory_size("1048575T"), 1048575 * 1024 * gib);
+  for (const char* outside : {"1048575", "1000000", "1048577T"})
+    EXPECT_THROW(parse_memory_size(outside), InputError) << outside;
+  EXPECT_EQ(format_bytes(1048575 * 1024 * gib), "1048575 TB");
 }
 
 TEST(MemorySize, NonsenseIsAnInputErrorNamingTheOption) {
