@@ -223,10 +223,10 @@ SharedThicknessScale shared_thickness_scale(const ComparisonInput& input) {
 
 std::string capped_scale_note(const SharedThicknessScale& scale, const std::string& map_noun) {
   if (!scale.capped) return "";
-  return format(
-      "topped at %g × the median %s's 95th percentile (thicker: the top colour); "
-      "peak %s µm",
-      kSharedScaleCap, map_noun.c_str(), fixed_text(scale.peak_um, scale.peak_um).c_str());
+  // one map ("") has its own percentile; several, the median one's
+  const std::string whose = map_noun.empty() ? "the" : "the median " + map_noun + "'s";
+  return format("topped at %g × %s 95th percentile (thicker: the top colour); peak %s µm",
+                kSharedScaleCap, whose.c_str(), fixed_text(scale.peak_um, scale.peak_um).c_str());
 }
 
 PlotResult render_comparison(const ComparisonInput& input, const std::string& png_path,

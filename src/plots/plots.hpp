@@ -58,7 +58,8 @@ constexpr double kSharedScaleCap = 2.0;
 // null or empty maps are skipped
 SharedThicknessScale capped_thickness_scale(const std::vector<const HeightMap*>& maps);
 // what a capped scale's colour bar says under its title ("topped at 2 × the median <map_noun>'s
-// 95th percentile (thicker: the top colour); peak N µm"); empty when not capped
+// 95th percentile (thicker: the top colour); peak N µm", "2 × the 95th percentile" for one map,
+// map_noun ""); empty when not capped
 std::string capped_scale_note(const SharedThicknessScale& scale, const std::string& map_noun);
 
 // Everything the run plots show. Pointers are borrowed for the call; the struct owns nothing.

@@ -260,6 +260,37 @@ TEST(RunPlots, EveryThicknessMapAxisHasAtLeastThreeTicks) {
   }
 }
 
+// thickness.png of a deposit with a blob 20 times its lines (layers stacked where they start):
+// its colour scale is topped at 2 x the map's 95th percentile, as comparison.png's and
+// layers.png's are, and says so over the map; an even deposit's reaches its own peak
+TEST(RunPlots, AThicknessMapsScaleIsToppedOverABlob) {
+  auto f = make_plot_fixture(testing_support::raster_toolpath(3), 0.3, false);
+  const double peak_um = f.thickness.max_value();
+  const std::string directory = output_directory("thickness_blob");
+  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
+  plots::render_run_plots(f.input(), directory + "/even", {RunPlot::thickness}, options);
+  const std::string even = testing_support::png_section(capture.script(), "thickness.png");
+  EXPECT_NE(even.find(plots::format("set cbrange [0:%.9g]", peak_um)), std::string::npos) << even;
+  EXPECT_EQ(even.find("colour scale topped"), std::string::npos);
+
+  for (int iy = 0; iy < 3; ++iy)
+    for (int ix = 0; ix < 3; ++ix)
+      f.thickness.thickness_um[static_cast<size_t>(iy) * f.thickness.nx + ix] =
+          static_cast<float>(20 * peak_um);
+  const plots::SharedThicknessScale scale = plots::capped_thickness_scale({&f.thickness});
+  ASSERT_TRUE(scale.capped);
+  EXPECT_LE(scale.top_um, 2.0 * peak_um);
+  const auto blob_capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture-2");
+  options.gnuplot = blob_capture.program;
+  plots::render_run_plots(f.input(), directory + "/blob", {RunPlot::thickness}, options);
+  const std::string blob = testing_support::png_section(blob_capture.script(), "thickness.png");
+  EXPECT_NE(blob.find(plots::format("set cbrange [0:%.9g]", scale.top_um)), std::string::npos)
+      << blob;
+  EXPECT_NE(blob.find("colour scale topped at 2 × the 95th percentile"), std::string::npos) << blob;
+}
+
 // errors.png with tiny position errors (a fixture whose lines are followed to within
 // micrometres: ticks like "0.0002"): the left margin leaves room for the widest tick label and
 // the two-line y label beside it, so the label is not pushed past the image's edge.
