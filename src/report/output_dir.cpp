@@ -110,6 +110,9 @@ fs::path nearest_existing(fs::path path) {
 
 // how often a writer waiting for an output's lock tries again
 constexpr std::chrono::milliseconds kLockPollPeriod{100};
+// a lock held by a holder that has not written its name yet: polls (a tenth of the period
+// each) before it is named "another depotwin process"
+constexpr int kPollsForTheHoldersName = 10;
 // what a depotwin lock file starts with (a file of that name holding anything else is not ours)
 constexpr const char* kLockTextPrefix = "depotwin lock held by ";
 
@@ -139,6 +142,7 @@ OutputLock::OutputLock(const std::string& target_path, const std::string& shown_
   auto refuse = [&](const std::string& why) { throw InputError("--out", shown_path + ": " + why); };
   const std::string folder = fs::path(target_path).parent_path().string();
   bool told = false;
+  int unnamed_polls = 0;
   while (true) {
     throw_if_interrupted();
     // O_CLOEXEC: a child process (gnuplot, ffmpeg) never inherits the lock
@@ -167,9 +171,14 @@ OutputLock::OutputLock(const std::string& target_path, const std::string& shown_
     descriptor_ = -1;
     if (why != EWOULDBLOCK && why != EINTR)
       refuse("cannot lock " + lock_path_ + ": " + std::strerror(why));
-    const std::string who = holder.rfind(kLockTextPrefix, 0) == 0
-                                ? holder.substr(std::strlen(kLockTextPrefix))
-                                : std::string("another depotwin process");
+    const bool named = holder.rfind(kLockTextPrefix, 0) == 0;
+    const std::string who = named ? holder.substr(std::strlen(kLockTextPrefix))
+                                  : std::string("another depotwin process");
+    // a holder writes its name just after it takes the lock: a few polls to read it
+    if (!named && ++unnamed_polls <= kPollsForTheHoldersName) {
+      std::this_thread::sleep_for(kLockPollPeriod / 10);
+      continue;
+    }
     if (!wait)
       refuse("is being written by " + who + " (" + lock_path_ +
              " is locked); run again when it is done, or without --no-wait to wait for it");
