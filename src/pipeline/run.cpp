@@ -252,7 +252,7 @@ void write_run(const PreparedJob& job, const SimulatedRun& run, const std::strin
   // files and renders the scene
   std::future<void> plots_done;
   if (settings.render) {
-    plots_done = std::async(std::launch::async, [&job, &run, &field, &map, &directory] {
+    plots_done = std::async(std::launch::async, [&job, &run, &map, &directory] {
       plots::RunPlotInput input;
       // the planner, and the run's label where it has its own (an order, a setting)
       const MetricsReport& r = run.report;

@@ -905,8 +905,7 @@ TEST(Gcode, PocketsCyclesAndAmbiguousUnitCodesAreRefused) {
   const char* codes[8] = {"G12 I: circular pockets",
                           "G13 I: circular pockets",
                           "G74 is not supported: a canned cycle",
-                          "G70 is not supported: it "
-                          "means inch or mm",
+                          "G70 is not supported: it means inch or mm",
                           "G71 is not supported: it means inch or mm",
                           "G12.1 is not supported: polar",
                           "G75 is not supported: a canned",
