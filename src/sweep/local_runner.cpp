@@ -85,12 +85,14 @@ std::string duration_text(double seconds) {
   return text;
 }
 
-// A worker that ended by a stop request (exit 128 + SIGINT, SIGTERM or SIGHUP: its task's
-// staging folder removed) was stopped, not failed: its task is not recorded
+// A worker that ended by a stop request was stopped, not failed: its task is not recorded.
+// Either it stopped itself (exit 128 + SIGINT, SIGTERM or SIGHUP, its task's staging folder
+// removed), or the signal came before it set its handlers (just started) and ended it.
 int stop_signal_of(int status) {
-  if (!WIFEXITED(status)) return 0;
   for (const int signal_number : {SIGINT, SIGTERM, SIGHUP})
-    if (WEXITSTATUS(status) == 128 + signal_number) return signal_number;
+    if ((WIFEXITED(status) && WEXITSTATUS(status) == 128 + signal_number) ||
+        (WIFSIGNALED(status) && WTERMSIG(status) == signal_number))
+      return signal_number;
   return 0;
 }
 
@@ -248,6 +250,7 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
         if (g_stop_signal == 0) g_stop_signal = stopped;
         worker.task.reset();
       }
+      if (g_stop_signal != 0) worker.task.reset();  // stopping: what ended it is no failure
       if (worker.task) {
         const std::uint64_t index = *worker.task;
         const SweepTask task = sweep.task(index);

@@ -384,6 +384,24 @@ TEST_F(SweepRoutes, ALocalRunSignalledAsAGroupLeavesNothingHalfWritten) {
   const CliResult resumed = depotwin("sweep " + sweep + " --quiet --no-render --out " + out);
   EXPECT_EQ(resumed.status, 0) << resumed.output;
   EXPECT_NE(resumed.output.find("(0 failed)"), std::string::npos) << resumed.output;
+
+  // the signal as the workers start (before some have set their handlers, so that the
+  // signal's default action ends them): stopped, no task recorded as failed
+  for (int trial = 0; trial < 3; ++trial) {
+    const std::string early = dir_ + "/group_early_" + std::to_string(trial);
+    const pid_t started =
+        spawn_depotwin({"sweep", sweep, "-j", "2", "--out", early, "--quiet"}, /*own_group=*/true);
+    ASSERT_GT(started, 0);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+    while (processes_with(early) == 0 && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    ::kill(-started, SIGTERM);
+    ASSERT_EQ(::waitpid(started, &status, 0), started);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << status;
+    EXPECT_EQ(names_holding(early, ".partial"), std::vector<std::string>{});
+    EXPECT_EQ(names_holding(early, "task.json"), std::vector<std::string>{}) << trial;
+    EXPECT_FALSE(fs::exists(early + ".lock"));
+  }
 }
 
 TEST_F(SweepRoutes, KeepAllKeepsWhatRunNoRenderWrites) {
