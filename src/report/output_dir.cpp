@@ -372,6 +372,10 @@ OutputFolder::OutputFolder(const std::string& final_path, const std::string& ver
   } catch (const InternalError& failure) {
     fs::remove_all(staging_path_, error);
     refuse(std::string("cannot write in it: ") + failure.what());
+  } catch (...) {
+    // (the destructor does not run for an object not made: the staging folder goes here)
+    fs::remove_all(staging_path_, error);
+    throw;
   }
 }
 
