@@ -184,28 +184,22 @@ SharedThicknessScale capped_thickness_scale(const std::vector<const HeightMap*>&
       scale.peak_um = std::max(scale.peak_um, static_cast<double>(map->max_value()));
     }
   if (!(scale.peak_um > 0.0)) return scale;
-  // each map's deposit cells' 95th percentile, from a histogram over [0, peak] (its bins a
-  // 4096th of the peak: fine for a colour scale), read at the bin's upper edge
-  constexpr int kBins = 4096;
-  constexpr double kDepositFloor = 0.01, kQuantile = 0.95;
-  const double bin_um = scale.peak_um / kBins;
+  // each map's deposit cells' 95th percentile (the cells above a 10^4th of its peak: a bead
+  // beside a blob a hundred times thicker still counts, a Gaussian's far tails hardly do)
+  constexpr double kDepositFloor = 1e-4, kQuantile = 0.95;
   std::vector<double> quantiles_um;
-  std::vector<size_t> histogram(kBins);
+  std::vector<float> deposit;
   for (const HeightMap* map : maps) {
-    std::fill(histogram.begin(), histogram.end(), 0);
     const double floor_um = kDepositFloor * map->max_value();
-    size_t cells = 0;
-    for (const float value : map->thickness_um) {
-      if (!(value > floor_um)) continue;
-      ++histogram[std::min(kBins - 1, static_cast<int>(value / bin_um))];
-      ++cells;
-    }
-    if (cells == 0) continue;
-    const size_t rank = static_cast<size_t>(std::ceil(kQuantile * static_cast<double>(cells)));
-    size_t below = 0;
-    int bin = 0;
-    while (bin + 1 < kBins && below + histogram[bin] < rank) below += histogram[bin++];
-    quantiles_um.push_back((bin + 1) * bin_um);
+    deposit.clear();
+    for (const float value : map->thickness_um)
+      if (value > floor_um) deposit.push_back(value);
+    if (deposit.empty()) continue;
+    const size_t rank =
+        static_cast<size_t>(std::ceil(kQuantile * static_cast<double>(deposit.size())));
+    const auto at = deposit.begin() + static_cast<std::ptrdiff_t>(std::max<size_t>(rank, 1) - 1);
+    std::nth_element(deposit.begin(), at, deposit.end());
+    quantiles_um.push_back(*at);
   }
   // the median run's (the lower of the middle two)
   std::sort(quantiles_um.begin(), quantiles_um.end());

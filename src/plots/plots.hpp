@@ -46,7 +46,7 @@ JointSeries joint_series(const RecordedRun& run, const std::vector<JointLimit>& 
 
 // The colour range maps drawn side by side share, [0, top_um]: the largest peak of all maps,
 // capped at kSharedScaleCap (2) x the median map's 95th percentile of its deposit cells (cells
-// above 1 % of its peak; the lower middle one of an even count), so one blob (a run's, or a
+// above a 10^4th of its peak; the lower middle one of an even count), so one blob (a run's, or a
 // layer start's) does not wash the other maps' lines out (its cells above the top take the
 // top colour; the colour bar's label then gives the peak). 1 um when all are empty.
 struct SharedThicknessScale {

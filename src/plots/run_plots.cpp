@@ -555,11 +555,12 @@ void thickness_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& 
   const SharedThicknessScale scale = capped_thickness_scale({input.thickness});
   s += format("set cbrange [0:%.9g]\n",
               std::max(scale.capped ? scale.top_um : static_cast<double>(map.max_value()), 1e-3));
-  if (scale.capped)  // (just over the map, under the title)
-    s += format(
-        "set label 905 %s at graph 0.5, graph 1 center offset 0, 0.8 font \",9\" tc rgb "
-        "\"#404040\"\n",
-        style::quoted("colour scale " + capped_scale_note(scale, "")).c_str());
+  if (scale.capped)  // (just over the map, under the title, which moves up for it)
+    s += "set title offset 0, 0.8\n" +
+         format(
+             "set label 905 %s at graph 0.5, graph 1 center offset 0, 0.8 font \",9\" tc rgb "
+             "\"#404040\"\n",
+             style::quoted("colour scale " + capped_scale_note(scale, "")).c_str());
   s += "set cblabel " + style::quoted(style::axis_label("thickness", "µm")) + " offset 1.5,0\n";
   s += "set colorbox\n";
   s += map_ranges({&map}, input.toolpath);

@@ -63,21 +63,30 @@ TEST(ComparisonScale, TopIsThePeakUnlessABlobWouldWashTheLinesOut) {
   EXPECT_DOUBLE_EQ(scale.top_um, 1.5);
   EXPECT_DOUBLE_EQ(scale.peak_um, 1.5);
   // a blob of 50 um over a tenth of the second (more than its 5 %): topped at 2 x the lower
-  // run's 95th percentile (1 um, to a bin of 50 / 4096 um), the peak kept for the label
+  // run's 95th percentile (1 um), the peak kept for the label
   HeightMap blob = spotted_map(50.0f);
   for (size_t k = 0; k < blob.thickness_um.size(); k += 10) blob.thickness_um[k] = 50.0f;
   input.columns[1].thickness = &blob;
   scale = plots::shared_thickness_scale(input);
   EXPECT_TRUE(scale.capped);
   EXPECT_DOUBLE_EQ(scale.peak_um, 50.0);
-  EXPECT_GE(scale.top_um, plots::kSharedScaleCap * 1.0);
-  EXPECT_LE(scale.top_um, plots::kSharedScaleCap * (1.0 + 50.0 / 4096));
+  EXPECT_DOUBLE_EQ(scale.top_um, plots::kSharedScaleCap * 1.0);
   // with a third, even run the median run is an even one: the same top
   input.columns.push_back(input.columns[0]);
   EXPECT_DOUBLE_EQ(plots::shared_thickness_scale(input).top_um, scale.top_um);
   // with two of the three blobbed the median run is blobbed: the blob's 95th percentile
   input.columns[0].thickness = &blob;
   EXPECT_DOUBLE_EQ(plots::shared_thickness_scale(input).top_um, 50.0);
+  // one map, lines of 1 um beside a spot 200 times thicker (a dwell): the lines below 1 % of
+  // the peak still make the percentile, so the scale is topped at 2 um, not left at the spot
+  HeightMap dwell = spotted_map(200.0f);
+  plots::ComparisonInput alone;
+  alone.columns.resize(1);
+  alone.columns[0].thickness = &dwell;
+  scale = plots::shared_thickness_scale(alone);
+  EXPECT_TRUE(scale.capped);
+  EXPECT_DOUBLE_EQ(scale.top_um, plots::kSharedScaleCap * 1.0);
+  EXPECT_DOUBLE_EQ(scale.peak_um, 200.0);
   // nothing deposited: 1 um
   HeightMap empty = spotted_map(0.0f);
   for (float& v : empty.thickness_um) v = 0.0f;
