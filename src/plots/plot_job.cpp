@@ -1,8 +1,25 @@
 #include "plots/plot_job.hpp"
 
+#include <algorithm>
+#include <tuple>
+
 #include "plots/style.hpp"
 
 namespace depotwin::plots {
+
+PlanRanges plan_ranges(const Range& x, const Range& y, double pad_fraction, double min_half_width) {
+  PlanRanges r;
+  std::tie(r.x_lo, r.x_hi) = x.padded(pad_fraction, min_half_width);
+  std::tie(r.y_lo, r.y_hi) = y.padded(pad_fraction, min_half_width);
+  const auto widen = [](double& lo, double& hi, double least) {
+    const double grow = 0.5 * std::max(0.0, least - (hi - lo));
+    lo -= grow;
+    hi += grow;
+  };
+  widen(r.x_lo, r.x_hi, kMinPlanAspect * (r.y_hi - r.y_lo));
+  widen(r.y_lo, r.y_hi, kMinPlanAspect * (r.x_hi - r.x_lo));
+  return r;
+}
 
 std::string plot_command(const std::vector<std::string>& elements, const char* verb) {
   std::string command;

@@ -74,6 +74,15 @@ struct Range {
   }
 };
 
+// A plan view's x and y ranges (drawn at 1:1): each padded, then the shorter one widened
+// about its middle to kMinPlanAspect of the longer, so that a long thin job (100 x 2 mm)
+// is not drawn as a strip of a few pixels with its tick labels over each other
+constexpr double kMinPlanAspect = 1.0 / 3.0;
+struct PlanRanges {
+  double x_lo = 0.0, x_hi = 1.0, y_lo = 0.0, y_hi = 1.0;
+};
+PlanRanges plan_ranges(const Range& x, const Range& y, double pad_fraction, double min_half_width);
+
 // "plot a, b, c" from the non-empty elements (`verb`: "plot" or "splot")
 std::string plot_command(const std::vector<std::string>& elements, const char* verb = "plot");
 // "with lines lw .. dt .. lc rgb .."
@@ -99,6 +108,7 @@ void paths3d_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& da
 std::string thickness_map_elements(PlotJob& job, const HeightMap& map, const Toolpath* toolpath,
                                    const std::string& stem, bool path_key);
 // `set xrange/yrange` covering the maps' cells (to their edges) and the print paths
+// (plan_ranges), with tick steps
 std::string map_ranges(const std::vector<const HeightMap*>& maps, const Toolpath* toolpath);
 
 }  // namespace depotwin::plots

@@ -188,7 +188,9 @@ void path_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
   x.add_x(data.simulated_xy), y.add_y(data.simulated_xy);
   x.add(toolpath.start_mm.x()), y.add(toolpath.start_mm.y());
   x.add(toolpath.end_mm.x()), y.add(toolpath.end_mm.y());
-  s += "set xrange " + x.gnuplot(0.05, 0.5) + "\nset yrange " + y.gnuplot(0.05, 0.5) + "\n";
+  const PlanRanges frame = plan_ranges(x, y, 0.05, 0.5);
+  s += format("set xrange [%.9g:%.9g]\nset yrange [%.9g:%.9g]\n", frame.x_lo, frame.x_hi,
+              frame.y_lo, frame.y_hi);
 
   // print paths numbered in print order at their middle (as in the paper's Fig. 7), 0-based
   // as in trajectory.csv and metrics.json
@@ -523,8 +525,7 @@ std::string map_ranges(const std::vector<const HeightMap*>& maps, const Toolpath
   // one tic step on both axes (the map is drawn at 1:1), about four over the longer side, so a
   // tall narrow map does not crowd its x axis with the step its own width would get; an axis
   // that step leaves with fewer than three ticks gets a finer one of its own
-  const auto [x_lo, x_hi] = x.padded(0.0, 0.05);
-  const auto [y_lo, y_hi] = y.padded(0.0, 0.05);
+  const auto [x_lo, x_hi, y_lo, y_hi] = plan_ranges(x, y, 0.0, 0.05);
   const double shared_step = round_step_up(std::max(x_hi - x_lo, y_hi - y_lo) / 4.0);
   return format("set xrange [%.9g:%.9g]\nset yrange [%.9g:%.9g]\n", x_lo, x_hi, y_lo, y_hi) +
          format("set xtics %.9g\nset ytics %.9g\n", axis_tick_step(x_lo, x_hi, shared_step),

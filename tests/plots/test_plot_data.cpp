@@ -6,6 +6,7 @@
 
 #include "plot_fixture.hpp"
 #include "plots/plot_data.hpp"
+#include "plots/plot_job.hpp"
 #include "plots/plots.hpp"
 #include "plots/style.hpp"
 
@@ -207,6 +208,24 @@ TEST(DataText, FixedFormatWithBlankLinesAtBreaks) {
   curve.add_break();  // doubled breaks collapse
   curve.add(5.0, 1e6);
   EXPECT_EQ(plots::format_curve(curve), "0.1 2\n0.333333333 -1e-07\n\n5 1000000\n");
+}
+
+// A long thin job (100 x 2 mm) is framed at least a third as wide as long, about its middle,
+// so that its plan views are not strips of a few pixels; a square one keeps its padding only
+TEST(PlanRanges, ALongThinJobIsFramedAtLeastAThirdAsWideAsLong) {
+  plots::Range x, y;
+  x.add(-50.0), x.add(50.0);
+  y.add(-1.0), y.add(1.0);
+  const plots::PlanRanges thin = plots::plan_ranges(x, y, 0.05, 0.5);
+  EXPECT_DOUBLE_EQ(thin.x_lo, -55.0);
+  EXPECT_DOUBLE_EQ(thin.x_hi, 55.0);
+  EXPECT_NEAR(thin.y_hi - thin.y_lo, 110.0 * plots::kMinPlanAspect, 1e-9);
+  EXPECT_NEAR(thin.y_lo + thin.y_hi, 0.0, 1e-9);
+  plots::Range square;
+  square.add(0.0), square.add(10.0);
+  const plots::PlanRanges even = plots::plan_ranges(square, square, 0.05, 0.5);
+  EXPECT_DOUBLE_EQ(even.x_lo, -0.5);
+  EXPECT_DOUBLE_EQ(even.y_hi, 10.5);
 }
 
 }  // namespace
