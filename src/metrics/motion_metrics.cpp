@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "core/interrupt.hpp"
 #include "metrics/polyline_distance.hpp"
@@ -146,10 +147,10 @@ std::vector<TimeSpan> speed_ramps(const MotionSamples& planned) {
     const double inner = last > first ? half_gap(first, first + 1) : 1e-9;
     const double before = first > 0 ? half_gap(first - 1, first) : inner;
     const double after = last + 1 < n ? half_gap(last, last + 1) : inner;
-    // A stretch that never reaches its desired speed is at speed where it reaches its own
-    // top speed: a line held below the speed on purpose (the limits, or conformal's
-    // constant scale-down) has a steady part, whose error is that shortfall.
-    // A peak (no sample between the first and last at that speed) is ramp throughout.
+    // A stretch that never reaches its desired speed is at speed where it holds its own top
+    // speed: a line held below the speed on purpose (the limits, or conformal's constant
+    // scale-down) has a steady part, whose error is that shortfall. Peaks that do not hold
+    // it (short moves' triangles, however many) are ramp throughout.
     double ceiling = std::numeric_limits<double>::infinity();
     size_t steady_first = first;
     while (steady_first <= last && !reached(steady_first, ceiling)) ++steady_first;
@@ -158,13 +159,27 @@ std::vector<TimeSpan> speed_ramps(const MotionSamples& planned) {
       ceiling = 0.0;
       for (size_t i = first; i <= last; ++i)
         ceiling = std::max(ceiling, planned.velocity_mm_s[i].norm());
-      steady_first = first;
-      while (steady_first < last && !reached(steady_first, ceiling)) ++steady_first;
-      while (steady_last > steady_first && !reached(steady_last, ceiling)) --steady_last;
-      if (ceiling <= 0.0 || steady_last <= steady_first + 1) {
+      // the first and last runs of samples at that speed held kHeldTopSpeed_s or longer
+      std::optional<size_t> first_held, last_held;
+      for (size_t i = first; i <= last;) {
+        if (!reached(i, ceiling)) {
+          ++i;
+          continue;
+        }
+        size_t end = i;
+        while (end < last && reached(end + 1, ceiling)) ++end;
+        if (planned.t_s[end] - planned.t_s[i] >= kHeldTopSpeed_s) {
+          if (!first_held) first_held = i;
+          last_held = end;
+        }
+        i = end + 1;
+      }
+      if (!(ceiling > 0.0) || !first_held) {
         ramps.push_back({planned.t_s[first] - before, planned.t_s[last] + after});
         continue;
       }
+      steady_first = *first_held;
+      steady_last = *last_held;
     }
     while (!reached(steady_last, ceiling)) --steady_last;
     // each ramp takes in the first (last) sample at speed: the servo follows a period late

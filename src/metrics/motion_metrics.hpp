@@ -49,6 +49,9 @@ struct TimeSpan {
 // (the cruise of an LSPB or a trapezoid is exact; a Bezier path's central part is within
 // 1e-9); a ramp ends where the plan first comes this close.
 constexpr double kRampTolerance_rel = 1e-4;
+// a stretch that never reaches its desired speed counts as at speed where it holds its own
+// top speed (within kRampTolerance_rel) for at least this long: a cruise, not a peak
+constexpr double kHeldTopSpeed_s = 0.01;
 
 // The start and end ramps of a plan (the papers' "central part" is what lies between):
 // every printed stretch (a maximal run of consecutive samples that deposit with a desired
@@ -58,14 +61,14 @@ constexpr double kRampTolerance_rel = 1e-4;
 // such sample (included) to its end. The sample at speed is part of the ramp because the
 // servo follows its setpoints a control period late: on the delta the simulated nozzle is
 // still 11 % short of 5 mm/s there, and within 0.4 % one period later. A stretch that never
-// reaches the desired speed is at speed where it reaches its own top planned speed (within
-// the same margin): a line held below its speed on purpose (by the limits, or conformal's
-// constant scale-down) has a steady part whose error is that shortfall. Where no sample
-// lies between its first and last at that speed (a peak, not a cruise), it is ramp
-// throughout: one span, as is a stretch at speed at one sample only (its start and end
-// ramps share that sample, counted once). The spans reach half a sample period beyond
-// their outer samples (open ends), so that the samples of another run at other times (the
-// simulation's) fall in them as the plan's would.
+// reaches the desired speed is at speed from the first to the last time it holds its own top
+// planned speed (within the same margin) for kHeldTopSpeed_s or longer: a line held below its
+// speed on purpose (by the limits, or conformal's constant scale-down) has a steady part
+// whose error is that shortfall. One that never holds it (its top a peak, or peaks: short
+// moves' triangles) is ramp throughout: one span, as is a stretch at speed at one sample
+// only (its start and end ramps share that sample, counted once). The spans reach half a sample
+// period beyond their outer samples (open ends), so that the samples of another run at other times
+// (the simulation's) fall in them as the plan's would.
 std::vector<TimeSpan> speed_ramps(const MotionSamples& planned);
 
 // velocity_error over the samples outside the spans (the steady error: outside the ramps)

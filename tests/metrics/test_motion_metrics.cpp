@@ -120,6 +120,25 @@ TEST(SpeedRamps, AStretchNeverAtSpeedIsAllRamp) {
   EXPECT_GT(velocity_error(planned).counted_s, trap.printing_s() - 1e-3);
 }
 
+// Connected short moves, each a triangle up to the same 3 mm/s (against 4 mm/s) and down to
+// rest at the joint: peaks, not a cruise, however many: ramp throughout (the stops between the
+// first and last peak were counted as steady error, 100 %, or not, as the peaks' last digits
+// fell)
+TEST(SpeedRamps, RepeatedPeaksBelowTheSpeedAreAllRamp) {
+  MotionSamples planned;
+  const double period_s = 1e-3, ramp_s = 0.1, v = 3.0;
+  double x = 0.0;
+  for (int k = 0; k <= 600; ++k) {
+    const double t = k * period_s, within = std::fmod(t, 2 * ramp_s);
+    const double speed = v * (within < ramp_s ? within : 2 * ramp_s - within) / ramp_s;
+    x += speed * period_s;
+    planned.push_back(t, Vec3(x, 0, 0), Vec3(speed, 0, 0), true, k / 200, 4.0);
+  }
+  const std::vector<TimeSpan> ramps = speed_ramps(planned);
+  ASSERT_EQ(ramps.size(), 1u);
+  EXPECT_EQ(velocity_error(planned, ramps).counted_s, 0.0);
+}
+
 // A stretch at its desired speed at one sample only (a triangle whose top sample is exactly
 // at speed): its start and end ramps share that sample, one span whose time counts it once,
 // not more than the stretch lasts (it was two spans, 1 ms over the print time)
