@@ -159,17 +159,22 @@ LocalRunSummary run_tasks_locally(const Sweep& sweep, const std::vector<std::uin
   }, previous{};
   ignore.sa_handler = SIG_IGN;
   ::sigaction(SIGPIPE, &ignore, &previous);
-  // Ctrl-C or a kill: recorded here (the workers ignore SIGINT), the workers ended, then the
-  // signal's own action
-  // (SIGHUP too: a closed terminal or a dropped ssh session)
+  // Ctrl-C or a kill: recorded here (the workers ignore SIGINT), the workers asked to stop,
+  // then this process (SIGHUP too: a closed terminal or a dropped ssh session). A signal
+  // ignored (nohup, a script's background job) stays ignored, here and in the workers,
+  // which inherit it
   struct sigaction stop {
   }, previous_int{}, previous_term{}, previous_hup{};
   stop.sa_handler = record_stop_signal;
   sigemptyset(&stop.sa_mask);
   g_stop_signal = 0;
-  ::sigaction(SIGINT, &stop, &previous_int);
-  ::sigaction(SIGTERM, &stop, &previous_term);
-  ::sigaction(SIGHUP, &stop, &previous_hup);
+  const auto catch_unless_ignored = [&](int signal_number, struct sigaction& previous_action) {
+    ::sigaction(signal_number, nullptr, &previous_action);
+    if (previous_action.sa_handler != SIG_IGN) ::sigaction(signal_number, &stop, nullptr);
+  };
+  catch_unless_ignored(SIGINT, previous_int);
+  catch_unless_ignored(SIGTERM, previous_term);
+  catch_unless_ignored(SIGHUP, previous_hup);
   // a signal that came before (while the tasks were checked) stops the run before it starts
   if (const int earlier = interrupt_signal(); earlier != 0) g_stop_signal = earlier;
 

@@ -404,6 +404,31 @@ TEST_F(SweepRoutes, ALocalRunSignalledAsAGroupLeavesNothingHalfWritten) {
   }
 }
 
+// started with SIGHUP ignored (nohup), a local run and its workers keep ignoring it: a hangup
+// to the whole group mid-run changes nothing (it stopped the run once its workers ran)
+TEST_F(SweepRoutes, ALocalRunStartedUnderNohupIgnoresAHangup) {
+  const std::string sweep = write_text(dir_, "nohup.yaml", kTwoTasks);
+  const std::string out = dir_ + "/nohup";
+  struct sigaction ignore {
+  }, previous{};
+  ignore.sa_handler = SIG_IGN;
+  ::sigaction(SIGHUP, &ignore, &previous);
+  const pid_t pid =
+      spawn_depotwin({"sweep", sweep, "-j", "2", "--out", out, "--quiet", "--no-render"},
+                     /*own_group=*/true);
+  ::sigaction(SIGHUP, &previous, nullptr);
+  ASSERT_GT(pid, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (names_holding(out, ".partial").empty() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ::kill(-pid, SIGHUP);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+  for (const char* task : {"/tasks/0000/task.json", "/tasks/0001/task.json"})
+    EXPECT_NE(read_text(out + task).find("\"ok\""), std::string::npos) << task;
+}
+
 TEST_F(SweepRoutes, KeepAllKeepsWhatRunNoRenderWrites) {
   const std::string sweep = write_text(dir_, "keep_all.yaml", R"(base: base.yaml
 keep: all
