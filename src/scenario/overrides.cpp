@@ -11,6 +11,7 @@
 
 #include "core/number_text.hpp"
 #include "scenario/override_tree.hpp"
+#include "scenario/scenario.hpp"
 
 namespace depotwin {
 
@@ -403,6 +404,7 @@ ResolvedScenario resolve_scenario(const std::string& path, const std::string& te
     if (tree["machine"] && tree["machine"].IsMap()) add_file(tree["machine"]["model"]);
     if (tree["machine"] && tree["machine"].IsScalar())
       resolved.shipped_machine = tree["machine"].Scalar();
+    if (!tree["machine"]) resolved.shipped_machine = kDefaultMachine;  // none named
     const YAML::Node toolpath = tree["toolpath"];
     if (toolpath && toolpath.IsMap()) {
       const YAML::Node gcode = toolpath["gcode"];

@@ -43,8 +43,9 @@ struct ResolvedScenario {
   // files the scenario reads besides itself (G-code, STL, MJCF model), resolved against the
   // scenario file's directory, in the order the tree names them
   std::vector<std::string> input_files;
-  // the shipped machine named by `machine: NAME` ("" for an MJCF of one's own, or none): it
-  // reads that machine's model from the models folder, which the loader's caller knows
+  // the shipped machine named by `machine: NAME`, or the default when none is named ("" for an
+  // MJCF of one's own): it reads that machine's model from the models folder, which the
+  // loader's caller knows
   std::string shipped_machine;
   // the run label (label:, else name) of each `planners` entry; nothing when the tree has no
   // `planners` (the loader's default planners run)

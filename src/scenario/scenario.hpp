@@ -119,13 +119,16 @@ struct PathSource {
   std::vector<int> point_lines;
 };
 
+// the machine of a scenario that names none
+inline constexpr const char* kDefaultMachine = "xy_stage";
+
 struct Scenario {
   std::string file;       // the scenario file as given
   std::string directory;  // its directory: relative paths resolve against it
   std::string name;
   // a registered machine (kinematics/registry.cpp): `machine: NAME`, or
   // `machine: {model: FILE.xml, kinematics: NAME}` for an MJCF model of one's own
-  std::string machine = "xy_stage";
+  std::string machine = kDefaultMachine;
   int machine_line = 0;           // where it was given, for messages
   std::string model_path;         // the resolved MJCF file of `machine: {model: ...}`; "" for the
                                   // machine's shipped model

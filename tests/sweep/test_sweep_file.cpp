@@ -416,6 +416,33 @@ TEST(ScenarioOverrides, HashesFollowTheShippedMachinesModel) {
   EXPECT_EQ(Sweep(file, "").input_hash(Sweep(file, "").task(0)), as_shipped);
 }
 
+// a scenario that names no machine runs the default one, xy_stage: its model counts the same
+TEST(ScenarioOverrides, HashesFollowTheDefaultMachinesModel) {
+  const std::string dir = fresh_directory("sweep_hash_default_model");
+  const std::string models = dir + "/models";
+  std::filesystem::create_directories(models);
+  const std::string shipped = read_text(std::string(DEPOTWIN_SOURCE_DIR) + "/models/xy_stage.xml");
+  write_text(models, "xy_stage.xml", shipped);
+  std::string fig7 = read_text(scenario_path("thompson_fig7.yaml"));
+  const std::size_t named = fig7.find("machine: xy_stage\n");
+  ASSERT_NE(named, std::string::npos);
+  fig7.erase(named, std::string("machine: xy_stage\n").size());
+  write_text(dir, "base.yaml", fig7);
+  const std::string file =
+      write_text(dir, "s.yaml", "base: base.yaml\ngrid:\n  planner: [lspb_mtt, stop_and_go]\n");
+  const char* previous = std::getenv("DEPOTWIN_MODELS_DIR");
+  const std::string previous_models = previous ? previous : "";
+  ::setenv("DEPOTWIN_MODELS_DIR", models.c_str(), 1);
+  const std::string as_shipped = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+  write_text(models, "xy_stage.xml", shipped + "<!-- retuned -->\n");
+  const std::string retuned = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+  if (previous)
+    ::setenv("DEPOTWIN_MODELS_DIR", previous_models.c_str(), 1);
+  else
+    ::unsetenv("DEPOTWIN_MODELS_DIR");
+  EXPECT_NE(retuned, as_shipped);
+}
+
 TEST(SweepTasks, ValidateAllListsEachProblemOnceWithTheTasksItConcerns) {
   const std::string dir = fresh_directory("sweep_validate");
   const std::string file =
