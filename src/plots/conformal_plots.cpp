@@ -392,7 +392,9 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
   // left of the first column, x under the last panel of each column), panel titles and gaps;
   // the grid of rows x columns that draws the maps largest, centred in the region.
   const double ex = data.layers_x_hi - data.layers_x_lo, ey = data.layers_y_hi - data.layers_y_lo;
-  constexpr double kRegionLeft = 30, kRegionRight = 690, kRegionTop = 44, kRegionBottom = 470;
+  constexpr double kRegionLeft = 30, kRegionRight = 690, kRegionTop = 44;
+  // (a topped scale's note takes a line under the x label: the grid ends higher for it)
+  const double kRegionBottom = data.layer_scale.capped ? 444 : 470;
   constexpr double kTicsLeft = 50, kTicsBottom = 22, kTitleTop = 22, kGap = 24, kRowGap = 4;
   size_t columns = 1;
   double scale = 0.0;  // px per mm
@@ -433,7 +435,7 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
     s += format(
         "set label 904 %s at screen 0.5, %.4f center tc rgb \"#404040\"\n",
         style::quoted("colour scale " + capped_scale_note(data.layer_scale, "layer")).c_str(),
-        1.0 - std::min(maps_bottom + kTicsBottom + 40, height_px - 12.0) / height_px);
+        1.0 - (maps_bottom + kTicsBottom + 40) / height_px);
   // the map's zero colour behind each panel, so that the extent a layer's grid does not
   // cover reads as "nothing there" like its empty cells
   s += "set object 1 rect from graph 0, graph 0 to graph 1, graph 1 behind fc rgb \"#440154\" "
