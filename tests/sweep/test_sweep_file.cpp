@@ -382,47 +382,69 @@ TEST(ScenarioOverrides, HashesFollowTheInputsNotTheWorkingDirectory) {
   EXPECT_NE(Sweep(file, "").input_hash(Sweep(file, "").task(0)), model_one);
 }
 
+// A private copy of the shipped xy_stage model that DEPOTWIN_MODELS_DIR points at while the
+// object lives (the previous value comes back after), so a test can retune the machine
+class PrivateModelsFolder {
+ public:
+  explicit PrivateModelsFolder(const std::string& dir)
+      : folder_(dir + "/models"),
+        shipped_(read_text(std::string(DEPOTWIN_SOURCE_DIR) + "/models/xy_stage.xml")) {
+    std::filesystem::create_directories(folder_);
+    write_stage(shipped_);
+    const char* previous = std::getenv("DEPOTWIN_MODELS_DIR");
+    had_previous_ = previous != nullptr;
+    previous_ = previous ? previous : "";
+    ::setenv("DEPOTWIN_MODELS_DIR", folder_.c_str(), 1);
+  }
+  ~PrivateModelsFolder() {
+    if (had_previous_)
+      ::setenv("DEPOTWIN_MODELS_DIR", previous_.c_str(), 1);
+    else
+      ::unsetenv("DEPOTWIN_MODELS_DIR");
+  }
+  PrivateModelsFolder(const PrivateModelsFolder&) = delete;
+  PrivateModelsFolder& operator=(const PrivateModelsFolder&) = delete;
+
+  const std::string& shipped() const { return shipped_; }
+  void write_stage(const std::string& mjcf) const { write_text(folder_, "xy_stage.xml", mjcf); }
+
+ private:
+  std::string folder_, shipped_, previous_;
+  bool had_previous_ = false;
+};
+
 // A shipped machine (`machine: xy_stage`) reads its MJCF from the models folder: those bytes
 // count too, so a retuned model makes every task stale (and another folder of the same
 // models gives the same hash)
 TEST(ScenarioOverrides, HashesFollowTheShippedMachinesModel) {
   const std::string dir = fresh_directory("sweep_hash_model");
-  const std::string models = dir + "/models";
-  std::filesystem::create_directories(models);
-  const std::string shipped = read_text(std::string(DEPOTWIN_SOURCE_DIR) + "/models/xy_stage.xml");
-  write_text(models, "xy_stage.xml", shipped);
   write_text(dir, "base.yaml", read_text(scenario_path("thompson_fig7.yaml")));
   const std::string file =
       write_text(dir, "s.yaml", "base: base.yaml\ngrid:\n  planner: [lspb_mtt, stop_and_go]\n");
-  const char* previous = std::getenv("DEPOTWIN_MODELS_DIR");
-  const std::string previous_models = previous ? previous : "";
-  ::setenv("DEPOTWIN_MODELS_DIR", models.c_str(), 1);
-  const std::string as_shipped = Sweep(file, "").input_hash(Sweep(file, "").task(0));
-  // a body heavier (a digit put before its first mass)
-  std::string heavier = shipped;
-  const std::size_t mass = heavier.find("mass=\"");
-  ASSERT_NE(mass, std::string::npos);
-  heavier.insert(mass + 6, "1");
-  write_text(models, "xy_stage.xml", heavier);
-  const std::string retuned = Sweep(file, "").input_hash(Sweep(file, "").task(0));
-  write_text(models, "xy_stage.xml", shipped);
-  const std::string restored = Sweep(file, "").input_hash(Sweep(file, "").task(0));
-  if (previous)
-    ::setenv("DEPOTWIN_MODELS_DIR", previous_models.c_str(), 1);
-  else
-    ::unsetenv("DEPOTWIN_MODELS_DIR");
-  EXPECT_NE(retuned, as_shipped);
-  EXPECT_EQ(restored, as_shipped);
+  std::string as_shipped;
+  {
+    const PrivateModelsFolder models(dir);
+    as_shipped = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+    // a body heavier (a digit put before its first mass)
+    std::string heavier = models.shipped();
+    const std::size_t mass = heavier.find("mass=\"");
+    ASSERT_NE(mass, std::string::npos);
+    heavier.insert(mass + 6, "1");
+    models.write_stage(heavier);
+    const std::string retuned = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+    models.write_stage(models.shipped());
+    const std::string restored = Sweep(file, "").input_hash(Sweep(file, "").task(0));
+    EXPECT_NE(retuned, as_shipped);
+    EXPECT_EQ(restored, as_shipped);
+  }
+  // the models folder the tests run with (the shipped one): the same bytes, the same hash
   EXPECT_EQ(Sweep(file, "").input_hash(Sweep(file, "").task(0)), as_shipped);
 }
 
 // a scenario that names no machine runs the default one, xy_stage: its model counts the same
 TEST(ScenarioOverrides, HashesFollowTheDefaultMachinesModel) {
   const std::string dir = fresh_directory("sweep_hash_default_model");
-  const std::string models = dir + "/models";
-  std::filesystem::create_directories(models);
-  const std::string shipped = read_text(std::string(DEPOTWIN_SOURCE_DIR) + "/models/xy_stage.xml");
-  write_text(models, "xy_stage.xml", shipped);
+  const PrivateModelsFolder models(dir);
   std::string fig7 = read_text(scenario_path("thompson_fig7.yaml"));
   const std::size_t named = fig7.find("machine: xy_stage\n");
   ASSERT_NE(named, std::string::npos);
@@ -430,16 +452,9 @@ TEST(ScenarioOverrides, HashesFollowTheDefaultMachinesModel) {
   write_text(dir, "base.yaml", fig7);
   const std::string file =
       write_text(dir, "s.yaml", "base: base.yaml\ngrid:\n  planner: [lspb_mtt, stop_and_go]\n");
-  const char* previous = std::getenv("DEPOTWIN_MODELS_DIR");
-  const std::string previous_models = previous ? previous : "";
-  ::setenv("DEPOTWIN_MODELS_DIR", models.c_str(), 1);
   const std::string as_shipped = Sweep(file, "").input_hash(Sweep(file, "").task(0));
-  write_text(models, "xy_stage.xml", shipped + "<!-- retuned -->\n");
+  models.write_stage(models.shipped() + "<!-- retuned -->\n");
   const std::string retuned = Sweep(file, "").input_hash(Sweep(file, "").task(0));
-  if (previous)
-    ::setenv("DEPOTWIN_MODELS_DIR", previous_models.c_str(), 1);
-  else
-    ::unsetenv("DEPOTWIN_MODELS_DIR");
   EXPECT_NE(retuned, as_shipped);
 }
 
