@@ -57,7 +57,8 @@ void joints_at(const Machine& machine, const TrajectorySample& sample, const Joi
                      "keep the paths farther from the edge, raise limits.a_max (and "
                      "limits.j_max where one is set: a jerk-limited stop takes longer; this is "
                      "where the move first leaves the travel, not how far it goes), or plan with "
-                     "stop_and_go, which starts and ends every path at rest)");
+                     "stop_and_go, which starts and ends every path at rest, or uniform, which "
+                     "does so where a move at speed would leave the travel)");
   };
   const bool solved = seed ? machine.inverse_near(sample.pose(), *seed, joints, &why)
                            : machine.inverse(sample.pose(), joints, &why);

@@ -864,6 +864,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
     // at print speed, the shutter closed; extrusion: the line ends at rest, the nozzle travels
     // with the flow off and the next line starts from rest, where the overlap calls for a trim)
     const auto add_loops = [&]() {
+      if (!options.loops_allowed) return;
       const double overlap = overlap_mm(g, model);
       if (!model.aerosol() && overlap <= 0.0) return;
       const double edge_in = (chain.points[corner] - chain.points[corner - 1]).norm();
@@ -917,6 +918,12 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
       // did not). The loops first, so the slowed corners can stop as soon as they cannot win
       add_loops();
       add_slowed(true);
+      // no loop allowed and no blend to slow: the corner taken at rest
+      if (candidates.empty()) {
+        CornerPlan plan;
+        plan.treatment = CornerTreatment::stop;
+        add("stop", plan, false);
+      }
     } else {
       // an extruder's flow follows the speed: slowed corners compete, and smaller blends may
       // win after a larger one lost (at 60 deg: the third), so their series runs in full

@@ -108,6 +108,9 @@ struct PathMotionOptions {
   // loops leave and re-enter their lines at rest (extrusion: the line ends at rest, the nozzle
   // travels with the flow off, the next line starts from rest); else at the lines' speeds
   bool loops_at_rest = false;
+  // corners may be looped (choose_corner's loop candidates); false where a loop's excursion
+  // past the corner would leave the machine's travel (the uniform planner finds that)
+  bool loops_allowed = true;
   // a speed change from or to rest (or a corner held at its cap) across blended corners whose
   // lines are too short for it is planned as one curve (the look-ahead changes speed on the
   // lines only)

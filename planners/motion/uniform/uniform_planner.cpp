@@ -26,6 +26,66 @@ Toolpath with_arcs_chorded(const Toolpath& toolpath, double tolerance_mm) {
   return chorded;
 }
 
+// A transition's samples for the travel check: at most kTravelSamplePeriod_s apart (and at
+// least kTravelMinSamples), plus each instant an axis turns back (its velocity crosses zero,
+// found by bisection), where that axis' overshoot peaks
+constexpr double kTravelSamplePeriod_s = 2e-3;
+constexpr int kTravelMinSamples = 16, kTravelMaxSamples = 4096, kTurnBisections = 48;
+// how many times a plan is made again for its moves beyond the travel (each time more chains
+// at rest at their ends or without loops)
+constexpr int kTravelAttempts = 2;
+
+// true when the transition piece takes some joint beyond its travel (or a pose out of
+// reach): a move that leaves or enters a path at speed overshoots that path's end, which
+// near the travel's end lies outside it
+bool leaves_travel(const TrajectoryPiece& piece, const JointMap& joint_map) {
+  const double duration_s = piece.t_end_s - piece.t_begin_s;
+  if (!(duration_s > 0.0)) return false;
+  const int n = std::clamp(static_cast<int>(std::ceil(duration_s / kTravelSamplePeriod_s)),
+                           kTravelMinSamples, kTravelMaxSamples);
+  std::vector<double> taus;
+  std::vector<Vec3> velocities;
+  taus.reserve(n + 8);
+  velocities.reserve(n + 1);
+  Vec3 position, velocity, acceleration;
+  for (int k = 0; k <= n; ++k) {
+    const double tau = duration_s * k / n;
+    evaluate_motion(piece, tau, position, velocity, acceleration);
+    taus.push_back(tau);
+    velocities.push_back(velocity);
+  }
+  for (int k = 0; k < n; ++k)
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(velocities[k][axis] * velocities[k + 1][axis] < 0.0)) continue;
+      double lo = taus[k], hi = taus[k + 1];
+      const bool rising = velocities[k][axis] < 0.0;
+      for (int i = 0; i < kTurnBisections; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        evaluate_motion(piece, mid, position, velocity, acceleration);
+        ((velocity[axis] < 0.0) == rising ? lo : hi) = mid;
+      }
+      taus.push_back(0.5 * (lo + hi));
+    }
+  std::vector<Pose> poses;
+  poses.reserve(taus.size());
+  std::sort(taus.begin(), taus.end());
+  for (const double tau : taus) {
+    Vec3 axis_now, turning;
+    double roll = 0.0;
+    evaluate_motion(piece, tau, position, velocity, acceleration);
+    evaluate_tool_axis(piece, tau, position, velocity, axis_now, turning, roll);
+    poses.emplace_back(position, axis_now, roll);
+  }
+  std::vector<JointVector> joints;
+  if (!joint_map.solve(poses, joints, nullptr)) return true;
+  for (const JointVector& q : joints)
+    for (size_t j = 0; j < q.size() && j < joint_map.limits.size(); ++j)
+      if (q[j] < joint_map.limits[j].min - kTravelRounding_mm ||
+          q[j] > joint_map.limits[j].max + kTravelRounding_mm)
+        return true;
+  return false;
+}
+
 // fine edges are merged within this share of the tolerance (merge_fine_edges); the blends keep
 // to the rest
 constexpr double kMergeShare = 0.5;
@@ -290,219 +350,299 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
       joints != nullptr && joints->turns_tool && turns_tool(toolpath))
     return plan_on_joints(toolpath, jerk_limits, settings_, model);
 
-  PathMotionOptions options;
-  options.enter_at_speed = options.leave_at_speed = aerosol;
-  options.lag_s = aerosol ? 0.0 : model.settings.tau_s;
-  options.flow_follows_speed = !aerosol;
-  options.flow_may_retract = !aerosol && model.settings.retract;
-  options.loops_at_rest = !aerosol;
-  options.period_s = settings_.period_s;
-  options.curved_ramps = settings_.curved_ramps;
+  PathMotionOptions base_options;
+  base_options.enter_at_speed = base_options.leave_at_speed = aerosol;
+  base_options.lag_s = aerosol ? 0.0 : model.settings.tau_s;
+  base_options.flow_follows_speed = !aerosol;
+  base_options.flow_may_retract = !aerosol && model.settings.retract;
+  base_options.loops_at_rest = !aerosol;
+  base_options.period_s = settings_.period_s;
+  base_options.curved_ramps = settings_.curved_ramps;
 
   const Toolpath chorded = with_arcs_chorded(toolpath, settings_.tolerance_mm);
+  const std::vector<PrintChain> chains = print_chains(chorded);
+  // (aerosol) the chains entered or left at rest instead of at print speed: the transition
+  // at speed took a joint beyond its travel (see the end of the attempt loop)
+  std::vector<char> enter_at_rest(chains.size(), 0), leave_at_rest(chains.size(), 0);
+  // (aerosol) the chains whose corners may not be looped: a loop took a joint beyond its travel
+  std::vector<char> without_loops(chains.size(), 0);
+  // each chain's pieces [first, end) in `pieces`
+  std::vector<std::pair<size_t, size_t>> chain_pieces(chains.size());
+  const JointMap* joint_map = jerk_limits.joint_map();
 
   std::vector<TrajectoryPiece> pieces;
   std::vector<PlanDecision> decisions;
   double t = 0.0;
   Vec3 position = toolpath.start_mm, velocity = Vec3::Zero();
   ToolOrientation orientation = toolpath.start_orientation();
+  // each transition: its piece and the chains it leaves and enters (-1: the job's start, end)
+  struct ChainTransition {
+    size_t piece = 0;
+    int from_chain = -1, to_chain = -1;
+  };
+  std::vector<ChainTransition> transitions;
+  int current_chain = -1;
   const auto add_transition = [&](const Vec3& to, const Vec3& to_velocity,
-                                  const ToolOrientation& to_orientation) {
+                                  const ToolOrientation& to_orientation, int to_chain) {
     if ((to - position).norm() <= 1e-12 && (to_velocity - velocity).norm() <= 1e-12) return;
+    transitions.push_back(ChainTransition{pieces.size(), current_chain, to_chain});
     pieces.push_back(transition_piece(t, position, velocity, to, to_velocity, jerk_limits,
                                       orientation, to_orientation));
     t = pieces.back().t_end_s;
   };
   PredictionScratch scratch;  // the corner predictions' processes, reused
+  // (a corner's decision does not depend on how its chain's ends are taken: its window enters
+  // and leaves at speed; it does on whether loops are allowed)
   CornerDecisionCache decided(jerk_limits, settings_.reuse_corner_decisions);
-  for (const PrintChain& given : print_chains(chorded)) {
-    // fine chords merged into edges their corners' blends fit (merge_fine_edges), each corner's
-    // blend within the tolerance left by its edges' merging
-    const MergedChain merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm);
-    const PrintChain& chain = merged.chain;
-    // each corner's treatment, by the predicted deposit
-    const std::vector<CornerGeometry> geometry =
-        corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
-    // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),
-    // where a corner alone cannot keep the print speed: at the print speed, not weighed (an
-    // even line within the tolerance); below it, weighed below; their corners reported as
-    // "arc"
-    const std::vector<std::shared_ptr<const ArcRun>> runs =
-        settings_.arc_runs
-            ? find_arc_runs(merged, given, geometry, settings_.tolerance_mm, jerk_limits, options)
-            : std::vector<std::shared_ptr<const ArcRun>>{};
-    std::vector<CornerPlan> corners(chain.points.size());
-    for (const std::shared_ptr<const ArcRun>& run : runs)
-      for (size_t i = run->first_corner(); i <= run->last_corner(); ++i) {
-        corners[i].treatment = CornerTreatment::arc;
-        corners[i].arc = run;
+  CornerDecisionCache decided_without_loops(jerk_limits, settings_.reuse_corner_decisions);
+  for (int attempt = 0;; ++attempt) {
+    pieces.clear();
+    decisions.clear();
+    transitions.clear();
+    t = 0.0;
+    position = toolpath.start_mm, velocity = Vec3::Zero();
+    orientation = toolpath.start_orientation();
+    current_chain = -1;
+    for (size_t c = 0; c < chains.size(); ++c) {
+      const PrintChain& given = chains[c];
+      PathMotionOptions options = base_options;
+      options.enter_at_speed = base_options.enter_at_speed && !enter_at_rest[c];
+      options.leave_at_speed = base_options.leave_at_speed && !leave_at_rest[c];
+      options.loops_allowed = !without_loops[c];
+      // what the travel changed, reported at the chain's first point
+      if (enter_at_rest[c] || leave_at_rest[c] || without_loops[c]) {
+        PlanDecision d;
+        d.path_index = given.point_path.front();
+        d.point_index = given.point_index.front();
+        d.kind = "path";
+        d.choice = "within_travel";
+        d.figures.push_back({"print_speed_mm_s", given.edge_speed_mm_s.front(), "mm/s"});
+        d.figures.push_back({"enters_at_rest", enter_at_rest[c] ? 1.0 : 0.0, "flag"});
+        d.figures.push_back({"leaves_at_rest", leave_at_rest[c] ? 1.0 : 0.0, "flag"});
+        d.figures.push_back({"loops_allowed", without_loops[c] ? 0.0 : 1.0, "flag"});
+        decisions.push_back(std::move(d));
       }
-    std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
-    const auto decide = [&](size_t i) {
-      chain_decisions.emplace_back(i, decided.decision(chain, i, geometry, [&]() {
-        return choose_corner(chain, i, geometry, jerk_limits, options, model,
-                             settings_.time_weight_mm_s, scratch);
-      }));
-      return chain_decisions.back().second.chosen.plan;
-    };
-    for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
-      if (taken_straight_on(geometry[i]) || corners[i].treatment == CornerTreatment::arc) continue;
-      corners[i] = decide(i);
-    }
-    // planned from 0, then placed after the transition that brings the nozzle to its start;
-    // blends that hold the look-ahead back are shrunk and the chain planned again (the quickest
-    // plan kept, its corners in `plan`)
-    const auto plan_resizing = [&](std::vector<CornerPlan>& plan) {
-      PlannedPath planned = plan_chain(chain, geometry, plan, jerk_limits, options, 0.0);
-      const std::vector<CornerPlan> chosen = plan;
-      std::vector<CornerPlan> trial = plan;
-      // (the look-ahead's corner speeds, without curved ramps: the trials are the same with
-      // or without them, each plan with them no slower)
-      std::vector<double> trial_speeds = planned.lookahead_corner_speed_mm_s;
-      for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
-                                                                    jerk_limits, chosen, trial);
-           ++pass) {
-        PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
-        trial_speeds = replanned.lookahead_corner_speed_mm_s;
-        if (replanned.t_end_s < planned.t_end_s) {
-          planned = std::move(replanned);
-          plan = trial;
+      // fine chords merged into edges their corners' blends fit (merge_fine_edges), each corner's
+      // blend within the tolerance left by its edges' merging
+      const MergedChain merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm);
+      const PrintChain& chain = merged.chain;
+      // each corner's treatment, by the predicted deposit
+      const std::vector<CornerGeometry> geometry =
+          corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
+      // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),
+      // where a corner alone cannot keep the print speed: at the print speed, not weighed (an
+      // even line within the tolerance); below it, weighed below; their corners reported as
+      // "arc"
+      const std::vector<std::shared_ptr<const ArcRun>> runs =
+          settings_.arc_runs
+              ? find_arc_runs(merged, given, geometry, settings_.tolerance_mm, jerk_limits, options)
+              : std::vector<std::shared_ptr<const ArcRun>>{};
+      std::vector<CornerPlan> corners(chain.points.size());
+      for (const std::shared_ptr<const ArcRun>& run : runs)
+        for (size_t i = run->first_corner(); i <= run->last_corner(); ++i) {
+          corners[i].treatment = CornerTreatment::arc;
+          corners[i].arc = run;
         }
-      }
-      return planned;
-    };
-    PlannedPath planned = plan_resizing(corners);
-    // A run below the print speed (sized below it for its arc, or held by the look-ahead on a
-    // circle an extrusion path starts or ends on, at rest), or one from rest to rest (its ramps
-    // on the curve, under limits lowered for the curve's own terms, may take longer than lines
-    // ramping between blends at the print speed), may cost more than its corners one by one:
-    // those are then chosen too and the chain planned without such runs, and the
-    // cheaper plan kept: their predicted errors plus time_weight x its time, against the runs'
-    // plan's time_weight x time and, for a stream that cannot follow the speed (aerosol), the
-    // thicker line it lays on the runs and their ramps (run_speed_deficit_mm x
-    // even_line_error_per_mm); an extruder's flow follows the speed: its bead stays even.
-    {
-      std::vector<CornerPlan> without = corners;
-      const size_t decided_before = chain_decisions.size();
-      for (const std::shared_ptr<const ArcRun>& run : runs) {
-        const size_t first = run->first_corner();
-        if (!run->from_rest_to_rest &&
-            planned.corner_speed_mm_s[first] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
+      std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
+      const auto decide = [&](size_t i) {
+        CornerDecisionCache& cache = options.loops_allowed ? decided : decided_without_loops;
+        chain_decisions.emplace_back(i, cache.decision(chain, i, geometry, [&]() {
+          return choose_corner(chain, i, geometry, jerk_limits, options, model,
+                               settings_.time_weight_mm_s, scratch);
+        }));
+        return chain_decisions.back().second.chosen.plan;
+      };
+      for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
+        if (taken_straight_on(geometry[i]) || corners[i].treatment == CornerTreatment::arc)
           continue;
-        for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(i);
+        corners[i] = decide(i);
       }
-      if (chain_decisions.size() > decided_before) {
-        PlannedPath alternative = plan_resizing(without);
+      // planned from 0, then placed after the transition that brings the nozzle to its start;
+      // blends that hold the look-ahead back are shrunk and the chain planned again (the quickest
+      // plan kept, its corners in `plan`)
+      const auto plan_resizing = [&](std::vector<CornerPlan>& plan) {
+        PlannedPath planned = plan_chain(chain, geometry, plan, jerk_limits, options, 0.0);
+        const std::vector<CornerPlan> chosen = plan;
+        std::vector<CornerPlan> trial = plan;
+        // (the look-ahead's corner speeds, without curved ramps: the trials are the same with
+        // or without them, each plan with them no slower)
+        std::vector<double> trial_speeds = planned.lookahead_corner_speed_mm_s;
+        for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
+                                                                      jerk_limits, chosen, trial);
+             ++pass) {
+          PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
+          trial_speeds = replanned.lookahead_corner_speed_mm_s;
+          if (replanned.t_end_s < planned.t_end_s) {
+            planned = std::move(replanned);
+            plan = trial;
+          }
+        }
+        return planned;
+      };
+      PlannedPath planned = plan_resizing(corners);
+      // A run below the print speed (sized below it for its arc, or held by the look-ahead on a
+      // circle an extrusion path starts or ends on, at rest), or one from rest to rest (its ramps
+      // on the curve, under limits lowered for the curve's own terms, may take longer than lines
+      // ramping between blends at the print speed), may cost more than its corners one by one:
+      // those are then chosen too and the chain planned without such runs, and the
+      // cheaper plan kept: their predicted errors plus time_weight x its time, against the runs'
+      // plan's time_weight x time and, for a stream that cannot follow the speed (aerosol), the
+      // thicker line it lays on the runs and their ramps (run_speed_deficit_mm x
+      // even_line_error_per_mm); an extruder's flow follows the speed: its bead stays even.
+      {
+        std::vector<CornerPlan> without = corners;
+        const size_t decided_before = chain_decisions.size();
+        for (const std::shared_ptr<const ArcRun>& run : runs) {
+          const size_t first = run->first_corner();
+          if (!run->from_rest_to_rest && planned.corner_speed_mm_s[first] >=
+                                             (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
+            continue;
+          for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(i);
+        }
+        if (chain_decisions.size() > decided_before) {
+          PlannedPath alternative = plan_resizing(without);
+          double corners_error_mm = 0.0;
+          for (size_t k = decided_before; k < chain_decisions.size(); ++k)
+            if (!chain_decisions[k].second.chosen.pruned)
+              corners_error_mm += chain_decisions[k].second.chosen.error_mm;
+          // (aerosol: two loops closer than the shutter's travel v T leave the line between them
+          // barely open, d / (2 T) of it let through, d = e / v < T; each corner's window sees its
+          // neighbours printed in full, so that loss is added here: on a finely chorded arc
+          // looped corner by corner almost nothing is printed)
+          if (aerosol) {
+            double unopened_mm = 0.0;
+            for (const std::shared_ptr<const ArcRun>& run : runs)
+              for (size_t i = run->first_corner(); i < run->last_corner(); ++i) {
+                if (without[i].treatment != CornerTreatment::loop ||
+                    without[i + 1].treatment != CornerTreatment::loop)
+                  continue;
+                const double edge = (chain.points[i + 1] - chain.points[i]).norm();
+                const double travel = chain.edge_speed_mm_s[i] * model.shutter_time_s;
+                if (edge < travel) unopened_mm += edge * (1.0 - edge / (2.0 * travel));
+              }
+            corners_error_mm += unopened_mm * even_line_error_per_mm(model);
+          }
+          const double runs_error_mm =
+              aerosol ? planned.run_speed_deficit_mm * even_line_error_per_mm(model) : 0.0;
+          if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <
+              runs_error_mm + settings_.time_weight_mm_s * planned.t_end_s) {
+            planned = std::move(alternative);
+            corners = std::move(without);
+          } else {
+            chain_decisions.resize(decided_before);
+          }
+        }
+      }
+      // the runs' corners, reported in order with the others
+      for (size_t i = 1; i + 1 < chain.points.size(); ++i)
+        if (corners[i].treatment == CornerTreatment::arc) {
+          CornerDecision taken;
+          taken.chosen.name = "arc";
+          taken.chosen.pruned = true;  // (its deposit not predicted: an even line, see above)
+          taken.chosen.plan = corners[i];
+          chain_decisions.emplace_back(i, taken);
+        }
+      std::sort(chain_decisions.begin(), chain_decisions.end(),
+                [](const auto& x, const auto& y) { return x.first < y.first; });
+      // aerosol: the whole chain at one constant speed instead (constant_speed_chain), where some
+      // corner is not taken at print speed and the even, thicker line costs less than the
+      // corners' own choices (their predicted errors and the chain's time)
+      bool at_constant_speed = false;
+      if (aerosol && !chain_decisions.empty()) {
+        const bool all_at_print_speed =
+            std::all_of(chain_decisions.begin(), chain_decisions.end(), [&](const auto& entry) {
+              const size_t i = entry.first;
+              return (corners[i].treatment == CornerTreatment::blend ||
+                      corners[i].treatment == CornerTreatment::arc) &&
+                     planned.corner_speed_mm_s[i] >=
+                         (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
+            });
         double corners_error_mm = 0.0;
-        for (size_t k = decided_before; k < chain_decisions.size(); ++k)
-          if (!chain_decisions[k].second.chosen.pruned)
-            corners_error_mm += chain_decisions[k].second.chosen.error_mm;
-        // (aerosol: two loops closer than the shutter's travel v T leave the line between them
-        // barely open, d / (2 T) of it let through, d = e / v < T; each corner's window sees its
-        // neighbours printed in full, so that loss is added here: on a finely chorded arc
-        // looped corner by corner almost nothing is printed)
-        if (aerosol) {
-          double unopened_mm = 0.0;
-          for (const std::shared_ptr<const ArcRun>& run : runs)
-            for (size_t i = run->first_corner(); i < run->last_corner(); ++i) {
-              if (without[i].treatment != CornerTreatment::loop ||
-                  without[i + 1].treatment != CornerTreatment::loop)
-                continue;
-              const double edge = (chain.points[i + 1] - chain.points[i]).norm();
-              const double travel = chain.edge_speed_mm_s[i] * model.shutter_time_s;
-              if (edge < travel) unopened_mm += edge * (1.0 - edge / (2.0 * travel));
-            }
-          corners_error_mm += unopened_mm * even_line_error_per_mm(model);
-        }
-        const double runs_error_mm =
-            aerosol ? planned.run_speed_deficit_mm * even_line_error_per_mm(model) : 0.0;
-        if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <
-            runs_error_mm + settings_.time_weight_mm_s * planned.t_end_s) {
-          planned = std::move(alternative);
-          corners = std::move(without);
-        } else {
-          chain_decisions.resize(decided_before);
-        }
-      }
-    }
-    // the runs' corners, reported in order with the others
-    for (size_t i = 1; i + 1 < chain.points.size(); ++i)
-      if (corners[i].treatment == CornerTreatment::arc) {
-        CornerDecision taken;
-        taken.chosen.name = "arc";
-        taken.chosen.pruned = true;  // (its deposit not predicted: an even line, see above)
-        taken.chosen.plan = corners[i];
-        chain_decisions.emplace_back(i, taken);
-      }
-    std::sort(chain_decisions.begin(), chain_decisions.end(),
-              [](const auto& x, const auto& y) { return x.first < y.first; });
-    // aerosol: the whole chain at one constant speed instead (constant_speed_chain), where some
-    // corner is not taken at print speed and the even, thicker line costs less than the
-    // corners' own choices (their predicted errors and the chain's time)
-    bool at_constant_speed = false;
-    if (aerosol && !chain_decisions.empty()) {
-      const bool all_at_print_speed =
-          std::all_of(chain_decisions.begin(), chain_decisions.end(), [&](const auto& entry) {
-            const size_t i = entry.first;
-            return (corners[i].treatment == CornerTreatment::blend ||
-                    corners[i].treatment == CornerTreatment::arc) &&
-                   planned.corner_speed_mm_s[i] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
-          });
-      double corners_error_mm = 0.0;
-      for (const auto& entry : chain_decisions)
-        if (!entry.second.chosen.pruned) corners_error_mm += entry.second.chosen.error_mm;
-      const double corners_cost = corners_error_mm + settings_.time_weight_mm_s * planned.t_end_s;
-      ConstantSpeedChain constant;
-      if (!all_at_print_speed)
-        constant =
-            constant_speed_chain(chain, geometry, settings_.tolerance_mm, merged.edge_error_mm,
-                                 jerk_limits, options, model, corners_cost);
-      if (constant.speed_mm_s > 0.0) {
-        const double constant_cost =
-            constant.error_mm + settings_.time_weight_mm_s * constant.planned.t_end_s;
-        if (constant_cost < corners_cost) {
-          PlanDecision d;
-          d.path_index = chain.point_path.front();
-          d.point_index = chain.point_index.front();
-          d.kind = "path";
-          d.choice = "constant_speed";
-          d.figures.push_back({"print_speed_mm_s", chain.edge_speed_mm_s.front(), "mm/s"});
-          d.figures.push_back({"constant_speed_mm_s", constant.speed_mm_s, "mm/s"});
-          d.figures.push_back({"constant_speed_error_mm", constant.error_mm, "mm"});
-          d.figures.push_back({"constant_speed_time_s", constant.planned.t_end_s, "s"});
-          d.figures.push_back({"corners_error_mm", corners_error_mm, "mm"});
-          d.figures.push_back({"corners_time_s", planned.t_end_s, "s"});
-          decisions.push_back(std::move(d));
-          planned = std::move(constant.planned);
-          corners = std::move(constant.corners);
-          at_constant_speed = true;
+        for (const auto& entry : chain_decisions)
+          if (!entry.second.chosen.pruned) corners_error_mm += entry.second.chosen.error_mm;
+        const double corners_cost = corners_error_mm + settings_.time_weight_mm_s * planned.t_end_s;
+        ConstantSpeedChain constant;
+        if (!all_at_print_speed)
+          constant =
+              constant_speed_chain(chain, geometry, settings_.tolerance_mm, merged.edge_error_mm,
+                                   jerk_limits, options, model, corners_cost);
+        if (constant.speed_mm_s > 0.0) {
+          const double constant_cost =
+              constant.error_mm + settings_.time_weight_mm_s * constant.planned.t_end_s;
+          if (constant_cost < corners_cost) {
+            PlanDecision d;
+            d.path_index = chain.point_path.front();
+            d.point_index = chain.point_index.front();
+            d.kind = "path";
+            d.choice = "constant_speed";
+            d.figures.push_back({"print_speed_mm_s", chain.edge_speed_mm_s.front(), "mm/s"});
+            d.figures.push_back({"constant_speed_mm_s", constant.speed_mm_s, "mm/s"});
+            d.figures.push_back({"constant_speed_error_mm", constant.error_mm, "mm"});
+            d.figures.push_back({"constant_speed_time_s", constant.planned.t_end_s, "s"});
+            d.figures.push_back({"corners_error_mm", corners_error_mm, "mm"});
+            d.figures.push_back({"corners_time_s", planned.t_end_s, "s"});
+            decisions.push_back(std::move(d));
+            planned = std::move(constant.planned);
+            corners = std::move(constant.corners);
+            at_constant_speed = true;
+          }
         }
       }
-    }
-    // each corner reported as planned: its blend (deviation) and the speed it is taken at (at
-    // the chain's constant speed: that choice, the corner's own candidates for comparison)
-    for (auto& [i, decision] : chain_decisions) {
-      if (at_constant_speed) {
-        decision.chosen = CornerCandidate{};
-        decision.chosen.name = "constant_speed";
-        decision.chosen.pruned = true;  // (its deposit is the chain's: no error of its own)
+      // each corner reported as planned: its blend (deviation) and the speed it is taken at (at
+      // the chain's constant speed: that choice, the corner's own candidates for comparison)
+      for (auto& [i, decision] : chain_decisions) {
+        if (at_constant_speed) {
+          decision.chosen = CornerCandidate{};
+          decision.chosen.name = "constant_speed";
+          decision.chosen.pruned = true;  // (its deposit is the chain's: no error of its own)
+        }
+        decision.chosen.plan = corners[i];
+        decision.chosen.speed_mm_s = planned.corner_speed_mm_s[i];
+        decisions.push_back(corner_report(chain, i, geometry[i], decision));
       }
-      decision.chosen.plan = corners[i];
-      decision.chosen.speed_mm_s = planned.corner_speed_mm_s[i];
-      decisions.push_back(corner_report(chain, i, geometry[i], decision));
+      add_transition(chain.points.front(), planned.start_velocity, chain.orientations.front(),
+                     static_cast<int>(c));
+      chain_pieces[c].first = pieces.size();
+      for (TrajectoryPiece& piece : planned.pieces) {
+        piece.t_begin_s += t;
+        piece.t_end_s += t;
+        pieces.push_back(std::move(piece));
+      }
+      chain_pieces[c].second = pieces.size();
+      t += planned.t_end_s;
+      position = chain.points.back();
+      velocity = planned.end_velocity;
+      orientation = chain.orientations.back();
+      current_chain = static_cast<int>(c);
     }
-    add_transition(chain.points.front(), planned.start_velocity, chain.orientations.front());
-    for (TrajectoryPiece& piece : planned.pieces) {
-      piece.t_begin_s += t;
-      piece.t_end_s += t;
-      pieces.push_back(std::move(piece));
+    add_transition(toolpath.end_mm, Vec3::Zero(), toolpath.end_orientation(), -1);
+    // A transition that leaves or enters a chain at speed overshoots the chain's end by the
+    // stopping distance, and a corner's loop (shutter closed) runs past the corner: near the
+    // travel's end either can go beyond it. Such chains are planned again to stop (and start)
+    // at rest at that end, as stop_and_go does (a move between two points at rest stays
+    // between them), or without loops (a blend, a slowed or a stopped corner stays inside the
+    // corner). Aerosol only: an extruder's ends and loops are at rest already.
+    if (attempt >= kTravelAttempts || joint_map == nullptr ||
+        !(base_options.enter_at_speed || base_options.leave_at_speed))
+      break;
+    bool replan = false;
+    for (const ChainTransition& transition : transitions) {
+      if (!leaves_travel(pieces[transition.piece], *joint_map)) continue;
+      if (transition.from_chain >= 0) leave_at_rest[transition.from_chain] = 1;
+      if (transition.to_chain >= 0) enter_at_rest[transition.to_chain] = 1;
+      replan = true;
     }
-    t += planned.t_end_s;
-    position = chain.points.back();
-    velocity = planned.end_velocity;
-    orientation = chain.orientations.back();
+    for (size_t c = 0; c < chains.size(); ++c) {
+      if (without_loops[c]) continue;
+      for (size_t k = chain_pieces[c].first; k < chain_pieces[c].second; ++k)
+        if (!pieces[k].depositing && leaves_travel(pieces[k], *joint_map)) {
+          without_loops[c] = 1;
+          replan = true;
+          break;
+        }
+    }
+    if (!replan) break;
   }
-  add_transition(toolpath.end_mm, Vec3::Zero(), toolpath.end_orientation());
   if (pieces.empty()) {
     // nothing to print and nowhere to go: at rest at the start
     pieces.push_back(transition_piece(0.0, position, velocity, position, velocity, jerk_limits,

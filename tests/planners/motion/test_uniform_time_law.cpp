@@ -4,10 +4,12 @@
 // carriages through their inverse kinematics).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "contract/planner_checks.hpp"
 #include "kinematics/linear_delta.hpp"
@@ -171,6 +173,93 @@ TEST(UniformTimeLaw, XyStageJointsWithinSpeedAccelerationAndJerk) {
     const UniformPlanner planner{UniformSettings{}};
     const Trajectory plan = planner.plan_in_context(zig_zag(3.0), limits, context);
     expect_joint_limits(plan, *stage, joint, true);
+  }
+}
+
+// An aerosol job on the XY stage (travel +-50 mm) whose paths end, start and turn within a
+// stopping distance (20^2 / (2 x 400) = 0.5 mm) of the travel's end: a transition or a loop
+// at print speed runs past it (the run's pose check then stops with exit 2). The plan keeps
+// every joint within its travel instead: the chains are entered or left at rest there and
+// their corners taken without loops, and each such chain reports it (`within_travel`). A job
+// away from the edge is planned exactly as without the machine's travel.
+TEST(UniformTravel, AerosolChainsNearTheTravelsEndStayWithinIt) {
+  const std::unique_ptr<Machine> stage = make_xy_stage();
+  const MachineLimits requested = MachineLimits::uniform(40.0, 400.0);
+  const TcpLimits stage_limits = stage->tcp_limits(requested);
+  PlanningContext context;
+  DepositionSettings aerosol;
+  aerosol.type = ProcessType::aerosol;
+  context.process = std::make_shared<const DepositionSettings>(aerosol);
+  const UniformPlanner planner{UniformSettings{}};
+  const auto job = [](const std::vector<std::vector<Vec3>>& polylines) {
+    Toolpath toolpath;
+    for (const std::vector<Vec3>& points : polylines) {
+      PrintPath path;
+      path.points = points;
+      path.speed_mm_s = 20.0;
+      path.source_index = static_cast<int>(toolpath.paths.size());
+      toolpath.paths.push_back(path);
+    }
+    return toolpath;  // from and back to the origin
+  };
+  // a plan's joints within the travel every 0.5 ms, and its within_travel reports as
+  // (path, enters at rest, leaves at rest, loops allowed)
+  const auto check = [&](const Trajectory& plan) {
+    JointVector joints;
+    std::string why;
+    for (double t = 0.0; t <= plan.duration_s(); t += 5e-4) {
+      const bool reachable = stage->inverse(plan.at(t).pose(), joints, &why);
+      EXPECT_TRUE(reachable) << "t = " << t << " s: " << why;
+      if (!reachable) break;
+    }
+    std::vector<std::array<int, 4>> reports;
+    for (const PlanDecision& d : plan.decisions()) {
+      if (d.choice != "within_travel") continue;
+      std::array<int, 4> report{d.path_index, -1, -1, -1};
+      for (const PlanFigure& f : d.figures) {
+        if (f.name == "enters_at_rest") report[1] = static_cast<int>(f.value);
+        if (f.name == "leaves_at_rest") report[2] = static_cast<int>(f.value);
+        if (f.name == "loops_allowed") report[3] = static_cast<int>(f.value);
+      }
+      reports.push_back(report);
+    }
+    return reports;
+  };
+  using Reports = std::vector<std::array<int, 4>>;
+  {
+    SCOPED_TRACE(
+        "path 1 starts 0.5 mm from x = 50 at print speed towards -x, ends 0.5 mm "
+        "from x = -50");
+    const Trajectory plan = planner.plan_in_context(
+        job({{{-49, -49, 0}, {49, -49, 0}, {49, 49, 0}}, {{49.5, 48, 0}, {-49.5, 48, 0}}}),
+        stage_limits, context);
+    EXPECT_EQ(check(plan), (Reports{{0, 0, 1, 1}, {1, 1, 1, 1}}));
+  }
+  {
+    SCOPED_TRACE("a square 0.2 mm inside the travel: loops at its corners would leave it");
+    const Trajectory plan = planner.plan_in_context(job({{{-49.8, -49.8, 0},
+                                                          {49.8, -49.8, 0},
+                                                          {49.8, 49.8, 0},
+                                                          {-49.8, 49.8, 0},
+                                                          {-49.8, -49.8, 0}}}),
+                                                    stage_limits, context);
+    EXPECT_EQ(check(plan), (Reports{{0, 1, 1, 0}}));
+    for (const PlanDecision& d : plan.decisions()) EXPECT_NE(d.choice, "loop");
+  }
+  {
+    SCOPED_TRACE("the same square at half the size: as if the travel had no end");
+    const std::vector<std::vector<Vec3>> square{{{-24.9, -24.9, 0},
+                                                 {24.9, -24.9, 0},
+                                                 {24.9, 24.9, 0},
+                                                 {-24.9, 24.9, 0},
+                                                 {-24.9, -24.9, 0}}};
+    const Trajectory plan = planner.plan_in_context(job(square), stage_limits, context);
+    EXPECT_TRUE(check(plan).empty());
+    const Trajectory free_plan = planner.plan_in_context(job(square), requested, context);
+    EXPECT_EQ(plan.duration_s(), free_plan.duration_s());
+    ASSERT_EQ(plan.decisions().size(), free_plan.decisions().size());
+    for (size_t i = 0; i < plan.decisions().size(); ++i)
+      EXPECT_EQ(plan.decisions()[i].choice, free_plan.decisions()[i].choice);
   }
 }
 
