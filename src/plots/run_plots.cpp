@@ -534,6 +534,9 @@ std::string map_ranges(const std::vector<const HeightMap*>& maps, const Toolpath
 
 namespace {
 
+// a map this many times as wide as high or more is a wide one (thickness_plot)
+constexpr double kWideMapAspect = 1.5;
+
 // thickness.png: top-down heat map with colour bar, mm axes, print paths overlaid
 void thickness_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
                     const std::string& png) {
@@ -564,6 +567,10 @@ void thickness_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& 
              style::quoted("colour scale " + capped_scale_note(scale, "")).c_str());
   s += "set cblabel " + style::quoted(style::axis_label("thickness", "µm")) + " offset 1.5,0\n";
   s += "set colorbox\n";
+  // a wide map (half as wide again as high) keeps room at its right for the colour bar, its
+  // tick labels and its label, which it ran past the image's edge (a narrower one is centred
+  // by its height and has that room)
+  if (map.nx >= kWideMapAspect * map.ny) s += "set rmargin 13\n";
   s += map_ranges({&map}, input.toolpath);
   s += thickness_map_elements(job, map, input.toolpath, "thickness_map", true);
   job.end_png();

@@ -3,6 +3,7 @@
 
 #include <stb_image.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <fstream>
 #include <iterator>
@@ -56,6 +57,24 @@ inline double pixel_variance(const std::string& bytes) {
   stbi_image_free(pixels);
   const double mean = sum / count;
   return sum_sq / count - mean * mean;
+}
+
+// true when the image's `columns` rightmost pixel columns are all white (grey above 250): nothing
+// drawn runs past its right edge; false too when it cannot decode
+inline bool right_edge_blank(const std::string& bytes, int columns) {
+  int width = 0, height = 0, channels = 0;
+  unsigned char* pixels =
+      stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()),
+                            static_cast<int>(bytes.size()), &width, &height, &channels, 3);
+  if (pixels == nullptr) return false;
+  bool blank = true;
+  for (int y = 0; y < height && blank; ++y)
+    for (int x = std::max(0, width - columns); x < width && blank; ++x) {
+      const unsigned char* rgb = pixels + 3 * (static_cast<size_t>(y) * width + x);
+      blank = (rgb[0] + rgb[1] + rgb[2]) / 3.0 > 250.0;
+    }
+  stbi_image_free(pixels);
+  return blank;
 }
 
 }  // namespace depotwin::testing_support

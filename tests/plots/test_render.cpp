@@ -260,6 +260,26 @@ TEST(RunPlots, EveryThicknessMapAxisHasAtLeastThreeTicks) {
   }
 }
 
+// thickness.png of a job several times as wide as high (two 30 mm lines 2 mm apart) and thin
+// (tick labels like 0.25): the colour bar's label stays inside the image (it ran past the right
+// edge, "thickness (µm" cut)
+TEST(RunPlots, AWideThicknessMapKeepsItsColourBarLabelInside) {
+  Toolpath toolpath;
+  toolpath.paths = {testing_support::line(0, 0, 30, 0), testing_support::line(30, 2, 0, 2)};
+  toolpath.start_mm = toolpath.paths.front().front();
+  toolpath.end_mm = toolpath.paths.back().back();
+  auto f = make_plot_fixture(toolpath, 0.3, false);
+  ASSERT_GE(f.thickness.nx, 3 * f.thickness.ny);
+  // a thin deposit, peak 0.285 um: the colour bar's tick labels are four characters wide
+  for (float& um : f.thickness.thickness_um) um *= 0.0285f;
+  const std::string directory = output_directory("wide_thickness");
+  const plots::PlotResult result =
+      plots::render_run_plots(f.input(), directory, {RunPlot::thickness});
+  ASSERT_EQ(result.files.size(), 1u);
+  const std::string bytes = testing_support::read_bytes(result.files[0]);
+  EXPECT_TRUE(testing_support::right_edge_blank(bytes, 4)) << result.files[0];
+}
+
 // thickness.png of a deposit with a blob 20 times its lines (layers stacked where they start):
 // its colour scale is topped at 2 x the map's 95th percentile, as comparison.png's and
 // layers.png's are, and says so over the map; an even deposit's reaches its own peak
