@@ -86,6 +86,17 @@ bool leaves_travel(const TrajectoryPiece& piece, const JointMap& joint_map) {
   return false;
 }
 
+// a `kind: path` decision about a whole chain, at its first point, with its print speed
+PlanDecision chain_decision(const PrintChain& chain, const char* choice) {
+  PlanDecision d;
+  d.path_index = chain.point_path.front();
+  d.point_index = chain.point_index.front();
+  d.kind = "path";
+  d.choice = choice;
+  d.figures.push_back({"print_speed_mm_s", chain.edge_speed_mm_s.front(), "mm/s"});
+  return d;
+}
+
 // fine edges are merged within this share of the tolerance (merge_fine_edges); the blends keep
 // to the rest
 constexpr double kMergeShare = 0.5;
@@ -411,12 +422,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
       options.loops_allowed = !without_loops[c];
       // what the travel changed, reported at the chain's first point
       if (enter_at_rest[c] || leave_at_rest[c] || without_loops[c]) {
-        PlanDecision d;
-        d.path_index = given.point_path.front();
-        d.point_index = given.point_index.front();
-        d.kind = "path";
-        d.choice = "within_travel";
-        d.figures.push_back({"print_speed_mm_s", given.edge_speed_mm_s.front(), "mm/s"});
+        PlanDecision d = chain_decision(given, "within_travel");
         d.figures.push_back({"enters_at_rest", enter_at_rest[c] ? 1.0 : 0.0, "flag"});
         d.figures.push_back({"leaves_at_rest", leave_at_rest[c] ? 1.0 : 0.0, "flag"});
         d.figures.push_back({"loops_allowed", without_loops[c] ? 0.0 : 1.0, "flag"});
@@ -570,12 +576,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
           const double constant_cost =
               constant.error_mm + settings_.time_weight_mm_s * constant.planned.t_end_s;
           if (constant_cost < corners_cost) {
-            PlanDecision d;
-            d.path_index = chain.point_path.front();
-            d.point_index = chain.point_index.front();
-            d.kind = "path";
-            d.choice = "constant_speed";
-            d.figures.push_back({"print_speed_mm_s", chain.edge_speed_mm_s.front(), "mm/s"});
+            PlanDecision d = chain_decision(chain, "constant_speed");
             d.figures.push_back({"constant_speed_mm_s", constant.speed_mm_s, "mm/s"});
             d.figures.push_back({"constant_speed_error_mm", constant.error_mm, "mm"});
             d.figures.push_back({"constant_speed_time_s", constant.planned.t_end_s, "s"});
