@@ -394,7 +394,7 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
   const double ex = data.layers_x_hi - data.layers_x_lo, ey = data.layers_y_hi - data.layers_y_lo;
   constexpr double kRegionLeft = 30, kRegionRight = 690, kRegionTop = 44;
   // (a topped scale's note takes a line under the x label: the grid ends higher for it)
-  const double kRegionBottom = data.layer_scale.capped ? 444 : 470;
+  const double region_bottom = data.layer_scale.capped ? 444 : 470;
   constexpr double kTicsLeft = 50, kTicsBottom = 22, kTitleTop = 22, kGap = 24, kRowGap = 4;
   size_t columns = 1;
   double scale = 0.0;  // px per mm
@@ -402,7 +402,7 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
     const size_t r = (n + c - 1) / c;
     const double map_w = ((kRegionRight - kRegionLeft) - kTicsLeft - (c - 1) * kGap) / c;
     const double map_h =
-        ((kRegionBottom - kRegionTop) - kTicsBottom - r * kTitleTop - (r - 1) * kRowGap) / r;
+        ((region_bottom - kRegionTop) - kTicsBottom - r * kTitleTop - (r - 1) * kRowGap) / r;
     const double fit = std::min(map_w / ex, map_h / ey);
     if (fit > scale * 1.0001) scale = fit, columns = c;
   }
@@ -411,7 +411,7 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
   const double grid_w = kTicsLeft + columns * map_w + (columns - 1) * kGap;
   const double grid_h = rows * (kTitleTop + map_h) + (rows - 1) * kRowGap + kTicsBottom;
   const double left0 = kRegionLeft + 0.5 * ((kRegionRight - kRegionLeft) - grid_w);
-  const double top0 = kRegionTop + 0.5 * ((kRegionBottom - kRegionTop) - grid_h);
+  const double top0 = kRegionTop + 0.5 * ((region_bottom - kRegionTop) - grid_h);
   const double x_step = nice_step(ex, std::max(3, static_cast<int>(map_w / 60))),
                y_step = nice_step(ey, std::max(3, static_cast<int>(map_h / 30)));
   s += format("set xtics %.9g\nset ytics %.9g\n", x_step, y_step);

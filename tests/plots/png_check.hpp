@@ -40,21 +40,43 @@ inline PngHeader png_header(const std::string& bytes) {
   return header;
 }
 
+// a PNG decoded to 8-bit RGB (stb_image), freed with it; empty when it cannot decode
+class DecodedRgb {
+ public:
+  explicit DecodedRgb(const std::string& bytes)
+      : pixels_(stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                      static_cast<int>(bytes.size()), &width_, &height_, &channels_,
+                                      3)) {}
+  ~DecodedRgb() { stbi_image_free(pixels_); }
+  DecodedRgb(const DecodedRgb&) = delete;
+  DecodedRgb& operator=(const DecodedRgb&) = delete;
+
+  bool empty() const { return pixels_ == nullptr; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  // the mean of pixel (x, y)'s three channels
+  double grey(int x, int y) const {
+    const unsigned char* rgb = pixels_ + 3 * (static_cast<size_t>(y) * width_ + x);
+    return (rgb[0] + rgb[1] + rgb[2]) / 3.0;
+  }
+
+ private:
+  int width_ = 0, height_ = 0, channels_ = 0;
+  unsigned char* pixels_ = nullptr;
+};
+
 // variance of the grey level over all pixels (0 for a blank image), -1 when it cannot decode
 inline double pixel_variance(const std::string& bytes) {
-  int width = 0, height = 0, channels = 0;
-  unsigned char* pixels =
-      stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()),
-                            static_cast<int>(bytes.size()), &width, &height, &channels, 3);
-  if (pixels == nullptr) return -1.0;
+  const DecodedRgb image(bytes);
+  if (image.empty()) return -1.0;
   double sum = 0.0, sum_sq = 0.0;
-  const size_t count = static_cast<size_t>(width) * height;
-  for (size_t i = 0; i < count; ++i) {
-    const double grey = (pixels[3 * i] + pixels[3 * i + 1] + pixels[3 * i + 2]) / 3.0;
-    sum += grey;
-    sum_sq += grey * grey;
-  }
-  stbi_image_free(pixels);
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      const double grey = image.grey(x, y);
+      sum += grey;
+      sum_sq += grey * grey;
+    }
+  const double count = static_cast<double>(image.width()) * image.height();
   const double mean = sum / count;
   return sum_sq / count - mean * mean;
 }
@@ -62,19 +84,12 @@ inline double pixel_variance(const std::string& bytes) {
 // true when the image's `columns` rightmost pixel columns are all white (grey above 250): nothing
 // drawn runs past its right edge; false too when it cannot decode
 inline bool right_edge_blank(const std::string& bytes, int columns) {
-  int width = 0, height = 0, channels = 0;
-  unsigned char* pixels =
-      stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()),
-                            static_cast<int>(bytes.size()), &width, &height, &channels, 3);
-  if (pixels == nullptr) return false;
-  bool blank = true;
-  for (int y = 0; y < height && blank; ++y)
-    for (int x = std::max(0, width - columns); x < width && blank; ++x) {
-      const unsigned char* rgb = pixels + 3 * (static_cast<size_t>(y) * width + x);
-      blank = (rgb[0] + rgb[1] + rgb[2]) / 3.0 > 250.0;
-    }
-  stbi_image_free(pixels);
-  return blank;
+  const DecodedRgb image(bytes);
+  if (image.empty()) return false;
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = std::max(0, image.width() - columns); x < image.width(); ++x)
+      if (!(image.grey(x, y) > 250.0)) return false;
+  return true;
 }
 
 }  // namespace depotwin::testing_support

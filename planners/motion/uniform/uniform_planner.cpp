@@ -43,39 +43,46 @@ bool leaves_travel(const TrajectoryPiece& piece, const JointMap& joint_map) {
   if (!(duration_s > 0.0)) return false;
   const int n = std::clamp(static_cast<int>(std::ceil(duration_s / kTravelSamplePeriod_s)),
                            kTravelMinSamples, kTravelMaxSamples);
-  std::vector<double> taus;
+  // the pose at each sample (with its time, and its velocity to find the turns between
+  // samples) and at each turn, put in time order: the joint map solves each pose nearest the
+  // one before
+  std::vector<std::pair<double, Pose>> timed;
   std::vector<Vec3> velocities;
-  taus.reserve(n + 8);
+  timed.reserve(n + 8);
   velocities.reserve(n + 1);
-  Vec3 position, velocity, acceleration;
+  const auto pose_at = [&piece](double tau, Vec3* velocity_out) {
+    Vec3 position, velocity, acceleration, tool_axis, turning;
+    double roll = 0.0;
+    evaluate_motion(piece, tau, position, velocity, acceleration);
+    evaluate_tool_axis(piece, tau, position, velocity, tool_axis, turning, roll);
+    if (velocity_out) *velocity_out = velocity;
+    return Pose(position, tool_axis, roll);
+  };
   for (int k = 0; k <= n; ++k) {
     const double tau = duration_s * k / n;
-    evaluate_motion(piece, tau, position, velocity, acceleration);
-    taus.push_back(tau);
+    Vec3 velocity;
+    timed.emplace_back(tau, pose_at(tau, &velocity));
     velocities.push_back(velocity);
   }
   for (int k = 0; k < n; ++k)
     for (int axis = 0; axis < 3; ++axis) {
       if (!(velocities[k][axis] * velocities[k + 1][axis] < 0.0)) continue;
-      double lo = taus[k], hi = taus[k + 1];
+      double lo = timed[k].first, hi = timed[k + 1].first;
       const bool rising = velocities[k][axis] < 0.0;
       for (int i = 0; i < kTurnBisections; ++i) {
         const double mid = 0.5 * (lo + hi);
+        Vec3 position, velocity, acceleration;
         evaluate_motion(piece, mid, position, velocity, acceleration);
         ((velocity[axis] < 0.0) == rising ? lo : hi) = mid;
       }
-      taus.push_back(0.5 * (lo + hi));
+      const double turn = 0.5 * (lo + hi);
+      timed.emplace_back(turn, pose_at(turn, nullptr));
     }
+  std::stable_sort(timed.begin(), timed.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<Pose> poses;
-  poses.reserve(taus.size());
-  std::sort(taus.begin(), taus.end());
-  for (const double tau : taus) {
-    Vec3 axis_now, turning;
-    double roll = 0.0;
-    evaluate_motion(piece, tau, position, velocity, acceleration);
-    evaluate_tool_axis(piece, tau, position, velocity, axis_now, turning, roll);
-    poses.emplace_back(position, axis_now, roll);
-  }
+  poses.reserve(timed.size());
+  for (const auto& [tau, pose] : timed) poses.push_back(pose);
   std::vector<JointVector> joints;
   if (!joint_map.solve(poses, joints, nullptr)) return true;
   for (const JointVector& q : joints)
