@@ -1,8 +1,11 @@
 #include "planners/motion/uniform/uniform_planner.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include "core/error.hpp"
@@ -413,6 +416,217 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
   // and leaves at speed; it does on whether loops are allowed)
   CornerDecisionCache decided(jerk_limits, settings_.reuse_corner_decisions);
   CornerDecisionCache decided_without_loops(jerk_limits, settings_.reuse_corner_decisions);
+  // one chain planned under its travel flags: its motion from 0, its reports, its ends
+  struct ChainPlan {
+    std::array<char, 3> flags{};  // enter_at_rest, leave_at_rest, without_loops
+    PlannedPath planned;
+    std::vector<PlanDecision> decisions;
+    Vec3 first_point, last_point;
+    ToolOrientation first_orientation, last_orientation;
+    // its pieces' times from 0 while the pieces are lent to the job (moved into `pieces`)
+    std::vector<std::pair<double, double>> piece_times_s;
+  };
+  const auto travel_flags = [&](size_t c) {
+    return std::array<char, 3>{enter_at_rest[c], leave_at_rest[c], without_loops[c]};
+  };
+  const auto plan_one_chain = [&](size_t c) {
+    ChainPlan result;
+    result.flags = travel_flags(c);
+    std::vector<PlanDecision>& reports = result.decisions;
+    const PrintChain& given = chains[c];
+    PathMotionOptions options = base_options;
+    options.enter_at_speed = base_options.enter_at_speed && !enter_at_rest[c];
+    options.leave_at_speed = base_options.leave_at_speed && !leave_at_rest[c];
+    options.loops_allowed = !without_loops[c];
+    // what the travel changed, reported at the chain's first point
+    if (enter_at_rest[c] || leave_at_rest[c] || without_loops[c]) {
+      PlanDecision d = chain_decision(given, "within_travel");
+      d.figures.push_back({"enters_at_rest", enter_at_rest[c] ? 1.0 : 0.0, "flag"});
+      d.figures.push_back({"leaves_at_rest", leave_at_rest[c] ? 1.0 : 0.0, "flag"});
+      d.figures.push_back({"loops_allowed", without_loops[c] ? 0.0 : 1.0, "flag"});
+      reports.push_back(std::move(d));
+    }
+    // fine chords merged into edges their corners' blends fit (merge_fine_edges), each corner's
+    // blend within the tolerance left by its edges' merging
+    const MergedChain merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm);
+    const PrintChain& chain = merged.chain;
+    // each corner's treatment, by the predicted deposit
+    const std::vector<CornerGeometry> geometry =
+        corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
+    // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),
+    // where a corner alone cannot keep the print speed: at the print speed, not weighed (an
+    // even line within the tolerance); below it, weighed below; their corners reported as
+    // "arc"
+    const std::vector<std::shared_ptr<const ArcRun>> runs =
+        settings_.arc_runs
+            ? find_arc_runs(merged, given, geometry, settings_.tolerance_mm, jerk_limits, options)
+            : std::vector<std::shared_ptr<const ArcRun>>{};
+    std::vector<CornerPlan> corners(chain.points.size());
+    for (const std::shared_ptr<const ArcRun>& run : runs)
+      for (size_t i = run->first_corner(); i <= run->last_corner(); ++i) {
+        corners[i].treatment = CornerTreatment::arc;
+        corners[i].arc = run;
+      }
+    std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
+    const auto decide = [&](size_t i) {
+      CornerDecisionCache& cache = options.loops_allowed ? decided : decided_without_loops;
+      chain_decisions.emplace_back(i, cache.decision(chain, i, geometry, [&]() {
+        return choose_corner(chain, i, geometry, jerk_limits, options, model,
+                             settings_.time_weight_mm_s, scratch);
+      }));
+      return chain_decisions.back().second.chosen.plan;
+    };
+    for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
+      if (taken_straight_on(geometry[i]) || corners[i].treatment == CornerTreatment::arc) continue;
+      corners[i] = decide(i);
+    }
+    // planned from 0, then placed after the transition that brings the nozzle to its start;
+    // blends that hold the look-ahead back are shrunk and the chain planned again (the quickest
+    // plan kept, its corners in `plan`)
+    const auto plan_resizing = [&](std::vector<CornerPlan>& plan) {
+      PlannedPath planned = plan_chain(chain, geometry, plan, jerk_limits, options, 0.0);
+      const std::vector<CornerPlan> chosen = plan;
+      std::vector<CornerPlan> trial = plan;
+      // (the look-ahead's corner speeds, without curved ramps: the trials are the same with
+      // or without them, each plan with them no slower)
+      std::vector<double> trial_speeds = planned.lookahead_corner_speed_mm_s;
+      for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
+                                                                    jerk_limits, chosen, trial);
+           ++pass) {
+        PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
+        trial_speeds = replanned.lookahead_corner_speed_mm_s;
+        if (replanned.t_end_s < planned.t_end_s) {
+          planned = std::move(replanned);
+          plan = trial;
+        }
+      }
+      return planned;
+    };
+    PlannedPath planned = plan_resizing(corners);
+    // A run below the print speed (sized below it for its arc, or held by the look-ahead on a
+    // circle an extrusion path starts or ends on, at rest), or one from rest to rest (its ramps
+    // on the curve, under limits lowered for the curve's own terms, may take longer than lines
+    // ramping between blends at the print speed), may cost more than its corners one by one:
+    // those are then chosen too and the chain planned without such runs, and the
+    // cheaper plan kept: their predicted errors plus time_weight x its time, against the runs'
+    // plan's time_weight x time and, for a stream that cannot follow the speed (aerosol), the
+    // thicker line it lays on the runs and their ramps (run_speed_deficit_mm x
+    // even_line_error_per_mm); an extruder's flow follows the speed: its bead stays even.
+    {
+      std::vector<CornerPlan> without = corners;
+      const size_t decided_before = chain_decisions.size();
+      for (const std::shared_ptr<const ArcRun>& run : runs) {
+        const size_t first = run->first_corner();
+        if (!run->from_rest_to_rest &&
+            planned.corner_speed_mm_s[first] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
+          continue;
+        for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(i);
+      }
+      if (chain_decisions.size() > decided_before) {
+        PlannedPath alternative = plan_resizing(without);
+        double corners_error_mm = 0.0;
+        for (size_t k = decided_before; k < chain_decisions.size(); ++k)
+          if (!chain_decisions[k].second.chosen.pruned)
+            corners_error_mm += chain_decisions[k].second.chosen.error_mm;
+        // (aerosol: two loops closer than the shutter's travel v T leave the line between them
+        // barely open, d / (2 T) of it let through, d = e / v < T; each corner's window sees its
+        // neighbours printed in full, so that loss is added here: on a finely chorded arc
+        // looped corner by corner almost nothing is printed)
+        if (aerosol) {
+          double unopened_mm = 0.0;
+          for (const std::shared_ptr<const ArcRun>& run : runs)
+            for (size_t i = run->first_corner(); i < run->last_corner(); ++i) {
+              if (without[i].treatment != CornerTreatment::loop ||
+                  without[i + 1].treatment != CornerTreatment::loop)
+                continue;
+              const double edge = (chain.points[i + 1] - chain.points[i]).norm();
+              const double travel = chain.edge_speed_mm_s[i] * model.shutter_time_s;
+              if (edge < travel) unopened_mm += edge * (1.0 - edge / (2.0 * travel));
+            }
+          corners_error_mm += unopened_mm * even_line_error_per_mm(model);
+        }
+        const double runs_error_mm =
+            aerosol ? planned.run_speed_deficit_mm * even_line_error_per_mm(model) : 0.0;
+        if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <
+            runs_error_mm + settings_.time_weight_mm_s * planned.t_end_s) {
+          planned = std::move(alternative);
+          corners = std::move(without);
+        } else {
+          chain_decisions.resize(decided_before);
+        }
+      }
+    }
+    // the runs' corners, reported in order with the others
+    for (size_t i = 1; i + 1 < chain.points.size(); ++i)
+      if (corners[i].treatment == CornerTreatment::arc) {
+        CornerDecision taken;
+        taken.chosen.name = "arc";
+        taken.chosen.pruned = true;  // (its deposit not predicted: an even line, see above)
+        taken.chosen.plan = corners[i];
+        chain_decisions.emplace_back(i, taken);
+      }
+    std::sort(chain_decisions.begin(), chain_decisions.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
+    // aerosol: the whole chain at one constant speed instead (constant_speed_chain), where some
+    // corner is not taken at print speed and the even, thicker line costs less than the
+    // corners' own choices (their predicted errors and the chain's time)
+    bool at_constant_speed = false;
+    if (aerosol && !chain_decisions.empty()) {
+      const bool all_at_print_speed =
+          std::all_of(chain_decisions.begin(), chain_decisions.end(), [&](const auto& entry) {
+            const size_t i = entry.first;
+            return (corners[i].treatment == CornerTreatment::blend ||
+                    corners[i].treatment == CornerTreatment::arc) &&
+                   planned.corner_speed_mm_s[i] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
+          });
+      double corners_error_mm = 0.0;
+      for (const auto& entry : chain_decisions)
+        if (!entry.second.chosen.pruned) corners_error_mm += entry.second.chosen.error_mm;
+      const double corners_cost = corners_error_mm + settings_.time_weight_mm_s * planned.t_end_s;
+      ConstantSpeedChain constant;
+      if (!all_at_print_speed)
+        constant =
+            constant_speed_chain(chain, geometry, settings_.tolerance_mm, merged.edge_error_mm,
+                                 jerk_limits, options, model, corners_cost);
+      if (constant.speed_mm_s > 0.0) {
+        const double constant_cost =
+            constant.error_mm + settings_.time_weight_mm_s * constant.planned.t_end_s;
+        if (constant_cost < corners_cost) {
+          PlanDecision d = chain_decision(chain, "constant_speed");
+          d.figures.push_back({"constant_speed_mm_s", constant.speed_mm_s, "mm/s"});
+          d.figures.push_back({"constant_speed_error_mm", constant.error_mm, "mm"});
+          d.figures.push_back({"constant_speed_time_s", constant.planned.t_end_s, "s"});
+          d.figures.push_back({"corners_error_mm", corners_error_mm, "mm"});
+          d.figures.push_back({"corners_time_s", planned.t_end_s, "s"});
+          reports.push_back(std::move(d));
+          planned = std::move(constant.planned);
+          corners = std::move(constant.corners);
+          at_constant_speed = true;
+        }
+      }
+    }
+    // each corner reported as planned: its blend (deviation) and the speed it is taken at (at
+    // the chain's constant speed: that choice, the corner's own candidates for comparison)
+    for (auto& [i, decision] : chain_decisions) {
+      if (at_constant_speed) {
+        decision.chosen = CornerCandidate{};
+        decision.chosen.name = "constant_speed";
+        decision.chosen.pruned = true;  // (its deposit is the chain's: no error of its own)
+      }
+      decision.chosen.plan = corners[i];
+      decision.chosen.speed_mm_s = planned.corner_speed_mm_s[i];
+      reports.push_back(corner_report(chain, i, geometry[i], decision));
+    }
+    result.first_point = chain.points.front();
+    result.last_point = chain.points.back();
+    result.first_orientation = chain.orientations.front();
+    result.last_orientation = chain.orientations.back();
+    result.planned = std::move(planned);
+    return result;
+  };
+  // each chain's plan, kept across the attempts: a chain whose travel flags did not change is
+  // not planned again
+  std::vector<std::optional<ChainPlan>> chain_plans(chains.size());
   for (int attempt = 0;; ++attempt) {
     pieces.clear();
     decisions.clear();
@@ -422,205 +636,25 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     orientation = toolpath.start_orientation();
     current_chain = -1;
     for (size_t c = 0; c < chains.size(); ++c) {
-      const PrintChain& given = chains[c];
-      PathMotionOptions options = base_options;
-      options.enter_at_speed = base_options.enter_at_speed && !enter_at_rest[c];
-      options.leave_at_speed = base_options.leave_at_speed && !leave_at_rest[c];
-      options.loops_allowed = !without_loops[c];
-      // what the travel changed, reported at the chain's first point
-      if (enter_at_rest[c] || leave_at_rest[c] || without_loops[c]) {
-        PlanDecision d = chain_decision(given, "within_travel");
-        d.figures.push_back({"enters_at_rest", enter_at_rest[c] ? 1.0 : 0.0, "flag"});
-        d.figures.push_back({"leaves_at_rest", leave_at_rest[c] ? 1.0 : 0.0, "flag"});
-        d.figures.push_back({"loops_allowed", without_loops[c] ? 0.0 : 1.0, "flag"});
-        decisions.push_back(std::move(d));
-      }
-      // fine chords merged into edges their corners' blends fit (merge_fine_edges), each corner's
-      // blend within the tolerance left by its edges' merging
-      const MergedChain merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm);
-      const PrintChain& chain = merged.chain;
-      // each corner's treatment, by the predicted deposit
-      const std::vector<CornerGeometry> geometry =
-          corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
-      // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),
-      // where a corner alone cannot keep the print speed: at the print speed, not weighed (an
-      // even line within the tolerance); below it, weighed below; their corners reported as
-      // "arc"
-      const std::vector<std::shared_ptr<const ArcRun>> runs =
-          settings_.arc_runs
-              ? find_arc_runs(merged, given, geometry, settings_.tolerance_mm, jerk_limits, options)
-              : std::vector<std::shared_ptr<const ArcRun>>{};
-      std::vector<CornerPlan> corners(chain.points.size());
-      for (const std::shared_ptr<const ArcRun>& run : runs)
-        for (size_t i = run->first_corner(); i <= run->last_corner(); ++i) {
-          corners[i].treatment = CornerTreatment::arc;
-          corners[i].arc = run;
-        }
-      std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
-      const auto decide = [&](size_t i) {
-        CornerDecisionCache& cache = options.loops_allowed ? decided : decided_without_loops;
-        chain_decisions.emplace_back(i, cache.decision(chain, i, geometry, [&]() {
-          return choose_corner(chain, i, geometry, jerk_limits, options, model,
-                               settings_.time_weight_mm_s, scratch);
-        }));
-        return chain_decisions.back().second.chosen.plan;
-      };
-      for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
-        if (taken_straight_on(geometry[i]) || corners[i].treatment == CornerTreatment::arc)
-          continue;
-        corners[i] = decide(i);
-      }
-      // planned from 0, then placed after the transition that brings the nozzle to its start;
-      // blends that hold the look-ahead back are shrunk and the chain planned again (the quickest
-      // plan kept, its corners in `plan`)
-      const auto plan_resizing = [&](std::vector<CornerPlan>& plan) {
-        PlannedPath planned = plan_chain(chain, geometry, plan, jerk_limits, options, 0.0);
-        const std::vector<CornerPlan> chosen = plan;
-        std::vector<CornerPlan> trial = plan;
-        // (the look-ahead's corner speeds, without curved ramps: the trials are the same with
-        // or without them, each plan with them no slower)
-        std::vector<double> trial_speeds = planned.lookahead_corner_speed_mm_s;
-        for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
-                                                                      jerk_limits, chosen, trial);
-             ++pass) {
-          PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
-          trial_speeds = replanned.lookahead_corner_speed_mm_s;
-          if (replanned.t_end_s < planned.t_end_s) {
-            planned = std::move(replanned);
-            plan = trial;
-          }
-        }
-        return planned;
-      };
-      PlannedPath planned = plan_resizing(corners);
-      // A run below the print speed (sized below it for its arc, or held by the look-ahead on a
-      // circle an extrusion path starts or ends on, at rest), or one from rest to rest (its ramps
-      // on the curve, under limits lowered for the curve's own terms, may take longer than lines
-      // ramping between blends at the print speed), may cost more than its corners one by one:
-      // those are then chosen too and the chain planned without such runs, and the
-      // cheaper plan kept: their predicted errors plus time_weight x its time, against the runs'
-      // plan's time_weight x time and, for a stream that cannot follow the speed (aerosol), the
-      // thicker line it lays on the runs and their ramps (run_speed_deficit_mm x
-      // even_line_error_per_mm); an extruder's flow follows the speed: its bead stays even.
-      {
-        std::vector<CornerPlan> without = corners;
-        const size_t decided_before = chain_decisions.size();
-        for (const std::shared_ptr<const ArcRun>& run : runs) {
-          const size_t first = run->first_corner();
-          if (!run->from_rest_to_rest && planned.corner_speed_mm_s[first] >=
-                                             (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
-            continue;
-          for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(i);
-        }
-        if (chain_decisions.size() > decided_before) {
-          PlannedPath alternative = plan_resizing(without);
-          double corners_error_mm = 0.0;
-          for (size_t k = decided_before; k < chain_decisions.size(); ++k)
-            if (!chain_decisions[k].second.chosen.pruned)
-              corners_error_mm += chain_decisions[k].second.chosen.error_mm;
-          // (aerosol: two loops closer than the shutter's travel v T leave the line between them
-          // barely open, d / (2 T) of it let through, d = e / v < T; each corner's window sees its
-          // neighbours printed in full, so that loss is added here: on a finely chorded arc
-          // looped corner by corner almost nothing is printed)
-          if (aerosol) {
-            double unopened_mm = 0.0;
-            for (const std::shared_ptr<const ArcRun>& run : runs)
-              for (size_t i = run->first_corner(); i < run->last_corner(); ++i) {
-                if (without[i].treatment != CornerTreatment::loop ||
-                    without[i + 1].treatment != CornerTreatment::loop)
-                  continue;
-                const double edge = (chain.points[i + 1] - chain.points[i]).norm();
-                const double travel = chain.edge_speed_mm_s[i] * model.shutter_time_s;
-                if (edge < travel) unopened_mm += edge * (1.0 - edge / (2.0 * travel));
-              }
-            corners_error_mm += unopened_mm * even_line_error_per_mm(model);
-          }
-          const double runs_error_mm =
-              aerosol ? planned.run_speed_deficit_mm * even_line_error_per_mm(model) : 0.0;
-          if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <
-              runs_error_mm + settings_.time_weight_mm_s * planned.t_end_s) {
-            planned = std::move(alternative);
-            corners = std::move(without);
-          } else {
-            chain_decisions.resize(decided_before);
-          }
-        }
-      }
-      // the runs' corners, reported in order with the others
-      for (size_t i = 1; i + 1 < chain.points.size(); ++i)
-        if (corners[i].treatment == CornerTreatment::arc) {
-          CornerDecision taken;
-          taken.chosen.name = "arc";
-          taken.chosen.pruned = true;  // (its deposit not predicted: an even line, see above)
-          taken.chosen.plan = corners[i];
-          chain_decisions.emplace_back(i, taken);
-        }
-      std::sort(chain_decisions.begin(), chain_decisions.end(),
-                [](const auto& x, const auto& y) { return x.first < y.first; });
-      // aerosol: the whole chain at one constant speed instead (constant_speed_chain), where some
-      // corner is not taken at print speed and the even, thicker line costs less than the
-      // corners' own choices (their predicted errors and the chain's time)
-      bool at_constant_speed = false;
-      if (aerosol && !chain_decisions.empty()) {
-        const bool all_at_print_speed =
-            std::all_of(chain_decisions.begin(), chain_decisions.end(), [&](const auto& entry) {
-              const size_t i = entry.first;
-              return (corners[i].treatment == CornerTreatment::blend ||
-                      corners[i].treatment == CornerTreatment::arc) &&
-                     planned.corner_speed_mm_s[i] >=
-                         (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
-            });
-        double corners_error_mm = 0.0;
-        for (const auto& entry : chain_decisions)
-          if (!entry.second.chosen.pruned) corners_error_mm += entry.second.chosen.error_mm;
-        const double corners_cost = corners_error_mm + settings_.time_weight_mm_s * planned.t_end_s;
-        ConstantSpeedChain constant;
-        if (!all_at_print_speed)
-          constant =
-              constant_speed_chain(chain, geometry, settings_.tolerance_mm, merged.edge_error_mm,
-                                   jerk_limits, options, model, corners_cost);
-        if (constant.speed_mm_s > 0.0) {
-          const double constant_cost =
-              constant.error_mm + settings_.time_weight_mm_s * constant.planned.t_end_s;
-          if (constant_cost < corners_cost) {
-            PlanDecision d = chain_decision(chain, "constant_speed");
-            d.figures.push_back({"constant_speed_mm_s", constant.speed_mm_s, "mm/s"});
-            d.figures.push_back({"constant_speed_error_mm", constant.error_mm, "mm"});
-            d.figures.push_back({"constant_speed_time_s", constant.planned.t_end_s, "s"});
-            d.figures.push_back({"corners_error_mm", corners_error_mm, "mm"});
-            d.figures.push_back({"corners_time_s", planned.t_end_s, "s"});
-            decisions.push_back(std::move(d));
-            planned = std::move(constant.planned);
-            corners = std::move(constant.corners);
-            at_constant_speed = true;
-          }
-        }
-      }
-      // each corner reported as planned: its blend (deviation) and the speed it is taken at (at
-      // the chain's constant speed: that choice, the corner's own candidates for comparison)
-      for (auto& [i, decision] : chain_decisions) {
-        if (at_constant_speed) {
-          decision.chosen = CornerCandidate{};
-          decision.chosen.name = "constant_speed";
-          decision.chosen.pruned = true;  // (its deposit is the chain's: no error of its own)
-        }
-        decision.chosen.plan = corners[i];
-        decision.chosen.speed_mm_s = planned.corner_speed_mm_s[i];
-        decisions.push_back(corner_report(chain, i, geometry[i], decision));
-      }
-      add_transition(chain.points.front(), planned.start_velocity, chain.orientations.front(),
+      if (!chain_plans[c] || chain_plans[c]->flags != travel_flags(c))
+        chain_plans[c] = plan_one_chain(c);
+      ChainPlan& plan = *chain_plans[c];
+      decisions.insert(decisions.end(), plan.decisions.begin(), plan.decisions.end());
+      add_transition(plan.first_point, plan.planned.start_velocity, plan.first_orientation,
                      static_cast<int>(c));
       chain_pieces[c].first = pieces.size();
-      for (TrajectoryPiece& piece : planned.pieces) {
+      plan.piece_times_s.clear();
+      for (TrajectoryPiece& piece : plan.planned.pieces) {
+        plan.piece_times_s.emplace_back(piece.t_begin_s, piece.t_end_s);
         piece.t_begin_s += t;
         piece.t_end_s += t;
         pieces.push_back(std::move(piece));
       }
       chain_pieces[c].second = pieces.size();
-      t += planned.t_end_s;
-      position = chain.points.back();
-      velocity = planned.end_velocity;
-      orientation = chain.orientations.back();
+      t += plan.planned.t_end_s;
+      position = plan.last_point;
+      velocity = plan.planned.end_velocity;
+      orientation = plan.last_orientation;
       current_chain = static_cast<int>(c);
     }
     add_transition(toolpath.end_mm, Vec3::Zero(), toolpath.end_orientation(), -1);
@@ -650,6 +684,15 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
         }
     }
     if (!replan) break;
+    // the pieces lent to the job back to their chains' plans, timed from 0 again
+    for (size_t c = 0; c < chains.size(); ++c) {
+      ChainPlan& plan = *chain_plans[c];
+      for (size_t k = 0; k < plan.planned.pieces.size(); ++k) {
+        plan.planned.pieces[k] = std::move(pieces[chain_pieces[c].first + k]);
+        std::tie(plan.planned.pieces[k].t_begin_s, plan.planned.pieces[k].t_end_s) =
+            plan.piece_times_s[k];
+      }
+    }
   }
   if (pieces.empty()) {
     // nothing to print and nowhere to go: at rest at the start
