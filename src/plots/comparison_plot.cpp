@@ -237,8 +237,8 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   const std::vector<std::string> caption = wrap_text(
       orders ? "top: print paths (dark, numbered in print order from 0) and travels; grey bands: "
                "transitions"
-             : "grey bands: transitions (nothing deposited); white box: the zoom below each map, "
-               "on the thickest spot of all runs",
+             : "dashed: the print paths; grey bands: transitions (nothing deposited); white "
+               "box: the zoom below each map, on the thickest spot of all runs",
       static_cast<size_t>((width_px - 2 * kCaptionSideMargin_px) / kCaptionCharWidth_px));
   const int caption_extra_px = static_cast<int>(caption.size() - 1) * kCaptionLine_px;
   const int height_px =

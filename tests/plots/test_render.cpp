@@ -430,6 +430,8 @@ TEST(Comparison, OneRunSheetWrapsItsFooterCaption) {
   const std::string caption = match[1];
   EXPECT_NE(caption.find("grey bands: transitions"), std::string::npos);
   EXPECT_NE(caption.find("thickest spot"), std::string::npos);
+  // the maps' dashed overlay is named (it has no key of its own)
+  EXPECT_NE(caption.find("dashed: the print paths"), std::string::npos);
   // lines split by gnuplot's \n, each at most the column's width at 8 px a character
   size_t lines = 0, start = 0;
   while (true) {
