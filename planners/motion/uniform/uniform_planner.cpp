@@ -1,7 +1,6 @@
 #include "planners/motion/uniform/uniform_planner.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -351,6 +350,276 @@ Trajectory plan_on_joints(const Toolpath& toolpath, const TcpLimits& jerk_limits
   return Trajectory("uniform", std::move(constant), std::move(warnings), std::move(decisions));
 }
 
+// How the machine's travel bounds a chain (aerosol: its transitions at speed and its loops
+// run past its points; see the attempt loop in plan_in_context)
+struct TravelFlags {
+  bool enter_at_rest = false;  // entered at rest instead of at print speed
+  bool leave_at_rest = false;  // left at rest instead of at print speed
+  bool without_loops = false;  // no corner looped
+  bool any() const { return enter_at_rest || leave_at_rest || without_loops; }
+  bool operator!=(const TravelFlags& other) const {
+    return enter_at_rest != other.enter_at_rest || leave_at_rest != other.leave_at_rest ||
+           without_loops != other.without_loops;
+  }
+};
+
+// One chain planned under its travel flags: its motion from 0, its reports, its ends
+struct ChainPlan {
+  TravelFlags flags;
+  PlannedPath planned;
+  std::vector<PlanDecision> decisions;
+  Vec3 first_point, last_point;
+  ToolOrientation first_orientation, last_orientation;
+  // its pieces' times from 0 while the pieces are lent to the job (moved into its pieces)
+  std::vector<std::pair<double, double>> piece_times_s;
+};
+
+// Plans the chains of a job one at a time: each corner's treatment by the predicted deposit,
+// the runs along circles, the aerosol chain at one constant speed; equal corners decided once
+// for the whole job (CornerDecisionCache).
+class ChainPlanner {
+ public:
+  ChainPlanner(const UniformSettings& settings, const TcpLimits& jerk_limits,
+               const DepositModel& model, const PathMotionOptions& base_options)
+      : settings_(settings),
+        jerk_limits_(jerk_limits),
+        model_(model),
+        base_options_(base_options),
+        aerosol_(model.aerosol()),
+        decided_(jerk_limits, settings.reuse_corner_decisions),
+        decided_without_loops_(jerk_limits, settings.reuse_corner_decisions) {}
+
+  ChainPlan plan(const PrintChain& given, const TravelFlags& flags);
+
+ private:
+  // one chain's working state
+  struct Work {
+    PathMotionOptions options;
+    MergedChain merged;  // fine chords merged (merge_fine_edges)
+    std::vector<CornerGeometry> geometry;
+    std::vector<std::shared_ptr<const ArcRun>> runs;
+    std::vector<CornerPlan> corners;                           // per point, its treatment
+    std::vector<std::pair<size_t, CornerDecision>> decisions;  // per decided corner
+    PlannedPath planned;
+    const PrintChain& chain() const { return merged.chain; }
+  };
+  CornerPlan decide(Work& work, size_t corner);
+  PlannedPath plan_resizing(const Work& work, std::vector<CornerPlan>& corners) const;
+  void weigh_runs_against_corners(Work& work);
+  bool take_constant_speed(Work& work, std::vector<PlanDecision>& reports) const;
+
+  const UniformSettings& settings_;
+  const TcpLimits& jerk_limits_;
+  const DepositModel& model_;
+  const PathMotionOptions& base_options_;
+  const bool aerosol_;
+  PredictionScratch scratch_;  // the corner predictions' processes, reused
+  // (a corner's decision does not depend on how its chain's ends are taken: its window enters
+  // and leaves at speed; it does on whether loops are allowed)
+  CornerDecisionCache decided_, decided_without_loops_;
+};
+
+ChainPlan ChainPlanner::plan(const PrintChain& given, const TravelFlags& flags) {
+  ChainPlan result;
+  result.flags = flags;
+  Work work;
+  work.options = base_options_;
+  work.options.enter_at_speed = base_options_.enter_at_speed && !flags.enter_at_rest;
+  work.options.leave_at_speed = base_options_.leave_at_speed && !flags.leave_at_rest;
+  work.options.loops_allowed = !flags.without_loops;
+  // what the travel changed, reported at the chain's first point
+  if (flags.any()) {
+    PlanDecision d = chain_decision(given, "within_travel");
+    d.figures.push_back({"enters_at_rest", flags.enter_at_rest ? 1.0 : 0.0, "flag"});
+    d.figures.push_back({"leaves_at_rest", flags.leave_at_rest ? 1.0 : 0.0, "flag"});
+    d.figures.push_back({"loops_allowed", flags.without_loops ? 0.0 : 1.0, "flag"});
+    result.decisions.push_back(std::move(d));
+  }
+  // fine chords merged into edges their corners' blends fit (merge_fine_edges), each corner's
+  // blend within the tolerance left by its edges' merging
+  work.merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm);
+  const PrintChain& chain = work.chain();
+  work.geometry = corner_geometry(chain.points, settings_.tolerance_mm, work.merged.edge_error_mm);
+  // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),
+  // where a corner alone cannot keep the print speed: at the print speed, not weighed (an
+  // even line within the tolerance); below it, weighed below; their corners reported as "arc"
+  if (settings_.arc_runs)
+    work.runs = find_arc_runs(work.merged, given, work.geometry, settings_.tolerance_mm,
+                              jerk_limits_, work.options);
+  work.corners.resize(chain.points.size());
+  for (const std::shared_ptr<const ArcRun>& run : work.runs)
+    for (size_t i = run->first_corner(); i <= run->last_corner(); ++i) {
+      work.corners[i].treatment = CornerTreatment::arc;
+      work.corners[i].arc = run;
+    }
+  // each other corner's treatment, by the predicted deposit
+  for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
+    if (taken_straight_on(work.geometry[i]) || work.corners[i].treatment == CornerTreatment::arc)
+      continue;
+    work.corners[i] = decide(work, i);
+  }
+  work.planned = plan_resizing(work, work.corners);
+  weigh_runs_against_corners(work);
+  // the runs' corners, reported in order with the others
+  for (size_t i = 1; i + 1 < chain.points.size(); ++i)
+    if (work.corners[i].treatment == CornerTreatment::arc) {
+      CornerDecision taken;
+      taken.chosen.name = "arc";
+      taken.chosen.pruned = true;  // (its deposit not predicted: an even line, see above)
+      taken.chosen.plan = work.corners[i];
+      work.decisions.emplace_back(i, taken);
+    }
+  std::sort(work.decisions.begin(), work.decisions.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  const bool at_constant_speed = take_constant_speed(work, result.decisions);
+  // each corner reported as planned: its blend (deviation) and the speed it is taken at (at
+  // the chain's constant speed: that choice, the corner's own candidates for comparison)
+  for (auto& [i, decision] : work.decisions) {
+    if (at_constant_speed) {
+      decision.chosen = CornerCandidate{};
+      decision.chosen.name = "constant_speed";
+      decision.chosen.pruned = true;  // (its deposit is the chain's: no error of its own)
+    }
+    decision.chosen.plan = work.corners[i];
+    decision.chosen.speed_mm_s = work.planned.corner_speed_mm_s[i];
+    result.decisions.push_back(corner_report(chain, i, work.geometry[i], decision));
+  }
+  result.first_point = chain.points.front();
+  result.last_point = chain.points.back();
+  result.first_orientation = chain.orientations.front();
+  result.last_orientation = chain.orientations.back();
+  result.planned = std::move(work.planned);
+  return result;
+}
+
+// the treatment of interior point `corner`, by its predicted deposit (an equal corner's, where
+// one was decided before), recorded in work.decisions
+CornerPlan ChainPlanner::decide(Work& work, size_t corner) {
+  CornerDecisionCache& cache = work.options.loops_allowed ? decided_ : decided_without_loops_;
+  work.decisions.emplace_back(corner, cache.decision(work.chain(), corner, work.geometry, [&]() {
+    return choose_corner(work.chain(), corner, work.geometry, jerk_limits_, work.options, model_,
+                         settings_.time_weight_mm_s, scratch_);
+  }));
+  return work.decisions.back().second.chosen.plan;
+}
+
+// The chain planned from 0 with `corners` (then placed after the transition that brings the
+// nozzle to its start); blends that hold the look-ahead back are shrunk and the chain planned
+// again: the quickest plan kept, its corners in `corners`
+PlannedPath ChainPlanner::plan_resizing(const Work& work, std::vector<CornerPlan>& corners) const {
+  const PrintChain& chain = work.chain();
+  PlannedPath planned = plan_chain(chain, work.geometry, corners, jerk_limits_, work.options, 0.0);
+  const std::vector<CornerPlan> chosen = corners;
+  std::vector<CornerPlan> trial = corners;
+  // (the look-ahead's corner speeds, without curved ramps: the trials are the same with or
+  // without them, each plan with them no slower)
+  std::vector<double> trial_speeds = planned.lookahead_corner_speed_mm_s;
+  for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, work.geometry, trial_speeds,
+                                                                jerk_limits_, chosen, trial);
+       ++pass) {
+    PlannedPath replanned =
+        plan_chain(chain, work.geometry, trial, jerk_limits_, work.options, 0.0);
+    trial_speeds = replanned.lookahead_corner_speed_mm_s;
+    if (replanned.t_end_s < planned.t_end_s) {
+      planned = std::move(replanned);
+      corners = trial;
+    }
+  }
+  return planned;
+}
+
+// A run below the print speed (sized below it for its arc, or held by the look-ahead on a
+// circle an extrusion path starts or ends on, at rest), or one from rest to rest (its ramps on
+// the curve, under limits lowered for the curve's own terms, may take longer than lines ramping
+// between blends at the print speed), may cost more than its corners one by one: those are
+// then chosen too and the chain planned without such runs, and the cheaper plan kept: their
+// predicted errors plus time_weight x its time, against the runs' plan's time_weight x time
+// and, for a stream that cannot follow the speed (aerosol), the thicker line it lays on the
+// runs and their ramps (run_speed_deficit_mm x even_line_error_per_mm); an extruder's flow
+// follows the speed: its bead stays even.
+void ChainPlanner::weigh_runs_against_corners(Work& work) {
+  const PrintChain& chain = work.chain();
+  std::vector<CornerPlan> without = work.corners;
+  const size_t decided_before = work.decisions.size();
+  for (const std::shared_ptr<const ArcRun>& run : work.runs) {
+    const size_t first = run->first_corner();
+    if (!run->from_rest_to_rest && work.planned.corner_speed_mm_s[first] >=
+                                       (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
+      continue;
+    for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(work, i);
+  }
+  if (work.decisions.size() == decided_before) return;
+  PlannedPath alternative = plan_resizing(work, without);
+  double corners_error_mm = 0.0;
+  for (size_t k = decided_before; k < work.decisions.size(); ++k)
+    if (!work.decisions[k].second.chosen.pruned)
+      corners_error_mm += work.decisions[k].second.chosen.error_mm;
+  // (aerosol: two loops closer than the shutter's travel v T leave the line between them barely
+  // open, d / (2 T) of it let through, d = e / v < T; each corner's window sees its neighbours
+  // printed in full, so that loss is added here: on a finely chorded arc looped corner by
+  // corner almost nothing is printed)
+  if (aerosol_) {
+    double unopened_mm = 0.0;
+    for (const std::shared_ptr<const ArcRun>& run : work.runs)
+      for (size_t i = run->first_corner(); i < run->last_corner(); ++i) {
+        if (without[i].treatment != CornerTreatment::loop ||
+            without[i + 1].treatment != CornerTreatment::loop)
+          continue;
+        const double edge = (chain.points[i + 1] - chain.points[i]).norm();
+        const double travel = chain.edge_speed_mm_s[i] * model_.shutter_time_s;
+        if (edge < travel) unopened_mm += edge * (1.0 - edge / (2.0 * travel));
+      }
+    corners_error_mm += unopened_mm * even_line_error_per_mm(model_);
+  }
+  const double runs_error_mm =
+      aerosol_ ? work.planned.run_speed_deficit_mm * even_line_error_per_mm(model_) : 0.0;
+  if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <
+      runs_error_mm + settings_.time_weight_mm_s * work.planned.t_end_s) {
+    work.planned = std::move(alternative);
+    work.corners = std::move(without);
+  } else {
+    work.decisions.resize(decided_before);
+  }
+}
+
+// Aerosol: the whole chain at one constant speed instead (constant_speed_chain), where some
+// corner is not taken at print speed and the even, thicker line costs less than the corners'
+// own choices (their predicted errors and the chain's time); true when taken (reported in
+// `reports`)
+bool ChainPlanner::take_constant_speed(Work& work, std::vector<PlanDecision>& reports) const {
+  if (!aerosol_ || work.decisions.empty()) return false;
+  const PrintChain& chain = work.chain();
+  const bool all_at_print_speed =
+      std::all_of(work.decisions.begin(), work.decisions.end(), [&](const auto& entry) {
+        const size_t i = entry.first;
+        return (work.corners[i].treatment == CornerTreatment::blend ||
+                work.corners[i].treatment == CornerTreatment::arc) &&
+               work.planned.corner_speed_mm_s[i] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
+      });
+  if (all_at_print_speed) return false;
+  double corners_error_mm = 0.0;
+  for (const auto& entry : work.decisions)
+    if (!entry.second.chosen.pruned) corners_error_mm += entry.second.chosen.error_mm;
+  const double corners_cost = corners_error_mm + settings_.time_weight_mm_s * work.planned.t_end_s;
+  ConstantSpeedChain constant =
+      constant_speed_chain(chain, work.geometry, settings_.tolerance_mm, work.merged.edge_error_mm,
+                           jerk_limits_, work.options, model_, corners_cost);
+  if (!(constant.speed_mm_s > 0.0)) return false;
+  const double constant_cost =
+      constant.error_mm + settings_.time_weight_mm_s * constant.planned.t_end_s;
+  if (!(constant_cost < corners_cost)) return false;
+  PlanDecision d = chain_decision(chain, "constant_speed");
+  d.figures.push_back({"constant_speed_mm_s", constant.speed_mm_s, "mm/s"});
+  d.figures.push_back({"constant_speed_error_mm", constant.error_mm, "mm"});
+  d.figures.push_back({"constant_speed_time_s", constant.planned.t_end_s, "s"});
+  d.figures.push_back({"corners_error_mm", corners_error_mm, "mm"});
+  d.figures.push_back({"corners_time_s", work.planned.t_end_s, "s"});
+  reports.push_back(std::move(d));
+  work.planned = std::move(constant.planned);
+  work.corners = std::move(constant.corners);
+  return true;
+}
+
 }  // namespace
 
 Trajectory UniformPlanner::plan(const Toolpath& toolpath, const TcpLimits& limits) const {
@@ -382,11 +651,10 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
 
   const Toolpath chorded = with_arcs_chorded(toolpath, settings_.tolerance_mm);
   const std::vector<PrintChain> chains = print_chains(chorded);
-  // (aerosol) the chains entered or left at rest instead of at print speed: the transition
-  // at speed took a joint beyond its travel (see the end of the attempt loop)
-  std::vector<char> enter_at_rest(chains.size(), 0), leave_at_rest(chains.size(), 0);
-  // (aerosol) the chains whose corners may not be looped: a loop took a joint beyond its travel
-  std::vector<char> without_loops(chains.size(), 0);
+  // (aerosol) per chain, whether it is entered or left at rest instead of at print speed (the
+  // transition at speed took a joint beyond its travel) and whether its corners may not be
+  // looped (a loop did): see the end of the attempt loop
+  std::vector<TravelFlags> travel(chains.size());
   // each chain's pieces [first, end) in `pieces`
   std::vector<std::pair<size_t, size_t>> chain_pieces(chains.size());
   const JointMap* joint_map = jerk_limits.joint_map();
@@ -411,219 +679,7 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
                                       orientation, to_orientation));
     t = pieces.back().t_end_s;
   };
-  PredictionScratch scratch;  // the corner predictions' processes, reused
-  // (a corner's decision does not depend on how its chain's ends are taken: its window enters
-  // and leaves at speed; it does on whether loops are allowed)
-  CornerDecisionCache decided(jerk_limits, settings_.reuse_corner_decisions);
-  CornerDecisionCache decided_without_loops(jerk_limits, settings_.reuse_corner_decisions);
-  // one chain planned under its travel flags: its motion from 0, its reports, its ends
-  struct ChainPlan {
-    std::array<char, 3> flags{};  // enter_at_rest, leave_at_rest, without_loops
-    PlannedPath planned;
-    std::vector<PlanDecision> decisions;
-    Vec3 first_point, last_point;
-    ToolOrientation first_orientation, last_orientation;
-    // its pieces' times from 0 while the pieces are lent to the job (moved into `pieces`)
-    std::vector<std::pair<double, double>> piece_times_s;
-  };
-  const auto travel_flags = [&](size_t c) {
-    return std::array<char, 3>{enter_at_rest[c], leave_at_rest[c], without_loops[c]};
-  };
-  const auto plan_one_chain = [&](size_t c) {
-    ChainPlan result;
-    result.flags = travel_flags(c);
-    std::vector<PlanDecision>& reports = result.decisions;
-    const PrintChain& given = chains[c];
-    PathMotionOptions options = base_options;
-    options.enter_at_speed = base_options.enter_at_speed && !enter_at_rest[c];
-    options.leave_at_speed = base_options.leave_at_speed && !leave_at_rest[c];
-    options.loops_allowed = !without_loops[c];
-    // what the travel changed, reported at the chain's first point
-    if (enter_at_rest[c] || leave_at_rest[c] || without_loops[c]) {
-      PlanDecision d = chain_decision(given, "within_travel");
-      d.figures.push_back({"enters_at_rest", enter_at_rest[c] ? 1.0 : 0.0, "flag"});
-      d.figures.push_back({"leaves_at_rest", leave_at_rest[c] ? 1.0 : 0.0, "flag"});
-      d.figures.push_back({"loops_allowed", without_loops[c] ? 0.0 : 1.0, "flag"});
-      reports.push_back(std::move(d));
-    }
-    // fine chords merged into edges their corners' blends fit (merge_fine_edges), each corner's
-    // blend within the tolerance left by its edges' merging
-    const MergedChain merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm);
-    const PrintChain& chain = merged.chain;
-    // each corner's treatment, by the predicted deposit
-    const std::vector<CornerGeometry> geometry =
-        corner_geometry(chain.points, settings_.tolerance_mm, merged.edge_error_mm);
-    // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),
-    // where a corner alone cannot keep the print speed: at the print speed, not weighed (an
-    // even line within the tolerance); below it, weighed below; their corners reported as
-    // "arc"
-    const std::vector<std::shared_ptr<const ArcRun>> runs =
-        settings_.arc_runs
-            ? find_arc_runs(merged, given, geometry, settings_.tolerance_mm, jerk_limits, options)
-            : std::vector<std::shared_ptr<const ArcRun>>{};
-    std::vector<CornerPlan> corners(chain.points.size());
-    for (const std::shared_ptr<const ArcRun>& run : runs)
-      for (size_t i = run->first_corner(); i <= run->last_corner(); ++i) {
-        corners[i].treatment = CornerTreatment::arc;
-        corners[i].arc = run;
-      }
-    std::vector<std::pair<size_t, CornerDecision>> chain_decisions;
-    const auto decide = [&](size_t i) {
-      CornerDecisionCache& cache = options.loops_allowed ? decided : decided_without_loops;
-      chain_decisions.emplace_back(i, cache.decision(chain, i, geometry, [&]() {
-        return choose_corner(chain, i, geometry, jerk_limits, options, model,
-                             settings_.time_weight_mm_s, scratch);
-      }));
-      return chain_decisions.back().second.chosen.plan;
-    };
-    for (size_t i = 1; i + 1 < chain.points.size(); ++i) {
-      if (taken_straight_on(geometry[i]) || corners[i].treatment == CornerTreatment::arc) continue;
-      corners[i] = decide(i);
-    }
-    // planned from 0, then placed after the transition that brings the nozzle to its start;
-    // blends that hold the look-ahead back are shrunk and the chain planned again (the quickest
-    // plan kept, its corners in `plan`)
-    const auto plan_resizing = [&](std::vector<CornerPlan>& plan) {
-      PlannedPath planned = plan_chain(chain, geometry, plan, jerk_limits, options, 0.0);
-      const std::vector<CornerPlan> chosen = plan;
-      std::vector<CornerPlan> trial = plan;
-      // (the look-ahead's corner speeds, without curved ramps: the trials are the same with
-      // or without them, each plan with them no slower)
-      std::vector<double> trial_speeds = planned.lookahead_corner_speed_mm_s;
-      for (int pass = 0; pass < kResizePasses && resize_held_blends(chain, geometry, trial_speeds,
-                                                                    jerk_limits, chosen, trial);
-           ++pass) {
-        PlannedPath replanned = plan_chain(chain, geometry, trial, jerk_limits, options, 0.0);
-        trial_speeds = replanned.lookahead_corner_speed_mm_s;
-        if (replanned.t_end_s < planned.t_end_s) {
-          planned = std::move(replanned);
-          plan = trial;
-        }
-      }
-      return planned;
-    };
-    PlannedPath planned = plan_resizing(corners);
-    // A run below the print speed (sized below it for its arc, or held by the look-ahead on a
-    // circle an extrusion path starts or ends on, at rest), or one from rest to rest (its ramps
-    // on the curve, under limits lowered for the curve's own terms, may take longer than lines
-    // ramping between blends at the print speed), may cost more than its corners one by one:
-    // those are then chosen too and the chain planned without such runs, and the
-    // cheaper plan kept: their predicted errors plus time_weight x its time, against the runs'
-    // plan's time_weight x time and, for a stream that cannot follow the speed (aerosol), the
-    // thicker line it lays on the runs and their ramps (run_speed_deficit_mm x
-    // even_line_error_per_mm); an extruder's flow follows the speed: its bead stays even.
-    {
-      std::vector<CornerPlan> without = corners;
-      const size_t decided_before = chain_decisions.size();
-      for (const std::shared_ptr<const ArcRun>& run : runs) {
-        const size_t first = run->first_corner();
-        if (!run->from_rest_to_rest &&
-            planned.corner_speed_mm_s[first] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
-          continue;
-        for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(i);
-      }
-      if (chain_decisions.size() > decided_before) {
-        PlannedPath alternative = plan_resizing(without);
-        double corners_error_mm = 0.0;
-        for (size_t k = decided_before; k < chain_decisions.size(); ++k)
-          if (!chain_decisions[k].second.chosen.pruned)
-            corners_error_mm += chain_decisions[k].second.chosen.error_mm;
-        // (aerosol: two loops closer than the shutter's travel v T leave the line between them
-        // barely open, d / (2 T) of it let through, d = e / v < T; each corner's window sees its
-        // neighbours printed in full, so that loss is added here: on a finely chorded arc
-        // looped corner by corner almost nothing is printed)
-        if (aerosol) {
-          double unopened_mm = 0.0;
-          for (const std::shared_ptr<const ArcRun>& run : runs)
-            for (size_t i = run->first_corner(); i < run->last_corner(); ++i) {
-              if (without[i].treatment != CornerTreatment::loop ||
-                  without[i + 1].treatment != CornerTreatment::loop)
-                continue;
-              const double edge = (chain.points[i + 1] - chain.points[i]).norm();
-              const double travel = chain.edge_speed_mm_s[i] * model.shutter_time_s;
-              if (edge < travel) unopened_mm += edge * (1.0 - edge / (2.0 * travel));
-            }
-          corners_error_mm += unopened_mm * even_line_error_per_mm(model);
-        }
-        const double runs_error_mm =
-            aerosol ? planned.run_speed_deficit_mm * even_line_error_per_mm(model) : 0.0;
-        if (corners_error_mm + settings_.time_weight_mm_s * alternative.t_end_s <
-            runs_error_mm + settings_.time_weight_mm_s * planned.t_end_s) {
-          planned = std::move(alternative);
-          corners = std::move(without);
-        } else {
-          chain_decisions.resize(decided_before);
-        }
-      }
-    }
-    // the runs' corners, reported in order with the others
-    for (size_t i = 1; i + 1 < chain.points.size(); ++i)
-      if (corners[i].treatment == CornerTreatment::arc) {
-        CornerDecision taken;
-        taken.chosen.name = "arc";
-        taken.chosen.pruned = true;  // (its deposit not predicted: an even line, see above)
-        taken.chosen.plan = corners[i];
-        chain_decisions.emplace_back(i, taken);
-      }
-    std::sort(chain_decisions.begin(), chain_decisions.end(),
-              [](const auto& x, const auto& y) { return x.first < y.first; });
-    // aerosol: the whole chain at one constant speed instead (constant_speed_chain), where some
-    // corner is not taken at print speed and the even, thicker line costs less than the
-    // corners' own choices (their predicted errors and the chain's time)
-    bool at_constant_speed = false;
-    if (aerosol && !chain_decisions.empty()) {
-      const bool all_at_print_speed =
-          std::all_of(chain_decisions.begin(), chain_decisions.end(), [&](const auto& entry) {
-            const size_t i = entry.first;
-            return (corners[i].treatment == CornerTreatment::blend ||
-                    corners[i].treatment == CornerTreatment::arc) &&
-                   planned.corner_speed_mm_s[i] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
-          });
-      double corners_error_mm = 0.0;
-      for (const auto& entry : chain_decisions)
-        if (!entry.second.chosen.pruned) corners_error_mm += entry.second.chosen.error_mm;
-      const double corners_cost = corners_error_mm + settings_.time_weight_mm_s * planned.t_end_s;
-      ConstantSpeedChain constant;
-      if (!all_at_print_speed)
-        constant =
-            constant_speed_chain(chain, geometry, settings_.tolerance_mm, merged.edge_error_mm,
-                                 jerk_limits, options, model, corners_cost);
-      if (constant.speed_mm_s > 0.0) {
-        const double constant_cost =
-            constant.error_mm + settings_.time_weight_mm_s * constant.planned.t_end_s;
-        if (constant_cost < corners_cost) {
-          PlanDecision d = chain_decision(chain, "constant_speed");
-          d.figures.push_back({"constant_speed_mm_s", constant.speed_mm_s, "mm/s"});
-          d.figures.push_back({"constant_speed_error_mm", constant.error_mm, "mm"});
-          d.figures.push_back({"constant_speed_time_s", constant.planned.t_end_s, "s"});
-          d.figures.push_back({"corners_error_mm", corners_error_mm, "mm"});
-          d.figures.push_back({"corners_time_s", planned.t_end_s, "s"});
-          reports.push_back(std::move(d));
-          planned = std::move(constant.planned);
-          corners = std::move(constant.corners);
-          at_constant_speed = true;
-        }
-      }
-    }
-    // each corner reported as planned: its blend (deviation) and the speed it is taken at (at
-    // the chain's constant speed: that choice, the corner's own candidates for comparison)
-    for (auto& [i, decision] : chain_decisions) {
-      if (at_constant_speed) {
-        decision.chosen = CornerCandidate{};
-        decision.chosen.name = "constant_speed";
-        decision.chosen.pruned = true;  // (its deposit is the chain's: no error of its own)
-      }
-      decision.chosen.plan = corners[i];
-      decision.chosen.speed_mm_s = planned.corner_speed_mm_s[i];
-      reports.push_back(corner_report(chain, i, geometry[i], decision));
-    }
-    result.first_point = chain.points.front();
-    result.last_point = chain.points.back();
-    result.first_orientation = chain.orientations.front();
-    result.last_orientation = chain.orientations.back();
-    result.planned = std::move(planned);
-    return result;
-  };
+  ChainPlanner chain_planner(settings_, jerk_limits, model, base_options);
   // each chain's plan, kept across the attempts: a chain whose travel flags did not change is
   // not planned again
   std::vector<std::optional<ChainPlan>> chain_plans(chains.size());
@@ -636,8 +692,8 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     orientation = toolpath.start_orientation();
     current_chain = -1;
     for (size_t c = 0; c < chains.size(); ++c) {
-      if (!chain_plans[c] || chain_plans[c]->flags != travel_flags(c))
-        chain_plans[c] = plan_one_chain(c);
+      if (!chain_plans[c] || chain_plans[c]->flags != travel[c])
+        chain_plans[c] = chain_planner.plan(chains[c], travel[c]);
       ChainPlan& plan = *chain_plans[c];
       decisions.insert(decisions.end(), plan.decisions.begin(), plan.decisions.end());
       add_transition(plan.first_point, plan.planned.start_velocity, plan.first_orientation,
@@ -670,15 +726,15 @@ Trajectory UniformPlanner::plan_in_context(const Toolpath& toolpath, const TcpLi
     bool replan = false;
     for (const ChainTransition& transition : transitions) {
       if (!leaves_travel(pieces[transition.piece], *joint_map)) continue;
-      if (transition.from_chain >= 0) leave_at_rest[transition.from_chain] = 1;
-      if (transition.to_chain >= 0) enter_at_rest[transition.to_chain] = 1;
+      if (transition.from_chain >= 0) travel[transition.from_chain].leave_at_rest = true;
+      if (transition.to_chain >= 0) travel[transition.to_chain].enter_at_rest = true;
       replan = true;
     }
     for (size_t c = 0; c < chains.size(); ++c) {
-      if (without_loops[c]) continue;
+      if (travel[c].without_loops) continue;
       for (size_t k = chain_pieces[c].first; k < chain_pieces[c].second; ++k)
         if (!pieces[k].depositing && leaves_travel(pieces[k], *joint_map)) {
-          without_loops[c] = 1;
+          travel[c].without_loops = true;
           replan = true;
           break;
         }
