@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 #include <tuple>
 
@@ -248,6 +249,36 @@ bool m_code_takes_no_axis_words(int tenths) {
 bool rest_is_blank(const char* p, const char* end) {
   while (p < end && is_space(*p)) ++p;
   return p == end || *p == ';' || *p == '(';
+}
+
+// whether a comment line (p at its ';') is a slicer's mark of a new layer: Cura's and
+// ideaMaker's `;LAYER:3` (`;LAYER:-1` for a raft; not `;LAYER_COUNT:`), PrusaSlicer's,
+// SuperSlicer's and OrcaSlicer's `;LAYER_CHANGE`, Bambu Studio's `; CHANGE_LAYER`, Simplify3D's
+// `; layer 3, Z = 0.600`
+bool is_layer_mark(const char* p, const char* end) {
+  const auto starts_with = [&](const char* q, const char* word) {
+    const size_t n = std::strlen(word);
+    return static_cast<size_t>(end - q) >= n && std::equal(word, word + n, q);
+  };
+  const auto ends_word = [&](const char* q) { return q == end || is_space(*q); };
+  ++p;  // the ';'
+  if (starts_with(p, "LAYER:")) {
+    const char* q = p + 6;
+    if (q < end && *q == '-') ++q;
+    const char* digits = q;
+    while (q < end && is_digit(*q)) ++q;
+    return q > digits && ends_word(q);
+  }
+  if (starts_with(p, "LAYER_CHANGE")) return ends_word(p + 12);
+  while (p < end && is_space(*p)) ++p;
+  if (starts_with(p, "CHANGE_LAYER")) return ends_word(p + 12);
+  if (starts_with(p, "layer ")) {
+    const char* q = p + 6;
+    const char* digits = q;
+    while (q < end && is_digit(*q)) ++q;
+    return q > digits && q < end && *q == ',';
+  }
+  return false;
 }
 
 // whether the code number at p (after its letter, spaces allowed) is `number`, whole
@@ -565,7 +596,11 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
       }
       return;
     }
-    if (p == end || *p == ';') return;
+    if (p == end) return;
+    if (*p == ';') {
+      if (is_layer_mark(p, end)) ++program_.n_layer_marks;
+      return;
+    }
     if (*p != '(') break;
     // a line that is a comment, or a comment then words
     const char* close = std::find(p, end, ')');
@@ -1183,6 +1218,7 @@ void GcodeParser::append_move(int motion, const Vec3& target_mm, double e_delta,
   record.feed_mm_s = feed_mm_s_;
   record.has_e = words_.has('E');
   record.open = open_ && !power_off_;
+  record.layer_mark = program_.n_layer_marks;
   position_mm_ = target_mm;
   if (record.length_mm > kMinMove_mm)
     program_.moves.push_back(record);
@@ -1423,7 +1459,8 @@ int level_index(const std::vector<double>& levels, double z) {
   return static_cast<int>(it - levels.begin());
 }
 
-// Calls on_run(first_move, end_move) for every uninterrupted run of print moves.
+// Calls on_run(first_move, end_move) for every uninterrupted run of print moves (a slicer's
+// layer mark between two moves interrupts it: a spiral vase's climb is cut into its layers).
 template <typename OnRun>
 void for_each_print_run(const GcodeProgram& program, PrintRule rule, OnRun on_run) {
   const std::vector<GcodeMove>& moves = program.moves;
@@ -1435,7 +1472,8 @@ void for_each_print_run(const GcodeProgram& program, PrintRule rule, OnRun on_ru
     }
     std::size_t end = i + 1;
     while (end < moves.size() && move_prints(moves[end], rule) &&
-           (moves[end].from_mm - moves[end - 1].to_mm).norm() <= kJoinTolerance_mm)
+           (moves[end].from_mm - moves[end - 1].to_mm).norm() <= kJoinTolerance_mm &&
+           moves[end].layer_mark == moves[end - 1].layer_mark)
       ++end;
     on_run(i, end);
     i = end;
@@ -1631,17 +1669,59 @@ bool move_prints(const GcodeMove& move, PrintRule resolved_rule) {
   return false;
 }
 
-std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
-  std::vector<double> levels;
-  for_each_print_run(program, resolved_rule, [&](std::size_t first, std::size_t end) {
-    levels.push_back(print_run_level(program, first, end));
-  });
+namespace {
+
+// the levels ascending, those within the tolerance of the previous kept one that layer
+std::vector<double> distinct_levels(std::vector<double> levels) {
   std::sort(levels.begin(), levels.end());
-  // levels within the tolerance of the previous kept one are that layer
   std::vector<double> distinct;
   for (const double z : levels)
     if (distinct.empty() || z - distinct.back() > kLayerTolerance_mm) distinct.push_back(z);
   return distinct;
+}
+
+// A file's layers: its print runs' levels, numbered from 0 by increasing z. In a file with a
+// slicer's layer marks, the runs before the first mark (a start block's purge or prime line)
+// that lie below the second marked level are layered with the first layer, not as layers of
+// their own (Cura purges at z = 0.3 over a first layer at 0.2).
+struct LayerLevels {
+  std::vector<double> levels;
+  // a run before the first mark below this joins layer 0
+  double joins_first_below = -std::numeric_limits<double>::infinity();
+};
+
+LayerLevels layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
+  std::vector<double> marked, unmarked;
+  for_each_print_run(program, resolved_rule, [&](std::size_t first, std::size_t end) {
+    (program.moves[first].layer_mark > 0 ? marked : unmarked)
+        .push_back(print_run_level(program, first, end));
+  });
+  LayerLevels result;
+  if (!marked.empty()) {
+    const std::vector<double> marked_levels = distinct_levels(marked);
+    result.joins_first_below = marked_levels.size() >= 2 ? marked_levels[1] - kLayerTolerance_mm
+                                                         : std::numeric_limits<double>::infinity();
+    for (const double z : unmarked)
+      if (!(z < result.joins_first_below)) marked.push_back(z);
+    result.levels = distinct_levels(std::move(marked));
+  } else {
+    result.levels = distinct_levels(std::move(unmarked));
+  }
+  return result;
+}
+
+// the layer of the print run first..end
+int run_layer(const GcodeProgram& program, const LayerLevels& layers, std::size_t first,
+              std::size_t end) {
+  const double z = print_run_level(program, first, end);
+  if (program.moves[first].layer_mark == 0 && z < layers.joins_first_below) return 0;
+  return level_index(layers.levels, z);
+}
+
+}  // namespace
+
+std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
+  return layer_levels(program, resolved_rule).levels;
 }
 
 std::string no_code_problem(int n_lines, int n_code_lines) {
@@ -1657,7 +1737,8 @@ GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions
   GcodeImport result;
   result.n_lines = program.n_lines, result.n_code_lines = program.n_code_lines;
   result.rule = resolve_print_rule(program, options.rule, &result.rule_reason);
-  result.layer_z_mm = print_layer_levels(program, result.rule);
+  const LayerLevels layers = layer_levels(program, result.rule);
+  result.layer_z_mm = layers.levels;
   const int n_layers = static_cast<int>(result.layer_z_mm.size());
   const int last_layer = options.last_layer < 0 ? n_layers - 1 : options.last_layer;
   if (n_layers > 0 &&
@@ -1671,7 +1752,7 @@ GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions
   std::vector<Problem> problems;
   bool reported_missing_feed = false;
   for_each_print_run(program, result.rule, [&](std::size_t first, std::size_t end) {
-    const int layer = level_index(result.layer_z_mm, print_run_level(program, first, end));
+    const int layer = run_layer(program, layers, first, end);
     if (layer < options.first_layer || layer > last_layer) return;
     PrintPath path;
     std::vector<int> lines;

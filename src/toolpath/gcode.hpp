@@ -70,6 +70,7 @@ struct GcodeMove {
   double feed_mm_s = 0.0;  // modal feed rate (0: none given yet)
   bool has_e = false;      // an E word on the line
   bool open = false;       // the open code was the last of open/close, and the modal S not 0
+  int layer_mark = 0;      // the slicer's layer marks read before it (GcodeProgram::n_layer_marks)
 };
 
 // Where the machine stands still between moves: a G4 dwell, or an E-only move (a retraction
@@ -102,6 +103,10 @@ struct GcodeProgram {
   int n_retractions = 0;
   double extrusion_e_total = 0.0;  // net E over the file (G92 resets excluded), mm
   double dwell_s = 0.0;            // sum of G4 dwells
+  // comment lines that mark a new layer as slicers write them (`;LAYER:3`, `;LAYER_CHANGE`, `;
+  // CHANGE_LAYER`, `; layer 3, Z = 0.6`): a print run ends at one, and print runs before the
+  // first (a start block's purge or prime line) are layered with the first layer
+  int n_layer_marks = 0;
   std::vector<GcodePause> pauses;  // dwells and E-only moves, in file order
   int n_lines = 0;
   // lines that hold code (a letter and a number), not only comments, grbl's $ commands or

@@ -471,6 +471,81 @@ TEST(Gcode, RunsThatPlungeWhileOpenAreLayeredWhereTheyPrintFlat) {
   EXPECT_EQ(selected.toolpath.paths[0].layer, 0);
 }
 
+TEST(Gcode, SlicersLayerMarksAreCountedOthersAreNot) {
+  // Cura's (a raft's negative one too), PrusaSlicer's, Bambu Studio's and Simplify3D's marks
+  const std::string marks =
+      ";LAYER:-1\n;LAYER:0\n;LAYER_CHANGE\n; CHANGE_LAYER\n; layer 3, Z = 0.600\n;LAYER:12 \n";
+  // comments that only look like them
+  const std::string others =
+      ";LAYER_COUNT:3\n;LAYER:\n;LAYER:x\n;LAYERS\n; layer height 0.2\n;LAYER_CHANGED\n"
+      "; layer 3 of 40\nG1 X1 F600 ;LAYER:4\n(LAYER:5)\n";
+  EXPECT_EQ(parse_gcode_program(marks + others, "marks.gcode", GcodeOptions{}).n_layer_marks, 6);
+  const GcodeProgram program =
+      parse_gcode_program("G1 X1 E1 F600\n;LAYER:0\nG1 X2 E2\n", "m.gcode", GcodeOptions{});
+  ASSERT_EQ(program.moves.size(), 2u);
+  EXPECT_EQ(program.moves[0].layer_mark, 0);
+  EXPECT_EQ(program.moves[1].layer_mark, 1);
+}
+
+TEST(Gcode, APurgeLineBeforeTheFirstLayerMarkIsLayeredWithTheFirstLayer) {
+  // Cura's start block purges at z = 0.3 over a first layer at 0.2: the slicer's two layers,
+  // not three, the purge printed with layer 0
+  const std::string text =
+      "G1 X0 Y20 Z0.3 F5000\nG1 Y100 E5 F1500\nG92 E0\n;LAYER_COUNT:2\n;LAYER:0\n"
+      "G0 X10 Y10 Z0.2\nG1 X20 E1\n;LAYER:1\nG0 Z0.4\nG1 X10 E2\n";
+  const GcodeProgram program = parse_gcode_program(text, "cura.gcode", GcodeOptions{});
+  const GcodeImport imported = import_gcode_program(program, GcodeOptions{});
+  EXPECT_EQ(imported.layer_z_mm, (std::vector<double>{0.2, 0.4}));
+  EXPECT_EQ(print_layer_levels(program, PrintRule::e), imported.layer_z_mm);
+  ASSERT_EQ(imported.toolpath.paths.size(), 3u);
+  EXPECT_EQ(imported.toolpath.paths[0].points.front(), Vec3(0, 20, 0.3));
+  for (const auto& [path, layer] : {std::pair{0, 0}, {1, 0}, {2, 1}})
+    EXPECT_EQ(imported.toolpath.paths[path].layer, layer) << "path " << path;
+  // layers [1, 1]: the second layer alone
+  GcodeOptions second;
+  second.first_layer = second.last_layer = 1;
+  const GcodeImport selected = import_gcode_program(program, second);
+  ASSERT_EQ(selected.toolpath.paths.size(), 1u);
+  EXPECT_EQ(selected.toolpath.paths[0].points.front(), Vec3(20, 10, 0.4));
+  // a print before the first mark as high as the second marked layer or higher is a layer of
+  // its own, as in a file without marks
+  const GcodeProgram high = parse_gcode_program(
+      "G1 X0 Y20 Z0.5 F5000\nG1 Y100 E5 F1500\nG92 E0\n" + text.substr(text.find(";LAYER_COUNT")),
+      "high.gcode", GcodeOptions{});
+  EXPECT_EQ(print_layer_levels(high, PrintRule::e), (std::vector<double>{0.2, 0.4, 0.5}));
+}
+
+TEST(Gcode, ASpiralVaseIsCutIntoItsLayersAtTheSlicersMarks) {
+  // PrusaSlicer's spiral vase: one climbing run, a ;LAYER_CHANGE at the start of each turn
+  std::string text = "G1 X0 Y0 Z0.2 F3000\n";
+  for (int turn = 0; turn < 3; ++turn) {
+    const double z = 0.2 * (turn + 1);
+    text += ";LAYER_CHANGE\n;Z:" + std::to_string(z) + "\n";
+    text += "G1 X10 Z" + std::to_string(z + 0.05) + " E" + std::to_string(4 * turn + 1) + "\n";
+    text += "G1 Y10 Z" + std::to_string(z + 0.1) + " E" + std::to_string(4 * turn + 2) + "\n";
+    text += "G1 X0 Z" + std::to_string(z + 0.15) + " E" + std::to_string(4 * turn + 3) + "\n";
+    text += "G1 Y0 Z" + std::to_string(z + 0.2) + " E" + std::to_string(4 * turn + 4) + "\n";
+  }
+  const GcodeImport vase = parse(text);
+  // a layer per turn, each starting where the one before ends (printed on through)
+  EXPECT_EQ(vase.layer_z_mm.size(), 3u);
+  ASSERT_EQ(vase.toolpath.paths.size(), 3u);
+  for (int turn = 0; turn < 3; ++turn) {
+    EXPECT_EQ(vase.toolpath.paths[turn].layer, turn);
+    EXPECT_NEAR(vase.layer_z_mm[turn], 0.2 * (turn + 1), 1e-12);
+    if (turn > 0) {
+      EXPECT_EQ(vase.toolpath.paths[turn].points.front(),
+                vase.toolpath.paths[turn - 1].points.back());
+    }
+  }
+  // without the marks: one run, one layer where it starts
+  std::string unmarked;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind(";LAYER_CHANGE", 0) != 0) unmarked += line + "\n";
+  EXPECT_EQ(parse(unmarked).layer_z_mm, (std::vector<double>{0.2}));
+}
+
 TEST(Gcode, DefaultSpeedUntilTheFirstFeedRate) {
   const GcodeImport imported = parse("G1 X1 E1\nG1 X2 E2 F120\n", 7.0);
   ASSERT_EQ(imported.toolpath.paths.size(), 2u);
