@@ -172,6 +172,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   bool previous_printed = false;
   Vec3 previous_end = Vec3::Zero();
   double previous_feed = 0.0;
+  int previous_layer_mark = 0;
   // every move: print or travel, its length, boxes and time
   for (const GcodeMove& move : program.moves) {
     const bool prints = move_prints(move, resolved);
@@ -181,9 +182,11 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
       facts.print_length_mm += move.length_mm;
       facts.n_print_arcs += move.arc.is_arc() ? 1 : 0;
       grow(facts.print_bbox, move);
-      // a print path as the import makes them: connected print moves at one feed rate
+      // a print path as the import makes them: connected print moves at one feed rate, with
+      // no slicer's layer mark between them
       const bool continues = previous_printed && move.feed_mm_s == previous_feed &&
-                             (move.from_mm - previous_end).norm() <= kJoinTolerance_mm;
+                             (move.from_mm - previous_end).norm() <= kJoinTolerance_mm &&
+                             move.layer_mark == previous_layer_mark;
       facts.n_print_paths += continues ? 0 : 1;
     } else {
       ++facts.n_travel_moves;
@@ -192,6 +195,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
     previous_printed = prints;
     previous_end = move.to_mm;
     previous_feed = move.feed_mm_s;
+    previous_layer_mark = move.layer_mark;
     if (move.feed_mm_s > 0.0)
       facts.feed_rate_time_s += move.length_mm / move.feed_mm_s;
     else

@@ -1682,12 +1682,15 @@ std::vector<double> distinct_levels(std::vector<double> levels) {
 
 // A file's layers: its print runs' levels, numbered from 0 by increasing z. In a file with a
 // slicer's layer marks, the runs before the first mark (a start block's purge or prime line)
-// that lie below the second marked level are layered with the first layer, not as layers of
-// their own (Cura purges at z = 0.3 over a first layer at 0.2).
+// that lie between the first and the second marked level are layered with the first layer,
+// not as layers of their own (Cura purges at z = 0.3 over a first layer at 0.2); below the
+// first marked level they are layers of their own (a file marking only the changes between
+// its layers).
 struct LayerLevels {
   std::vector<double> levels;
-  // a run before the first mark below this joins layer 0
-  double joins_first_below = -std::numeric_limits<double>::infinity();
+  // a run before the first mark at or above `from` and below `below` joins layer 0
+  double joins_first_from = std::numeric_limits<double>::infinity();
+  double joins_first_below = std::numeric_limits<double>::infinity();
 };
 
 LayerLevels layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
@@ -1699,14 +1702,12 @@ LayerLevels layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
   LayerLevels result;
   if (!marked.empty()) {
     const std::vector<double> marked_levels = distinct_levels(marked);
-    result.joins_first_below = marked_levels.size() >= 2 ? marked_levels[1] - kLayerTolerance_mm
-                                                         : std::numeric_limits<double>::infinity();
-    for (const double z : unmarked)
-      if (!(z < result.joins_first_below)) marked.push_back(z);
-    result.levels = distinct_levels(std::move(marked));
-  } else {
-    result.levels = distinct_levels(std::move(unmarked));
+    result.joins_first_from = marked_levels[0] - kLayerTolerance_mm;
+    if (marked_levels.size() >= 2) result.joins_first_below = marked_levels[1] - kLayerTolerance_mm;
   }
+  for (const double z : unmarked)
+    if (!(z >= result.joins_first_from && z < result.joins_first_below)) marked.push_back(z);
+  result.levels = distinct_levels(std::move(marked));
   return result;
 }
 
@@ -1714,7 +1715,9 @@ LayerLevels layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
 int run_layer(const GcodeProgram& program, const LayerLevels& layers, std::size_t first,
               std::size_t end) {
   const double z = print_run_level(program, first, end);
-  if (program.moves[first].layer_mark == 0 && z < layers.joins_first_below) return 0;
+  if (program.moves[first].layer_mark == 0 && z >= layers.joins_first_from &&
+      z < layers.joins_first_below)
+    return 0;
   return level_index(layers.levels, z);
 }
 

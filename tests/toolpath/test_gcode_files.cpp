@@ -164,6 +164,20 @@ TEST(GcodeFiles, PrintPathsSplitAtFeedChangesAsTheImportSplitsThem) {
             static_cast<std::size_t>(facts.n_print_paths));
 }
 
+TEST(GcodeFiles, PrintPathsSplitAtASlicersLayerMarkAsTheImportSplitsThem) {
+  // one connected climb at one feed with a ;LAYER_CHANGE in it (a spiral vase's turn): two
+  // print paths and two layers, in inspect as in the import
+  const std::string text =
+      "G1 X0 Y0 Z0.2 F1200\nG1 X10 Z0.3 E1\nG1 Y10 Z0.4 E2\n;LAYER_CHANGE\nG1 X0 Z0.5 E3\n"
+      "G1 Y0 Z0.6 E4\n";
+  const GcodeProgram program = parse_gcode_program(text, "vase.gcode", GcodeOptions{});
+  const GcodeFacts facts = gcode_facts(program, PrintRule::automatic);
+  EXPECT_EQ(facts.n_print_paths, 2);
+  EXPECT_EQ(facts.layer_z_values, (std::vector<double>{0.2, 0.4}));
+  EXPECT_EQ(import_gcode_program(program, GcodeOptions{}).toolpath.paths.size(),
+            static_cast<std::size_t>(facts.n_print_paths));
+}
+
 TEST(GcodeFiles, AerosolShutterCodes) {
   // auto: no E, M3/M5 present -> shutter: 25 + 20 mm printed, the G1 with M5 is a travel
   const GcodeFacts facts = facts_of("aerosol_m3_m5.ngc");
