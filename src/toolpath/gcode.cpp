@@ -1688,7 +1688,9 @@ std::vector<double> distinct_levels(std::vector<double> levels) {
 // its layers).
 struct LayerLevels {
   std::vector<double> levels;
-  // a run before the first mark at or above `from` and below `below` joins layer 0
+  // a run before the first mark at or above `from` (the first marked level) and below `below`
+  // (the second) joins the first marked layer, at `first_marked`
+  double first_marked = std::numeric_limits<double>::infinity();
   double joins_first_from = std::numeric_limits<double>::infinity();
   double joins_first_below = std::numeric_limits<double>::infinity();
 };
@@ -1702,6 +1704,7 @@ LayerLevels layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
   LayerLevels result;
   if (!marked.empty()) {
     const std::vector<double> marked_levels = distinct_levels(marked);
+    result.first_marked = marked_levels[0];
     result.joins_first_from = marked_levels[0] - kLayerTolerance_mm;
     if (marked_levels.size() >= 2) result.joins_first_below = marked_levels[1] - kLayerTolerance_mm;
   }
@@ -1715,10 +1718,9 @@ LayerLevels layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
 int run_layer(const GcodeProgram& program, const LayerLevels& layers, std::size_t first,
               std::size_t end) {
   const double z = print_run_level(program, first, end);
-  if (program.moves[first].layer_mark == 0 && z >= layers.joins_first_from &&
-      z < layers.joins_first_below)
-    return 0;
-  return level_index(layers.levels, z);
+  const bool joins_first = program.moves[first].layer_mark == 0 && z >= layers.joins_first_from &&
+                           z < layers.joins_first_below;
+  return level_index(layers.levels, joins_first ? layers.first_marked : z);
 }
 
 }  // namespace

@@ -513,6 +513,16 @@ TEST(Gcode, APurgeLineBeforeTheFirstLayerMarkIsLayeredWithTheFirstLayer) {
       "G1 X0 Y20 Z0.5 F5000\nG1 Y100 E5 F1500\nG92 E0\n" + text.substr(text.find(";LAYER_COUNT")),
       "high.gcode", GcodeOptions{});
   EXPECT_EQ(print_layer_levels(high, PrintRule::e), (std::vector<double>{0.2, 0.4, 0.5}));
+  // one below the first marked level too (a file that marks only its layer changes): a layer
+  // of its own, under the first marked layer, which the purge still joins
+  const GcodeImport low = import_gcode_program(
+      parse_gcode_program("G1 X0 Y10 Z0.1 F5000\nG1 Y15 E1 F1500\nG92 E0\n" + text, "low.gcode",
+                          GcodeOptions{}),
+      GcodeOptions{});
+  EXPECT_EQ(low.layer_z_mm, (std::vector<double>{0.1, 0.2, 0.4}));
+  ASSERT_EQ(low.toolpath.paths.size(), 4u);
+  for (const auto& [path, layer] : {std::pair{0, 0}, {1, 1}, {2, 1}, {3, 2}})
+    EXPECT_EQ(low.toolpath.paths[path].layer, layer) << "path " << path;
 }
 
 TEST(Gcode, ASpiralVaseIsCutIntoItsLayersAtTheSlicersMarks) {
