@@ -9,7 +9,6 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
-#include <limits>
 #include <sstream>
 #include <tuple>
 
@@ -1669,64 +1668,17 @@ bool move_prints(const GcodeMove& move, PrintRule resolved_rule) {
   return false;
 }
 
-namespace {
-
-// the levels ascending, those within the tolerance of the previous kept one that layer
-std::vector<double> distinct_levels(std::vector<double> levels) {
+std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
+  std::vector<double> levels;
+  for_each_print_run(program, resolved_rule, [&](std::size_t first, std::size_t end) {
+    levels.push_back(print_run_level(program, first, end));
+  });
   std::sort(levels.begin(), levels.end());
+  // levels within the tolerance of the previous kept one are that layer
   std::vector<double> distinct;
   for (const double z : levels)
     if (distinct.empty() || z - distinct.back() > kLayerTolerance_mm) distinct.push_back(z);
   return distinct;
-}
-
-// A file's layers: its print runs' levels, numbered from 0 by increasing z. In a file with a
-// slicer's layer marks, the runs before the first mark (a start block's purge or prime line)
-// that lie between the first and the second marked level are layered with the first layer,
-// not as layers of their own (Cura purges at z = 0.3 over a first layer at 0.2); below the
-// first marked level they are layers of their own (a file marking only the changes between
-// its layers).
-struct LayerLevels {
-  std::vector<double> levels;
-  // a run before the first mark at or above `from` (the first marked level) and below `below`
-  // (the second) joins the first marked layer, at `first_marked`
-  double first_marked = std::numeric_limits<double>::infinity();
-  double joins_first_from = std::numeric_limits<double>::infinity();
-  double joins_first_below = std::numeric_limits<double>::infinity();
-};
-
-LayerLevels layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
-  std::vector<double> marked, unmarked;
-  for_each_print_run(program, resolved_rule, [&](std::size_t first, std::size_t end) {
-    (program.moves[first].layer_mark > 0 ? marked : unmarked)
-        .push_back(print_run_level(program, first, end));
-  });
-  LayerLevels result;
-  if (!marked.empty()) {
-    const std::vector<double> marked_levels = distinct_levels(marked);
-    result.first_marked = marked_levels[0];
-    result.joins_first_from = marked_levels[0] - kLayerTolerance_mm;
-    if (marked_levels.size() >= 2) result.joins_first_below = marked_levels[1] - kLayerTolerance_mm;
-  }
-  for (const double z : unmarked)
-    if (!(z >= result.joins_first_from && z < result.joins_first_below)) marked.push_back(z);
-  result.levels = distinct_levels(std::move(marked));
-  return result;
-}
-
-// the layer of the print run first..end
-int run_layer(const GcodeProgram& program, const LayerLevels& layers, std::size_t first,
-              std::size_t end) {
-  const double z = print_run_level(program, first, end);
-  const bool joins_first = program.moves[first].layer_mark == 0 && z >= layers.joins_first_from &&
-                           z < layers.joins_first_below;
-  return level_index(layers.levels, joins_first ? layers.first_marked : z);
-}
-
-}  // namespace
-
-std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {
-  return layer_levels(program, resolved_rule).levels;
 }
 
 std::string no_code_problem(int n_lines, int n_code_lines) {
@@ -1742,8 +1694,7 @@ GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions
   GcodeImport result;
   result.n_lines = program.n_lines, result.n_code_lines = program.n_code_lines;
   result.rule = resolve_print_rule(program, options.rule, &result.rule_reason);
-  const LayerLevels layers = layer_levels(program, result.rule);
-  result.layer_z_mm = layers.levels;
+  result.layer_z_mm = print_layer_levels(program, result.rule);
   const int n_layers = static_cast<int>(result.layer_z_mm.size());
   const int last_layer = options.last_layer < 0 ? n_layers - 1 : options.last_layer;
   if (n_layers > 0 &&
@@ -1757,7 +1708,7 @@ GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions
   std::vector<Problem> problems;
   bool reported_missing_feed = false;
   for_each_print_run(program, result.rule, [&](std::size_t first, std::size_t end) {
-    const int layer = run_layer(program, layers, first, end);
+    const int layer = level_index(result.layer_z_mm, print_run_level(program, first, end));
     if (layer < options.first_layer || layer > last_layer) return;
     PrintPath path;
     std::vector<int> lines;

@@ -487,42 +487,21 @@ TEST(Gcode, SlicersLayerMarksAreCountedOthersAreNot) {
   EXPECT_EQ(program.moves[1].layer_mark, 1);
 }
 
-TEST(Gcode, APurgeLineBeforeTheFirstLayerMarkIsLayeredWithTheFirstLayer) {
-  // Cura's start block purges at z = 0.3 over a first layer at 0.2: the slicer's two layers,
-  // not three, the purge printed with layer 0
+TEST(Gcode, APurgeLineAtItsOwnHeightStaysALayerOfItsOwn) {
+  // Cura's start block purges at z = 0.3 over a first layer at 0.2: layered by z, marks or
+  // not, so that layers [1, 1]... leave it out and layers [0, 0] is the part's first layer
+  // alone (one height, as a machine without z needs)
   const std::string text =
       "G1 X0 Y20 Z0.3 F5000\nG1 Y100 E5 F1500\nG92 E0\n;LAYER_COUNT:2\n;LAYER:0\n"
       "G0 X10 Y10 Z0.2\nG1 X20 E1\n;LAYER:1\nG0 Z0.4\nG1 X10 E2\n";
   const GcodeProgram program = parse_gcode_program(text, "cura.gcode", GcodeOptions{});
-  const GcodeImport imported = import_gcode_program(program, GcodeOptions{});
-  EXPECT_EQ(imported.layer_z_mm, (std::vector<double>{0.2, 0.4}));
-  EXPECT_EQ(print_layer_levels(program, PrintRule::e), imported.layer_z_mm);
-  ASSERT_EQ(imported.toolpath.paths.size(), 3u);
-  EXPECT_EQ(imported.toolpath.paths[0].points.front(), Vec3(0, 20, 0.3));
-  for (const auto& [path, layer] : {std::pair{0, 0}, {1, 0}, {2, 1}})
-    EXPECT_EQ(imported.toolpath.paths[path].layer, layer) << "path " << path;
-  // layers [1, 1]: the second layer alone
-  GcodeOptions second;
-  second.first_layer = second.last_layer = 1;
-  const GcodeImport selected = import_gcode_program(program, second);
+  EXPECT_EQ(program.n_layer_marks, 2);
+  EXPECT_EQ(print_layer_levels(program, PrintRule::e), (std::vector<double>{0.2, 0.3, 0.4}));
+  GcodeOptions first;
+  first.first_layer = first.last_layer = 0;
+  const GcodeImport selected = import_gcode_program(program, first);
   ASSERT_EQ(selected.toolpath.paths.size(), 1u);
-  EXPECT_EQ(selected.toolpath.paths[0].points.front(), Vec3(20, 10, 0.4));
-  // a print before the first mark as high as the second marked layer or higher is a layer of
-  // its own, as in a file without marks
-  const GcodeProgram high = parse_gcode_program(
-      "G1 X0 Y20 Z0.5 F5000\nG1 Y100 E5 F1500\nG92 E0\n" + text.substr(text.find(";LAYER_COUNT")),
-      "high.gcode", GcodeOptions{});
-  EXPECT_EQ(print_layer_levels(high, PrintRule::e), (std::vector<double>{0.2, 0.4, 0.5}));
-  // one below the first marked level too (a file that marks only its layer changes): a layer
-  // of its own, under the first marked layer, which the purge still joins
-  const GcodeImport low = import_gcode_program(
-      parse_gcode_program("G1 X0 Y10 Z0.1 F5000\nG1 Y15 E1 F1500\nG92 E0\n" + text, "low.gcode",
-                          GcodeOptions{}),
-      GcodeOptions{});
-  EXPECT_EQ(low.layer_z_mm, (std::vector<double>{0.1, 0.2, 0.4}));
-  ASSERT_EQ(low.toolpath.paths.size(), 4u);
-  for (const auto& [path, layer] : {std::pair{0, 0}, {1, 1}, {2, 1}, {3, 2}})
-    EXPECT_EQ(low.toolpath.paths[path].layer, layer) << "path " << path;
+  expect_points(selected.toolpath.paths[0], {Vec3(10, 10, 0.2), Vec3(20, 10, 0.2)});
 }
 
 TEST(Gcode, ASpiralVaseIsCutIntoItsLayersAtTheSlicersMarks) {
