@@ -150,18 +150,24 @@ TEST(GcodeFiles, M83RelativeExtrusionAndShortNumbers) {
   EXPECT_EQ(facts.layer_z_values, std::vector<double>{0.2});
 }
 
+// the facts of G-code text, whose print paths must be the import's
+GcodeFacts facts_split_as_imported(const std::string& text, const std::string& name) {
+  const GcodeProgram program = parse_gcode_program(text, name, GcodeOptions{});
+  const GcodeFacts facts = gcode_facts(program, PrintRule::automatic);
+  EXPECT_EQ(import_gcode_program(program, GcodeOptions{}).toolpath.paths.size(),
+            static_cast<std::size_t>(facts.n_print_paths));
+  return facts;
+}
+
 TEST(GcodeFiles, PrintPathsSplitAtFeedChangesAsTheImportSplitsThem) {
   // a CAM contour whose plunge, cut and lead-out run at three feeds is one connected run but
   // three print paths, as a scenario imports it (a path has one speed)
   const std::string text =
       "G21 G90\nG0 X0 Y0 Z5\nM3 S1000\nG1 Z0 F300\nG1 X20 F1200\nG1 Y10\nG1 X0 F600\n"
       "M5\nG0 Z5\n";
-  const GcodeProgram program = parse_gcode_program(text, "contour.nc", GcodeOptions{});
-  const GcodeFacts facts = gcode_facts(program, PrintRule::automatic);
+  const GcodeFacts facts = facts_split_as_imported(text, "contour.nc");
   EXPECT_EQ(facts.n_print_moves, 4);
   EXPECT_EQ(facts.n_print_paths, 3);
-  EXPECT_EQ(import_gcode_program(program, GcodeOptions{}).toolpath.paths.size(),
-            static_cast<std::size_t>(facts.n_print_paths));
 }
 
 TEST(GcodeFiles, PrintPathsSplitAtASlicersLayerMarkAsTheImportSplitsThem) {
@@ -170,12 +176,9 @@ TEST(GcodeFiles, PrintPathsSplitAtASlicersLayerMarkAsTheImportSplitsThem) {
   const std::string text =
       "G1 X0 Y0 Z0.2 F1200\nG1 X10 Z0.3 E1\nG1 Y10 Z0.4 E2\n;LAYER_CHANGE\nG1 X0 Z0.5 E3\n"
       "G1 Y0 Z0.6 E4\n";
-  const GcodeProgram program = parse_gcode_program(text, "vase.gcode", GcodeOptions{});
-  const GcodeFacts facts = gcode_facts(program, PrintRule::automatic);
+  const GcodeFacts facts = facts_split_as_imported(text, "vase.gcode");
   EXPECT_EQ(facts.n_print_paths, 2);
   EXPECT_EQ(facts.layer_z_values, (std::vector<double>{0.2, 0.4}));
-  EXPECT_EQ(import_gcode_program(program, GcodeOptions{}).toolpath.paths.size(),
-            static_cast<std::size_t>(facts.n_print_paths));
 }
 
 TEST(GcodeFiles, AerosolShutterCodes) {
