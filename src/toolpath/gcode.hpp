@@ -103,8 +103,8 @@ struct GcodeProgram {
   int n_retractions = 0;
   double extrusion_e_total = 0.0;  // net E over the file (G92 resets excluded), mm
   double dwell_s = 0.0;            // sum of G4 dwells
-  // comment lines that mark a new layer as slicers write them (`;LAYER:3`, `;LAYER_CHANGE`, `;
-  // CHANGE_LAYER`, `; layer 3, Z = 0.6`): a print run ends at one
+  // comment lines that mark a new layer as slicers write them: `;LAYER:3`, `;LAYER_CHANGE`,
+  // `; CHANGE_LAYER`, `; layer 3, Z = 0.6` (a print run ends at one)
   int n_layer_marks = 0;
   std::vector<GcodePause> pauses;  // dwells and E-only moves, in file order
   int n_lines = 0;
