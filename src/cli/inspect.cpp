@@ -169,10 +169,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   facts.ignored_axis_codes = program.ignored_axis_codes;
   facts.program_end_line = program.program_end_line;
   facts.n_lines_after_end = program.n_lines_after_end;
-  bool previous_printed = false;
-  Vec3 previous_end = Vec3::Zero();
-  double previous_feed = 0.0;
-  int previous_layer_mark = 0;
+  const GcodeMove* previous_print = nullptr;  // the move before, where it printed
   // every move: print or travel, its length, boxes and time
   for (const GcodeMove& move : program.moves) {
     const bool prints = move_prints(move, resolved);
@@ -182,20 +179,16 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
       facts.print_length_mm += move.length_mm;
       facts.n_print_arcs += move.arc.is_arc() ? 1 : 0;
       grow(facts.print_bbox, move);
-      // a print path as the import makes them: connected print moves at one feed rate, with
-      // no slicer's layer mark between them
-      const bool continues = previous_printed && move.feed_mm_s == previous_feed &&
-                             (move.from_mm - previous_end).norm() <= kJoinTolerance_mm &&
-                             move.layer_mark == previous_layer_mark;
+      // a print path as the import makes them: print moves in one run at one feed rate
+      const bool continues = previous_print != nullptr &&
+                             move.feed_mm_s == previous_print->feed_mm_s &&
+                             continues_print_run(*previous_print, move);
       facts.n_print_paths += continues ? 0 : 1;
     } else {
       ++facts.n_travel_moves;
       facts.travel_length_mm += move.length_mm;
     }
-    previous_printed = prints;
-    previous_end = move.to_mm;
-    previous_feed = move.feed_mm_s;
-    previous_layer_mark = move.layer_mark;
+    previous_print = prints ? &move : nullptr;
     if (move.feed_mm_s > 0.0)
       facts.feed_rate_time_s += move.length_mm / move.feed_mm_s;
     else

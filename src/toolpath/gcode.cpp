@@ -1471,8 +1471,7 @@ void for_each_print_run(const GcodeProgram& program, PrintRule rule, OnRun on_ru
     }
     std::size_t end = i + 1;
     while (end < moves.size() && move_prints(moves[end], rule) &&
-           (moves[end].from_mm - moves[end - 1].to_mm).norm() <= kJoinTolerance_mm &&
-           moves[end].layer_mark == moves[end - 1].layer_mark)
+           continues_print_run(moves[end - 1], moves[end]))
       ++end;
     on_run(i, end);
     i = end;
@@ -1666,6 +1665,11 @@ bool move_prints(const GcodeMove& move, PrintRule resolved_rule) {
       break;
   }
   return false;
+}
+
+bool continues_print_run(const GcodeMove& previous, const GcodeMove& next) {
+  return (next.from_mm - previous.to_mm).norm() <= kJoinTolerance_mm &&
+         next.layer_mark == previous.layer_mark;
 }
 
 std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule) {

@@ -149,6 +149,9 @@ GcodeProgram read_gcode_program(const std::string& path, const GcodeOptions& opt
 PrintRule resolve_print_rule(const GcodeProgram& program, PrintRule rule, std::string* reason);
 // whether a move deposits under a resolved rule
 bool move_prints(const GcodeMove& move, PrintRule resolved_rule);
+// whether print move `next` prints on from `previous` in one run: it starts where `previous`
+// ends, with no slicer's layer mark between them (both must print)
+bool continues_print_run(const GcodeMove& previous, const GcodeMove& next);
 // the z levels of the program's print runs under a resolved rule, ascending (file layers)
 std::vector<double> print_layer_levels(const GcodeProgram& program, PrintRule resolved_rule);
 
