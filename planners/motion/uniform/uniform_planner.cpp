@@ -374,6 +374,11 @@ struct ChainPlan {
   std::vector<std::pair<double, double>> piece_times_s;
 };
 
+// whether the plan takes corner i at its print speed (to rounding)
+bool at_print_speed(const PlannedPath& planned, const PrintChain& chain, size_t i) {
+  return planned.corner_speed_mm_s[i] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
+}
+
 // Plans the chains of a job one at a time: each corner's treatment by the predicted deposit,
 // the runs along circles, the aerosol chain at one constant speed; equal corners decided once
 // for the whole job (CornerDecisionCache).
@@ -543,9 +548,7 @@ void ChainPlanner::weigh_runs_against_corners(Work& work) {
   const size_t decided_before = work.decisions.size();
   for (const std::shared_ptr<const ArcRun>& run : work.runs) {
     const size_t first = run->first_corner();
-    if (!run->from_rest_to_rest && work.planned.corner_speed_mm_s[first] >=
-                                       (1.0 - 1e-9) * chain.corner_print_speed_mm_s(first))
-      continue;
+    if (!run->from_rest_to_rest && at_print_speed(work.planned, chain, first)) continue;
     for (size_t i = first; i <= run->last_corner(); ++i) without[i] = decide(work, i);
   }
   if (work.decisions.size() == decided_before) return;
@@ -594,7 +597,7 @@ bool ChainPlanner::take_constant_speed(Work& work, std::vector<PlanDecision>& re
         const size_t i = entry.first;
         return (work.corners[i].treatment == CornerTreatment::blend ||
                 work.corners[i].treatment == CornerTreatment::arc) &&
-               work.planned.corner_speed_mm_s[i] >= (1.0 - 1e-9) * chain.corner_print_speed_mm_s(i);
+               at_print_speed(work.planned, chain, i);
       });
   if (all_at_print_speed) return false;
   double corners_error_mm = 0.0;
