@@ -510,10 +510,11 @@ TEST(Gcode, ASpiralVaseIsCutIntoItsLayersAtTheSlicersMarks) {
   for (int turn = 0; turn < 3; ++turn) {
     const double z = 0.2 * (turn + 1);
     text += ";LAYER_CHANGE\n;Z:" + std::to_string(z) + "\n";
-    text += "G1 X10 Z" + std::to_string(z + 0.05) + " E" + std::to_string(4 * turn + 1) + "\n";
-    text += "G1 Y10 Z" + std::to_string(z + 0.1) + " E" + std::to_string(4 * turn + 2) + "\n";
-    text += "G1 X0 Z" + std::to_string(z + 0.15) + " E" + std::to_string(4 * turn + 3) + "\n";
-    text += "G1 Y0 Z" + std::to_string(z + 0.2) + " E" + std::to_string(4 * turn + 4) + "\n";
+    // the square's four sides, each climbing a quarter of the layer
+    const char* corners[] = {"X10", "Y10", "X0", "Y0"};
+    for (int side = 1; side <= 4; ++side)
+      text += std::string("G1 ") + corners[side - 1] + " Z" + std::to_string(z + 0.05 * side) +
+              " E" + std::to_string(4 * turn + side) + "\n";
   }
   const GcodeImport vase = parse(text);
   // a layer per turn, each starting where the one before ends (printed on through)
