@@ -32,9 +32,11 @@ constexpr double kMetricsTop = 0.115, kMetricsLine = 0.017;
 // and below it), the panels under it as many pixels up as on the full sheet
 constexpr int kOrdersHeight_px = 1000;
 constexpr double kTravelBottom = 0.43, kTravelHeight = 0.53;
-// at most this many points per x-y curve, and this many path numbers
+// at most this many points per x-y curve, and this many path number labels (none when more
+// would be drawn); numbers closer than this share of the panel's larger side share a label
 constexpr size_t kMaxPathPoints = 1200;
 constexpr size_t kMaxPathLabels = 40;
+constexpr double kLabelMergeShare = 0.03;
 // the zoom window: this fraction of the largest map extent a side, at least this many cells
 constexpr double kZoomFraction = 0.125;
 constexpr int kZoomMinCells = 24;
@@ -52,15 +54,17 @@ std::string window_outline(const ZoomWindow& w) {
       w.x_lo, w.y_lo, w.x_hi, w.y_hi);
 }
 
-// the print paths (dark), the travels (the column's colour) and the path numbers
-std::string travel_elements(PlotJob& job, const ComparisonColumn& column, size_t c) {
+// the print paths (dark), the travels (the column's colour) and the path numbers (those
+// within merge_within_mm of one another share a label)
+std::string travel_elements(PlotJob& job, const ComparisonColumn& column, size_t c,
+                            double merge_within_mm) {
   std::string s;
-  for (size_t i = 0; i < column.path_labels.size(); ++i) {
-    const PathLabel& label = column.path_labels[i];
+  const std::vector<DrawnLabel> labels =
+      drawn_path_labels(column.path_labels, merge_within_mm, kMaxPathLabels);
+  for (size_t i = 0; i < labels.size(); ++i)
     s += format(
-        "set label %zu \"%d\" at %.9g,%.9g offset 0.5,0.5 tc rgb \"#404040\" font \",9\" front\n",
-        1000 + i, label.path, label.x_mm, label.y_mm);
-  }
+        "set label %zu \"%s\" at %.9g,%.9g offset 0.5,0.5 tc rgb \"#404040\" font \",9\" front\n",
+        1000 + i, labels[i].text.c_str(), labels[i].x_mm, labels[i].y_mm);
   std::vector<std::string> elements;
   if (column.print_xy.point_count() > 0)
     elements.push_back(job.data_file(format("prints_%zu.dat", c), format_curve(column.print_xy)) +
@@ -73,15 +77,24 @@ std::string travel_elements(PlotJob& job, const ComparisonColumn& column, size_t
   return s + plot_command(elements);
 }
 
-// the x-y ranges of every column's print and travel curves (shared by the travel panels)
-std::string travel_ranges(const std::vector<ComparisonColumn>& columns) {
+// the x-y extent of every column's print and travel curves (shared by the travel panels)
+struct TravelExtent {
   Range x, y;
-  for (const ComparisonColumn& c : columns) {
-    x.add_x(c.print_xy), y.add_y(c.print_xy);
-    x.add_x(c.travel_xy), y.add_y(c.travel_xy);
+
+  explicit TravelExtent(const std::vector<ComparisonColumn>& columns) {
+    for (const ComparisonColumn& c : columns) {
+      x.add_x(c.print_xy), y.add_y(c.print_xy);
+      x.add_x(c.travel_xy), y.add_y(c.travel_xy);
+    }
   }
-  return "set xrange " + x.gnuplot(0.03, 0.5) + "\nset yrange " + y.gnuplot(0.03, 0.5) + "\n";
-}
+  std::string gnuplot_ranges() const {
+    return "set xrange " + x.gnuplot(0.03, 0.5) + "\nset yrange " + y.gnuplot(0.03, 0.5) + "\n";
+  }
+  // path numbers closer than kLabelMergeShare of the larger side share a label
+  double label_merge_mm() const {
+    return x.empty() ? 0.0 : kLabelMergeShare * std::max(x.hi - x.lo, y.hi - y.lo);
+  }
+};
 
 }  // namespace
 
@@ -93,10 +106,9 @@ void set_speed_error(ComparisonColumn& column, const MotionSamples& samples) {
 void set_travels(ComparisonColumn& column, const MotionSamples& planned) {
   column.print_xy = xy_path_curve(planned, PathPart::printing, kMaxPathPoints);
   column.travel_xy = xy_path_curve(planned, PathPart::transition, kMaxPathPoints);
-  column.path_labels.clear();
   // each printed run's path number at its middle sample
+  column.path_labels.clear();
   size_t k = 0;
-  std::vector<PathLabel> labels;
   while (k < planned.size()) {
     const int path = planned.path_index[k];
     if (!planned.depositing[k] || path < 0) {
@@ -106,9 +118,8 @@ void set_travels(ComparisonColumn& column, const MotionSamples& planned) {
     const size_t first = k;
     while (k < planned.size() && planned.depositing[k] && planned.path_index[k] == path) ++k;
     const Vec3& middle = planned.position_mm[(first + k - 1) / 2];
-    labels.push_back({middle.x(), middle.y(), path});
+    column.path_labels.push_back({middle.x(), middle.y(), path});
   }
-  if (labels.size() <= kMaxPathLabels) column.path_labels = std::move(labels);
 }
 
 bool is_orders_comparison(const std::vector<ComparisonColumn>& columns) {
@@ -323,7 +334,7 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   s += format("set label 900 %s at screen 0.5,%.4f center tc rgb \"#606060\"\n",
               style::double_quoted_lines(caption).c_str(), 0.012 * bottom_scale + lift);
   const std::string shared_map_ranges = maps.empty() ? "" : map_ranges(maps, input.toolpath);
-  const std::string shared_travel_ranges = orders ? travel_ranges(input.columns) : "";
+  const TravelExtent travel_extent(input.columns);
   bool colour_bar_drawn = false;
 
   for (size_t c = 0; c < columns; ++c) {
@@ -339,8 +350,9 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
       // the print paths numbered in print order, and the travels between them
       s += "set margins -1,-1,-1,-1\nset origin " + format("%.4f,%.4f\n", left, kTravelBottom);
       s += format("set size ratio -1 %.4f,%.4f\n", width, kTravelHeight);
-      s += "unset colorbox\nset grid\nunset key\n" + shared_travel_ranges + title + xy_labels;
-      s += travel_elements(job, column, c);
+      s += "unset colorbox\nset grid\nunset key\n" + travel_extent.gnuplot_ranges() + title +
+           xy_labels;
+      s += travel_elements(job, column, c, travel_extent.label_merge_mm());
       s += "unset title\nunset label\n";
     } else if (has_map(column.thickness)) {
       // thickness map, the colour bar drawn once with the first map, the zoom window outlined

@@ -69,6 +69,68 @@ std::vector<TimeInterval> transition_intervals(const MotionSamples& samples) {
   return bands;
 }
 
+std::vector<PathLabel> halfway_path_labels(const Toolpath& toolpath) {
+  std::vector<PathLabel> labels;
+  for (size_t i = 0; i < toolpath.paths.size(); ++i) {
+    const PrintPath& path = toolpath.paths[i];
+    // the edge the half length falls on, and where on it
+    const double half_mm = 0.5 * path.length_mm();
+    double walked_mm = 0.0;
+    Vec3 halfway = path.points.back();
+    for (size_t edge = 0; edge + 1 < path.points.size(); ++edge) {
+      const double length = path.edge_length(edge);
+      if (walked_mm + length >= half_mm && length > 0.0) {
+        halfway = path.edge_point(edge, (half_mm - walked_mm) / length);
+        break;
+      }
+      walked_mm += length;
+    }
+    labels.push_back({halfway.x(), halfway.y(), static_cast<int>(i)});
+  }
+  return labels;
+}
+
+namespace {
+
+// "0", "0, 1" or "0–3, 7": the distinct numbers ascending, runs of three or more as ranges
+std::string number_list(std::vector<int> numbers) {
+  std::sort(numbers.begin(), numbers.end());
+  numbers.erase(std::unique(numbers.begin(), numbers.end()), numbers.end());
+  std::string text;
+  for (size_t i = 0; i < numbers.size();) {
+    size_t last = i;
+    while (last + 1 < numbers.size() && numbers[last + 1] == numbers[last] + 1) ++last;
+    if (!text.empty()) text += ", ";
+    text += std::to_string(numbers[i]);
+    if (last > i) text += (last == i + 1 ? ", " : "–") + std::to_string(numbers[last]);
+    i = last + 1;
+  }
+  return text;
+}
+
+}  // namespace
+
+std::vector<DrawnLabel> drawn_path_labels(const std::vector<PathLabel>& labels,
+                                          double merge_within_mm, size_t max_drawn) {
+  // (each label costs at most max_drawn distances: the search stops past max_drawn)
+  std::vector<DrawnLabel> drawn;
+  std::vector<std::vector<int>> numbers;
+  for (const PathLabel& label : labels) {
+    size_t joins = 0;
+    while (joins < drawn.size() && std::hypot(drawn[joins].x_mm - label.x_mm,
+                                              drawn[joins].y_mm - label.y_mm) > merge_within_mm)
+      ++joins;
+    if (joins == drawn.size()) {
+      if (drawn.size() == max_drawn) return {};
+      drawn.push_back({"", label.x_mm, label.y_mm});
+      numbers.emplace_back();
+    }
+    numbers[joins].push_back(label.path);
+  }
+  for (size_t i = 0; i < drawn.size(); ++i) drawn[i].text = number_list(numbers[i]);
+  return drawn;
+}
+
 void Curve::add(double px, double py) {
   x.push_back(px);
   y.push_back(py);

@@ -30,6 +30,25 @@ std::vector<TimeInterval> transition_intervals(const Trajectory& trajectory);
 // last sample); exact to the sampling period
 std::vector<TimeInterval> transition_intervals(const MotionSamples& samples);
 
+// A print path's number (0-based, in print order) at a point of it.
+struct PathLabel {
+  double x_mm = 0.0, y_mm = 0.0;
+  int path = 0;
+};
+// each path's number at the point halfway along its length (its arcs followed exactly)
+std::vector<PathLabel> halfway_path_labels(const Toolpath& toolpath);
+
+// A label as drawn: the path numbers it stands for ("3", "0–2", "0, 4") at a point.
+struct DrawnLabel {
+  std::string text;
+  double x_mm = 0.0, y_mm = 0.0;
+};
+// The labels to draw, so that numbers do not cover one another: taken in order, a label within
+// merge_within_mm (in x-y) of a drawn label's point joins it (a part's stacked layers share
+// one); a new one is drawn at its own point. Empty when more than max_drawn would be drawn.
+std::vector<DrawnLabel> drawn_path_labels(const std::vector<PathLabel>& labels,
+                                          double merge_within_mm, size_t max_drawn);
+
 // A curve as gnuplot draws it: points in order, a NaN in x marks a break in the line.
 struct Curve {
   std::vector<double> x, y;

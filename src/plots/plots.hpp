@@ -198,12 +198,6 @@ PlotResult render_run_plots(const RunPlotInput& input, const std::string& direct
                             const std::vector<RunPlot>& plots = {},
                             const PlotOptions& options = {});
 
-// A print path's number (0-based, in print order) at a point of it.
-struct PathLabel {
-  double x_mm = 0.0, y_mm = 0.0;
-  int path = 0;
-};
-
 // One planner's column of the comparison sheet.
 struct ComparisonColumn {
   std::string planner;
@@ -224,7 +218,7 @@ struct ComparisonColumn {
 // fill t_s and speed_error_rel from samples (the simulated ones when there are)
 void set_speed_error(ComparisonColumn& column, const MotionSamples& samples);
 // fill print_xy, travel_xy and path_labels from the plan's samples: each printed run is
-// labelled with its path index (0-based print order) at its middle sample; at most 40 labels
+// labelled with its path index (0-based print order) at its middle sample
 void set_travels(ComparisonColumn& column, const MotionSamples& planned);
 
 // The comparison sheet's zoom: a square window around the thickest cell of all the maps (the

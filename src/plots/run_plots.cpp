@@ -20,6 +20,11 @@ std::string zero_based_range(double max_value) {
   return format("[0:%.9g]", max_value > 0.0 ? 1.08 * max_value : 1.0);
 }
 
+// path.png: path numbers closer than this share of the plot's larger span share a label; no
+// numbers when more than kMaxPathLabels labels would be drawn
+constexpr double kLabelMergeShare = 0.03;
+constexpr size_t kMaxPathLabels = 40;
+
 // thickness_profile.png: at most this many key entries go under the plot (two rows of three)
 constexpr size_t kProfileKeyEntriesBelow = 6;
 
@@ -193,26 +198,15 @@ void path_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
               frame.y_lo, frame.y_hi);
 
   // print paths numbered in print order at their middle (as in the paper's Fig. 7), 0-based
-  // as in trajectory.csv and metrics.json
-  if (toolpath.paths.size() <= 40) {
-    for (size_t i = 0; i < toolpath.paths.size(); ++i) {
-      const auto& points = toolpath.paths[i].points;
-      const double half_mm = 0.5 * toolpath.paths[i].length_mm();
-      double walked_mm = 0.0;
-      Vec3 middle = points.front();
-      for (size_t j = 1; j < points.size(); ++j) {
-        const double step = (points[j] - points[j - 1]).norm();
-        if (walked_mm + step >= half_mm && step > 0.0) {
-          middle = points[j - 1] + (half_mm - walked_mm) / step * (points[j] - points[j - 1]);
-          break;
-        }
-        walked_mm += step;
-      }
-      s += format(
-          "set label %zu \"%zu\" at %.9g,%.9g offset 0.7,0.7 tc rgb \"#404040\" boxed front\n",
-          i + 1, i, middle.x(), middle.y());
-    }
-  }
+  // as in trajectory.csv and metrics.json; numbers that would cover one another (a part's
+  // layers) share one label, "0–2"
+  const double merge_within_mm =
+      kLabelMergeShare * std::max(frame.x_hi - frame.x_lo, frame.y_hi - frame.y_lo);
+  const std::vector<DrawnLabel> labels =
+      drawn_path_labels(halfway_path_labels(toolpath), merge_within_mm, kMaxPathLabels);
+  for (size_t i = 0; i < labels.size(); ++i)
+    s += format("set label %zu \"%s\" at %.9g,%.9g offset 0.7,0.7 tc rgb \"#404040\" boxed front\n",
+                i + 1, labels[i].text.c_str(), labels[i].x_mm, labels[i].y_mm);
 
   s += format("$start << EOD\n%.9g %.9g\nEOD\n$end << EOD\n%.9g %.9g\nEOD\n", toolpath.start_mm.x(),
               toolpath.start_mm.y(), toolpath.end_mm.x(), toolpath.end_mm.y());

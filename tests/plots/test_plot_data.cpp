@@ -228,5 +228,53 @@ TEST(PlanRanges, ALongThinJobIsFramedAtLeastAThirdAsWideAsLong) {
   EXPECT_DOUBLE_EQ(even.y_hi, 10.5);
 }
 
+// A half circle of radius 10 (one arc edge from (10, 0) to (-10, 0) about the centre) is
+// labelled at the top of the arc, (0, 10), not at the middle of its chord; a straight
+// two-edge path of 4 mm then 6 mm at 5 mm along it.
+TEST(PathLabels, EachPathIsNumberedHalfwayAlongItsLength) {
+  Toolpath toolpath;
+  PrintPath arc;
+  arc.points = {Vec3(10, 0, 0), Vec3(-10, 0, 0)};
+  arc.arcs = {EdgeArc{Vec3::Zero(), Vec3::UnitZ(), M_PI}};
+  PrintPath corner;
+  corner.points = {Vec3(0, 0, 1), Vec3(4, 0, 1), Vec3(4, 6, 1)};
+  toolpath.paths = {arc, corner};
+  const std::vector<plots::PathLabel> labels = plots::halfway_path_labels(toolpath);
+  ASSERT_EQ(labels.size(), 2u);
+  EXPECT_EQ(labels[0].path, 0);
+  EXPECT_NEAR(labels[0].x_mm, 0.0, 1e-9);
+  EXPECT_NEAR(labels[0].y_mm, 10.0, 1e-9);
+  EXPECT_EQ(labels[1].path, 1);
+  EXPECT_NEAR(labels[1].x_mm, 4.0, 1e-9);
+  EXPECT_NEAR(labels[1].y_mm, 1.0, 1e-9);
+}
+
+// Numbers whose points lie within the merge distance of a drawn label share it, listed
+// ascending once each, runs of three or more as a range; others get their own label, at their
+// own point; too many labels draw none.
+TEST(PathLabels, NumbersThatWouldCoverOneAnotherShareOneLabel) {
+  // three stacked layers at one spot (one of them a second run of path 1), then path 5 there
+  // too, paths 3 and 4 side by side elsewhere, path 6 just outside the first spot's reach
+  const std::vector<plots::PathLabel> labels = {{10.0, 10.0, 0}, {10.0, 10.0, 1}, {10.0, 10.2, 2},
+                                                {10.0, 10.0, 1}, {30.0, 0.0, 3},  {30.3, 0.0, 4},
+                                                {10.4, 10.0, 5}, {10.0, 10.6, 6}};
+  const std::vector<plots::DrawnLabel> drawn = plots::drawn_path_labels(labels, 0.5, 40);
+  ASSERT_EQ(drawn.size(), 3u);
+  EXPECT_EQ(drawn[0].text, "0–2, 5");
+  EXPECT_EQ(drawn[0].x_mm, 10.0);
+  EXPECT_EQ(drawn[0].y_mm, 10.0);
+  EXPECT_EQ(drawn[1].text, "3, 4");
+  EXPECT_EQ(drawn[1].x_mm, 30.0);
+  EXPECT_EQ(drawn[2].text, "6");
+  EXPECT_EQ(drawn[2].y_mm, 10.6);
+  // three labels are one more than two
+  EXPECT_EQ(plots::drawn_path_labels(labels, 0.5, 3).size(), 3u);
+  EXPECT_TRUE(plots::drawn_path_labels(labels, 0.5, 2).empty());
+  // a merge distance of 0: only numbers at the very same point share a label (0 and 1)
+  const std::vector<plots::DrawnLabel> apart = plots::drawn_path_labels(labels, 0.0, 40);
+  ASSERT_EQ(apart.size(), 6u);
+  EXPECT_EQ(apart[0].text, "0, 1");
+}
+
 }  // namespace
 }  // namespace depotwin

@@ -86,6 +86,32 @@ TEST(RunPlots, AllFiveInOneCallAndByteIdenticalTwice) {
   }
 }
 
+// path.png of three stacked layers of one line and a line beside them: the layers' numbers,
+// which were drawn at one point over one another, share one label "0–2"; the fourth line
+// keeps its own, "3".
+TEST(RunPlots, StackedLayersShareOnePathNumberLabel) {
+  Toolpath toolpath = testing_support::raster_toolpath(1);
+  for (int layer = 1; layer <= 2; ++layer) {
+    PrintPath path = testing_support::line(0, 0, 10, 0);
+    for (Vec3& point : path.points) point.z() = 0.2 * layer;
+    path.layer = layer;
+    toolpath.paths.push_back(path);
+  }
+  toolpath.paths.push_back(testing_support::line(0, 5, 10, 5));
+  const auto f = make_plot_fixture(toolpath, 0.5, false);
+  const std::string directory = output_directory("stacked_layer_labels");
+  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
+  plots::render_run_plots(f.input(), directory + "/plot", {RunPlot::path}, options);
+  const std::string section = testing_support::png_section(capture.script(), "path.png");
+  const std::regex label_command(R"re(set label (\d+) "([^"]*)" at ([-\d.e]+),([-\d.e]+))re");
+  std::vector<std::string> texts;
+  for (std::sregex_iterator it(section.begin(), section.end(), label_command), end; it != end; ++it)
+    texts.push_back((*it)[2].str() + " at " + (*it)[3].str() + "," + (*it)[4].str());
+  EXPECT_EQ(texts, (std::vector<std::string>{"0–2 at 5,0", "3 at 5,5"})) << section;
+}
+
 TEST(RunPlots, PlanOnlyRunWithoutThickness) {
   auto f = make_plot_fixture(testing_support::thompson_like_toolpath(), 1.5, false);
   auto input = f.input("plan only");
