@@ -169,6 +169,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   facts.ignored_axis_codes = program.ignored_axis_codes;
   facts.program_end_line = program.program_end_line;
   facts.n_lines_after_end = program.n_lines_after_end;
+  facts.slicer_notes = program.slicer_notes;
   const GcodeMove* previous_print = nullptr;  // the move before, where it printed
   // every move: print or travel, its length, boxes and time
   for (const GcodeMove& move : program.moves) {
@@ -231,6 +232,15 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
   out["program_end_line"] =
       facts.program_end_line > 0 ? nlohmann::json(facts.program_end_line) : nlohmann::json();
   out["n_lines_after_end"] = facts.n_lines_after_end;
+  // the slicer's own declarations, to set beside the facts above
+  const auto or_null = [](const auto& value) {
+    return value ? nlohmann::json(*value) : nlohmann::json();
+  };
+  const SlicerNotes& notes = facts.slicer_notes;
+  out["slicer_notes"] = {{"slicer", or_null(notes.slicer)},
+                         {"estimated_time_s", or_null(notes.estimated_time_s)},
+                         {"layer_count", or_null(notes.layer_count)},
+                         {"filament_used_mm", or_null(notes.filament_used_mm)}};
   return out;
 }
 

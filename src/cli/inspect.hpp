@@ -52,6 +52,9 @@ struct GcodeFacts {
   // lines holding anything came after it, unread
   int program_end_line = 0;
   int n_lines_after_end = 0;
+  // what the slicer's comments declare: who made the file, its time estimate, layer count and
+  // filament length (toolpath/slicer_notes.hpp), each null in the JSON when not declared
+  SlicerNotes slicer_notes;
   std::string baseline_machine;  // the machine and firmware mode estimated_time_s assumes
   std::string baseline_mode;
 };

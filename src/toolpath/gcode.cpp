@@ -597,7 +597,10 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     }
     if (p == end) return;
     if (*p == ';') {
-      if (is_layer_mark(p, end)) ++program_.n_layer_marks;
+      if (is_layer_mark(p, end))
+        ++program_.n_layer_marks;
+      else
+        read_slicer_note(p, end, program_.slicer_notes);
       return;
     }
     if (*p != '(') break;

@@ -224,6 +224,8 @@ TEST(GcodeFiles, CuraPurgeLine) {
   EXPECT_NEAR(facts.extrusion_e_total, 30.66, 1e-12);
   EXPECT_EQ(facts.layer_z_values, std::vector<double>{0.3});
   expect_box(facts.print_bbox, Vec3(0.1, 10, 0.3), Vec3(20, 200, 0.3));
+  // the file's `;LAYER_COUNT:1`, as many layers as the import finds
+  EXPECT_EQ(gcode_facts_json(facts)["slicer_notes"]["layer_count"], 1);
 }
 
 TEST(GcodeFiles, FiveLayerSquare) {
@@ -330,8 +332,13 @@ TEST(GcodeFiles, InspectJsonKeys) {
   for (const char* key :
        {"n_print_moves", "n_travel_moves", "print_length_mm", "travel_length_mm", "n_layers",
         "layer_z_values", "print_bbox", "all_moves_bbox", "n_print_arcs", "n_retractions",
-        "extrusion_e_total", "estimated_time_s", "rule"})
+        "extrusion_e_total", "estimated_time_s", "rule", "slicer_notes"})
     EXPECT_TRUE(json.contains(key)) << key;
+  // a hand-written file declares nothing: every note null
+  EXPECT_EQ(json["slicer_notes"], (nlohmann::json{{"slicer", nullptr},
+                                                  {"estimated_time_s", nullptr},
+                                                  {"layer_count", nullptr},
+                                                  {"filament_used_mm", nullptr}}));
   EXPECT_EQ(json["n_layers"], 1);
   EXPECT_EQ(json["print_bbox"]["min"][0], -10.0);
 }
