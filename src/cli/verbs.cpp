@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <map>
 
 #include "core/error.hpp"
 #include "core/number_text.hpp"
@@ -45,13 +46,61 @@ JobBudget job_budget(const std::string& max_memory) {
   return budget;
 }
 
-// each run's warnings, named by its run label (two runs of one planner with other settings
-// are told apart)
-void print_warnings(const std::vector<MetricsReport>& reports) {
+// at most this many warnings of one kind (the same text but for its numbers) are printed for
+// a run: a slicer's file can give lspb_mtt one per segment, hundreds; the rest are counted
+constexpr int kWarningsPrintedPerKind = 3;
+
+// a warning's kind: its text with each number (a run of digits and points) as '#' ("path #
+// segment #: no LSPB in L/v = # s; ...")
+std::string warning_kind(const std::string& warning) {
+  const auto in_number = [&](size_t k) {
+    return k < warning.size() && ((warning[k] >= '0' && warning[k] <= '9') || warning[k] == '.');
+  };
+  std::string kind;
+  for (size_t i = 0; i < warning.size();) {
+    if (in_number(i) && warning[i] != '.') {
+      while (in_number(i)) ++i;
+      kind += '#';
+    } else {
+      kind += warning[i++];
+    }
+  }
+  return kind;
+}
+
+// a run's warnings, named by its run label (two runs of one planner with other settings are
+// told apart), in order: of each kind the first kWarningsPrintedPerKind, then how many more
+// of the kinds that had more, and where all of them are
+void print_run_warnings(const std::string& run, const std::vector<std::string>& warnings,
+                        const std::string& where_all_are) {
+  // each kind in the order of its first warning: that warning, and how many of the kind
+  struct Kind {
+    const std::string* first;
+    int count;
+  };
+  std::vector<Kind> kinds;
+  std::map<std::string, size_t> kind_index;
+  for (const std::string& warning : warnings) {
+    const auto [at, is_new] = kind_index.try_emplace(warning_kind(warning), kinds.size());
+    if (is_new) kinds.push_back({&warning, 0});
+    if (++kinds[at->second].count <= kWarningsPrintedPerKind)
+      std::cout << "warning (" << terminal_text(run) << "): " << terminal_text(warning) << '\n';
+  }
+  for (const Kind& kind : kinds)
+    if (kind.count > kWarningsPrintedPerKind)
+      std::cout << "warning (" << terminal_text(run) << "): ... and "
+                << kind.count - kWarningsPrintedPerKind << " more like \""
+                << printable_text(*kind.first, 40) << "\", " << where_all_are << '\n';
+}
+
+// each run's warnings, as print_run_warnings prints them; every one of them is in the run's
+// folder under `directory`, in metrics.json
+void print_warnings(const std::vector<MetricsReport>& reports, const std::string& directory) {
   for (const MetricsReport& report : reports) {
     const std::string& run = report.label.empty() ? report.planner : report.label;
-    for (const std::string& warning : report.warnings)
-      std::cout << "warning (" << terminal_text(run) << "): " << terminal_text(warning) << '\n';
+    print_run_warnings(run, report.warnings,
+                       "every one in " + terminal_text(directory + "/" + run + "/metrics.json") +
+                           " (\"warnings\")");
   }
 }
 
@@ -85,7 +134,7 @@ int plan_verb(const RunOptions& options) {
             << job.machine->name() << ", order " << scenario.order.label() << ", "
             << job.toolpath.paths.size() << " print paths\n\n"
             << summary_table(reports) << '\n';
-  print_warnings(reports);
+  print_warnings(reports, directory);
   std::cout << "plans written to " << run_folders_text(directory, planners)
             << " (metrics.json, trajectory.csv)\n";
   return kExitOk;
@@ -126,9 +175,8 @@ int validate_verb(const std::string& path, const std::string& max_memory, bool q
   // and what each planner said of its plan, as `plan` and `run` print it
   for (const PlannerSpec& spec : scenario.planners)
     if (const Trajectory* plan = job.checked_plan(spec))
-      for (const std::string& warning : plan_warnings(job, *plan))
-        std::cout << "warning (" << terminal_text(spec.run_label())
-                  << "): " << terminal_text(warning) << '\n';
+      print_run_warnings(spec.run_label(), plan_warnings(job, *plan),
+                         "`depotwin plan` writes every one to the run's metrics.json");
   return kExitOk;
 }
 
@@ -182,7 +230,7 @@ int run_verb(const RunOptions& options) {
             << job.machine->name() << ", process " << scenario.process.type << ", order "
             << scenario.order.label() << "\n\n"
             << summary_table(reports) << '\n';
-  print_warnings(reports);
+  print_warnings(reports, directory);
   std::cout << "results written to " << run_folders_text(directory, planners)
             << " (metrics.json, trajectory.csv, "
             << "thickness.csv" << (settings.render ? ", images" : "") << ")\n";
@@ -212,7 +260,7 @@ int compare_verb(const CompareOptions& options) {
   std::cout << "scenario " << scenario.name << " (" << terminal_text(scenario.file)
             << "): " << (orders.empty() ? "planners" : "print orders") << " compared\n\n"
             << summary_table(reports) << '\n';
-  print_warnings(reports);
+  print_warnings(reports, directory);
   std::cout << "comparison written to " << terminal_text(directory) << "/comparison.{json,csv,md"
             << (settings.render ? ",png" : "") << "}, one folder per run\n";
   return kExitOk;

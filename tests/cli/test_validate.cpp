@@ -123,6 +123,47 @@ TEST(ValidateVerb, WarningsNameTheRunByItsLabelInEveryVerb) {
   }
 }
 
+// a slicer's zig-zag of 0.45 mm steps at 60 mm/s gives lspb_mtt one warning per step (no
+// LSPB in L/v): of that kind the verbs print three, then how many more there are, where
+// metrics.json keeps every one; a warning of another kind (the rule the file is read by) is
+// still printed
+TEST(ValidateVerb, ManyWarningsOfOneKindArePrintedThreeThenCounted) {
+  const std::string dir = fresh_directory("validate_many_warnings");
+  std::string gcode = "M83\nG1 X0 Y0 Z0.2 F3600\n";
+  for (int i = 0; i < 20; ++i)
+    gcode += "G1 X" + std::string(i % 2 == 0 ? "20" : "0") + " Y" + std::to_string(0.45 * i) +
+             " E0.6\nG1 Y" + std::to_string(0.45 * (i + 1)) + " E0.02\n";
+  write_text(dir, "zigzag.gcode", gcode);
+  const std::string scenario = write_text(dir, "zigzag.yaml", R"(machine: cartesian
+limits: {v_max: 100, a_max: 1000}
+process: {type: extrusion, bead_width_mm: 0.45, layer_height_mm: 0.2}
+toolpath: {gcode: zigzag.gcode}
+planners: [lspb_mtt]
+)");
+  const auto count = [](const std::string& text, const std::string& word) {
+    size_t n = 0;
+    for (size_t at = text.find(word); at != std::string::npos; at = text.find(word, at + 1)) ++n;
+    return n;
+  };
+  const auto planned = depotwin("plan --quiet --out " + dir + "/out " + scenario);
+  ASSERT_EQ(planned.status, 0) << planned.output;
+  const std::string metrics = testing_support::read_text(dir + "/out/lspb_mtt/metrics.json");
+  const size_t all = count(metrics, ": no LSPB in L/v = ");
+  ASSERT_GT(all, 10u) << metrics;
+  const auto validated = depotwin("validate --quiet " + scenario);
+  ASSERT_EQ(validated.status, 0) << validated.output;
+  for (const auto* r : {&planned, &validated}) {
+    EXPECT_EQ(count(r->output, "warning (lspb_mtt): path "), 3u) << r->output;
+    EXPECT_NE(r->output.find("warning (lspb_mtt): ... and " + std::to_string(all - 3) +
+                             " more like \"path 0 segment "),
+              std::string::npos)
+        << r->output;
+    EXPECT_NE(r->output.find("toolpath.gcode: auto chose e"), std::string::npos) << r->output;
+  }
+  EXPECT_NE(planned.output.find("/out/lspb_mtt/metrics.json (\"warnings\")"), std::string::npos)
+      << planned.output;
+}
+
 // the memory validate prints is the figure --max-memory is compared with: a budget 3 % below it
 // refuses the job, 3 % above accepts it
 TEST(ValidateVerb, TheMemoryItPrintsIsWhatMaxMemoryIsComparedWith) {
