@@ -243,29 +243,6 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   const size_t columns = input.columns.size();
   const int width_px = static_cast<int>(columns) * style::kComparisonColumnWidth_px;
   const bool orders = is_orders_comparison(input.columns);
-  // the footer caption, wrapped to the sheet's width (a one-run sheet is too narrow for one
-  // line); each line past the first makes the sheet that much taller
-  const std::vector<std::string> caption = wrap_text(
-      orders ? "top: print paths (dark, numbered in print order from 0) and travels; grey bands: "
-               "transitions"
-             : "dashed: the print paths; grey bands: transitions (nothing deposited); white "
-               "box: the zoom below each map, on the thickest spot of all runs",
-      static_cast<size_t>((width_px - 2 * kCaptionSideMargin_px) / kCaptionCharWidth_px));
-  const int caption_extra_px = static_cast<int>(caption.size() - 1) * kCaptionLine_px;
-  const int height_px =
-      (orders ? kOrdersHeight_px : style::kComparisonHeight_px) + caption_extra_px;
-  job.begin_png(png_path, width_px, height_px);
-  std::string& s = job.script();
-  // the panels under the maps (speed error, metrics, the footnote) keep their pixels from the
-  // sheet's bottom (raised by the caption's extra lines): their screen fractions grow as the
-  // sheet gets shorter
-  const double bottom_scale = static_cast<double>(style::kComparisonHeight_px) / height_px;
-  const double lift = static_cast<double>(caption_extra_px) / height_px;
-  const double speed_bottom = kSpeedBottom * bottom_scale + lift,
-               speed_top = kSpeedTop * bottom_scale + lift;
-  const double metrics_top = kMetricsTop * bottom_scale + lift,
-               metrics_line = kMetricsLine * bottom_scale;
-
   // every run's map padded with zero cells to the extent of all of them, so that each fills
   // the shared axes (map and zoom) instead of leaving a white strip where its grid ends
   Range map_x, map_y;
@@ -317,6 +294,43 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
     if (has_map(&zoom_map))
       largest_zoom_peak_um =
           std::max(largest_zoom_peak_um, static_cast<double>(zoom_map.max_value()));
+
+  // where the print paths are drawn (thickness_map_elements leaves them off a map they would
+  // hide: a slicer's infill), for the caption
+  const auto crowded = [&](const HeightMap& map) {
+    return input.toolpath != nullptr && has_map(&map) && paths_crowd_map(*input.toolpath, map);
+  };
+  const bool maps_crowded = !maps.empty() && crowded(*maps.front());
+  const bool zooms_crowded =
+      std::any_of(zoom_maps.begin(), zoom_maps.end(), crowded) || !zoom.found;
+  const std::string paths_note =
+      !maps_crowded    ? "dashed: the print paths"
+      : !zooms_crowded ? "dashed: the print paths, on the zooms (over the whole maps they would "
+                         "hide the deposit)"
+                       : "print paths not drawn (denser than the maps show)";
+  // the footer caption, wrapped to the sheet's width (a one-run sheet is too narrow for one
+  // line); each line past the first makes the sheet that much taller
+  const std::vector<std::string> caption = wrap_text(
+      orders ? "top: print paths (dark, numbered in print order from 0) and travels; grey bands: "
+               "transitions"
+             : paths_note +
+                   "; grey bands: transitions (nothing deposited); white box: the zoom "
+                   "below each map, on the thickest spot of all runs",
+      static_cast<size_t>((width_px - 2 * kCaptionSideMargin_px) / kCaptionCharWidth_px));
+  const int caption_extra_px = static_cast<int>(caption.size() - 1) * kCaptionLine_px;
+  const int height_px =
+      (orders ? kOrdersHeight_px : style::kComparisonHeight_px) + caption_extra_px;
+  job.begin_png(png_path, width_px, height_px);
+  std::string& s = job.script();
+  // the panels under the maps (speed error, metrics, the footnote) keep their pixels from the
+  // sheet's bottom (raised by the caption's extra lines): their screen fractions grow as the
+  // sheet gets shorter
+  const double bottom_scale = static_cast<double>(style::kComparisonHeight_px) / height_px;
+  const double lift = static_cast<double>(caption_extra_px) / height_px;
+  const double speed_bottom = kSpeedBottom * bottom_scale + lift,
+               speed_top = kSpeedTop * bottom_scale + lift;
+  const double metrics_top = kMetricsTop * bottom_scale + lift,
+               metrics_line = kMetricsLine * bottom_scale;
 
   s += "set multiplot title " +
        style::quoted(input.title + (orders ? ": print order comparison" : ": planner comparison")) +

@@ -131,6 +131,74 @@ std::vector<DrawnLabel> drawn_path_labels(const std::vector<PathLabel>& labels,
   return drawn;
 }
 
+bool paths_crowd_window(const Toolpath& toolpath, double x_lo, double x_hi, double y_lo,
+                        double y_hi) {
+  // (a clipped straight edge needs at most about 3 kCrowdGrid samples)
+  constexpr double kMaxArcSamples = 4096, kMaxStraightSamples = 1 << 20;
+  const double cell_mm = std::max(x_hi - x_lo, y_hi - y_lo) / kCrowdGrid;
+  if (!(cell_mm > 0.0)) return false;
+  const int nx = std::max(1, static_cast<int>(std::ceil((x_hi - x_lo) / cell_mm)));
+  const int ny = std::max(1, static_cast<int>(std::ceil((y_hi - y_lo) / cell_mm)));
+  // the share is of the cells the paths' bounds cover in the window (a map has margins)
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const PrintPath& path : toolpath.paths) {
+    Vec3 path_lo, path_hi;
+    path.bounds(path_lo, path_hi);
+    lo = lo.cwiseMin(path_lo), hi = hi.cwiseMax(path_hi);
+  }
+  const auto cell_span = [&](double from, double to, double origin, int n) {
+    const int first = std::max(0, static_cast<int>(std::floor((from - origin) / cell_mm)));
+    const int last = std::min(n - 1, static_cast<int>(std::floor((to - origin) / cell_mm)));
+    return std::max(0, last - first + 1);
+  };
+  // (no paths, or none in the window)
+  if (!(lo.x() <= x_hi && hi.x() >= x_lo && lo.y() <= y_hi && hi.y() >= y_lo)) return false;
+  const double bounded_cells =
+      static_cast<double>(cell_span(std::max(lo.x(), x_lo), std::min(hi.x(), x_hi), x_lo, nx)) *
+      cell_span(std::max(lo.y(), y_lo), std::min(hi.y(), y_hi), y_lo, ny);
+  if (bounded_cells == 0.0) return false;
+  const size_t crowded_above = static_cast<size_t>(kCrowdedShare * bounded_cells);
+  std::vector<char> crossed(static_cast<size_t>(nx) * ny, 0);
+  size_t n_crossed = 0;
+  for (const PrintPath& path : toolpath.paths)
+    for (size_t edge = 0; edge + 1 < path.points.size(); ++edge) {
+      // the part of the edge to sample: a straight edge's within the window (Liang-Barsky), an
+      // arc whole (at most kMaxArcSamples points: this is an estimate for the eye)
+      double s0 = 0.0, s1 = 1.0;
+      const bool straight = path.arcs.empty() || !path.arcs[edge].is_arc();
+      if (straight) {
+        const Vec3 &a = path.points[edge], d = path.points[edge + 1] - a;
+        // (per side: how fast the edge heads out through it, and the room it has there)
+        const double outward[4] = {-d.x(), d.x(), -d.y(), d.y()};
+        const double room[4] = {a.x() - x_lo, x_hi - a.x(), a.y() - y_lo, y_hi - a.y()};
+        for (int side = 0; side < 4 && s0 <= s1; ++side) {
+          if (outward[side] == 0.0) {
+            if (room[side] < 0.0) s0 = 2.0;  // parallel to the side, outside it
+          } else if (outward[side] < 0.0) {
+            s0 = std::max(s0, room[side] / outward[side]);
+          } else {
+            s1 = std::min(s1, room[side] / outward[side]);
+          }
+        }
+        if (s0 > s1) continue;
+      }
+      // the cells of points half a cell apart along it
+      const double length_mm = (s1 - s0) * path.edge_length(edge);
+      const int samples = static_cast<int>(std::min(straight ? kMaxStraightSamples : kMaxArcSamples,
+                                                    1.0 + std::ceil(length_mm / (0.5 * cell_mm))));
+      for (int k = 0; k <= samples; ++k) {
+        const Vec3 p = path.edge_point(edge, s0 + (s1 - s0) * k / samples);
+        const int ix = static_cast<int>(std::floor((p.x() - x_lo) / cell_mm));
+        const int iy = static_cast<int>(std::floor((p.y() - y_lo) / cell_mm));
+        if (ix < 0 || ix >= nx || iy < 0 || iy >= ny) continue;
+        char& cell = crossed[static_cast<size_t>(iy) * nx + ix];
+        if (cell == 0 && ++n_crossed > crowded_above) return true;
+        cell = 1;
+      }
+    }
+  return false;
+}
+
 void Curve::add(double px, double py) {
   x.push_back(px);
   y.push_back(py);

@@ -49,6 +49,16 @@ struct DrawnLabel {
 std::vector<DrawnLabel> drawn_path_labels(const std::vector<PathLabel>& labels,
                                           double merge_within_mm, size_t max_drawn);
 
+// Whether a toolpath's print paths drawn over a map of the window [x_lo, x_hi] x [y_lo, y_hi]
+// (mm) would hide it: they pass through more than kCrowdedShare of the cells (a grid of
+// kCrowdGrid cells along the window's longer side, about 4 px each on a map) that their bounds
+// cover in the window, as a slicer's infill does, its lines closer than two cells. Arcs are
+// followed exactly; layers stacked on one another count once.
+constexpr int kCrowdGrid = 100;
+constexpr double kCrowdedShare = 0.5;
+bool paths_crowd_window(const Toolpath& toolpath, double x_lo, double x_hi, double y_lo,
+                        double y_hi);
+
 // A curve as gnuplot draws it: points in order, a NaN in x marks a break in the line.
 struct Curve {
   std::vector<double> x, y;

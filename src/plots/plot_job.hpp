@@ -102,9 +102,12 @@ void layers_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& dat
 void paths3d_plot(PlotJob& job, const RunPlotInput& input, const RunPlotData& data,
                   const std::string& png);
 
+// whether the print paths would hide the map, drawn over it (paths_crowd_window on the map's
+// cells, to their edges)
+bool paths_crowd_map(const Toolpath& toolpath, const HeightMap& map);
 // the thickness map as an image (colours by the current cbrange) with the print paths
-// overlaid as thin, translucent dashed lines: a plot command; shared by thickness.png and the
-// comparison sheet
+// overlaid as thin, translucent dashed lines, unless they would hide it (with `path_key`, the
+// key then says so): a plot command; shared by thickness.png and the comparison sheet
 std::string thickness_map_elements(PlotJob& job, const HeightMap& map, const Toolpath* toolpath,
                                    const std::string& stem, bool path_key);
 // `set xrange/yrange` covering the maps' cells (to their edges) and the print paths

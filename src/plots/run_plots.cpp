@@ -491,7 +491,13 @@ std::string thickness_map_elements(PlotJob& job, const HeightMap& map, const Too
                             "format='%%float32' endian=default with image notitle",
                             map.nx, map.ny, map.cell_mm, map.cell_mm, map.origin_x_mm,
                             map.origin_y_mm));
-  if (toolpath != nullptr && !toolpath->paths.empty()) {
+  // (not over a map they would hide, as a slicer's infill would: the key says so)
+  if (toolpath != nullptr && !toolpath->paths.empty() && paths_crowd_map(*toolpath, map)) {
+    if (path_key)
+      elements.push_back(
+          "keyentry with lines lc rgb \"#FF000000\" title 'print paths: too "
+          "dense to draw over the map'");
+  } else if (toolpath != nullptr && !toolpath->paths.empty()) {
     Curve paths;
     for (const PrintPath& path : toolpath->paths) {
       for (const Vec3& p : path.points) paths.add(p.x(), p.y());
@@ -502,6 +508,12 @@ std::string thickness_map_elements(PlotJob& job, const HeightMap& map, const Too
                        (path_key ? " title 'print path'" : " notitle"));
   }
   return plot_command(elements);
+}
+
+bool paths_crowd_map(const Toolpath& toolpath, const HeightMap& map) {
+  return paths_crowd_window(
+      toolpath, map.origin_x_mm - 0.5 * map.cell_mm, map.origin_x_mm + (map.nx - 0.5) * map.cell_mm,
+      map.origin_y_mm - 0.5 * map.cell_mm, map.origin_y_mm + (map.ny - 0.5) * map.cell_mm);
 }
 
 std::string map_ranges(const std::vector<const HeightMap*>& maps, const Toolpath* toolpath) {

@@ -276,5 +276,37 @@ TEST(PathLabels, NumbersThatWouldCoverOneAnotherShareOneLabel) {
   EXPECT_EQ(apart[0].text, "0, 1");
 }
 
+// A slicer's infill (lines 0.3 mm apart over 40 mm: 0.75 of a 0.4 mm cell) crowds its map,
+// the same lines 4 mm apart do not, nor does a zoom of 5 mm on the dense ones (30 cells between
+// lines); an outline never does, however many layers repeat it; concentric full circles
+// 0.3 mm apart, each one arc edge that starts where it ends, crowd it as the lines do.
+TEST(PathOverlay, PrintPathsCrowdAMapWhereTheyWouldHideIt) {
+  const auto raster = [](double spacing_mm) {
+    Toolpath toolpath;
+    for (double y = 0.0; y <= 40.0; y += spacing_mm)
+      toolpath.paths.push_back(testing_support::line(0, y, 40, y));
+    return toolpath;
+  };
+  EXPECT_TRUE(plots::paths_crowd_window(raster(0.3), 0, 40, 0, 40));
+  EXPECT_FALSE(plots::paths_crowd_window(raster(4.0), 0, 40, 0, 40));
+  EXPECT_FALSE(plots::paths_crowd_window(raster(0.3), 10, 15, 10, 15));
+  Toolpath outline;
+  for (int layer = 0; layer < 50; ++layer) {
+    PrintPath square;
+    for (const auto& [x, y] : {std::pair{0, 0}, {40, 0}, {40, 40}, {0, 40}, {0, 0}})
+      square.points.push_back(Vec3(x, y, 0.2 * layer));
+    outline.paths.push_back(square);
+  }
+  EXPECT_FALSE(plots::paths_crowd_window(outline, 0, 40, 0, 40));
+  Toolpath circles;
+  for (double r = 0.3; r <= 20.0; r += 0.3) {
+    PrintPath circle;
+    circle.points = {Vec3(20 + r, 20, 0), Vec3(20 + r, 20, 0)};
+    circle.arcs = {EdgeArc{Vec3(20, 20, 0), Vec3::UnitZ(), 2 * M_PI}};
+    circles.paths.push_back(circle);
+  }
+  EXPECT_TRUE(plots::paths_crowd_window(circles, 0, 40, 0, 40));
+}
+
 }  // namespace
 }  // namespace depotwin

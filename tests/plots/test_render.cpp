@@ -112,6 +112,33 @@ TEST(RunPlots, StackedLayersShareOnePathNumberLabel) {
   EXPECT_EQ(texts, (std::vector<std::string>{"0–2 at 5,0", "3 at 5,5"})) << section;
 }
 
+// thickness.png draws the print paths over a map they leave legible (7 lines 1 mm apart) and
+// leaves them off one they would hide (60 lines 0.2 mm apart), the key saying so
+TEST(RunPlots, ThePrintPathsAreLeftOffAMapTheyWouldHide) {
+  for (const int lines : {7, 60}) {
+    SCOPED_TRACE(lines);
+    const double spacing_mm = lines == 7 ? 1.0 : 0.2;
+    Toolpath toolpath;
+    for (int i = 0; i < lines; ++i)
+      toolpath.paths.push_back(i % 2 == 0
+                                   ? testing_support::line(0, i * spacing_mm, 10, i * spacing_mm)
+                                   : testing_support::line(10, i * spacing_mm, 0, i * spacing_mm));
+    toolpath.start_mm = toolpath.paths.front().front();
+    toolpath.end_mm = toolpath.paths.back().back();
+    const auto f = make_plot_fixture(toolpath, 0.2);
+    const std::string directory = output_directory("overlay_" + std::to_string(lines));
+    const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+    plots::PlotOptions options;
+    options.gnuplot = capture.program;
+    plots::render_run_plots(f.input(), directory + "/plot", {RunPlot::thickness}, options);
+    const std::string section = testing_support::png_section(capture.script(), "thickness.png");
+    const bool drawn = section.find("thickness_map_paths.dat") != std::string::npos;
+    const bool said = section.find("print paths: too dense to draw") != std::string::npos;
+    EXPECT_EQ(drawn, lines == 7) << section;
+    EXPECT_EQ(said, lines == 60) << section;
+  }
+}
+
 TEST(RunPlots, PlanOnlyRunWithoutThickness) {
   auto f = make_plot_fixture(testing_support::thompson_like_toolpath(), 1.5, false);
   auto input = f.input("plan only");
