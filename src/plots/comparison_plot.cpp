@@ -32,11 +32,8 @@ constexpr double kMetricsTop = 0.115, kMetricsLine = 0.017;
 // and below it), the panels under it as many pixels up as on the full sheet
 constexpr int kOrdersHeight_px = 1000;
 constexpr double kTravelBottom = 0.43, kTravelHeight = 0.53;
-// at most this many points per x-y curve, and this many path number labels (none when more
-// would be drawn); numbers closer than this share of the panel's larger side share a label
+// at most this many points per x-y curve
 constexpr size_t kMaxPathPoints = 1200;
-constexpr size_t kMaxPathLabels = 40;
-constexpr double kLabelMergeShare = 0.03;
 // the zoom window: this fraction of the largest map extent a side, at least this many cells
 constexpr double kZoomFraction = 0.125;
 constexpr int kZoomMinCells = 24;

@@ -146,13 +146,13 @@ bool paths_crowd_window(const Toolpath& toolpath, double x_lo, double x_hi, doub
     path.bounds(path_lo, path_hi);
     lo = lo.cwiseMin(path_lo), hi = hi.cwiseMax(path_hi);
   }
+  // (no paths, or none in the window)
+  if (!(lo.x() <= x_hi && hi.x() >= x_lo && lo.y() <= y_hi && hi.y() >= y_lo)) return false;
   const auto cell_span = [&](double from, double to, double origin, int n) {
     const int first = std::max(0, static_cast<int>(std::floor((from - origin) / cell_mm)));
     const int last = std::min(n - 1, static_cast<int>(std::floor((to - origin) / cell_mm)));
     return std::max(0, last - first + 1);
   };
-  // (no paths, or none in the window)
-  if (!(lo.x() <= x_hi && hi.x() >= x_lo && lo.y() <= y_hi && hi.y() >= y_lo)) return false;
   const double bounded_cells =
       static_cast<double>(cell_span(std::max(lo.x(), x_lo), std::min(hi.x(), x_hi), x_lo, nx)) *
       cell_span(std::max(lo.y(), y_lo), std::min(hi.y(), y_hi), y_lo, ny);

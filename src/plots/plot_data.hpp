@@ -48,6 +48,10 @@ struct DrawnLabel {
 // one); a new one is drawn at its own point. Empty when more than max_drawn would be drawn.
 std::vector<DrawnLabel> drawn_path_labels(const std::vector<PathLabel>& labels,
                                           double merge_within_mm, size_t max_drawn);
+// path.png and the orders comparison: numbers closer than kLabelMergeShare of the plot's
+// larger side share a label; none are drawn when more than kMaxPathLabels labels would be
+constexpr double kLabelMergeShare = 0.03;
+constexpr size_t kMaxPathLabels = 40;
 
 // Whether a toolpath's print paths drawn over a map of the window [x_lo, x_hi] x [y_lo, y_hi]
 // (mm) would hide it: they pass through more than kCrowdedShare of the cells (a grid of

@@ -20,11 +20,6 @@ std::string zero_based_range(double max_value) {
   return format("[0:%.9g]", max_value > 0.0 ? 1.08 * max_value : 1.0);
 }
 
-// path.png: path numbers closer than this share of the plot's larger span share a label; no
-// numbers when more than kMaxPathLabels labels would be drawn
-constexpr double kLabelMergeShare = 0.03;
-constexpr size_t kMaxPathLabels = 40;
-
 // thickness_profile.png: at most this many key entries go under the plot (two rows of three)
 constexpr size_t kProfileKeyEntriesBelow = 6;
 
