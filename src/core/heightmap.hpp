@@ -15,6 +15,11 @@ struct HeightMap {
   std::vector<float> thickness_um;  // row-major, index = iy * nx + ix
 
   float at(int ix, int iy) const { return thickness_um[static_cast<size_t>(iy) * nx + ix]; }
+  // the edges of the outer cells (the map covers [x_lo, x_hi] x [y_lo, y_hi], mm)
+  double x_lo_mm() const { return origin_x_mm - 0.5 * cell_mm; }
+  double x_hi_mm() const { return origin_x_mm + (nx - 0.5) * cell_mm; }
+  double y_lo_mm() const { return origin_y_mm - 0.5 * cell_mm; }
+  double y_hi_mm() const { return origin_y_mm + (ny - 0.5) * cell_mm; }
   float max_value() const;
 };
 

@@ -131,10 +131,10 @@ ZoomWindow thickest_spot_window(const std::vector<const HeightMap*>& maps) {
   double cell_mm = 0.0;
   for (const HeightMap* map : maps) {
     if (!has_map(map)) continue;
-    x.add(map->origin_x_mm - 0.5 * map->cell_mm);
-    x.add(map->origin_x_mm + (map->nx - 0.5) * map->cell_mm);
-    y.add(map->origin_y_mm - 0.5 * map->cell_mm);
-    y.add(map->origin_y_mm + (map->ny - 0.5) * map->cell_mm);
+    x.add(map->x_lo_mm());
+    x.add(map->x_hi_mm());
+    y.add(map->y_lo_mm());
+    y.add(map->y_hi_mm());
     cell_mm = std::max(cell_mm, map->cell_mm);
     // the first thickest cell, row by row
     for (int iy = 0; iy < map->ny; ++iy)
@@ -246,10 +246,10 @@ PlotResult render_comparison(const ComparisonInput& input, const std::string& pn
   for (const ComparisonColumn& column : input.columns)
     if (has_map(column.thickness)) {
       const HeightMap& m = *column.thickness;
-      map_x.add(m.origin_x_mm - 0.5 * m.cell_mm);
-      map_x.add(m.origin_x_mm + (m.nx - 0.5) * m.cell_mm);
-      map_y.add(m.origin_y_mm - 0.5 * m.cell_mm);
-      map_y.add(m.origin_y_mm + (m.ny - 0.5) * m.cell_mm);
+      map_x.add(m.x_lo_mm());
+      map_x.add(m.x_hi_mm());
+      map_y.add(m.y_lo_mm());
+      map_y.add(m.y_hi_mm());
     }
   std::vector<HeightMap> padded_maps(columns);
   for (size_t c = 0; c < columns; ++c)

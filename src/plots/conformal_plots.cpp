@@ -159,10 +159,10 @@ void prepare_layer_panels(const RunPlotInput& input, const PlotOptions& options,
       panel.map = downsample_for_display(*map, cells);
       shown_maps.push_back(map);
       const HeightMap& m = panel.map;
-      x.add(m.origin_x_mm - 0.5 * m.cell_mm);
-      x.add(m.origin_x_mm + (m.nx - 0.5) * m.cell_mm);
-      y.add(m.origin_y_mm - 0.5 * m.cell_mm);
-      y.add(m.origin_y_mm + (m.ny - 0.5) * m.cell_mm);
+      x.add(m.x_lo_mm());
+      x.add(m.x_hi_mm());
+      y.add(m.y_lo_mm());
+      y.add(m.y_hi_mm());
     }
     if (input.toolpath != nullptr)
       for (const PrintPath& path : input.toolpath->paths) {

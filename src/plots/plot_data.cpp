@@ -656,10 +656,10 @@ HeightMap pad_to_extent(const HeightMap& map, double x_lo, double x_hi, double y
   const auto cells_beyond = [&](double gap_mm) {
     return std::max(0, static_cast<int>(std::ceil(gap_mm / map.cell_mm - 1e-6)));
   };
-  const int left = cells_beyond(map.origin_x_mm - 0.5 * map.cell_mm - x_lo);
-  const int right = cells_beyond(x_hi - (map.origin_x_mm + (map.nx - 0.5) * map.cell_mm));
-  const int bottom = cells_beyond(map.origin_y_mm - 0.5 * map.cell_mm - y_lo);
-  const int top = cells_beyond(y_hi - (map.origin_y_mm + (map.ny - 0.5) * map.cell_mm));
+  const int left = cells_beyond(map.x_lo_mm() - x_lo);
+  const int right = cells_beyond(x_hi - map.x_hi_mm());
+  const int bottom = cells_beyond(map.y_lo_mm() - y_lo);
+  const int top = cells_beyond(y_hi - map.y_hi_mm());
   if (left + right + bottom + top == 0) return map;
   HeightMap out;
   out.cell_mm = map.cell_mm;

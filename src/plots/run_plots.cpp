@@ -486,39 +486,39 @@ std::string thickness_map_elements(PlotJob& job, const HeightMap& map, const Too
                             "format='%%float32' endian=default with image notitle",
                             map.nx, map.ny, map.cell_mm, map.cell_mm, map.origin_x_mm,
                             map.origin_y_mm));
-  // (not over a map they would hide, as a slicer's infill would: the key says so)
-  if (toolpath != nullptr && !toolpath->paths.empty() && paths_crowd_map(*toolpath, map)) {
-    if (path_key)
-      elements.push_back(
-          "keyentry with lines lc rgb \"#FF000000\" title 'print paths: too "
-          "dense to draw over the map'");
-  } else if (toolpath != nullptr && !toolpath->paths.empty()) {
-    Curve paths;
-    for (const PrintPath& path : toolpath->paths) {
-      for (const Vec3& p : path.points) paths.add(p.x(), p.y());
-      paths.add_break();
+  if (toolpath != nullptr && !toolpath->paths.empty()) {
+    if (paths_crowd_map(*toolpath, map)) {
+      // (not over a map they would hide, as a slicer's infill would: the key says so)
+      if (path_key)
+        elements.push_back(
+            "keyentry with lines lc rgb \"#FF000000\" title 'print paths: too dense to draw over "
+            "the map'");
+    } else {
+      Curve paths;
+      for (const PrintPath& path : toolpath->paths) {
+        for (const Vec3& p : path.points) paths.add(p.x(), p.y());
+        paths.add_break();
+      }
+      elements.push_back(job.data_file(stem + "_paths.dat", format_curve(paths)) + " " +
+                         line_style(style::kPathOverlayColour, style::kPathOverlayLineWidth, 2) +
+                         (path_key ? " title 'print path'" : " notitle"));
     }
-    elements.push_back(job.data_file(stem + "_paths.dat", format_curve(paths)) + " " +
-                       line_style(style::kPathOverlayColour, style::kPathOverlayLineWidth, 2) +
-                       (path_key ? " title 'print path'" : " notitle"));
   }
   return plot_command(elements);
 }
 
 bool paths_crowd_map(const Toolpath& toolpath, const HeightMap& map) {
-  return paths_crowd_window(
-      toolpath, map.origin_x_mm - 0.5 * map.cell_mm, map.origin_x_mm + (map.nx - 0.5) * map.cell_mm,
-      map.origin_y_mm - 0.5 * map.cell_mm, map.origin_y_mm + (map.ny - 0.5) * map.cell_mm);
+  return paths_crowd_window(toolpath, map.x_lo_mm(), map.x_hi_mm(), map.y_lo_mm(), map.y_hi_mm());
 }
 
 std::string map_ranges(const std::vector<const HeightMap*>& maps, const Toolpath* toolpath) {
   Range x, y;
   for (const HeightMap* map : maps) {
     if (map == nullptr || map->nx <= 0 || map->ny <= 0) continue;
-    x.add(map->origin_x_mm - 0.5 * map->cell_mm);
-    x.add(map->origin_x_mm + (map->nx - 0.5) * map->cell_mm);
-    y.add(map->origin_y_mm - 0.5 * map->cell_mm);
-    y.add(map->origin_y_mm + (map->ny - 0.5) * map->cell_mm);
+    x.add(map->x_lo_mm());
+    x.add(map->x_hi_mm());
+    y.add(map->y_lo_mm());
+    y.add(map->y_hi_mm());
   }
   if (toolpath != nullptr)
     for (const PrintPath& path : toolpath->paths)
