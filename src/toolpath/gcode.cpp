@@ -19,6 +19,7 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "core/number_text.hpp"
+#include "toolpath/ascii_text.hpp"
 
 namespace depotwin {
 
@@ -65,18 +66,10 @@ std::string printable(const char* begin, const char* end) {
   return out;
 }
 
-bool is_space(char c) {
-  return c == ' ' || c == '\t' || c == '\r';
-}
-bool is_digit(char c) {
-  return c >= '0' && c <= '9';
-}
-bool is_letter(char c) {
-  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z');
-}
-char upper(char c) {
-  return c >= 'a' && c <= 'z' ? static_cast<char>(c - 'a' + 'A') : c;
-}
+using ascii::is_digit;
+using ascii::is_letter;
+using ascii::is_space;
+using ascii::upper;
 
 // A command code: G or M and its number times 10 (G90.1 = 901).
 struct Code {

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/number_text.hpp"
+#include "toolpath/ascii_text.hpp"
 
 namespace depotwin {
 
@@ -14,15 +15,10 @@ namespace {
 // the longest slicer name kept (a comment can be any length)
 constexpr size_t kMaxSlicerChars = 80;
 
-char lower(char c) {
-  return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c;
-}
-bool is_space(char c) {
-  return c == ' ' || c == '\t' || c == '\r';
-}
-bool is_letter(char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
-}
+using ascii::is_digit;
+using ascii::is_letter;
+using ascii::is_space;
+using ascii::lower;
 
 // A comment's text, read left to right.
 struct Text {
@@ -221,7 +217,7 @@ void read_slicer_note(const char* begin, const char* end, SlicerNotes& notes) {
     return set_filament(text, 1.0);
   if (text.take("material#")) {
     // ideaMaker: one line per material, summed
-    while (text.p < text.end && *text.p >= '0' && *text.p <= '9') ++text.p;
+    while (text.p < text.end && is_digit(*text.p)) ++text.p;
     text.skip_spaces();
     if (!take_key(text, "used", ':')) return;
     if (const std::optional<double> used = length_sum_mm(text, 1.0))
