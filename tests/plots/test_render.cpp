@@ -47,6 +47,17 @@ void expect_png(const std::string& path, std::uint32_t width, std::uint32_t heig
   EXPECT_GT(testing_support::pixel_variance(bytes), 100.0);
 }
 
+// the part of the gnuplot script that draws `plot` of `input`, rendered into directory/plot
+// through a stand-in that captures the job
+std::string drawn_section(const plots::RunPlotInput& input, const std::string& directory,
+                          RunPlot plot) {
+  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
+  plots::PlotOptions options;
+  options.gnuplot = capture.program;
+  plots::render_run_plots(input, directory + "/plot", {plot}, options);
+  return testing_support::png_section(capture.script(), plots::file_name(plot));
+}
+
 const std::vector<RunPlot> kAllRunPlots = {RunPlot::path, RunPlot::axes, RunPlot::errors,
                                            RunPlot::thickness_profile, RunPlot::thickness};
 
@@ -100,11 +111,7 @@ TEST(RunPlots, StackedLayersShareOnePathNumberLabel) {
   toolpath.paths.push_back(testing_support::line(0, 5, 10, 5));
   const auto f = make_plot_fixture(toolpath, 0.5, false);
   const std::string directory = output_directory("stacked_layer_labels");
-  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
-  plots::PlotOptions options;
-  options.gnuplot = capture.program;
-  plots::render_run_plots(f.input(), directory + "/plot", {RunPlot::path}, options);
-  const std::string section = testing_support::png_section(capture.script(), "path.png");
+  const std::string section = drawn_section(f.input(), directory, RunPlot::path);
   const std::regex label_command(R"re(set label (\d+) "([^"]*)" at ([-\d.e]+),([-\d.e]+))re");
   std::vector<std::string> texts;
   for (std::sregex_iterator it(section.begin(), section.end(), label_command), end; it != end; ++it)
@@ -127,11 +134,7 @@ TEST(RunPlots, ThePrintPathsAreLeftOffAMapTheyWouldHide) {
     toolpath.end_mm = toolpath.paths.back().back();
     const auto f = make_plot_fixture(toolpath, 0.2);
     const std::string directory = output_directory("overlay_" + std::to_string(lines));
-    const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
-    plots::PlotOptions options;
-    options.gnuplot = capture.program;
-    plots::render_run_plots(f.input(), directory + "/plot", {RunPlot::thickness}, options);
-    const std::string section = testing_support::png_section(capture.script(), "thickness.png");
+    const std::string section = drawn_section(f.input(), directory, RunPlot::thickness);
     const bool drawn = section.find("thickness_map_paths.dat") != std::string::npos;
     const bool said = section.find("print paths: too dense to draw") != std::string::npos;
     EXPECT_EQ(drawn, lines == 7) << section;
@@ -298,11 +301,7 @@ std::vector<double> set_numbers(const std::string& section, const std::string& c
 TEST(RunPlots, EveryThicknessMapAxisHasAtLeastThreeTicks) {
   const auto f = make_plot_fixture(testing_support::raster_toolpath(3), 0.3, false);
   const std::string directory = output_directory("short_axis_ticks");
-  const auto capture = testing_support::capturing_gnuplot(directory, "gnuplot-capture");
-  plots::PlotOptions options;
-  options.gnuplot = capture.program;
-  plots::render_run_plots(f.input(), directory + "/plot", {RunPlot::thickness}, options);
-  const std::string section = testing_support::png_section(capture.script(), "thickness.png");
+  const std::string section = drawn_section(f.input(), directory, RunPlot::thickness);
   for (const char* axis : {"x", "y"}) {
     SCOPED_TRACE(axis);
     const std::vector<double> range = set_numbers(section, axis + std::string("range"));
