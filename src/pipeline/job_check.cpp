@@ -234,6 +234,9 @@ std::string fewer_layers_hint(const Scenario& scenario) {
          " layers (toolpath.gcode.layers: [from, to])";
 }
 
+// the largest --max-memory, 1048576T (1 EiB): a size beyond it is no budget anyone gives
+constexpr double kMostMemoryBytes = 1024.0 * 1024.0 * 1024.0 * 1024.0 * 1024.0 * 1024.0;
+
 }  // namespace
 
 double parse_memory_size(const std::string& text, const std::string& option) {
@@ -260,9 +263,8 @@ double parse_memory_size(const std::string& text, const std::string& option) {
   }
   // between 1M and 1048576T (1 MiB and 1 EiB), in the powers of 1024 the units are
   constexpr double kLeast_bytes = 1024.0 * 1024.0;
-  const double most_bytes = std::pow(1024.0, 6.0);
   if (end == 0 || !std::isfinite(value) || !(value > 0.0) || !(value * scale >= kLeast_bytes) ||
-      !(value * scale <= most_bytes))
+      !(value * scale <= kMostMemoryBytes))
     throw InputError(option, "'" + printable_text(text) +
                                  "' is not a memory size between 1M and 1048576T (1 MiB and 1 "
                                  "EiB; e.g. 8G, 512M, 1.5GiB, or bytes)");
@@ -278,8 +280,10 @@ std::string format_bytes(double bytes) {
     std::snprintf(text, sizeof text, "%.3g GB", mib / 1024.0);
   else if (mib < 1024.0 * 1024.0 * 1024.0)
     std::snprintf(text, sizeof text, "%.3g TB", mib / (1024.0 * 1024.0));
-  else  // TB in full (1048576 TB at most): the units the command line takes
+  else if (bytes <= kMostMemoryBytes)  // TB in full: the units the command line takes
     std::snprintf(text, sizeof text, "%.0f TB", mib / (1024.0 * 1024.0));
+  else  // beyond any --max-memory (a job at 1e-300 mm/s): in full, its digits would not fit
+    std::snprintf(text, sizeof text, "%.3g TB", mib / (1024.0 * 1024.0));
   return text;
 }
 

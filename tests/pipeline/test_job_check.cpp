@@ -35,6 +35,10 @@ TEST(MemorySize, UnitsArePowersOf1024) {
   for (const char* outside : {"1048575", "1000000", "1048577T"})
     EXPECT_THROW(parse_memory_size(outside), InputError) << outside;
   EXPECT_EQ(format_bytes(1048575 * 1024 * gib), "1048575 TB");
+  // beyond the largest budget (a job at 1e-300 mm/s needs 1e+46 bytes) the figure is still
+  // a figure with its unit: in full it was 47 digits, and the buffer cut off the " TB"
+  EXPECT_EQ(format_bytes(2048576.0 * 1024 * gib), "2.05e+06 TB");
+  EXPECT_EQ(format_bytes(1e46), "9.09e+33 TB");
 }
 
 TEST(MemorySize, NonsenseIsAnInputErrorNamingTheOption) {
