@@ -170,6 +170,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   facts.program_end_line = program.program_end_line;
   facts.n_lines_after_end = program.n_lines_after_end;
   facts.slicer_notes = program.slicer_notes;
+  facts.firmware_settings = program.firmware_settings;
   const GcodeMove* previous_print = nullptr;  // the move before, where it printed
   // every move: print or travel, its length, boxes and time
   for (const GcodeMove& move : program.moves) {
@@ -241,6 +242,15 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
                          {"estimated_time_s", or_null(notes.estimated_time_s)},
                          {"layer_count", or_null(notes.layer_count)},
                          {"filament_used_mm", or_null(notes.filament_used_mm)}};
+  // the firmware settings the file makes, to set beside --machine's limits
+  out["firmware_settings"] = nlohmann::json::array();
+  for (const GcodeSetting& setting : facts.firmware_settings.settings)
+    out["firmware_settings"].push_back({{"command", setting.command},
+                                        {"parameter", setting.parameter},
+                                        {"value", setting.value},
+                                        {"line", setting.line},
+                                        {"last_value", setting.last_value},
+                                        {"n_changes", setting.n_changes}});
   return out;
 }
 

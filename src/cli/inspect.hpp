@@ -55,6 +55,9 @@ struct GcodeFacts {
   // what the slicer's comments declare: who made the file, its time estimate, layer count and
   // filament length (toolpath/slicer_notes.hpp), each null in the JSON when not declared
   SlicerNotes slicer_notes;
+  // M201-M205, M220, M221, M900 and Klipper's SET_VELOCITY_LIMIT and SET_PRESSURE_ADVANCE as
+  // the file sets them (toolpath/gcode_settings.hpp)
+  GcodeSettings firmware_settings;
   std::string baseline_machine;  // the machine and firmware mode estimated_time_s assumes
   std::string baseline_mode;
 };

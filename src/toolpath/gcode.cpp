@@ -622,6 +622,8 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
   if (*p == '_' || (is_letter(*p) && p + 1 < end && (is_letter(p[1]) || p[1] == '_'))) {
     if (const std::string reason = named_command_problem(p, end); !reason.empty())
       problem(line_number, reason);
+    else
+      read_klipper_settings(p, end, line_number, program_.firmware_settings);
     return;
   }
   ++program_.n_code_lines;
@@ -668,6 +670,9 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
         }
       }
     }
+    // a firmware setting (M201 X1000, M204 P800), listed as written
+    if (tenths >= 0 && !shutter_code)
+      read_m_code_settings(tenths, stop, end, line_number, program_.firmware_settings);
     // any other M code but M82, M83 and the shutter's: the firmware's settings, whose
     // parameters need not be numbers (M862.3 P "MK3S", M115 U3.13.2); no geometry, unless the
     // line also holds a G code (checked below, as a whole line)

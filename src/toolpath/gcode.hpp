@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "core/toolpath.hpp"
+#include "toolpath/gcode_settings.hpp"
 #include "toolpath/slicer_notes.hpp"
 
 namespace depotwin {
@@ -107,8 +108,9 @@ struct GcodeProgram {
   // comment lines that mark a new layer as slicers write them: `;LAYER:3`, `;LAYER_CHANGE`,
   // `; CHANGE_LAYER`, `; layer 3, Z = 0.6` (a print run ends at one)
   int n_layer_marks = 0;
-  SlicerNotes slicer_notes;        // what the slicer's comments declare (slicer_notes.hpp)
-  std::vector<GcodePause> pauses;  // dwells and E-only moves, in file order
+  SlicerNotes slicer_notes;         // what the slicer's comments declare (slicer_notes.hpp)
+  GcodeSettings firmware_settings;  // M201-M205, ... as set (gcode_settings.hpp)
+  std::vector<GcodePause> pauses;   // dwells and E-only moves, in file order
   int n_lines = 0;
   // lines that hold code (a letter and a number), not only comments, grbl's $ commands or
   // Klipper's named commands: none in a file that is no G-code (a README, a YAML file)

@@ -332,8 +332,9 @@ TEST(GcodeFiles, InspectJsonKeys) {
   for (const char* key :
        {"n_print_moves", "n_travel_moves", "print_length_mm", "travel_length_mm", "n_layers",
         "layer_z_values", "print_bbox", "all_moves_bbox", "n_print_arcs", "n_retractions",
-        "extrusion_e_total", "estimated_time_s", "rule", "slicer_notes"})
+        "extrusion_e_total", "estimated_time_s", "rule", "slicer_notes", "firmware_settings"})
     EXPECT_TRUE(json.contains(key)) << key;
+  EXPECT_EQ(json["firmware_settings"], nlohmann::json::array());  // it sets none
   // a hand-written file declares nothing: every note null
   EXPECT_EQ(json["slicer_notes"], (nlohmann::json{{"slicer", nullptr},
                                                   {"estimated_time_s", nullptr},
@@ -341,6 +342,17 @@ TEST(GcodeFiles, InspectJsonKeys) {
                                                   {"filament_used_mm", nullptr}}));
   EXPECT_EQ(json["n_layers"], 1);
   EXPECT_EQ(json["print_bbox"]["min"][0], -10.0);
+}
+
+// each firmware setting as one JSON object: its first value and line, its last value and how
+// often it changed
+TEST(GcodeFiles, InspectListsTheFirmwareSettingsAsSet) {
+  const GcodeProgram program = parse_gcode_program(
+      "M204 P800 ; first layer\nG1 X1 E1 F600\nM204 P1250\nG1 X2 E2\n", "s.gcode", GcodeOptions{});
+  const nlohmann::json json = gcode_facts_json(gcode_facts(program, PrintRule::automatic));
+  EXPECT_EQ(json["firmware_settings"],
+            nlohmann::json::parse(R"([{"command": "M204", "parameter": "P", "value": 800,
+                                       "line": 1, "last_value": 1250, "n_changes": 1}])"));
 }
 
 // a file that holds no code (a README, a YAML file, comments only) gives no facts: inspect

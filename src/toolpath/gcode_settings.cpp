@@ -1,0 +1,142 @@
+#include "toolpath/gcode_settings.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <optional>
+
+#include "toolpath/ascii_text.hpp"
+
+namespace depotwin {
+
+namespace {
+
+using ascii::is_digit;
+using ascii::is_letter;
+using ascii::is_space;
+using ascii::upper;
+
+// Klipper's setting commands and the parameters of each read here
+struct KlipperCommand {
+  const char* name;
+  std::vector<const char*> parameters;
+};
+const std::vector<KlipperCommand>& klipper_commands() {
+  static const std::vector<KlipperCommand> commands = {
+      {"SET_VELOCITY_LIMIT",
+       {"VELOCITY", "ACCEL", "ACCEL_TO_DECEL", "SQUARE_CORNER_VELOCITY", "MINIMUM_CRUISE_RATIO"}},
+      {"SET_PRESSURE_ADVANCE", {"ADVANCE", "SMOOTH_TIME"}}};
+  return commands;
+}
+
+// a name as Klipper reads it: letters, digits and '_', upper case
+std::string read_name(const char*& p, const char* end) {
+  std::string name;
+  while (p < end && (is_letter(*p) || is_digit(*p) || *p == '_')) name += upper(*p++);
+  return name;
+}
+
+// the parameter letters an M code (in tenths: M204 is 2040) sets; nullptr for another code
+const char* setting_letters(int m_code_tenths) {
+  switch (m_code_tenths) {
+    case 2010:  // M201
+    case 2030:  // M203
+      return "XYZE";
+    case 2040:
+      return "PRTS";
+    case 2050:
+      return "XYZEJSTB";
+    case 2200:
+    case 2210:
+      return "S";
+    case 9000:
+      return "K";
+    default:
+      return nullptr;
+  }
+}
+
+// a finite number at p that ends a word (at the line's end, a space, a comment or checksum),
+// advancing p past it; nullopt otherwise
+std::optional<double> read_number(const char*& p, const char* end) {
+  const char* start = p < end && *p == '+' ? p + 1 : p;
+  double value = 0.0;
+  const auto [stop, error] = std::from_chars(start, end, value);
+  if (error != std::errc() || stop == start || !std::isfinite(value)) return std::nullopt;
+  if (stop != end && !is_space(*stop) && std::strchr(";#*(", *stop) == nullptr) return std::nullopt;
+  p = stop;
+  return value;
+}
+
+// past the word at p (to the next space or comment)
+void skip_word(const char*& p, const char* end) {
+  while (p < end && !is_space(*p) && std::strchr(";#*(", *p) == nullptr) ++p;
+}
+
+}  // namespace
+
+void GcodeSettings::set(const std::string& command, const std::string& parameter, double value,
+                        int line) {
+  for (GcodeSetting& setting : settings) {
+    if (setting.command != command || setting.parameter != parameter) continue;
+    if (value != setting.last_value) ++setting.n_changes;
+    setting.last_value = value;
+    return;
+  }
+  settings.push_back({command, parameter, value, line, value, 0});
+}
+
+void read_klipper_settings(const char* begin, const char* end, int line, GcodeSettings& settings) {
+  const char* p = begin;
+  const std::string name = read_name(p, end);
+  const KlipperCommand* command = nullptr;
+  for (const KlipperCommand& known : klipper_commands())
+    if (name == known.name) command = &known;
+  if (command == nullptr) return;
+  // NAME=VALUE words up to a comment
+  while (p < end && *p != ';' && *p != '#') {
+    if (is_space(*p)) {
+      ++p;
+      continue;
+    }
+    const std::string parameter = read_name(p, end);
+    if (parameter.empty() || p == end || *p != '=') {  // not NAME=VALUE
+      if (parameter.empty()) ++p;                      // ('(', '*', '=': one character on)
+      skip_word(p, end);
+      continue;
+    }
+    ++p;
+    if (const std::optional<double> value = read_number(p, end))
+      for (const char* known : command->parameters)
+        if (parameter == known) settings.set(command->name, parameter, *value, line);
+    skip_word(p, end);
+  }
+}
+
+void read_m_code_settings(int m_code_tenths, const char* begin, const char* end, int line,
+                          GcodeSettings& settings) {
+  const char* letters = setting_letters(m_code_tenths);
+  if (letters == nullptr) return;
+  const std::string command = "M" + std::to_string(m_code_tenths / 10);
+  const char* p = begin;
+  while (p < end && *p != ';' && *p != '*') {
+    if (is_space(*p)) {
+      ++p;
+    } else if (*p == '(') {  // a comment within the line
+      p = std::find(p, end, ')');
+      if (p < end) ++p;
+    } else if (is_letter(*p) && std::strchr(letters, upper(*p)) != nullptr) {
+      const char letter = upper(*p++);
+      while (p < end && is_space(*p)) ++p;
+      if (const std::optional<double> value = read_number(p, end))
+        settings.set(command, std::string(1, letter), *value, line);
+      skip_word(p, end);
+    } else {
+      ++p;
+      skip_word(p, end);
+    }
+  }
+}
+
+}  // namespace depotwin
