@@ -947,6 +947,11 @@ void Loader::read_gcode_file(const Field& field, const std::optional<double>& de
   settings->layer_z_mm = imported.layer_z_mm;
   if (settings->rule == "auto")
     scenario_.notes.push_back("toolpath.gcode: " + imported.rule_reason);
+  if (imported.first_speed_factor_line > 0)
+    scenario_.notes.push_back(
+        "toolpath.gcode: the M220 on line " + std::to_string(imported.first_speed_factor_line) +
+        " sets a speed factor other than 100 %: " + std::to_string(imported.n_speed_factor_moves) +
+        " moves run at their F times it, as firmware runs them");
   if (const std::string no_code = no_code_problem(imported.n_lines, imported.n_code_lines);
       !no_code.empty()) {
     problems_.add(field.line, field.key, "G-code file '" + *given + "' " + no_code);

@@ -420,6 +420,9 @@ class GcodeParser {
   int save_slot(char letter, const std::string& command, int line_number);
   // Marlin's G61: a travel back to the position G60 saved
   void return_to_saved(int line_number);
+  // M220 (its words from `begin` to the line's `end`): the speed factor saved, restored or
+  // set; false (and a problem) when S is not a factor above 0
+  bool set_speed_factor(const char* begin, const char* end, int line_number);
   bool arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc);
   void set_position();
   // G10 L2 / L20: a work system's offsets; false (and a problem) when malformed
@@ -449,6 +452,8 @@ class GcodeParser {
   bool extruder_relative_ = false;       // M83
   double unit_mm_ = 1.0;                 // G20: 25.4
   double feed_mm_s_ = 0.0;               // 0: no F given yet
+  double speed_factor_ = 1.0;            // M220 S / 100: the moves run at F times it
+  double saved_speed_factor_ = 1.0;      // M220 B's
   int motion_mode_ = -1;                 // last G0..G3, -1: none
   int plane_ = 17;                       // G17, G18, G19
   bool open_ = false;                    // the shutter's open code is active
@@ -673,6 +678,7 @@ void GcodeParser::line(const char* begin, const char* end, int line_number) {
     // a firmware setting (M201 X1000, M204 P800), listed as written
     if (tenths >= 0 && !shutter_code)
       read_m_code_settings(tenths, stop, end, line_number, program_.firmware_settings);
+    if (tenths == 2200 && !shutter_code && !set_speed_factor(stop, end, line_number)) return;
     // any other M code but M82, M83 and the shutter's: the firmware's settings, whose
     // parameters need not be numbers (M862.3 P "MK3S", M115 U3.13.2); no geometry, unless the
     // line also holds a G code (checked below, as a whole line)
@@ -1215,17 +1221,18 @@ void GcodeParser::append_move(int motion, const Vec3& target_mm, double e_delta,
     record.length_mm = (target_mm - position_mm_).norm();
   }
   record.e_delta = e_delta;
-  record.feed_mm_s = feed_mm_s_;
+  record.feed_mm_s = feed_mm_s_ * speed_factor_;
   record.has_e = words_.has('E');
   record.open = open_ && !power_off_;
   record.layer_mark = program_.n_layer_marks;
   position_mm_ = target_mm;
-  if (record.length_mm > kMinMove_mm)
+  if (record.length_mm > kMinMove_mm) {
     program_.moves.push_back(record);
-  else if (e_delta != 0.0)  // the extruder alone: a retraction or a prime, at the feed rate
-    program_.pauses.push_back(GcodePause{program_.moves.size(),
-                                         feed_mm_s_ > 0.0 ? std::abs(e_delta) / feed_mm_s_ : 0.0,
-                                         line_number});
+    if (speed_factor_ != 1.0 && feed_mm_s_ > 0.0) ++program_.n_speed_factor_moves;
+  } else if (e_delta != 0.0)  // the extruder alone: a retraction or a prime, at the feed rate
+    program_.pauses.push_back(GcodePause{
+        program_.moves.size(),
+        feed_mm_s_ > 0.0 ? std::abs(e_delta) / (feed_mm_s_ * speed_factor_) : 0.0, line_number});
 }
 
 bool GcodeParser::arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc) {
@@ -1391,6 +1398,21 @@ bool GcodeParser::set_work_offsets(int line_number) {
     // (G92's offsets on top, as before). G91 changes neither.
     work_offset_mm_[system][axis] = l20 ? position_mm_[axis] - offset_mm_[axis] - value : value;
   }
+  return true;
+}
+
+bool GcodeParser::set_speed_factor(const char* begin, const char* end, int line_number) {
+  const SpeedFactorWords words = read_speed_factor_words(begin, end);
+  if (words.has_percent && !(words.percent > 0.0)) {
+    problem(line_number, "M220 S" + message_number(words.percent) +
+                             ": a speed factor must be a percentage above 0 (S100: as written)");
+    return false;
+  }
+  if (words.backup) saved_speed_factor_ = speed_factor_;
+  if (words.restore) speed_factor_ = saved_speed_factor_;
+  if (words.has_percent) speed_factor_ = words.percent / 100.0;
+  if (speed_factor_ != 1.0 && program_.first_speed_factor_line == 0)
+    program_.first_speed_factor_line = line_number;
   return true;
 }
 
@@ -1698,6 +1720,8 @@ std::string no_code_problem(int n_lines, int n_code_lines) {
 GcodeImport import_gcode_program(const GcodeProgram& program, const GcodeOptions& options) {
   GcodeImport result;
   result.n_lines = program.n_lines, result.n_code_lines = program.n_code_lines;
+  result.n_speed_factor_moves = program.n_speed_factor_moves;
+  result.first_speed_factor_line = program.first_speed_factor_line;
   result.rule = resolve_print_rule(program, options.rule, &result.rule_reason);
   result.layer_z_mm = print_layer_levels(program, result.rule);
   const int n_layers = static_cast<int>(result.layer_z_mm.size());

@@ -69,7 +69,7 @@ struct GcodeMove {
   EdgeArc arc;             // sweep 0 for G0/G1
   double length_mm = 0.0;  // helical for arcs
   double e_delta = 0.0;    // extruder change during the move (mm of filament)
-  double feed_mm_s = 0.0;  // modal feed rate (0: none given yet)
+  double feed_mm_s = 0.0;  // modal feed rate times M220's factor (0: no F given yet)
   bool has_e = false;      // an E word on the line
   bool open = false;       // the open code was the last of open/close, and the modal S not 0
   int layer_mark = 0;      // the slicer's layer marks read before it (GcodeProgram::n_layer_marks)
@@ -121,6 +121,10 @@ struct GcodeProgram {
   // anything are not read (LinuxCNC ignores them)
   int program_end_line = 0;
   int n_lines_after_end = 0;
+  // moves whose feed rate an M220 speed factor other than 100 % scaled (GcodeMove::feed_mm_s
+  // is F times the factor, as firmware runs it), and the line of the first such M220
+  int n_speed_factor_moves = 0;
+  int first_speed_factor_line = 0;
 };
 
 // "G41", "G51.1": a G code as written, from its number in tenths (IgnoredAxisCode::tenths)
@@ -172,6 +176,8 @@ struct GcodeImport {
   int first_layer = 0;                 // file layer of toolpath layer 0
   std::optional<Vec3> first_point_mm;  // the first imported print point
   int n_lines = 0, n_code_lines = 0;   // the program's
+  int n_speed_factor_moves = 0;        // the program's: moves an M220 factor scaled
+  int first_speed_factor_line = 0;
 };
 
 // Print paths of a parsed program under the options' rule and layer selection.

@@ -114,6 +114,30 @@ void read_klipper_settings(const char* begin, const char* end, int line, GcodeSe
   }
 }
 
+SpeedFactorWords read_speed_factor_words(const char* begin, const char* end) {
+  SpeedFactorWords words;
+  const char* p = begin;
+  while (p < end && *p != ';' && *p != '*') {
+    if (is_space(*p)) {
+      ++p;
+    } else if (*p == '(') {  // a comment within the line
+      p = std::find(p, end, ')');
+      if (p < end) ++p;
+    } else {
+      const char letter = upper(*p++);
+      if (letter == 'S') {
+        while (p < end && is_space(*p)) ++p;
+        words.has_percent = true;
+        words.percent = read_number(p, end).value_or(std::nan(""));
+      }
+      words.backup = words.backup || letter == 'B';
+      words.restore = words.restore || letter == 'R';
+      skip_word(p, end);
+    }
+  }
+  return words;
+}
+
 void read_m_code_settings(int m_code_tenths, const char* begin, const char* end, int line,
                           GcodeSettings& settings) {
   const char* letters = setting_letters(m_code_tenths);

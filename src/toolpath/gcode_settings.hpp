@@ -44,6 +44,17 @@ struct GcodeSettings {
 void read_m_code_settings(int m_code_tenths, const char* begin, const char* end, int line,
                           GcodeSettings& settings);
 
+// M220's words (Marlin, Klipper, RepRapFirmware): S the speed factor in percent, which
+// scales the feed rate of every move after it; Marlin's B saves the factor and R restores
+// the saved one (B, then R, then S, as Marlin applies them).
+struct SpeedFactorWords {
+  bool has_percent = false;
+  double percent = 0.0;  // S as written (NaN when S is not one finite number)
+  bool backup = false;   // B
+  bool restore = false;  // R
+};
+SpeedFactorWords read_speed_factor_words(const char* begin, const char* end);
+
 // Read a Klipper command line (`begin` at its name, `end` its end without the line break):
 // SET_VELOCITY_LIMIT's and SET_PRESSURE_ADVANCE's NAME=VALUE parameters (case ignored, a
 // comment after `;` or `#` left out); any other command, or a value that does not read as a

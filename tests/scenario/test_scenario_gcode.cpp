@@ -52,6 +52,21 @@ toolpath: {gcode: fast.gcode}
             "mm/s)");
 }
 
+// an M220 speed factor: the print paths run at F times it, and metrics.json's warnings say so
+TEST_F(ScenarioGcode, ASpeedFactorScalesThePrintSpeedsAndIsNoted) {
+  write("slow.gcode", "G1 X0 Y0 F600\nM220 S50\nG1 X10 Y0 E1\nG1 X10 Y10 E2\n");
+  const Scenario s = load_scenario(write("s.yaml", R"(
+limits: {v_max: 100, a_max: 1000}
+toolpath: {gcode: {file: slow.gcode, rule: e}}
+)"));
+  ASSERT_EQ(s.toolpath.paths.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.toolpath.paths[0].speed_mm_s, 5.0);
+  ASSERT_EQ(s.notes.size(), 1u);
+  EXPECT_EQ(s.notes[0],
+            "toolpath.gcode: the M220 on line 2 sets a speed factor other than 100 %: 2 moves "
+            "run at their F times it, as firmware runs them");
+}
+
 // `feed: error` keeps the error, at the move's line
 TEST_F(ScenarioGcode, FeedErrorRefusesMovesAboveTheLimits) {
   write("fast.gcode", "G1 X1 Y0 E1 F120\nG1 X11 Y0 E2 F600\n");

@@ -615,6 +615,34 @@ TEST(GcodeSettings, KlippersSettingCommandsAreListed) {
                   .empty());
 }
 
+// M220 S scales the feed rate of every move after it, as firmware runs them (Marlin, Klipper,
+// RepRapFirmware): B saves the factor, R restores it; an E-only move's time too
+TEST(GcodeSettings, TheSpeedFactorScalesTheFeedRatesAfterIt) {
+  const GcodeProgram program = parse_gcode_program(
+      "G1 X10 F600\nM220 S50\nG1 X20\nM220 B\nM220 S200\nG1 X30\nM220 R\nG1 X40\n"
+      "G1 E-1\nM220 S100\nG1 X50\n",
+      "m220.gcode", GcodeOptions{});
+  std::vector<double> feeds;
+  for (const GcodeMove& move : program.moves) feeds.push_back(move.feed_mm_s);
+  EXPECT_EQ(feeds, (std::vector<double>{10.0, 5.0, 20.0, 5.0, 10.0}));
+  ASSERT_EQ(program.pauses.size(), 1u);
+  EXPECT_DOUBLE_EQ(program.pauses[0].duration_s, 1.0 / 5.0);  // 1 mm of E at 5 mm/s
+  EXPECT_EQ(program.n_speed_factor_moves, 3);
+  EXPECT_EQ(program.first_speed_factor_line, 2);
+  // a factor of 100 % changes nothing and is not counted
+  const GcodeProgram as_written =
+      parse_gcode_program("M220 S100\nG1 X10 F600\n", "s100.gcode", GcodeOptions{});
+  EXPECT_EQ(as_written.moves.at(0).feed_mm_s, 10.0);
+  EXPECT_EQ(as_written.first_speed_factor_line, 0);
+  // no factor at all is no speed, and none that does not read
+  const auto problems = problems_of("G1 X1 E1 F600\nM220 S0\nM220 S-5\nM220 Sfast\n");
+  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  EXPECT_EQ(problems[0].line, 2);
+  EXPECT_EQ(problems[0].message,
+            "M220 S0: a speed factor must be a percentage above 0 (S100: as written)");
+  EXPECT_EQ(problems[2].line, 4);
+}
+
 TEST(Gcode, APurgeLineAtItsOwnHeightStaysALayerOfItsOwn) {
   // Cura's start block purges at z = 0.3 over a first layer at 0.2: layered by z, marks or
   // not, so that layers [1, 1]... leave it out and layers [0, 0] is the part's first layer
