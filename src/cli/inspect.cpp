@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <optional>
 
 #include "core/error.hpp"
 #include "kinematics/machine.hpp"
@@ -49,32 +50,97 @@ double move_time_s(const FirmwareMove& move, const FirmwareProfile& profile, siz
 // dwells, E-only moves (retractions, primes) and jumps of the position (G92, G28), where the
 // machine stands still; those pauses' own times are added. Each move's speed and acceleration
 // are capped so no axis exceeds the machine's limits over the file's box.
+// What the firmware plans a move with: its settings resolved over the axes' limits, the
+// junction deviation and the axes' accelerations around its junctions. `file` (null: the
+// machine's limits and the firmware's defaults alone) overrides them with the file's settings
+// in force: M201 and M203 the axes' limits; Marlin's print acceleration for a move with E (its
+// planner's esteps) and the travel acceleration for one without, Klipper's one acceleration
+// for both; M205 J, and Klipper's velocity, square-corner velocity and cruise ratio.
+struct MovePlanning {
+  MachineLimits limits;
+  FirmwareSettings settings;
+  double junction_deviation_mm = 0.0;
+  Vec3 axis_accel = Vec3::Zero();
+};
+MovePlanning move_planning(const MachineLimits& machine_limits, FirmwareMode mode,
+                           const FileMotionLimits* file, bool moves_extruder) {
+  MovePlanning planning;
+  planning.limits = machine_limits;
+  FirmwareSettings given;
+  given.mode = mode;
+  if (file != nullptr) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (file->axis_accel_mm_s2[axis] > 0.0)
+        planning.limits.axes[axis].a_max_mm_s2 = file->axis_accel_mm_s2[axis];
+      if (file->axis_feed_mm_s[axis] > 0.0)
+        planning.limits.axes[axis].v_max_mm_s = file->axis_feed_mm_s[axis];
+    }
+    const double print = file->print_accel_mm_s2, travel = file->travel_accel_mm_s2;
+    double accel = moves_extruder ? print : travel;
+    if (mode == FirmwareMode::klipper)  // M204 P and T: Klipper takes the smaller
+      accel = print > 0.0 && travel > 0.0 ? std::min(print, travel) : std::max(print, travel);
+    if (accel > 0.0) given.max_accel = accel;
+    if (file->junction_deviation_mm > 0.0)
+      given.junction_deviation_mm = file->junction_deviation_mm;
+    if (file->max_velocity_mm_s > 0.0) given.max_velocity = file->max_velocity_mm_s;
+    if (!std::isnan(file->square_corner_velocity))
+      given.square_corner_velocity = file->square_corner_velocity;
+    if (!std::isnan(file->minimum_cruise_ratio))
+      given.minimum_cruise_ratio = file->minimum_cruise_ratio;
+    if (file->max_accel_to_decel > 0.0) given.max_accel_to_decel = file->max_accel_to_decel;
+  }
+  planning.settings =
+      resolved_firmware_settings(given, planning.limits, planning.junction_deviation_mm);
+  const double max_accel = planning.settings.max_accel;
+  planning.axis_accel =
+      Vec3(planning.limits.axes[0].a_max_mm_s2, planning.limits.axes[1].a_max_mm_s2,
+           planning.limits.axes[2].a_max_mm_s2)
+          .cwiseMin(max_accel > 0.0 ? max_accel : kUnbounded);
+  return planning;
+}
+
 double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
-                           const std::string& mode, const Box3& all_moves_bbox) {
+                           const std::string& mode, const std::string& limits_source,
+                           const Box3& all_moves_bbox) {
   if (program.moves.empty()) {
     double pauses_s = 0.0;
     for (const GcodePause& pause : program.pauses) pauses_s += pause.duration_s;
     return pauses_s;
   }
-  const MachineLimits limits = machine.cartesian_limits(
+  const MachineLimits machine_limits = machine.cartesian_limits(
       MachineLimits::uniform(kUnbounded, kUnbounded), all_moves_bbox.lo, all_moves_bbox.hi);
   // the firmware's configuration as the planner applies it: Marlin's junction deviation, or
-  // Klipper's square-corner velocity and its max_accel, both at the x and y axes' acceleration
-  FirmwareSettings given;
-  given.mode = mode == "klipper" ? FirmwareMode::klipper : FirmwareMode::marlin;
-  double junction_deviation_mm = 0.0;
-  const FirmwareSettings settings =
-      resolved_firmware_settings(given, limits, junction_deviation_mm);
-  const double max_accel = settings.max_accel;
-  const Vec3 axis_accel =
-      Vec3(limits.axes[0].a_max_mm_s2, limits.axes[1].a_max_mm_s2, limits.axes[2].a_max_mm_s2)
-          .cwiseMin(max_accel > 0.0 ? max_accel : kUnbounded);
+  // Klipper's square-corner velocity and its max_accel, both at the x and y axes' acceleration;
+  // with --limits file, per move under the file's settings in force (each kind worked out once)
+  const FirmwareMode firmware_mode =
+      mode == "klipper" ? FirmwareMode::klipper : FirmwareMode::marlin;
+  const bool file_limits = limits_source == "file";
+  const std::vector<FileMotionLimits>& file_states = program.firmware_settings.motion_limits;
+  // the planning of the last settings met, for a move with E and one without (moves come in
+  // runs under one state; a file may change its settings at every move, so no table of all)
+  std::optional<MovePlanning> recent[2];
+  int recent_state[2] = {-1, -1};
+  const auto planning_of = [&](const GcodeMove& move) -> const MovePlanning& {
+    const int extruder = move.e_delta != 0.0 ? 1 : 0;
+    const int state = file_limits ? move.motion_limits : 0;
+    if (recent_state[extruder] != state) {
+      recent[extruder] = move_planning(
+          machine_limits, firmware_mode,
+          file_limits ? &file_states[static_cast<size_t>(state)] : nullptr, extruder == 1);
+      recent_state[extruder] = state;
+    }
+    return *recent[extruder];
+  };
 
   double total_s = 0.0;
   std::vector<FirmwareMove> chain;
+  // the junction settings the chain is planned under (its first move's)
+  FirmwareSettings chain_settings;
+  double chain_junction_deviation_mm = 0.0;
   const auto flush = [&] {
     if (chain.empty()) return;
-    const FirmwareProfile profile = firmware_lookahead(chain, settings, junction_deviation_mm);
+    const FirmwareProfile profile =
+        firmware_lookahead(chain, chain_settings, chain_junction_deviation_mm);
     for (size_t k = 0; k < chain.size(); ++k) total_s += move_time_s(chain[k], profile, k);
     chain.clear();
   };
@@ -89,7 +155,18 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       total_s += program.pauses[next_pause].duration_s;
       stops = true;
     }
+    // the look-ahead plans a chain under one junction deviation and cruise ratio: a change of
+    // them (M205 J, Klipper's square-corner velocity) plans the chain so far
+    const MovePlanning& planning = planning_of(move);
+    if (!chain.empty() &&
+        (planning.junction_deviation_mm != chain_junction_deviation_mm ||
+         planning.settings.minimum_cruise_ratio != chain_settings.minimum_cruise_ratio))
+      stops = true;
     if (stops) flush();
+    if (chain.empty()) {
+      chain_settings = planning.settings;
+      chain_junction_deviation_mm = planning.junction_deviation_mm;
+    }
     previous_end = move.to_mm;
     // the move's straight pieces (an arc's chords)
     std::vector<Vec3> points{move.from_mm, move.to_mm};
@@ -112,10 +189,11 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       // no axis beyond its own speed and acceleration (Marlin's max_feedrate, max_acceleration),
       // and Klipper's max_accel the same in every direction, as the firmware planner has them
       double speed_cap = 0.0;
-      move_caps(piece.direction, limits, 0.0, max_accel, speed_cap, piece.accel_mm_s2);
+      move_caps(piece.direction, planning.limits, planning.settings.max_velocity,
+                planning.settings.max_accel, speed_cap, piece.accel_mm_s2);
       piece.cruise_speed_mm_s =
           std::min(move.feed_mm_s > 0.0 ? move.feed_mm_s : kUnbounded, speed_cap);
-      piece.blend_accel_mm_s2 = axis_accel;
+      piece.blend_accel_mm_s2 = planning.axis_accel;
       chain.push_back(piece);
       if (chain.size() >= kMaxChainPieces) flush();
     }
@@ -156,9 +234,13 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   if (baseline.mode != "marlin" && baseline.mode != "klipper")
     throw InputError("--mode",
                      "unknown firmware mode '" + baseline.mode + "' (known: marlin, klipper)");
+  if (baseline.limits != "machine" && baseline.limits != "file")
+    throw InputError("--limits",
+                     "unknown source of limits '" + baseline.limits + "' (known: machine, file)");
   GcodeFacts facts;
   facts.baseline_machine = baseline.machine;
   facts.baseline_mode = baseline.mode;
+  facts.baseline_limits = baseline.limits;
   const PrintRule resolved = resolve_print_rule(program, rule, &facts.rule_reason);
   facts.rule = print_rule_name(resolved);
   facts.n_lines = program.n_lines;
@@ -198,7 +280,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   }
   // what the firmware baseline predicts for the whole file
   facts.estimated_time_s =
-      firmware_estimate_s(program, *machine, baseline.mode, facts.all_moves_bbox);
+      firmware_estimate_s(program, *machine, baseline.mode, baseline.limits, facts.all_moves_bbox);
   return facts;
 }
 
@@ -220,8 +302,10 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
   out["n_retractions"] = facts.n_retractions;
   out["extrusion_e_total"] = facts.extrusion_e_total;
   out["estimated_time_s"] = facts.estimated_time_s;
-  out["baseline"] = {
-      {"planner", "firmware"}, {"mode", facts.baseline_mode}, {"machine", facts.baseline_machine}};
+  out["baseline"] = {{"planner", "firmware"},
+                     {"mode", facts.baseline_mode},
+                     {"machine", facts.baseline_machine},
+                     {"limits", facts.baseline_limits}};
   out["feed_rate_time_s"] = facts.feed_rate_time_s;
   out["n_moves_without_feed"] = facts.n_moves_without_feed;
   out["ignored_axis_words"] = nlohmann::json::array();

@@ -58,8 +58,9 @@ struct GcodeFacts {
   // M201-M205, M220, M221, M900 and Klipper's SET_VELOCITY_LIMIT and SET_PRESSURE_ADVANCE as
   // the file sets them (toolpath/gcode_settings.hpp)
   GcodeSettings firmware_settings;
-  std::string baseline_machine;  // the machine and firmware mode estimated_time_s assumes
-  std::string baseline_mode;
+  std::string baseline_machine;  // the machine, firmware mode and limits estimated_time_s
+  std::string baseline_mode;     // assumes
+  std::string baseline_limits;
 };
 
 // What `inspect` plans the file with: the `firmware` planner with its default parameters in
@@ -67,10 +68,13 @@ struct GcodeFacts {
 struct InspectBaseline {
   std::string machine = "cartesian";
   std::string mode = "marlin";  // marlin | klipper
+  // machine: the machine's limits and the firmware's defaults; file: over them, the file's
+  // own settings in force at each move (M201, M203, M204, M205 J, SET_VELOCITY_LIMIT)
+  std::string limits = "machine";
 };
 
-// Throws InputError naming --machine or --mode when the baseline names neither a machine
-// nor a mode that exists.
+// Throws InputError naming --machine, --mode or --limits when the baseline names a machine,
+// mode or source of limits that does not exist.
 GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
                        const InspectBaseline& baseline = {});
 

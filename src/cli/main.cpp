@@ -290,6 +290,10 @@ int run_command_line(int argc, char** argv) {
   inspect->add_option("--mode", inspect_baseline.mode,
                       "the firmware's look-ahead for estimated_time_s: marlin (junction "
                       "deviation) or klipper (square-corner velocity); default marlin");
+  inspect->add_option("--limits", inspect_baseline.limits,
+                      "the limits of estimated_time_s: machine (--machine's, the firmware's "
+                      "defaults) or file (over them, the file's M201, M203, M204, M205 J and "
+                      "SET_VELOCITY_LIMIT in force at each move); default machine");
   // ---- end inspect ----
 
   // ---- sweep (parameter studies: src/cli/sweep_verb.cpp, src/sweep/) ----

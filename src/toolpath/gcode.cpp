@@ -1227,6 +1227,7 @@ void GcodeParser::append_move(int motion, const Vec3& target_mm, double e_delta,
   record.layer_mark = program_.n_layer_marks;
   position_mm_ = target_mm;
   if (record.length_mm > kMinMove_mm) {
+    record.motion_limits = program_.firmware_settings.motion_limits_for_move();
     program_.moves.push_back(record);
     if (speed_factor_ != 1.0 && feed_mm_s_ > 0.0) ++program_.n_speed_factor_moves;
   } else if (e_delta != 0.0)  // the extruder alone: a retraction or a prime, at the feed rate

@@ -73,6 +73,8 @@ struct GcodeMove {
   bool has_e = false;      // an E word on the line
   bool open = false;       // the open code was the last of open/close, and the modal S not 0
   int layer_mark = 0;      // the slicer's layer marks read before it (GcodeProgram::n_layer_marks)
+  // the file's motion settings in force (GcodeProgram::firmware_settings.motion_limits index)
+  int motion_limits = 0;
 };
 
 // Where the machine stands still between moves: a G4 dwell, or an E-only move (a retraction

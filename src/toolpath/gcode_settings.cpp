@@ -76,15 +76,51 @@ void skip_word(const char*& p, const char* end) {
 
 }  // namespace
 
+FileMotionLimits& GcodeSettings::changing_limits() {
+  if (limits_taken_) motion_limits.push_back(motion_limits.back());
+  limits_taken_ = false;
+  return motion_limits.back();
+}
+
 void GcodeSettings::set(const std::string& command, const std::string& parameter, double value,
                         int line) {
+  // listed: the first value, the last and the changes between
+  bool listed = false;
   for (GcodeSetting& setting : settings) {
     if (setting.command != command || setting.parameter != parameter) continue;
     if (value != setting.last_value) ++setting.n_changes;
     setting.last_value = value;
-    return;
+    listed = true;
+    break;
   }
-  settings.push_back({command, parameter, value, line, value, 0});
+  if (!listed) settings.push_back({command, parameter, value, line, value, 0});
+  // the motion limits from here on (a negative value sets none: no firmware takes it)
+  if (value < 0.0) return;
+  const int axis = parameter == "X" ? 0 : parameter == "Y" ? 1 : parameter == "Z" ? 2 : -1;
+  if ((command == "M201" || command == "M203") && axis >= 0) {
+    FileMotionLimits& limits = changing_limits();
+    (command == "M201" ? limits.axis_accel_mm_s2 : limits.axis_feed_mm_s)[axis] = value;
+  } else if (command == "M204" && (parameter == "P" || parameter == "S")) {
+    changing_limits().print_accel_mm_s2 = value;
+    if (parameter == "S") motion_limits.back().travel_accel_mm_s2 = value;
+  } else if (command == "M204" && parameter == "T") {
+    changing_limits().travel_accel_mm_s2 = value;
+  } else if (command == "M205" && parameter == "J") {
+    changing_limits().junction_deviation_mm = value;
+  } else if (command == "SET_VELOCITY_LIMIT") {
+    if (parameter == "ACCEL") {
+      changing_limits().print_accel_mm_s2 = value;
+      motion_limits.back().travel_accel_mm_s2 = value;
+    } else if (parameter == "VELOCITY") {
+      changing_limits().max_velocity_mm_s = value;
+    } else if (parameter == "SQUARE_CORNER_VELOCITY") {
+      changing_limits().square_corner_velocity = value;
+    } else if (parameter == "MINIMUM_CRUISE_RATIO") {
+      changing_limits().minimum_cruise_ratio = value;
+    } else if (parameter == "ACCEL_TO_DECEL") {
+      changing_limits().max_accel_to_decel = value;
+    }
+  }
 }
 
 void read_klipper_settings(const char* begin, const char* end, int line, GcodeSettings& settings) {

@@ -15,6 +15,7 @@
 // Other parameters of these commands (M221 T, EXTRUDER=) are not settings read here.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,11 +31,40 @@ struct GcodeSetting {
   int n_changes = 0;  // later lines that set it to another value (a slicer's per-feature M204)
 };
 
+// The motion limits the file's settings give the firmware from some line on, as `inspect
+// --limits file` estimates with them; 0 (NaN for the square-corner velocity, where 0 is a
+// setting): not set, the machine's or the firmware's default holds. Marlin's classic jerk
+// (M205 X Y) has no place here: the estimate's corners are junction deviation's or Klipper's.
+struct FileMotionLimits {
+  double axis_accel_mm_s2[3] = {0.0, 0.0, 0.0};  // M201 X Y Z
+  double axis_feed_mm_s[3] = {0.0, 0.0, 0.0};    // M203 X Y Z (Marlin's mm/s)
+  double print_accel_mm_s2 = 0.0;                // M204 P (and S); Klipper's ACCEL
+  double travel_accel_mm_s2 = 0.0;               // M204 T (and S); Klipper's ACCEL
+  double junction_deviation_mm = 0.0;            // M205 J
+  double max_velocity_mm_s = 0.0;                // Klipper's VELOCITY
+  double square_corner_velocity = std::numeric_limits<double>::quiet_NaN();
+  double minimum_cruise_ratio = std::numeric_limits<double>::quiet_NaN();  // Klipper's
+  double max_accel_to_decel = 0.0;  // Klipper's older ACCEL_TO_DECEL
+};
+
 struct GcodeSettings {
   std::vector<GcodeSetting> settings;  // in the order the file first sets them
+  // the motion limits in force, one entry per change that a move came under; entry 0 is the
+  // file's start (nothing set)
+  std::vector<FileMotionLimits> motion_limits{1};
 
   // one parameter read at `line`
   void set(const std::string& command, const std::string& parameter, double value, int line);
+  // the index in motion_limits of those in force, for a move made now
+  int motion_limits_for_move() {
+    limits_taken_ = true;
+    return static_cast<int>(motion_limits.size()) - 1;
+  }
+
+ private:
+  // the limits in force, about to change: a new entry once a move came under the last
+  FileMotionLimits& changing_limits();
+  bool limits_taken_ = false;
 };
 
 // Read an M code's parameters (`begin` just after its number, `end` the line's end): for the

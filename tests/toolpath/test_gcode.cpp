@@ -615,6 +615,26 @@ TEST(GcodeSettings, KlippersSettingCommandsAreListed) {
                   .empty());
 }
 
+// the motion limits in force per move (inspect --limits file): a change makes a new entry only
+// once a move came under the last, so settings without moves between them take no room
+TEST(GcodeSettings, EachMoveIsUnderTheMotionLimitsInForce) {
+  std::string text = "G1 X1 F600\n";
+  for (int i = 0; i < 1000; ++i) text += i % 2 == 0 ? "M204 T500\n" : "M204 T700\n";
+  text += "G1 X2\nM201 X200\nSET_VELOCITY_LIMIT SQUARE_CORNER_VELOCITY=0\nG1 X3\nG1 X4\n";
+  const GcodeProgram program = parse_gcode_program(text, "limits.gcode", GcodeOptions{});
+  const std::vector<FileMotionLimits>& limits = program.firmware_settings.motion_limits;
+  ASSERT_EQ(limits.size(), 3u);
+  std::vector<int> states;
+  for (const GcodeMove& move : program.moves) states.push_back(move.motion_limits);
+  EXPECT_EQ(states, (std::vector<int>{0, 1, 2, 2}));
+  EXPECT_EQ(limits[0].travel_accel_mm_s2, 0.0);  // nothing set before the first move
+  EXPECT_EQ(limits[1].travel_accel_mm_s2, 700.0);
+  EXPECT_EQ(limits[2].axis_accel_mm_s2[0], 200.0);
+  EXPECT_EQ(limits[2].travel_accel_mm_s2, 700.0);    // kept
+  EXPECT_EQ(limits[2].square_corner_velocity, 0.0);  // 0 is a setting
+  EXPECT_TRUE(std::isnan(limits[1].square_corner_velocity));
+}
+
 // M220 S scales the feed rate of every move after it, as firmware runs them (Marlin, Klipper,
 // RepRapFirmware): B saves the factor, R restores it; an E-only move's time too
 TEST(GcodeSettings, TheSpeedFactorScalesTheFeedRatesAfterIt) {

@@ -294,6 +294,49 @@ TEST(GcodeFiles, EstimatedTimeIsTheFirmwaresTrapezoids) {
   EXPECT_GT(estimate("G1 X50 F3000\nG1 Y50\n"), 100.0 / 50.0 + 50.0 / a);
 }
 
+// --limits file: the file's settings in force at each move over the machine's (300 mm/s and
+// 3000 mm/s^2 in x and y), in the same closed forms; --limits machine ignores them
+TEST(GcodeFiles, EstimateUnderTheFilesOwnLimits) {
+  const auto estimate = [](const std::string& text, const std::string& limits = "file",
+                           const std::string& mode = "marlin") {
+    const GcodeProgram program = parse_gcode_program(text, "estimate.gcode", GcodeOptions{});
+    InspectBaseline baseline;
+    baseline.mode = mode;
+    baseline.limits = limits;
+    return gcode_facts(program, PrintRule::automatic, baseline).estimated_time_s;
+  };
+  const double a = 3000.0;
+  // Marlin: a move with E at M204 P, one without at T; Klipper: the smaller of the two
+  const std::string accels = "M204 P500 T2000\nM83\n";
+  EXPECT_NEAR(estimate(accels + "G1 X100 E1 F3000\n"), 2.0 + 50.0 / 500.0, 1e-9);
+  EXPECT_NEAR(estimate(accels + "G1 X100 F3000\n"), 2.0 + 50.0 / 2000.0, 1e-9);
+  EXPECT_NEAR(estimate(accels + "G1 X100 F3000\n", "file", "klipper"), 2.0 + 50.0 / 500.0, 1e-9);
+  EXPECT_NEAR(estimate(accels + "G1 X100 E1 F3000\n", "machine"), 2.0 + 50.0 / a, 1e-9);
+  // M201 and M203: an axis' own acceleration and feed rate
+  EXPECT_NEAR(estimate("M201 X200\nG1 X100 F3000\n"), 2.0 + 50.0 / 200.0, 1e-9);
+  EXPECT_NEAR(estimate("M203 X20\nG1 X100 F3000\n"), 100.0 / 20.0 + 20.0 / a, 1e-9);
+  // a change between two collinear moves: one queue, each move at its own acceleration (up at
+  // 500 over the first, down at 1000 over the second)
+  EXPECT_NEAR(estimate("M204 T500\nG1 X100 F3000\nM204 T1000\nG1 X200\n"),
+              200.0 / 50.0 + 50.0 / (2.0 * 500.0) + 50.0 / (2.0 * 1000.0), 1e-9);
+  // Klipper's square-corner velocity: its default written out changes nothing, a slower one
+  // slows the corner; a junction deviation as large as the corner's turn lets it go faster
+  const std::string corner = "G1 X50 F3000\nG1 Y50\n";
+  const double klipper = estimate(corner, "machine", "klipper");
+  EXPECT_EQ(estimate("SET_VELOCITY_LIMIT SQUARE_CORNER_VELOCITY=5\n" + corner, "file", "klipper"),
+            klipper);
+  EXPECT_GT(estimate("SET_VELOCITY_LIMIT SQUARE_CORNER_VELOCITY=1\n" + corner, "file", "klipper"),
+            klipper);
+  EXPECT_LT(estimate("M205 J1\n" + corner), estimate(corner, "machine"));
+  // no such source of limits
+  try {
+    estimate(corner, "slicer");
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problems().at(0).key, "--limits");
+  }
+}
+
 // a look-ahead chain is planned and emptied every 2^20 pieces (bounded memory on a file of
 // arcs that never stops): 2^20 collinear moves of 0.001 mm, then one of 100 mm, are two
 // chains from rest to rest, L / v + 2 v / a, where one chain would be L / v + v / a
