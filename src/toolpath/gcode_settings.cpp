@@ -74,6 +74,32 @@ void skip_word(const char*& p, const char* end) {
   while (p < end && !is_space(*p) && std::strchr(";#*(", *p) == nullptr) ++p;
 }
 
+// Each word of an M code's parameters, from `begin` (just after its number) up to a `;`
+// comment or `*` checksum, `(...)` comments skipped: visit(letter, value) with its letter in
+// upper case ('\0' for a word that starts with none) and the finite number after it, if one
+// is (`X1000`, `X 1000`)
+template <typename Visit>
+void for_each_m_word(const char* begin, const char* end, Visit visit) {
+  const char* p = begin;
+  while (p < end && *p != ';' && *p != '*') {
+    if (is_space(*p)) {
+      ++p;
+    } else if (*p == '(') {  // a comment within the line
+      p = std::find(p, end, ')');
+      if (p < end) ++p;
+    } else {
+      const char letter = is_letter(*p) ? upper(*p) : '\0';
+      ++p;
+      const char* number = p;
+      while (number < end && is_space(*number)) ++number;
+      const std::optional<double> value = read_number(number, end);
+      if (value) p = number;
+      visit(letter, value);
+      skip_word(p, end);
+    }
+  }
+}
+
 }  // namespace
 
 FileMotionLimits& GcodeSettings::changing_limits() {
@@ -152,25 +178,14 @@ void read_klipper_settings(const char* begin, const char* end, int line, GcodeSe
 
 SpeedFactorWords read_speed_factor_words(const char* begin, const char* end) {
   SpeedFactorWords words;
-  const char* p = begin;
-  while (p < end && *p != ';' && *p != '*') {
-    if (is_space(*p)) {
-      ++p;
-    } else if (*p == '(') {  // a comment within the line
-      p = std::find(p, end, ')');
-      if (p < end) ++p;
-    } else {
-      const char letter = upper(*p++);
-      if (letter == 'S') {
-        while (p < end && is_space(*p)) ++p;
-        words.has_percent = true;
-        words.percent = read_number(p, end).value_or(std::nan(""));
-      }
-      words.backup = words.backup || letter == 'B';
-      words.restore = words.restore || letter == 'R';
-      skip_word(p, end);
+  for_each_m_word(begin, end, [&](char letter, std::optional<double> value) {
+    if (letter == 'S') {
+      words.has_percent = true;
+      words.percent = value.value_or(std::nan(""));
     }
-  }
+    words.backup = words.backup || letter == 'B';
+    words.restore = words.restore || letter == 'R';
+  });
   return words;
 }
 
@@ -179,24 +194,10 @@ void read_m_code_settings(int m_code_tenths, const char* begin, const char* end,
   const char* letters = setting_letters(m_code_tenths);
   if (letters == nullptr) return;
   const std::string command = "M" + std::to_string(m_code_tenths / 10);
-  const char* p = begin;
-  while (p < end && *p != ';' && *p != '*') {
-    if (is_space(*p)) {
-      ++p;
-    } else if (*p == '(') {  // a comment within the line
-      p = std::find(p, end, ')');
-      if (p < end) ++p;
-    } else if (is_letter(*p) && std::strchr(letters, upper(*p)) != nullptr) {
-      const char letter = upper(*p++);
-      while (p < end && is_space(*p)) ++p;
-      if (const std::optional<double> value = read_number(p, end))
-        settings.set(command, std::string(1, letter), *value, line);
-      skip_word(p, end);
-    } else {
-      ++p;
-      skip_word(p, end);
-    }
-  }
+  for_each_m_word(begin, end, [&](char letter, std::optional<double> value) {
+    if (letter != '\0' && std::strchr(letters, letter) != nullptr && value)
+      settings.set(command, std::string(1, letter), *value, line);
+  });
 }
 
 }  // namespace depotwin
