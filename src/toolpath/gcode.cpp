@@ -1402,11 +1402,18 @@ bool GcodeParser::set_work_offsets(int line_number) {
   return true;
 }
 
+constexpr double kLeastSpeedFactorPercent = 1.0;
+constexpr double kMostSpeedFactorPercent = 10000.0;
+
 bool GcodeParser::set_speed_factor(const char* begin, const char* end, int line_number) {
   const SpeedFactorWords words = read_speed_factor_words(begin, end);
-  if (words.has_percent && !(words.percent > 0.0)) {
+  // 1 % to 100 x: a factor no firmware's dial goes below (Marlin's stops at 10 %) would take
+  // the feed rates under the least one read (and the time estimates' squared speeds to 0)
+  if (words.has_percent &&
+      !(words.percent >= kLeastSpeedFactorPercent && words.percent <= kMostSpeedFactorPercent)) {
     problem(line_number, "M220 S" + message_number(words.percent) +
-                             ": a speed factor must be a percentage above 0 (S100: as written)");
+                             ": a speed factor must be a percentage from 1 to 10000 (S100: the "
+                             "feed rates as written)");
     return false;
   }
   if (words.backup) saved_speed_factor_ = speed_factor_;

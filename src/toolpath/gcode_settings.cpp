@@ -17,6 +17,11 @@ using ascii::is_letter;
 using ascii::is_space;
 using ascii::upper;
 
+// the range of a setting that sets a motion limit (FileMotionLimits): the G-code reader's
+// largest number, and the least limit taken as one
+constexpr double kMostSettingValue = 1e9;
+constexpr double kLeastLimitValue = 1e-6;
+
 // Klipper's setting commands and the parameters of each read here
 struct KlipperCommand {
   const char* name;
@@ -120,31 +125,34 @@ void GcodeSettings::set(const std::string& command, const std::string& parameter
     break;
   }
   if (!listed) settings.push_back({command, parameter, value, line, value, 0});
-  // the motion limits from here on (a negative value sets none: no firmware takes it)
-  if (value < 0.0) return;
+  // the motion limits from here on: a value no firmware takes (negative, above 1e9, NaN) sets
+  // none; a limit below 1e-6 (0 among them) is no limit, the machine's holds (a feed rate of
+  // 1e-300 mm/s would take the estimate's squared speeds to 0)
+  if (!(value >= 0.0 && value <= kMostSettingValue)) return;
+  const double limit = value >= kLeastLimitValue ? value : 0.0;
   const int axis = parameter == "X" ? 0 : parameter == "Y" ? 1 : parameter == "Z" ? 2 : -1;
   if ((command == "M201" || command == "M203") && axis >= 0) {
     FileMotionLimits& limits = changing_limits();
-    (command == "M201" ? limits.axis_accel_mm_s2 : limits.axis_feed_mm_s)[axis] = value;
+    (command == "M201" ? limits.axis_accel_mm_s2 : limits.axis_feed_mm_s)[axis] = limit;
   } else if (command == "M204" && (parameter == "P" || parameter == "S")) {
-    changing_limits().print_accel_mm_s2 = value;
-    if (parameter == "S") motion_limits.back().travel_accel_mm_s2 = value;
+    changing_limits().print_accel_mm_s2 = limit;
+    if (parameter == "S") motion_limits.back().travel_accel_mm_s2 = limit;
   } else if (command == "M204" && parameter == "T") {
-    changing_limits().travel_accel_mm_s2 = value;
+    changing_limits().travel_accel_mm_s2 = limit;
   } else if (command == "M205" && parameter == "J") {
-    changing_limits().junction_deviation_mm = value;
+    changing_limits().junction_deviation_mm = limit;
   } else if (command == "SET_VELOCITY_LIMIT") {
     if (parameter == "ACCEL") {
-      changing_limits().print_accel_mm_s2 = value;
-      motion_limits.back().travel_accel_mm_s2 = value;
+      changing_limits().print_accel_mm_s2 = limit;
+      motion_limits.back().travel_accel_mm_s2 = limit;
     } else if (parameter == "VELOCITY") {
-      changing_limits().max_velocity_mm_s = value;
+      changing_limits().max_velocity_mm_s = limit;
     } else if (parameter == "SQUARE_CORNER_VELOCITY") {
       changing_limits().square_corner_velocity = value;
-    } else if (parameter == "MINIMUM_CRUISE_RATIO") {
+    } else if (parameter == "MINIMUM_CRUISE_RATIO" && value < 1.0) {  // Klipper's range [0, 1)
       changing_limits().minimum_cruise_ratio = value;
     } else if (parameter == "ACCEL_TO_DECEL") {
-      changing_limits().max_accel_to_decel = value;
+      changing_limits().max_accel_to_decel = limit;
     }
   }
 }

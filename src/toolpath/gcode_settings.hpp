@@ -32,8 +32,10 @@ struct GcodeSetting {
 };
 
 // The motion limits the file's settings give the firmware from some line on, as `inspect
-// --limits file` estimates with them; 0 (NaN for the square-corner velocity, where 0 is a
-// setting): not set, the machine's or the firmware's default holds. Marlin's classic jerk
+// --limits file` estimates with them; 0 (NaN for the square-corner velocity and the cruise
+// ratio, where 0 is a setting): not set, the machine's or the firmware's default holds. A
+// value no firmware takes (negative, above 1e9, a cruise ratio of 1 or more) sets nothing,
+// and a limit below 1e-6 is none. Marlin's classic jerk
 // (M205 X Y) has no place here: the estimate's corners are junction deviation's or Klipper's.
 struct FileMotionLimits {
   double axis_accel_mm_s2[3] = {0.0, 0.0, 0.0};  // M201 X Y Z

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "fuzz/fuzz_check.hpp"
@@ -48,10 +49,32 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   require(
       program.n_lines >= 0 && is_finite(program.dwell_s) && is_finite(program.extrusion_e_total),
       "finite program totals");
-  for (const depotwin::GcodeMove& move : program.moves)
+  const auto& motion_limits = program.firmware_settings.motion_limits;
+  for (const depotwin::GcodeMove& move : program.moves) {
     require(move.from_mm.allFinite() && move.to_mm.allFinite() && is_finite(move.length_mm) &&
                 move.length_mm > 0.0 && is_finite(move.e_delta),
             "finite moves");
+    // the feed rate times M220's factor: finite, and none or at least the least F read
+    require(is_finite(move.feed_mm_s) && (move.feed_mm_s == 0.0 || move.feed_mm_s >= 1e-10),
+            "a finite feed rate, none or one to move at");
+    require(move.motion_limits >= 0 &&
+                static_cast<std::size_t>(move.motion_limits) < motion_limits.size(),
+            "each move under motion limits the program holds");
+  }
+  // the firmware settings: as written, finite; the motion limits taken from them in range
+  for (const depotwin::GcodeSetting& setting : program.firmware_settings.settings)
+    require(is_finite(setting.value) && is_finite(setting.last_value) && setting.line >= 1,
+            "finite settings");
+  for (const depotwin::FileMotionLimits& limits : motion_limits) {
+    std::vector<double> values = {limits.print_accel_mm_s2, limits.travel_accel_mm_s2,
+                                  limits.junction_deviation_mm, limits.max_velocity_mm_s};
+    for (int axis = 0; axis < 3; ++axis) {
+      values.push_back(limits.axis_accel_mm_s2[axis]);
+      values.push_back(limits.axis_feed_mm_s[axis]);
+    }
+    for (const double value : values)
+      require(value == 0.0 || (value >= 1e-6 && value <= 1e9), "motion limits in range");
+  }
   // every rule, every layer; then the last layer alone, with a default speed (as a scenario's
   // toolpath.speed gives)
   for (const depotwin::PrintRule rule : {depotwin::PrintRule::automatic, depotwin::PrintRule::e,

@@ -633,6 +633,19 @@ TEST(GcodeSettings, EachMoveIsUnderTheMotionLimitsInForce) {
   EXPECT_EQ(limits[2].travel_accel_mm_s2, 700.0);    // kept
   EXPECT_EQ(limits[2].square_corner_velocity, 0.0);  // 0 is a setting
   EXPECT_TRUE(std::isnan(limits[1].square_corner_velocity));
+  // values no firmware takes set no limit: negative, above 1e9, a feed rate too small to move
+  // at (the machine's holds), a cruise ratio of 1 or more
+  const GcodeProgram odd = parse_gcode_program(
+      "M203 X1e-300 Y-5 Z2e9\nM204 T1e-7\nSET_VELOCITY_LIMIT MINIMUM_CRUISE_RATIO=1\n"
+      "G1 X1 F600\n",
+      "odd.gcode", GcodeOptions{});
+  const FileMotionLimits& none = odd.firmware_settings.motion_limits.at(0);
+  EXPECT_EQ(none.axis_feed_mm_s[0], 0.0);
+  EXPECT_EQ(none.axis_feed_mm_s[1], 0.0);
+  EXPECT_EQ(none.axis_feed_mm_s[2], 0.0);
+  EXPECT_EQ(none.travel_accel_mm_s2, 0.0);
+  EXPECT_TRUE(std::isnan(none.minimum_cruise_ratio));
+  EXPECT_EQ(odd.firmware_settings.settings.size(), 5u);  // each listed as written
 }
 
 // M220 S scales the feed rate of every move after it, as firmware runs them (Marlin, Klipper,
@@ -654,13 +667,19 @@ TEST(GcodeSettings, TheSpeedFactorScalesTheFeedRatesAfterIt) {
       parse_gcode_program("M220 S100\nG1 X10 F600\n", "s100.gcode", GcodeOptions{});
   EXPECT_EQ(as_written.moves.at(0).feed_mm_s, 10.0);
   EXPECT_EQ(as_written.first_speed_factor_line, 0);
-  // no factor at all is no speed, and none that does not read
-  const auto problems = problems_of("G1 X1 E1 F600\nM220 S0\nM220 S-5\nM220 Sfast\n");
-  ASSERT_EQ(problems.size(), 3u) << dump(problems);
+  // a factor from 1 to 10000 %: none, one that would take the feed rates under the least
+  // read (1e-6 per minute; F1 at S1e-300 % gave a 1e-301 mm/s move an estimate of 0 s), or
+  // none that reads, is refused at its line
+  const auto problems = problems_of(
+      "G1 X1 E1 F600\nM220 S0\nM220 S-5\nM220 Sfast\nM220 S1e-300\nM220 S10001\nM220 S1\n"
+      "M220 S10000\n");
+  ASSERT_EQ(problems.size(), 5u) << dump(problems);
   EXPECT_EQ(problems[0].line, 2);
   EXPECT_EQ(problems[0].message,
-            "M220 S0: a speed factor must be a percentage above 0 (S100: as written)");
+            "M220 S0: a speed factor must be a percentage from 1 to 10000 (S100: the feed rates "
+            "as written)");
   EXPECT_EQ(problems[2].line, 4);
+  EXPECT_EQ(problems[4].line, 6);
 }
 
 TEST(Gcode, APurgeLineAtItsOwnHeightStaysALayerOfItsOwn) {
