@@ -44,12 +44,6 @@ double move_time_s(const FirmwareMove& move, const FirmwareProfile& profile, siz
   return 0.5 * tau0 + (peak - v0) / a + cruise_s + (peak - v1) / a + 0.5 * tau1;
 }
 
-// What the firmware baseline predicts for the whole file: every move, printing or not, goes
-// through one look-ahead queue as a printer's firmware plans it (Marlin and Klipper treat G0
-// as G1 at the modal feed rate; before any F, the machine's top speed). The queue empties at
-// dwells, E-only moves (retractions, primes) and jumps of the position (G92, G28), where the
-// machine stands still; those pauses' own times are added. Each move's speed and acceleration
-// are capped so no axis exceeds the machine's limits over the file's box.
 // What the firmware plans a move with: its settings resolved over the axes' limits, the
 // junction deviation and the axes' accelerations around its junctions. `file` (null: the
 // machine's limits and the firmware's defaults alone) overrides them with the file's settings
@@ -99,6 +93,13 @@ MovePlanning move_planning(const MachineLimits& machine_limits, FirmwareMode mod
   return planning;
 }
 
+// What the firmware baseline predicts for the whole file: every move, printing or not, goes
+// through one look-ahead queue as a printer's firmware plans it (Marlin and Klipper treat G0
+// as G1 at the modal feed rate; before any F, the machine's top speed). The queue empties at
+// dwells, E-only moves (retractions, primes) and jumps of the position (G92, G28), where the
+// machine stands still; those pauses' own times are added. Each move's speed and acceleration
+// are capped so no axis exceeds the machine's limits over the file's box, or with --limits
+// file the file's settings in force at the move over them (move_planning).
 double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
                            const std::string& mode, const std::string& limits_source,
                            const Box3& all_moves_bbox) {
@@ -111,7 +112,7 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       MachineLimits::uniform(kUnbounded, kUnbounded), all_moves_bbox.lo, all_moves_bbox.hi);
   // the firmware's configuration as the planner applies it: Marlin's junction deviation, or
   // Klipper's square-corner velocity and its max_accel, both at the x and y axes' acceleration;
-  // with --limits file, per move under the file's settings in force (each kind worked out once)
+  // with --limits file, per move under the file's settings in force
   const FirmwareMode firmware_mode =
       mode == "klipper" ? FirmwareMode::klipper : FirmwareMode::marlin;
   const bool file_limits = limits_source == "file";
@@ -252,7 +253,7 @@ GcodeFacts gcode_facts(const GcodeProgram& program, PrintRule rule,
   facts.program_end_line = program.program_end_line;
   facts.n_lines_after_end = program.n_lines_after_end;
   facts.slicer_notes = program.slicer_notes;
-  facts.firmware_settings = program.firmware_settings;
+  facts.firmware_settings = program.firmware_settings.settings;
   const GcodeMove* previous_print = nullptr;  // the move before, where it printed
   // every move: print or travel, its length, boxes and time
   for (const GcodeMove& move : program.moves) {
@@ -328,7 +329,7 @@ nlohmann::json gcode_facts_json(const GcodeFacts& facts) {
                          {"filament_used_mm", or_null(notes.filament_used_mm)}};
   // the firmware settings the file makes, to set beside --machine's limits
   out["firmware_settings"] = nlohmann::json::array();
-  for (const GcodeSetting& setting : facts.firmware_settings.settings)
+  for (const GcodeSetting& setting : facts.firmware_settings)
     out["firmware_settings"].push_back({{"command", setting.command},
                                         {"parameter", setting.parameter},
                                         {"value", setting.value},

@@ -57,7 +57,7 @@ struct GcodeFacts {
   SlicerNotes slicer_notes;
   // M201-M205, M220, M221, M900 and Klipper's SET_VELOCITY_LIMIT and SET_PRESSURE_ADVANCE as
   // the file sets them (toolpath/gcode_settings.hpp)
-  GcodeSettings firmware_settings;
+  std::vector<GcodeSetting> firmware_settings;
   std::string baseline_machine;  // the machine, firmware mode and limits estimated_time_s
   std::string baseline_mode;     // assumes
   std::string baseline_limits;

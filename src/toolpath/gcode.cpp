@@ -37,6 +37,10 @@ constexpr double kMinMove_mm = kJoinTolerance_mm;
 constexpr double kMaxMagnitude = 1e9;
 // the least feed rate read (per minute, in the file's unit)
 constexpr double kLeastFeedPerMinute = 1e-6;
+// M220's speed factor, in percent: 1 % to 100 x (Marlin's dial stops at 10 %); a smaller one
+// could take a feed rate under the least one read
+constexpr double kLeastSpeedFactorPercent = 1.0;
+constexpr double kMostSpeedFactorPercent = 10000.0;
 // the largest G or M code number (Marlin's and RepRapFirmware's run to a few thousand); its
 // tenths must fit an int
 constexpr int kMaxCodeNumber = 99999;
@@ -421,7 +425,7 @@ class GcodeParser {
   // Marlin's G61: a travel back to the position G60 saved
   void return_to_saved(int line_number);
   // M220 (its words from `begin` to the line's `end`): the speed factor saved, restored or
-  // set; false (and a problem) when S is not a factor above 0
+  // set; false (and a problem) when S is no percentage from 1 to 10000
   bool set_speed_factor(const char* begin, const char* end, int line_number);
   bool arc_geometry(int motion, const Vec3& target, int line_number, EdgeArc& arc);
   void set_position();
@@ -1402,13 +1406,8 @@ bool GcodeParser::set_work_offsets(int line_number) {
   return true;
 }
 
-constexpr double kLeastSpeedFactorPercent = 1.0;
-constexpr double kMostSpeedFactorPercent = 10000.0;
-
 bool GcodeParser::set_speed_factor(const char* begin, const char* end, int line_number) {
   const SpeedFactorWords words = read_speed_factor_words(begin, end);
-  // 1 % to 100 x: a factor no firmware's dial goes below (Marlin's stops at 10 %) would take
-  // the feed rates under the least one read (and the time estimates' squared speeds to 0)
   if (words.has_percent &&
       !(words.percent >= kLeastSpeedFactorPercent && words.percent <= kMostSpeedFactorPercent)) {
     problem(line_number, "M220 S" + message_number(words.percent) +

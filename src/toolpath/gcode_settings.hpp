@@ -1,11 +1,13 @@
 // The firmware settings a G-code file makes: the limits and factors its start block (or a
 // slicer's per-feature lines) gives the printer, which a slicer's own time estimate follows.
-// `inspect` lists them, so a file can be held against `--machine`'s limits. Read as written,
-// in the file's units (Marlin's M203 is in mm/s, RepRapFirmware's in mm/min):
+// `inspect` lists them, so a file can be held against `--machine`'s limits, and estimates
+// with those of motion (`--limits file`). Read as written, in the file's units (Marlin's M203
+// is in mm/s, RepRapFirmware's in mm/min):
 //   M201 X Y Z E        the axes' largest accelerations
 //   M203 X Y Z E        the axes' largest feed rates
 //   M204 P R T S        print, retract and travel accelerations (S: Marlin's older both,
-//                       Klipper's one)
+//                       Klipper's one; Marlin 1.0 and older Prusa firmware read T as the
+//                       retract acceleration)
 //   M205 X Y Z E J S T B  jerks, junction deviation, least feed rates, least segment time
 //   M220 S, M221 S      speed and flow factors (%)
 //   M900 K              Linear Advance's factor
@@ -35,8 +37,8 @@ struct GcodeSetting {
 // --limits file` estimates with them; 0 (NaN for the square-corner velocity and the cruise
 // ratio, where 0 is a setting): not set, the machine's or the firmware's default holds. A
 // value no firmware takes (negative, above 1e9, a cruise ratio of 1 or more) sets nothing,
-// and a limit below 1e-6 is none. Marlin's classic jerk
-// (M205 X Y) has no place here: the estimate's corners are junction deviation's or Klipper's.
+// and a limit below 1e-6 is none. Marlin's classic jerk (M205 X Y) has no place here: the
+// estimate's corners are junction deviation's or Klipper's.
 struct FileMotionLimits {
   double axis_accel_mm_s2[3] = {0.0, 0.0, 0.0};  // M201 X Y Z
   double axis_feed_mm_s[3] = {0.0, 0.0, 0.0};    // M203 X Y Z (Marlin's mm/s)
