@@ -278,11 +278,11 @@ std::string format_bytes(double bytes) {
     std::snprintf(text, sizeof text, "%.0f MB", mib);
   else if (mib < 1024.0 * 1024.0)
     std::snprintf(text, sizeof text, "%.3g GB", mib / 1024.0);
-  else if (mib < 1024.0 * 1024.0 * 1024.0)
-    std::snprintf(text, sizeof text, "%.3g TB", mib / (1024.0 * 1024.0));
-  else if (bytes <= kMostMemoryBytes)  // TB in full: the units the command line takes
+  // from 1 PiB up to the largest --max-memory, TB in full (the units the command line takes);
+  // beyond it (a job at 1e-300 mm/s) three digits, as in full they would not fit
+  else if (mib >= 1024.0 * 1024.0 * 1024.0 && bytes <= kMostMemoryBytes)
     std::snprintf(text, sizeof text, "%.0f TB", mib / (1024.0 * 1024.0));
-  else  // beyond any --max-memory (a job at 1e-300 mm/s): in full, its digits would not fit
+  else
     std::snprintf(text, sizeof text, "%.3g TB", mib / (1024.0 * 1024.0));
   return text;
 }
