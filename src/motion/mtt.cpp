@@ -30,6 +30,17 @@ double lowest_cruise(double T, double v0, double v1, double V, double A) {
   return std::max(-V, 0.5 * (v0 + v1 - A * T));
 }
 
+// 2 sigma s - (v0 + v1) for the peak sigma s = ±sqrt(lambda), without the cancellation of
+// two near-equal speeds: cruising at v0 = v1 with a tiny A, the difference is 1e-5 of the speeds
+// and its rounding error moved the shortest duration by 1e-9 s, past what reachable() forgives
+// (found by fuzz_move). Since 4 lambda - (v0 + v1)^2 = 4 A d + (v0 - v1)^2, the difference is
+// that over 2 sigma s + (v0 + v1) when the two terms share a sign.
+double peak_excess(double sigma, double s, double d, double v0, double v1, double A) {
+  const double sum = v0 + v1;
+  if (sigma * sum <= 0.0) return 2.0 * sigma * s - sum;
+  return (4.0 * A * d + (v0 - v1) * (v0 - v1)) / (2.0 * sigma * s + sum);
+}
+
 // The durations T >= |v1 - v0| / A in which even the fastest profile falls short of d,
 // D_max(T) < d, as a half-open interval [lo, hi) (empty when lo >= hi). D_max is convex
 // in T (its slope is the highest cruise velocity, which grows with T), so the set is
@@ -43,8 +54,8 @@ std::pair<double, double> falls_short(double d, double v0, double v1, double V, 
     const double p_lo = std::max(-s, std::max(v0, v1));
     const double p_hi = std::min(s, V);
     if (p_lo < p_hi) {
-      lo = (2.0 * p_lo - v0 - v1) / A;
-      hi = (2.0 * p_hi - v0 - v1) / A;
+      lo = (p_lo == -s ? peak_excess(-1.0, s, d, v0, v1, A) : 2.0 * p_lo - v0 - v1) / A;
+      hi = (p_hi == s ? peak_excess(+1.0, s, d, v0, v1, A) : 2.0 * p_hi - v0 - v1) / A;
     }
   }
   const double t_clamp = (2.0 * V - v0 - v1) / A;  // the highest cruise reaches V here

@@ -59,6 +59,25 @@ TEST(Mtt, ALongMoveHasNoFeasibleSliverOfOneRoundingError) {
   EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
 }
 
+TEST(Mtt, CoastingAtATinyAccelerationKeepsItsNarrowWindow) {
+  // 77 mm at 770 mm/s in and out, a_max 1.81e-4 mm/s^2: coasting takes 0.1 s, and speeding up
+  // (or slowing down) for half of it gives v T +- a T^2 / 4 = d, so the feasible durations are
+  // T = 2 d / (v + sqrt(v^2 +- a d)), 0.1 s -+ 5.9e-10 s. The peak speed was the difference of
+  // two near-equal speeds, which put the shortest duration 4.8e-10 s too early, outside the
+  // window (an internal error then): found by fuzz_move
+  const AxisBoundary b{0, 77, 770, 770};
+  const double v_max = 7770, a_max = 1.81e-4, v = 770, d = 77;
+  const double shortest_s = 2 * d / (v + std::sqrt(v * v + a_max * d));
+  const double longest_s = 2 * d / (v + std::sqrt(v * v - a_max * d));
+  const FeasibleDurations durations = feasible_durations(b, v_max, a_max);
+  ASSERT_FALSE(durations.intervals.empty());
+  EXPECT_NEAR(durations.intervals[0].first, shortest_s, 1e-13);
+  EXPECT_NEAR(durations.intervals[0].second, longest_s, 1e-13);
+  const SynchronizedMove move = synchronized_move({AxisMove{b, v_max, a_max}});
+  EXPECT_NEAR(move.duration_s, shortest_s, 1e-13);
+  expect_meets(move.axes[0], b, v_max, a_max);
+}
+
 TEST(Mtt, RestToRestTrapezoid) {
   // T = d / v + v / a
   const AxisBoundary b{1, 11, 0, 0};
