@@ -31,10 +31,11 @@ double lowest_cruise(double T, double v0, double v1, double V, double A) {
 }
 
 // 2 sigma s - (v0 + v1) for the peak sigma s = ±sqrt(lambda), without the cancellation of
-// two near-equal speeds: cruising at v0 = v1 with a tiny A, the difference is 1e-5 of the speeds
-// and its rounding error moved the shortest duration by 1e-9 s, past what reachable() forgives
-// (found by fuzz_move). Since 4 lambda - (v0 + v1)^2 = 4 A d + (v0 - v1)^2, the difference is
-// that over 2 sigma s + (v0 + v1) when the two terms share a sign.
+// two near-equal speeds: coasting at v0 = v1 with a tiny A d, the difference is 1e-5 of the
+// speeds or less (s can even round to v0), and its rounding error moved the shortest duration by
+// 1e-9 s, past what reachable() forgives, or to zero (found by fuzz_move). Since
+// 4 lambda - (v0 + v1)^2 = 4 A d + (v0 - v1)^2, the difference is that over
+// 2 sigma s + (v0 + v1) when the two terms share a sign.
 double peak_excess(double sigma, double s, double d, double v0, double v1, double A) {
   const double sum = v0 + v1;
   if (sigma * sum <= 0.0) return 2.0 * sigma * s - sum;
@@ -50,12 +51,14 @@ std::pair<double, double> falls_short(double d, double v0, double v1, double V, 
   double lo = kInf, hi = -kInf;
   const double lambda = A * d + 0.5 * (v0 * v0 + v1 * v1);
   if (lambda > 0.0) {
+    // the peaks v_p in [max(-s, v0, v1), min(s, V)], as their excess 2 v_p - v0 - v1 = A T
+    // (monotone in v_p; compared as excesses, since s itself can round to v0 = v1)
     const double s = std::sqrt(lambda);
-    const double p_lo = std::max(-s, std::max(v0, v1));
-    const double p_hi = std::min(s, V);
-    if (p_lo < p_hi) {
-      lo = (p_lo == -s ? peak_excess(-1.0, s, d, v0, v1, A) : 2.0 * p_lo - v0 - v1) / A;
-      hi = (p_hi == s ? peak_excess(+1.0, s, d, v0, v1, A) : 2.0 * p_hi - v0 - v1) / A;
+    const double excess_lo = std::max(peak_excess(-1.0, s, d, v0, v1, A), std::abs(v0 - v1));
+    const double excess_hi = std::min(peak_excess(+1.0, s, d, v0, v1, A), 2.0 * V - v0 - v1);
+    if (excess_lo < excess_hi) {
+      lo = excess_lo / A;
+      hi = excess_hi / A;
     }
   }
   const double t_clamp = (2.0 * V - v0 - v1) / A;  // the highest cruise reaches V here

@@ -78,6 +78,18 @@ TEST(Mtt, CoastingAtATinyAccelerationKeepsItsNarrowWindow) {
   expect_meets(move.axes[0], b, v_max, a_max);
 }
 
+TEST(Mtt, ACoastOfAFewNanometresTakesItsTime) {
+  // 7.9e-8 mm at 66800 mm/s in and out, a_max 0.2 mm/s^2: T = d / v = 1.18e-12 s (the window
+  // 2 d / (v + sqrt(v^2 +- a d)) is far narrower). sqrt(v^2 + a d) rounds to v, so the durations
+  // that fall short were taken for none, and the move got a zero duration (an internal error)
+  const AxisBoundary b{0, 7.9e-8, 66800, 66800};
+  const double v_max = 170000, a_max = 0.2, expected_s = b.q1 / b.v0;
+  EXPECT_NEAR(min_time_move(b, v_max, a_max).duration_s(), expected_s, 1e-9 * expected_s);
+  const SynchronizedMove move = synchronized_move({AxisMove{b, v_max, a_max}});
+  EXPECT_NEAR(move.duration_s, expected_s, 1e-9 * expected_s);
+  expect_meets(move.axes[0], b, v_max, a_max);
+}
+
 TEST(Mtt, RestToRestTrapezoid) {
   // T = d / v + v / a
   const AxisBoundary b{1, 11, 0, 0};
