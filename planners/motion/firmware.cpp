@@ -317,6 +317,50 @@ double junction_speed_squared(const Vec3& u_prev, const Vec3& u_next, double acc
   return accel_mm_s2 * junction_deviation_mm * sin_half / (1.0 - sin_half);
 }
 
+namespace {
+
+// a move's x, y, z and extruder speeds at speed v along it
+void axis_speeds(const FirmwareMove& move, double v, double speeds[4]) {
+  for (int axis = 0; axis < 3; ++axis) speeds[axis] = v * move.direction[axis];
+  speeds[3] = v * move.e_per_mm;
+}
+
+// the fastest a move may start from rest with classic jerk: no axis's speed above its jerk
+double classic_jerk_safe_speed(const FirmwareMove& move, const double jerk_mm_s[4]) {
+  double speeds[4];
+  axis_speeds(move, 1.0, speeds);
+  double safe = move.cruise_speed_mm_s;
+  for (int axis = 0; axis < 4; ++axis)
+    if (std::abs(speeds[axis]) * safe > jerk_mm_s[axis])
+      safe = jerk_mm_s[axis] / std::abs(speeds[axis]);
+  return safe;
+}
+
+}  // namespace
+
+double classic_jerk_junction_speed(const FirmwareMove& prev, const FirmwareMove& next,
+                                   const double jerk_mm_s[4]) {
+  double v = std::min(prev.cruise_speed_mm_s, next.cruise_speed_mm_s);
+  double exit_speeds[4], entry_speeds[4];
+  axis_speeds(prev, v, exit_speeds);
+  axis_speeds(next, next.cruise_speed_mm_s, entry_speeds);
+  // each axis's jump: the difference when it keeps its way, the larger speed otherwise
+  double factor = 1.0;
+  for (int axis = 0; axis < 4; ++axis) {
+    const double exit = exit_speeds[axis], entry = entry_speeds[axis];
+    const bool same_way = (exit > 0.0 && entry > 0.0) || (exit < 0.0 && entry < 0.0);
+    const double jump =
+        same_way ? std::abs(entry - exit) : std::max(std::abs(exit), std::abs(entry));
+    if (jump * factor > jerk_mm_s[axis]) factor = jerk_mm_s[axis] / jump;
+  }
+  v *= factor;
+  // when both moves could start from rest faster, the outgoing move's safe speed
+  const double safe_prev = classic_jerk_safe_speed(prev, jerk_mm_s);
+  const double safe_next = classic_jerk_safe_speed(next, jerk_mm_s);
+  if (safe_prev > 0.99 * v && safe_next > 0.99 * v) v = safe_next;
+  return v;
+}
+
 FirmwareSettings resolved_firmware_settings(const FirmwareSettings& given,
                                             const MachineLimits& limits,
                                             double& junction_deviation_mm) {
@@ -382,9 +426,14 @@ FirmwareProfile firmware_lookahead(const std::vector<FirmwareMove>& moves,
     const FirmwareMove& prev = moves[j - 1];
     const FirmwareMove& next = moves[j];
     double c2 = std::min(cruise2[j - 1], cruise2[j]);
-    c2 = std::min(c2, junction_speed_squared(prev.direction, next.direction,
-                                             std::min(prev.accel_mm_s2, next.accel_mm_s2),
-                                             junction_deviation_mm));
+    if (settings.uses_classic_jerk()) {
+      const double v = classic_jerk_junction_speed(prev, next, settings.classic_jerk_mm_s);
+      c2 = std::min(c2, v * v);
+    } else {
+      c2 = std::min(c2, junction_speed_squared(prev.direction, next.direction,
+                                               std::min(prev.accel_mm_s2, next.accel_mm_s2),
+                                               junction_deviation_mm));
+    }
     if (settings.mode == FirmwareMode::klipper) {
       // Klipper's limit for short moves: the virtual arc's centripetal acceleration within
       // each move's own, v^2 <= d tan(theta/2) a / 2 (toolhead.py calc_junction)

@@ -2,7 +2,8 @@
 // per straight move (accelerate, cruise, decelerate) under look-ahead over the whole queue of
 // connected moves: each junction's speed is capped by junction deviation (Marlin,
 // `mode: marlin`, `junction_deviation_mm`) or by Klipper's square-corner velocity (`mode:
-// klipper`, `square_corner_velocity`, converted to a junction deviation), a backward and a
+// klipper`, `square_corner_velocity`, converted to a junction deviation) or, for `inspect
+// --limits file` on a file that sets jerks, Marlin's classic jerk; a backward and a
 // forward pass make every junction reachable from the previous one and able to stop in time
 // for the next, and Klipper's `minimum_cruise_ratio` (older `max_accel_to_decel`) lowers the
 // peak of short zig-zags. Travels between separate paths are rest-to-rest trapezoids along
@@ -52,7 +53,19 @@ struct FirmwareSettings {
   double max_accel_to_decel = 0.0;       // Klipper < 0.12's name for it, mm/s^2; 0: not given
   double max_accel = 0.0;                // mm/s^2; 0: from the scenario's limits
   double max_velocity = 0.0;             // mm/s; 0: from the scenario's limits
+  // Marlin's classic jerk (CLASSIC_JERK; M205 X Y Z E, mm/s): the largest instant change of the
+  // x, y, z and extruder speeds at a junction, which then decides the junction speeds in place
+  // of the junction deviation (marlin); all 0: not used (`inspect --limits file` sets them)
+  double classic_jerk_mm_s[4] = {0.0, 0.0, 0.0, 0.0};
+  bool uses_classic_jerk() const {
+    return mode == FirmwareMode::marlin &&
+           (classic_jerk_mm_s[0] > 0.0 || classic_jerk_mm_s[1] > 0.0 ||
+            classic_jerk_mm_s[2] > 0.0 || classic_jerk_mm_s[3] > 0.0);
+  }
 };
+// Marlin's defaults for the classic jerks a file does not set (Configuration.h DEFAULT_XJERK,
+// DEFAULT_YJERK, DEFAULT_ZJERK, DEFAULT_EJERK), mm/s
+constexpr double kMarlinDefaultJerk_mm_s[4] = {10.0, 10.0, 0.3, 5.0};
 
 // One straight move of a connected chain as the look-ahead sees it.
 struct FirmwareMove {
@@ -65,6 +78,9 @@ struct FirmwareMove {
   // around its start junction (0: none)
   double jerk_mm_s3 = std::numeric_limits<double>::infinity();
   Vec3 blend_jerk_mm_s3 = Vec3::Zero();
+  // classic jerk only: the extruder's travel per mm of the move (its speed there is the move's
+  // times this)
+  double e_per_mm = 0.0;
 };
 
 // The look-ahead's answer for one chain of n moves (rest at both ends).
@@ -82,6 +98,16 @@ struct FirmwareProfile {
 // Infinite for collinear moves, 0 for a reversal.
 double junction_speed_squared(const Vec3& u_prev, const Vec3& u_next, double accel_mm_s2,
                               double junction_deviation_mm);
+// Marlin's classic jerk at the junction of two moves, each at its top speed (Marlin
+// planner.cpp with CLASSIC_JERK, after Prusa's firmware): the junction speed v starts at the
+// smaller top speed; each axis's speed jumps from the incoming move's at v to the outgoing
+// move's at its own top speed, by their difference when both run the same way and by the larger
+// of the two otherwise (a reversal or a start), and every jump over the axis's jerk scales v
+// down by jerk / jump. When both moves' safe speeds (the fastest each may start from rest at:
+// no axis's speed above its jerk) exceed 0.99 v, the outgoing move's safe speed is taken
+// instead. Speeds in mm/s; the extruder's from each move's e_per_mm.
+double classic_jerk_junction_speed(const FirmwareMove& prev, const FirmwareMove& next,
+                                   const double jerk_mm_s[4]);
 // The largest move speed and acceleration along unit direction u under per-axis limits and
 // the firmware's own caps (0: none): a firmware scales a move so that no axis exceeds its
 // max feed rate or acceleration (Marlin's max_feedrate / max_acceleration per axis; Klipper's

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <iterator>
 #include <optional>
 
 #include "core/error.hpp"
@@ -49,7 +50,8 @@ double move_time_s(const FirmwareMove& move, const FirmwareProfile& profile, siz
 // machine's limits and the firmware's defaults alone) overrides them with the file's settings
 // in force: M201 and M203 the axes' limits; Marlin's print acceleration for a move with E (its
 // planner's esteps) and the travel acceleration for one without, Klipper's one acceleration
-// for both; M205 J, and Klipper's velocity, square-corner velocity and cruise ratio.
+// for both; M205 J, or Marlin's classic jerks M205 X Y Z E when the file sets no M205 J, and
+// Klipper's velocity, square-corner velocity and cruise ratio.
 struct MovePlanning {
   MachineLimits limits;
   FirmwareSettings settings;
@@ -76,6 +78,14 @@ MovePlanning move_planning(const MachineLimits& machine_limits, FirmwareMode mod
     if (accel > 0.0) given.max_accel = accel;
     if (file->junction_deviation_mm > 0.0)
       given.junction_deviation_mm = file->junction_deviation_mm;
+    // jerks set (M205 X or Y) and no junction deviation: a classic-jerk firmware (Prusa's, or
+    // Marlin built with CLASSIC_JERK), Marlin's defaults for the jerks not set
+    const double* jerk = file->jerk_mm_s;
+    if (mode == FirmwareMode::marlin && !(file->junction_deviation_mm > 0.0) &&
+        (jerk[0] > 0.0 || jerk[1] > 0.0))
+      for (int axis = 0; axis < 4; ++axis)
+        given.classic_jerk_mm_s[axis] =
+            jerk[axis] > 0.0 ? jerk[axis] : kMarlinDefaultJerk_mm_s[axis];
     if (file->max_velocity_mm_s > 0.0) given.max_velocity = file->max_velocity_mm_s;
     if (!std::isnan(file->square_corner_velocity))
       given.square_corner_velocity = file->square_corner_velocity;
@@ -156,12 +166,16 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       total_s += program.pauses[next_pause].duration_s;
       stops = true;
     }
-    // the look-ahead plans a chain under one junction deviation and cruise ratio: a change of
-    // them (M205 J, Klipper's square-corner velocity) plans the chain so far
+    // the look-ahead plans a chain under one junction deviation (or classic jerks) and cruise
+    // ratio: a change of them (M205 J or X Y Z E, Klipper's square-corner velocity) plans the
+    // chain so far
     const MovePlanning& planning = planning_of(move);
     if (!chain.empty() &&
         (planning.junction_deviation_mm != chain_junction_deviation_mm ||
-         planning.settings.minimum_cruise_ratio != chain_settings.minimum_cruise_ratio))
+         planning.settings.minimum_cruise_ratio != chain_settings.minimum_cruise_ratio ||
+         !std::equal(std::begin(planning.settings.classic_jerk_mm_s),
+                     std::end(planning.settings.classic_jerk_mm_s),
+                     std::begin(chain_settings.classic_jerk_mm_s))))
       stops = true;
     if (stops) flush();
     if (chain.empty()) {
@@ -180,6 +194,11 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       const double coarsest_mm = radius_mm * (1.0 - std::cos(kPi / kMaxChordsPerTurn));
       points = arc_path.chorded(std::max(kChordTolerance_mm, coarsest_mm)).points;
     }
+    // the extruder's travel per mm along the move (classic jerk counts its speed)
+    double move_length_mm = 0.0;
+    for (size_t i = 0; i + 1 < points.size(); ++i)
+      move_length_mm += (points[i + 1] - points[i]).norm();
+    const double e_per_mm = move_length_mm > 1e-12 ? move.e_delta / move_length_mm : 0.0;
     for (size_t i = 0; i + 1 < points.size(); ++i) {
       const Vec3 step = points[i + 1] - points[i];
       const double length_mm = step.norm();
@@ -195,6 +214,7 @@ double firmware_estimate_s(const GcodeProgram& program, const Machine& machine,
       piece.cruise_speed_mm_s =
           std::min(move.feed_mm_s > 0.0 ? move.feed_mm_s : kUnbounded, speed_cap);
       piece.blend_accel_mm_s2 = planning.axis_accel;
+      piece.e_per_mm = e_per_mm;
       chain.push_back(piece);
       if (chain.size() >= kMaxChainPieces) flush();
     }

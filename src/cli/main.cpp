@@ -292,8 +292,9 @@ int run_command_line(int argc, char** argv) {
                       "deviation) or klipper (square-corner velocity); default marlin");
   inspect->add_option("--limits", inspect_baseline.limits,
                       "the limits of estimated_time_s: machine (--machine's, the firmware's "
-                      "defaults) or file (over them, the file's M201, M203, M204, M205 J and "
-                      "SET_VELOCITY_LIMIT in force at each move); default machine");
+                      "defaults) or file (over them, the file's M201, M203, M204, M205 J or "
+                      "jerks X Y Z E, and SET_VELOCITY_LIMIT in force at each move); default "
+                      "machine");
   // ---- end inspect ----
 
   // ---- sweep (parameter studies: src/cli/sweep_verb.cpp, src/sweep/) ----

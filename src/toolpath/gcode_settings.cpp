@@ -141,6 +141,8 @@ void GcodeSettings::set(const std::string& command, const std::string& parameter
     changing_limits().travel_accel_mm_s2 = limit;
   } else if (command == "M205" && parameter == "J") {
     changing_limits().junction_deviation_mm = limit;
+  } else if (command == "M205" && (axis >= 0 || parameter == "E")) {
+    changing_limits().jerk_mm_s[axis >= 0 ? axis : 3] = limit;
   } else if (command == "SET_VELOCITY_LIMIT") {
     if (parameter == "ACCEL") {
       changing_limits().print_accel_mm_s2 = limit;

@@ -37,14 +37,14 @@ struct GcodeSetting {
 // --limits file` estimates with them; 0 (NaN for the square-corner velocity and the cruise
 // ratio, where 0 is a setting): not set, the machine's or the firmware's default holds. A
 // value no firmware takes (negative, above 1e9, a cruise ratio of 1 or more) sets nothing,
-// and a limit below 1e-6 is none. Marlin's classic jerk (M205 X Y) has no place here: the
-// estimate's corners are junction deviation's or Klipper's.
+// and a limit below 1e-6 is none.
 struct FileMotionLimits {
   double axis_accel_mm_s2[3] = {0.0, 0.0, 0.0};  // M201 X Y Z
   double axis_feed_mm_s[3] = {0.0, 0.0, 0.0};    // M203 X Y Z (Marlin's mm/s)
   double print_accel_mm_s2 = 0.0;                // M204 P (and S); Klipper's ACCEL
   double travel_accel_mm_s2 = 0.0;               // M204 T (and S); Klipper's ACCEL
   double junction_deviation_mm = 0.0;            // M205 J
+  double jerk_mm_s[4] = {0.0, 0.0, 0.0, 0.0};    // M205 X Y Z E: Marlin's classic jerks
   double max_velocity_mm_s = 0.0;                // Klipper's VELOCITY
   double square_corner_velocity = std::numeric_limits<double>::quiet_NaN();
   double minimum_cruise_ratio = std::numeric_limits<double>::quiet_NaN();  // Klipper's

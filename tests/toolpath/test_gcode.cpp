@@ -633,6 +633,13 @@ TEST(GcodeSettings, EachMoveIsUnderTheMotionLimitsInForce) {
   EXPECT_EQ(limits[2].travel_accel_mm_s2, 700.0);    // kept
   EXPECT_EQ(limits[2].square_corner_velocity, 0.0);  // 0 is a setting
   EXPECT_TRUE(std::isnan(limits[1].square_corner_velocity));
+  // Marlin's classic jerks, per axis and E
+  const GcodeProgram jerks =
+      parse_gcode_program("M205 X8 Y9 Z0.4 E4.5 S0\nG1 X1 F600\n", "jerk.gcode", GcodeOptions{});
+  const FileMotionLimits& jerk = jerks.firmware_settings.motion_limits.at(0);
+  EXPECT_EQ(std::vector<double>(jerk.jerk_mm_s, jerk.jerk_mm_s + 4),
+            (std::vector<double>{8.0, 9.0, 0.4, 4.5}));
+  EXPECT_EQ(jerk.junction_deviation_mm, 0.0);
   // values no firmware takes set no limit: negative, above 1e9, a feed rate too small to move
   // at (the machine's holds), a cruise ratio of 1 or more
   const GcodeProgram odd = parse_gcode_program(

@@ -337,6 +337,51 @@ TEST(GcodeFiles, EstimateUnderTheFilesOwnLimits) {
   }
 }
 
+// Marlin's classic jerk (M205 X Y Z E, no M205 J): each axis's speed may jump by its jerk at a
+// junction, by the difference of its speeds when it keeps its way and by the larger speed
+// otherwise; when both moves may start from rest faster (their safe speeds), that is taken
+TEST(GcodeFiles, EstimateUnderClassicJerk) {
+  const auto estimate = [](const std::string& text, const std::string& mode = "marlin") {
+    const GcodeProgram program = parse_gcode_program(text, "jerk.gcode", GcodeOptions{});
+    InspectBaseline baseline;
+    baseline.mode = mode;
+    baseline.limits = "file";
+    return gcode_facts(program, PrintRule::automatic, baseline).estimated_time_s;
+  };
+  // a trapezoid over length l from v0 up to v and down to v1 at acceleration a
+  const auto trapezoid = [](double l, double v0, double v, double v1, double a) {
+    return (v - v0) / a + (v - v1) / a + (l - (2 * v * v - v0 * v0 - v1 * v1) / (2 * a)) / v;
+  };
+  const double a = 1000.0;  // M204 P and T
+  const std::string start = "M204 P1000 T1000\nM83\n";
+  // 20 then 100 mm/s along x, jerk 10: the jump of 80 scales the junction to 20 * 10 / 80 =
+  // 2.5 mm/s, and both moves' safe speed, 10, is taken instead (junction deviation: 20)
+  const std::string speed_up = "G1 X50 F1200\nG1 X100 F6000\n";
+  EXPECT_NEAR(estimate(start + "M205 X10 Y10\n" + speed_up),
+              trapezoid(50, 0, 20, 10, a) + trapezoid(50, 10, 100, 0, a), 1e-9);
+  EXPECT_NEAR(estimate(start + speed_up),
+              trapezoid(50, 0, 20, 20, a) + trapezoid(50, 20, 100, 0, a), 1e-9);
+  // a 90 deg corner at 50 mm/s, jerk 8: x stops and y starts, 50 each, so 8 mm/s. Its velocity
+  // turns over tau = 8 / a (as every junction of the estimate), half on each move
+  const double tau = 8.0 / a;
+  EXPECT_NEAR(estimate(start + "M205 X8 Y8\nG1 X50 F3000\nG1 Y50\n"),
+              2 * (trapezoid(50 - 0.5 * 8 * tau, 0, 50, 8, a) + 0.5 * tau), 1e-9);
+  // the extruder's jerk: 0.05 then 0.25 mm of E per mm at 50 mm/s, 2.5 then 12.5 mm/s. E jerk
+  // 2 scales the junction to 50 * 2 / 10 = 10 mm/s (the second move's safe speed, 2 / 0.25 =
+  // 8, is below it); Marlin's default E jerk, 5, to 25 mm/s
+  const std::string flow_step = "G1 X50 E2.5 F3000\nG1 X100 E12.5\n";
+  EXPECT_NEAR(estimate(start + "M205 X10 Y10 E2\n" + flow_step),
+              trapezoid(50, 0, 50, 10, a) + trapezoid(50, 10, 50, 0, a), 1e-9);
+  EXPECT_NEAR(estimate(start + "M205 X10 Y10\n" + flow_step),
+              trapezoid(50, 0, 50, 25, a) + trapezoid(50, 25, 50, 0, a), 1e-9);
+  // a junction deviation set decides over the jerks; Klipper has no jerks
+  const std::string corner = "G1 X50 F3000\nG1 Y50\n";
+  EXPECT_EQ(estimate(start + "M205 X8 Y8 J0.02\n" + corner),
+            estimate(start + "M205 J0.02\n" + corner));
+  EXPECT_EQ(estimate(start + "M205 X1 Y1\n" + corner, "klipper"),
+            estimate(start + corner, "klipper"));
+}
+
 // a look-ahead chain is planned and emptied every 2^20 pieces (bounded memory on a file of
 // arcs that never stops): 2^20 collinear moves of 0.001 mm, then one of 100 mm, are two
 // chains from rest to rest, L / v + 2 v / a, where one chain would be L / v + v / a
