@@ -51,6 +51,8 @@ constexpr double kArcRadiusTolerance_mm = 0.005;
 constexpr double kArcRadiusTolerance_rel = 1e-3;
 // G60 S: save slots read (Marlin's SAVED_POSITIONS, RepRapFirmware's restore points)
 constexpr int kSavedPositionSlots = 10;
+// the modal motion after a refused cycle or spline: its repeating lines are not read as moves
+constexpr int kRefusedMotion = -2;
 
 // text for a message: printable ASCII kept, other bytes as \xNN, at most 32 characters
 std::string printable(const char* begin, const char* end) {
@@ -458,7 +460,7 @@ class GcodeParser {
   double feed_mm_s_ = 0.0;               // 0: no F given yet
   double speed_factor_ = 1.0;            // M220 S / 100: the moves run at F times it
   double saved_speed_factor_ = 1.0;      // M220 B's
-  int motion_mode_ = -1;                 // last G0..G3, -1: none
+  int motion_mode_ = -1;                 // last G0..G3, -1: none, kRefusedMotion: a cycle
   int plane_ = 17;                       // G17, G18, G19
   bool open_ = false;                    // the shutter's open code is active
   bool power_off_ = false;               // the modal S is 0 (a laser's or spindle's power)
@@ -549,6 +551,41 @@ const char* unsupported_g_code_reason(int tenths) {
              "program expanded)";
     default:
       return nullptr;
+  }
+}
+
+// The refused G codes that are modal motion: splines, threading, canned cycles and a modal
+// macro call. The axis words of the lines after one repeat it (`G81 X20 Y20 Z-5 R2`, then
+// `X30`): they are no G0..G3 of the mode before, and the code is refused once, at its line.
+bool is_modal_motion(int tenths) {
+  switch (tenths) {
+    case 50:  // G5, G5.1, G5.2
+    case 51:
+    case 52:
+    case 330:  // G33, G33.1
+    case 331:
+    case 720:  // G72..G79, G81..G89: canned cycles (Fanuc's lathe cycles among them)
+    case 730:
+    case 740:
+    case 750:
+    case 760:
+    case 770:
+    case 780:
+    case 790:
+    case 810:
+    case 820:
+    case 830:
+    case 840:
+    case 850:
+    case 860:
+    case 870:
+    case 880:
+    case 890:
+    case 661:  // G66.1: a macro call at every line after it (G66: at every move)
+    case 660:
+      return true;
+    default:
+      return false;
   }
 }
 
@@ -918,6 +955,7 @@ void GcodeParser::execute(int line_number) {
     }
     if (const char* reason = unsupported_g_code_reason(code.tenths)) {
       problem(line_number, g_code_name(code.tenths) + reason);
+      if (is_modal_motion(code.tenths)) motion_mode_ = kRefusedMotion;
       return;
     }
     // G12 and G13 with a radius I: Mach3's circular pocket, a circle cut about the position
@@ -1118,6 +1156,7 @@ void GcodeParser::execute(int line_number) {
       ++it->n_lines;
   }
   if (motion < 0 && !uses_axes && axis_words) {
+    if (motion_mode_ == kRefusedMotion) return;  // repeats the refused cycle, reported once
     if (motion_mode_ < 0) {
       problem(line_number, "axis words without a motion command (G0, G1, G2 or G3)");
       return;

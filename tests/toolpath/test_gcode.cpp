@@ -812,6 +812,24 @@ TEST(Gcode, EveryMalformedLineIsReported) {
   EXPECT_EQ(inside[0].line, 2);
 }
 
+// A refused canned cycle's or spline's following lines repeat it (`X30` drills again): the
+// code is reported once, where the lines had been read as the arc before it (an arc without
+// I, J or R) or as straight moves
+TEST(Gcode, LinesRepeatingARefusedCycleAreReportedOnce) {
+  const auto drill = problems_of(
+      "G0 X0 Y0 F600\nG2 X10 Y0 I5 J0\nG81 X20 Y20 Z-5 R2 F200\nX30\nX40 Y30\nG80\n"
+      "G0 X0 Y0\nG1 X5 F600\n");
+  ASSERT_EQ(drill.size(), 1u) << dump(drill);
+  EXPECT_EQ(drill[0].line, 3);
+  EXPECT_NE(drill[0].message.find("G81 is not supported"), std::string::npos);
+  // a spline's, until G80 cancels the mode (then axis words alone have no motion command)
+  const auto spline = problems_of("G1 X0 Y0 F600\nG5 I1 J1 P1 Q1 X1 Y1\nX2 Y2\nG80\nX4\n");
+  ASSERT_EQ(spline.size(), 2u) << dump(spline);
+  EXPECT_EQ(spline[0].line, 2);
+  EXPECT_EQ(spline[1].line, 5);
+  EXPECT_NE(spline[1].message.find("without a motion command"), std::string::npos);
+}
+
 TEST(Gcode, PackedFilesAreNamedWithTheWayOut) {
   // PrusaSlicer's binary G-code, a Bambu .gcode.3mf (zip), a gzip file, UTF-16: one problem at
   // line 1 naming the container, instead of a control byte at a column
