@@ -1,11 +1,14 @@
 // Fuzz target: the G-code importer (toolpath/gcode.hpp) on arbitrary text, as a scenario's
-// `gcode:` file goes through it: parse, import under every print rule, chord the arcs. Bad
-// input must be an InputError; whatever is imported must be finite, with positive speeds.
+// `gcode:` file goes through it: parse, import under every print rule, chord the arcs; and
+// `inspect`'s facts (cli/inspect.hpp), whose time estimate plans every move under the file's
+// own limits. Bad input must be an InputError; whatever is imported must be finite, with
+// positive speeds, and the estimate a finite time.
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "cli/inspect.hpp"
 #include "core/error.hpp"
 #include "fuzz/fuzz_check.hpp"
 #include "toolpath/gcode.hpp"
@@ -72,8 +75,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       values.push_back(limits.axis_accel_mm_s2[axis]);
       values.push_back(limits.axis_feed_mm_s[axis]);
     }
+    for (const double jerk : limits.jerk_mm_s) values.push_back(jerk);
     for (const double value : values)
       require(value == 0.0 || (value >= 1e-6 && value <= 1e9), "motion limits in range");
+  }
+  // inspect's facts: the firmware's time estimate under the file's own limits, Marlin's (with
+  // its junction deviation or classic jerks) and Klipper's
+  for (const char* mode : {"marlin", "klipper"}) {
+    depotwin::InspectBaseline baseline;
+    baseline.mode = mode;
+    baseline.limits = "file";
+    try {
+      const depotwin::GcodeFacts facts =
+          depotwin::gcode_facts(program, depotwin::PrintRule::automatic, baseline);
+      require(is_finite(facts.estimated_time_s) && facts.estimated_time_s >= 0.0,
+              "a finite estimate");
+      (void)depotwin::gcode_facts_json(facts).dump();
+    } catch (const depotwin::InputError&) {
+      // refused with a message: expected
+    }
   }
   // every rule, every layer; then the last layer alone, with a default speed (as a scenario's
   // toolpath.speed gives)
