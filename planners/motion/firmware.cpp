@@ -767,6 +767,16 @@ std::vector<PlannerParameter> firmware_parameters() {
        false,
        {},
        "mm"},
+      {"classic_jerk",
+       0.0,
+       0.0,
+       1000.0,
+       "marlin with CLASSIC_JERK (Prusa's firmware): the x and y axes' jerk, the largest instant "
+       "change of their speeds at a junction, in place of the junction deviation (z: Marlin's "
+       "0.3 mm/s); 0: junction deviation",
+       false,
+       {},
+       "mm/s"},
       {"square_corner_velocity",
        5.0,
        0.0,
@@ -825,8 +835,13 @@ std::unique_ptr<Planner> make_firmware_planner(const PlannerSpec& spec) {
     refuse("square_corner_velocity", "klipper");
     refuse("minimum_cruise_ratio", "klipper");
     refuse("max_accel_to_decel", "klipper");
+    if (spec.params.count("classic_jerk") != 0 && spec.params.count("junction_deviation_mm") != 0)
+      throw InputError("planners.firmware.classic_jerk",
+                       "give junction_deviation_mm or classic_jerk, not both (Marlin corners by "
+                       "one of them)");
   } else {
     refuse("junction_deviation_mm", "marlin");
+    refuse("classic_jerk", "marlin");
     if (spec.params.count("minimum_cruise_ratio") != 0 &&
         spec.params.count("max_accel_to_decel") != 0)
       throw InputError("planners.firmware.max_accel_to_decel",
@@ -840,6 +855,13 @@ std::unique_ptr<Planner> make_firmware_planner(const PlannerSpec& spec) {
   settings.max_accel_to_decel = spec.get("max_accel_to_decel", settings.max_accel_to_decel);
   settings.max_accel = spec.get("max_accel", settings.max_accel);
   settings.max_velocity = spec.get("max_velocity", settings.max_velocity);
+  // classic jerk: x and y as given, z and E at Marlin's defaults (the flow is no axis here)
+  const double classic_jerk = spec.get("classic_jerk", 0.0);
+  if (classic_jerk > 0.0) {
+    settings.classic_jerk_mm_s[0] = settings.classic_jerk_mm_s[1] = classic_jerk;
+    settings.classic_jerk_mm_s[2] = kMarlinDefaultJerk_mm_s[2];
+    settings.classic_jerk_mm_s[3] = kMarlinDefaultJerk_mm_s[3];
+  }
   return std::make_unique<FirmwarePlanner>(settings);
 }
 

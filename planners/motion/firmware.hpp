@@ -2,12 +2,12 @@
 // per straight move (accelerate, cruise, decelerate) under look-ahead over the whole queue of
 // connected moves: each junction's speed is capped by junction deviation (Marlin,
 // `mode: marlin`, `junction_deviation_mm`) or by Klipper's square-corner velocity (`mode:
-// klipper`, `square_corner_velocity`, converted to a junction deviation) or, for `inspect
-// --limits file` on a file that sets jerks, Marlin's classic jerk; a backward and a
-// forward pass make every junction reachable from the previous one and able to stop in time
-// for the next, and Klipper's `minimum_cruise_ratio` (older `max_accel_to_decel`) lowers the
-// peak of short zig-zags. Travels between separate paths are rest-to-rest trapezoids along
-// the line at the machine's speed, the material off; it is on on every print move.
+// klipper`, `square_corner_velocity`, converted to a junction deviation) or by Marlin's
+// classic jerk (`classic_jerk`; `inspect --limits file` on a file that sets jerks); a backward and
+// a forward pass make every junction reachable from the previous one and able to stop in time for
+// the next, and Klipper's `minimum_cruise_ratio` (older `max_accel_to_decel`) lowers the peak of
+// short zig-zags. Travels between separate paths are rest-to-rest trapezoids along the line at the
+// machine's speed, the material off; it is on on every print move.
 //
 // The firmware changes the velocity's direction instantly at a junction; the twin's machine
 // cannot, so each junction's velocity change is spread over tau = max_i |dv_i| / a_i (every
@@ -55,7 +55,8 @@ struct FirmwareSettings {
   double max_velocity = 0.0;             // mm/s; 0: from the scenario's limits
   // Marlin's classic jerk (CLASSIC_JERK; M205 X Y Z E, mm/s): the largest instant change of the
   // x, y, z and extruder speeds at a junction, which then decides the junction speeds in place
-  // of the junction deviation (marlin); all 0: not used (`inspect --limits file` sets them)
+  // of the junction deviation (marlin); all 0: not used (the planner's `classic_jerk`, and
+  // `inspect --limits file` on a file that sets them)
   double classic_jerk_mm_s[4] = {0.0, 0.0, 0.0, 0.0};
   bool uses_classic_jerk() const {
     return mode == FirmwareMode::marlin &&

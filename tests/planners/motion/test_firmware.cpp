@@ -93,6 +93,37 @@ TEST(Firmware, KlipperSquareCornerVelocityIsTheNinetyDegreeSpeed) {
   EXPECT_NEAR(before.velocity_mm_s.x(), 7.0, 1e-5);
 }
 
+// Marlin's classic jerk: a 90 deg corner at 50 mm/s stops x and starts y, a jump of 50 each,
+// scaled to the jerk; 20 then 100 mm/s along x jumps by 80, scaled to 20 * 8 / 80 = 2 mm/s,
+// and both moves' safe speed (the jerk, 8) is taken instead
+TEST(Firmware, ClassicJerkBoundsEachAxisJump) {
+  FirmwareSettings classic;
+  classic.classic_jerk_mm_s[0] = classic.classic_jerk_mm_s[1] = 8.0;
+  classic.classic_jerk_mm_s[2] = 0.3;
+  classic.classic_jerk_mm_s[3] = 5.0;
+  ASSERT_TRUE(classic.uses_classic_jerk());
+  const FirmwareMove x_fast = move_along(Vec3::UnitX(), 20, 1000, 50);
+  const FirmwareMove y_fast = move_along(Vec3::UnitY(), 20, 1000, 50);
+  const FirmwareMove x_slow = move_along(Vec3::UnitX(), 20, 1000, 20);
+  const FirmwareMove x_faster = move_along(Vec3::UnitX(), 20, 1000, 100);
+  EXPECT_DOUBLE_EQ(classic_jerk_junction_speed(x_fast, y_fast, classic.classic_jerk_mm_s), 8.0);
+  EXPECT_DOUBLE_EQ(classic_jerk_junction_speed(x_slow, x_faster, classic.classic_jerk_mm_s), 8.0);
+  // a 45 deg turn: y starts at 50 cos 45 = 35.4, the largest jump (x's is 14.6), so v = 50 * 8 /
+  // 35.4 = 8 sqrt 2; the x move's safe speed, 8, is below 0.99 v, so v stays
+  const FirmwareMove diagonal = move_along(Vec3(1, 1, 0), 20, 1000, 50);
+  EXPECT_NEAR(classic_jerk_junction_speed(x_fast, diagonal, classic.classic_jerk_mm_s),
+              8.0 * std::sqrt(2.0), 1e-12);
+  // the look-ahead corners by it, and the planner with `classic_jerk` takes the L's corner at 8
+  const FirmwareProfile profile = firmware_lookahead({x_fast, y_fast}, classic, 0.013);
+  EXPECT_NEAR(profile.junction_speed_mm_s[1], 8.0, 1e-12);
+  const Toolpath toolpath = polyline_job({{0, 0, 0}, {20, 0, 0}, {20, 20, 0}}, 50.0);
+  const Trajectory plan = plan_with({"firmware", {{"classic_jerk", {8.0}}}, 0}, toolpath,
+                                    MachineLimits::uniform(100, 1000));
+  const TrajectorySample before = plan.at(plan.pieces()[0].t_end_s - 0.5 * 8.0 / 1000 - 1e-9);
+  EXPECT_NEAR(before.velocity_mm_s.x(), 8.0, 1e-5);
+  EXPECT_NEAR(before.velocity_mm_s.y(), 0.0, 1e-9);
+}
+
 TEST(Firmware, CollinearMovesNeverSlowAtTheJoints) {
   // 30 mm in three collinear moves at 50 mm/s, a = 1000: one trapezoid, d / v + v / a
   const Toolpath toolpath = polyline_job({{0, 0, 0}, {10, 0, 0}, {17, 0, 0}, {30, 0, 0}}, 50.0);
@@ -364,6 +395,11 @@ TEST(Firmware, ParametersOfTheOtherFirmwareAreRefused) {
   EXPECT_THROW(make_planner({"firmware", {{"square_corner_velocity", {5.0}}}, 0}), InputError);
   EXPECT_THROW(
       make_planner({"firmware", {{"junction_deviation_mm", {0.02}}}, 0, {{"mode", "klipper"}}}),
+      InputError);
+  EXPECT_THROW(make_planner({"firmware", {{"classic_jerk", {8.0}}}, 0, {{"mode", "klipper"}}}),
+               InputError);
+  EXPECT_THROW(
+      make_planner({"firmware", {{"classic_jerk", {8.0}}, {"junction_deviation_mm", {0.02}}}, 0}),
       InputError);
   EXPECT_THROW(make_planner({"firmware",
                              {{"minimum_cruise_ratio", {0.3}}, {"max_accel_to_decel", {500.0}}},
