@@ -59,6 +59,32 @@ void grow_arc_bounds(const Vec3& start, const Vec3& end, const EdgeArc& arc, Vec
   }
 }
 
+Vec3 arc_tangent_extent(const Vec3& start, const Vec3& end, const EdgeArc& arc, double phi0,
+                        double phi1) {
+  // the tangent d/dphi = -sin(phi) u + cos(phi) w + (h / sweep) a has the constant length
+  // sqrt(r^2 + (h / sweep)^2); its coordinate k peaks where u_k cos(phi) + w_k sin(phi) = 0
+  const Vec3 u = arc_radius_vector(start, arc);
+  const Vec3 w = arc.axis.cross(u);
+  const Vec3 rise_rate = ((end - start).dot(arc.axis) / arc.sweep_rad) * arc.axis;
+  const double length = std::hypot(u.norm(), rise_rate.norm());
+  Vec3 extent = Vec3::Zero();
+  if (!(length > 0.0)) return extent;
+  const auto take = [&](double phi) {
+    extent =
+        extent.cwiseMax((-std::sin(phi) * u + std::cos(phi) * w + rise_rate).cwiseAbs() / length);
+  };
+  take(phi0);
+  take(phi1);
+  for (int k = 0; k < 3; ++k) {
+    const double phase = std::atan2(-u[k], w[k]);
+    for (const double turn : {-2.0, -1.0, 0.0, 1.0, 2.0, 3.0}) {
+      const double phi = phase + turn * kPi;
+      if (phi > phi0 && phi < phi1) take(phi);
+    }
+  }
+  return extent.cwiseMin(Vec3::Ones());
+}
+
 bool PrintPath::has_arcs() const {
   for (const EdgeArc& arc : arcs)
     if (arc.is_arc()) return true;

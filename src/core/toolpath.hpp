@@ -107,6 +107,12 @@ int arc_chord_count(double radius_mm, double sweep_rad, double tolerance_mm);
 // The exact axis-aligned bounds of an arc edge from `start` (EdgeArc above), grown into lo/hi.
 void grow_arc_bounds(const Vec3& start, const Vec3& end, const EdgeArc& arc, Vec3& lo, Vec3& hi);
 
+// The largest magnitude of each coordinate of an arc edge's unit tangent over the angles
+// [phi0, phi1] of its sweep (0 <= phi0 <= phi1 <= sweep): at both ends, and where a coordinate
+// peaks between them. A speed v along the arc needs at most v times it on each axis.
+Vec3 arc_tangent_extent(const Vec3& start, const Vec3& end, const EdgeArc& arc, double phi0,
+                        double phi1);
+
 // Two path ends closer than this (mm) are one point: printing continues through them.
 constexpr double kJoinTolerance_mm = 1e-6;
 

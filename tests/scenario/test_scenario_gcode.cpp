@@ -343,6 +343,31 @@ toolpath: {gcode: {file: circle.gcode, feed: clamp}}
   EXPECT_NEAR(s.toolpath.paths.front().speed_mm_s, 300.0, 0.5);
 }
 
+// A circle passes through tangents along x and y, so the clamp slows it to v_max exactly: the
+// fine chords alone miss those tangents by half a chord's turn and allowed 300.15 mm/s at
+// radius 2 mm, which chords cut otherwise (the uniform planner's) then needed on an axis
+TEST_F(ScenarioGcode, AnArcIsClampedAlongItsExactTangents) {
+  write("small.gcode", "G21\nG90\nM83\nG1 X0 Y0 Z0.2 F6000\nG2 X0 Y0 I2 J0 E0.02 F60000\n");
+  const Scenario s = load_scenario(write("s.yaml", R"(
+machine: cartesian
+limits: {v_max: 300, a_max: 3000}
+toolpath: {gcode: {file: small.gcode, feed: clamp}}
+)"));
+  ASSERT_EQ(s.exact_toolpath.paths.size(), 1u);
+  const PrintPath& circle = s.exact_toolpath.paths.front();
+  EXPECT_NEAR(circle.speed_mm_s, 300.0, 300.0 * 1e-12);
+  // the exact arc's chords at any tolerance need at most v_max on each axis
+  for (const double tolerance_mm : {0.05, 0.01, 1e-3, 1e-4, 1e-6}) {
+    const PrintPath chords = circle.chorded(tolerance_mm);
+    for (std::size_t k = 0; k + 1 < chords.points.size(); ++k) {
+      const Vec3 step = chords.points[k + 1] - chords.points[k];
+      for (int axis = 0; axis < 2; ++axis)
+        EXPECT_LE(circle.speed_mm_s * std::abs(step[axis]) / step.norm(), 300.0 * (1.0 + 1e-12))
+            << "tolerance " << tolerance_mm << ", chord " << k << ", axis " << axis;
+    }
+  }
+}
+
 // describe shows the keys (the same tables the loader checks)
 // arcs whose chords a job cannot hold are counted, not cut: 100 circles of radius 1e9 mm (a
 // number a file may hold) would take 7 * 10^7 chords within 0.01 mm, minutes to cut before
