@@ -268,6 +268,9 @@ class TileReader {
 // entering and leaving at print speed), and the even deposit it is compared with.
 struct CornerWindow {
   PrintChain chain;  // a - c - b
+  // the limits it is planned under: those over the corner's own edges (the box of a, c and b
+  // where they lie on the path), the same along an edge taken on past its end
+  TcpLimits limits;
   std::vector<CornerGeometry> geometry;
   Vec3 a, c, b;
   Vec3 d_in, d_out;
@@ -346,6 +349,15 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   const Vec3 a = window_end(edge_in, chain.points[corner - 1], -geometry.d_in);
   const Vec3 b = window_end(edge_out, chain.points[corner + 1], geometry.d_out);
   w.a = a, w.b = b, w.c = c;
+  // the limits where the corner is: an edge taken on straight past its end runs out of the
+  // path's region, where a delta's limits fall (a short edge at 99 mm/s on x, taken on 39 mm,
+  // needed more than its 94 there and refused the whole plan)
+  const Vec3 path_a = edge_in <= reach ? chain.points[corner - 1] : a;
+  const Vec3 path_b = edge_out <= reach ? chain.points[corner + 1] : b;
+  w.limits = limits.same_everywhere() ? limits
+                                      : TcpLimits(limits.over(path_a.cwiseMin(c).cwiseMin(path_b),
+                                                              path_a.cwiseMax(c).cwiseMax(path_b)),
+                                                  nullptr, limits.shared_joint_map());
   w.cell_mm = kCellSigmas * sigma;
   w.frame_corner = Vec3(kFrameCornerCells * w.cell_mm, kFrameCornerCells * w.cell_mm, 0.0);
   w.d_in = geometry.d_in, w.d_out = geometry.d_out;
@@ -670,7 +682,7 @@ bool steady_on_shared_ends(const CornerWindow& w, int kind, const Trajectory& mo
 // whose extra time alone costs at least prune_above_mm is not deposited (pruned); one whose
 // deposit so far already costs more than abandon_above_mm is deposited no further (abandoned:
 // its error and cost are then lower bounds).
-CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const TcpLimits& limits,
+CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan,
                                 const PathMotionOptions& options, const DepositModel& model,
                                 double time_weight_mm_s, double prune_above_mm,
                                 double abandon_above_mm = kInf) {
@@ -685,7 +697,7 @@ CornerCandidate evaluate_corner(CornerWindow& w, const CornerPlan& plan, const T
   // their velocities; the chosen plan is sampled at options.period_s)
   window_options.period_s =
       std::max(options.period_s, 0.5 * prediction_step_s(sigma, std::max(w.v_in, w.v_out)));
-  PlannedPath planned = plan_chain(w.chain, w.geometry, plans, limits, window_options, 0.0);
+  PlannedPath planned = plan_chain(w.chain, w.geometry, plans, w.limits, window_options, 0.0);
   const Trajectory motion("uniform", std::move(planned.pieces));
   const double duration = motion.duration_s();
   const double v_in = w.v_in, v_out = w.v_out;
@@ -830,8 +842,8 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
   // than the best so far; with `may_abandon`, only until its deposit does) and returns it
   const auto add = [&](const std::string& name, const CornerPlan& plan, bool may_abandon) {
     const bool abandon = may_abandon && model.abandon_costly_predictions;
-    CornerCandidate candidate = evaluate_corner(window, plan, limits, options, model,
-                                                time_weight_mm_s, best, abandon ? best : kInf);
+    CornerCandidate candidate = evaluate_corner(window, plan, options, model, time_weight_mm_s,
+                                                best, abandon ? best : kInf);
     candidate.name = name;
     candidates.push_back(candidate);
     if (!candidate.pruned && !candidate.abandoned) best = std::min(best, candidate.cost);
@@ -855,7 +867,7 @@ CornerDecision choose_corner(const PrintChain& chain, size_t corner,
     // within the tolerance, nothing to weigh it against (its deposit is not predicted; its
     // time is)
     CornerCandidate candidate =
-        evaluate_corner(window, full_speed, limits, options, model, time_weight_mm_s, -kInf);
+        evaluate_corner(window, full_speed, options, model, time_weight_mm_s, -kInf);
     candidate.name = "blend";
     candidates.push_back(candidate);
   } else {

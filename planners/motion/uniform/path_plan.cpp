@@ -341,7 +341,8 @@ TcpLimits with_jerk_limits(const TcpLimits& limits, double jerk_ramp_s) {
   return filled;
 }
 
-MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm) {
+MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm,
+                             const TcpLimits* limits) {
   MergedChain merged;
   const size_t n = chain.points.size();
   if (n < 3 || !(max_error_mm > 0.0)) {
@@ -359,11 +360,28 @@ MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm) {
     const ToolOrientation& q = chain.orientations[j];
     return p.axis == q.axis && p.roll_rad == q.roll_rad;
   };
+  // the merged edge's print speed within every axis's limit along it: its direction is none
+  // of the edges' it replaces (chords zig-zagging 0.1 off x, each slowed to v_max / cos 5.7
+  // deg, merged into one along x needed 1.005 v_max)
+  const auto speed_fits = [&](size_t anchor, size_t edge) {
+    if (limits == nullptr) return true;
+    const Vec3& from = chain.points[anchor];
+    const Vec3& to = chain.points[edge + 1];
+    const Vec3 step = to - from;
+    const double length = step.norm();
+    if (!(length > 0.0)) return true;
+    const MachineLimits along = limits->along(from, to);
+    for (int axis = 0; axis < 3; ++axis)
+      if (chain.edge_speed_mm_s[anchor] * std::abs(step[axis]) / length >
+          along.axes[axis].v_max_mm_s * (1 + 1e-12))
+        return false;
+    return true;
+  };
   const FineEdgeMerge kept = merge_polyline_edges(
       chain.points, max_error_mm, kMaxMergedPoints, [&](size_t anchor, size_t edge) {
         return chain.edge_path[edge] == chain.edge_path[anchor] &&
                chain.edge_speed_mm_s[edge] == chain.edge_speed_mm_s[anchor] &&
-               (!chain.oriented || same_orientation(anchor, edge + 1));
+               (!chain.oriented || same_orientation(anchor, edge + 1)) && speed_fits(anchor, edge);
       });
   PrintChain& out = merged.chain;
   out.oriented = chain.oriented;

@@ -136,7 +136,10 @@ struct MergedChain {
   std::vector<double> edge_error_mm;
   std::vector<size_t> source_point;  // per kept point, its index in the given chain
 };
-MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm);
+// With `limits`, an edge is merged only where the print speed keeps within every axis's v_max
+// along the merged edge (plan_chain's check), whose direction differs from each edge's.
+MergedChain merge_fine_edges(const PrintChain& chain, double max_error_mm,
+                             const TcpLimits* limits = nullptr);
 
 // A corner's geometry (interior points only): its directions, turn and blend shape.
 struct CornerGeometry {

@@ -442,7 +442,7 @@ ChainPlan ChainPlanner::plan(const PrintChain& given, const TravelFlags& flags) 
   }
   // fine chords merged into edges their corners' blends fit (merge_fine_edges), each corner's
   // blend within the tolerance left by its edges' merging
-  work.merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm);
+  work.merged = merge_fine_edges(given, kMergeShare * settings_.tolerance_mm, &jerk_limits_);
   const PrintChain& chain = work.chain();
   work.geometry = corner_geometry(chain.points, settings_.tolerance_mm, work.merged.edge_error_mm);
   // runs of corners along a circle taken as one curve at one constant speed (arc_run.hpp),

@@ -130,6 +130,27 @@ TEST(MergeFineEdges, LeavesCoarseChainsAndTurningToolsAlone) {
   EXPECT_EQ(merge_fine_edges(with_normals, 0.025).chain.points, with_normals.points);
 }
 
+// A merged edge runs in none of its edges' directions: chords zig-zagging 0.02 mm off x, at
+// the speed x allows along each (v_max / cos 1.15 deg), merged into edges along x would need
+// more than v_max on x. With the limits, they are merged only where the speed fits.
+TEST(MergeFineEdges, MergedEdgesKeepThePrintSpeedWithinTheAxisLimits) {
+  std::vector<Vec3> zig;
+  for (int k = 0; k <= 20; ++k) zig.emplace_back(k, (k % 2) * 0.02, 0.0);
+  const double speed = 100.0 * std::hypot(1.0, 0.02);  // 100 mm/s on x along each chord
+  const PrintChain chain = print_chains(polyline_job(zig, speed)).front();
+  EXPECT_LT(merge_fine_edges(chain, 0.025).chain.points.size(), chain.points.size());
+  const TcpLimits tight = MachineLimits::uniform(100.0, 1000.0);
+  EXPECT_EQ(merge_fine_edges(chain, 0.025, &tight).chain.points, chain.points);
+  const TcpLimits loose = MachineLimits::uniform(101.0, 1000.0);
+  EXPECT_EQ(merge_fine_edges(chain, 0.025, &loose).chain.points,
+            merge_fine_edges(chain, 0.025).chain.points);
+  // the planner merges under its limits: the job is planned, where the merged edges along x
+  // refused it ("needs 100.02 mm/s on axis x")
+  EXPECT_NO_THROW(UniformPlanner{UniformSettings{}}.plan_in_context(
+      polyline_job(zig, speed), MachineLimits::uniform(100.0, 1000.0),
+      process_context(ProcessType::extrusion)));
+}
+
 // The arm's planar jobs carry a roll per point (arm_posture.cpp), one roll all along: its fine
 // chords merge as on a stage, the orientations of the kept points kept; a roll that changes
 // keeps the points where it does. (Left alone, a 90 deg corner between two 1e-4 mm edges was
