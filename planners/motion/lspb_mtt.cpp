@@ -1,5 +1,6 @@
 #include "planners/motion/lspb_mtt.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -14,17 +15,30 @@ namespace depotwin {
 
 namespace {
 
+// The velocity at the joint of two segments, eqs. (52)-(53): the average of their desired
+// velocities; beyond the paper, each axis within both segments' v_max there (a machine's
+// limits differ per segment's box: a line at 100 mm/s on x joined to one slowed to 99.7 by a
+// delta's limits averaged 99.85, over the second's limit, and failed as an internal error)
+Vec3 joint_velocity(const PrintSegment& before, const PrintSegment& after) {
+  Vec3 v = 0.5 * (before.v_desired + after.v_desired);
+  for (int axis = 0; axis < 3; ++axis) {
+    const double v_max =
+        std::min(before.limits.axes[axis].v_max_mm_s, after.limits.axes[axis].v_max_mm_s);
+    v[axis] = std::clamp(v[axis], -v_max, v_max);
+  }
+  return v;
+}
+
 // Boundary velocities of every print segment, eqs. (48)-(53): the desired velocity at an
-// isolated end, the average of both segments' desired velocities at a shared joint.
+// isolated end, the joint velocity at a shared joint.
 void assign_boundary_velocities(std::vector<PrintSegment>& segments) {
   for (size_t i = 0; i < segments.size(); ++i) {
     PrintSegment& s = segments[i];
     s.v_begin = s.v_desired;  // eqs. (48)-(49)
     s.v_end = s.v_desired;
-    if (i > 0 && s.joined_to_previous)
-      s.v_begin = 0.5 * (segments[i - 1].v_desired + s.v_desired);  // eqs. (52)-(53)
+    if (i > 0 && s.joined_to_previous) s.v_begin = joint_velocity(segments[i - 1], s);
     if (i + 1 < segments.size() && segments[i + 1].joined_to_previous)
-      s.v_end = 0.5 * (s.v_desired + segments[i + 1].v_desired);
+      s.v_end = joint_velocity(s, segments[i + 1]);
   }
 }
 

@@ -268,8 +268,8 @@ class TileReader {
 // entering and leaving at print speed), and the even deposit it is compared with.
 struct CornerWindow {
   PrintChain chain;  // a - c - b
-  // the limits it is planned under: those over the corner's own edges (the box of a, c and b
-  // where they lie on the path), the same along an edge taken on past its end
+  // the limits it is planned under: the machine's, with every box clamped into the corner's
+  // edges' box on the path (an edge taken on past its end keeps the limits at its end)
   TcpLimits limits;
   std::vector<CornerGeometry> geometry;
   Vec3 a, c, b;
@@ -349,15 +349,24 @@ CornerWindow corner_window(const PrintChain& chain, size_t corner, const CornerG
   const Vec3 a = window_end(edge_in, chain.points[corner - 1], -geometry.d_in);
   const Vec3 b = window_end(edge_out, chain.points[corner + 1], geometry.d_out);
   w.a = a, w.b = b, w.c = c;
-  // the limits where the corner is: an edge taken on straight past its end runs out of the
-  // path's region, where a delta's limits fall (a short edge at 99 mm/s on x, taken on 39 mm,
-  // needed more than its 94 there and refused the whole plan)
+  // the limits where the corner is: every box the window asks about is clamped into its edges'
+  // box on the path, since an edge taken on straight past its end runs out of the path's
+  // region, where a delta's limits fall (a short edge at 99 mm/s on x, taken on 39 mm, needed
+  // more than its 94 there and refused the whole plan); each edge keeps its own box within it
+  // (the limits over both edges' box would hold a line at 100 mm/s to the other's 99.6)
   const Vec3 path_a = edge_in <= reach ? chain.points[corner - 1] : a;
   const Vec3 path_b = edge_out <= reach ? chain.points[corner + 1] : b;
-  w.limits = limits.same_everywhere() ? limits
-                                      : TcpLimits(limits.over(path_a.cwiseMin(c).cwiseMin(path_b),
-                                                              path_a.cwiseMax(c).cwiseMax(path_b)),
-                                                  nullptr, limits.shared_joint_map());
+  const Vec3 region_lo = path_a.cwiseMin(c).cwiseMin(path_b);
+  const Vec3 region_hi = path_a.cwiseMax(c).cwiseMax(path_b);
+  w.limits = limits.same_everywhere()
+                 ? limits
+                 : TcpLimits(
+                       limits.requested(),
+                       [limits, region_lo, region_hi](const Vec3& lo, const Vec3& hi) {
+                         return limits.over(lo.cwiseMax(region_lo).cwiseMin(region_hi),
+                                            hi.cwiseMax(region_lo).cwiseMin(region_hi));
+                       },
+                       limits.shared_joint_map());
   w.cell_mm = kCellSigmas * sigma;
   w.frame_corner = Vec3(kFrameCornerCells * w.cell_mm, kFrameCornerCells * w.cell_mm, 0.0);
   w.d_in = geometry.d_in, w.d_out = geometry.d_out;

@@ -169,6 +169,38 @@ TEST(StopAndGo, RestToRestSegmentsAtPrintSpeed) {
   EXPECT_NEAR(velocity_error(sample_trajectory(plan, 1e-3)).max_rel, 1.0, 1e-9);
 }
 
+// A joint between segments whose limits differ (a machine maps its joints' limits per box):
+// 100 mm/s along x, joined to a line slowed to 99 mm/s where x's v_max is 99. Eqs. (52)-(53)
+// average the joint velocity to 99.5 mm/s on x, over the second segment's limit (an internal
+// error then); it is held to 99, and the plan keeps every axis within each segment's limits.
+TEST(LspbMtt, AJointVelocityKeepsWithinBothSegmentsLimits) {
+  const MachineLimits fast = MachineLimits::uniform(100, 1000);
+  MachineLimits slow = fast;
+  slow.axes[0].v_max_mm_s = 99.0;
+  const TcpLimits limits(fast, [fast, slow](const Vec3& /*lo*/, const Vec3& hi) {
+    return hi.x() > 10.0 + 1e-9 ? slow : fast;
+  });
+  Toolpath toolpath;
+  PrintPath first = segment({0, 0, 0}, {10, 0, 0}, 0);
+  first.speed_mm_s = 100.0;
+  PrintPath second = segment({10, 0, 0}, {20, 0, 0}, 1);
+  second.speed_mm_s = 99.0;
+  toolpath.paths = {first, second};
+  toolpath.start_mm = Vec3(0, 0, 0);
+  toolpath.end_mm = Vec3(20, 0, 0);
+  Trajectory plan;
+  ASSERT_NO_THROW(plan = LspbMttPlanner().plan(toolpath, limits));
+  for (const TrajectoryPiece& piece : plan.pieces()) {
+    if (!piece.depositing) continue;
+    const double v_max = piece.path_index == 0 ? 100.0 : 99.0;
+    for (double t = piece.t_begin_s; t <= piece.t_end_s; t += 1e-4)
+      EXPECT_LE(std::abs(plan.at(t).velocity_mm_s.x()), v_max * (1 + 1e-9))
+          << "path " << piece.path_index << " at " << t;
+  }
+  // the joint at 99 mm/s: the second line runs at its speed from its start
+  EXPECT_NEAR(plan.at(plan.pieces()[2].t_begin_s).velocity_mm_s.x(), 99.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace depotwin
 
