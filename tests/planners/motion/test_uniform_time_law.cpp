@@ -263,6 +263,31 @@ TEST(UniformTravel, AerosolChainsNearTheTravelsEndStayWithinIt) {
   }
 }
 
+// The delta's carriages' peak speed and acceleration along a plan, by finite differences of
+// 1 ms samples of the inverse kinematics
+struct CarriagePeaks {
+  double speed = 0.0, acceleration = 0.0;
+};
+CarriagePeaks carriage_peaks(const LinearDelta& delta, const Trajectory& plan) {
+  CarriagePeaks peaks;
+  const double dt = 0.001;
+  JointVector previous, before;
+  for (double t = 0.0; t <= plan.duration_s(); t += dt) {
+    JointVector joints;
+    EXPECT_TRUE(delta.inverse(Pose(plan.at(t).position_mm), joints)) << t;
+    if (!previous.empty())
+      for (size_t j = 0; j < 3; ++j)
+        peaks.speed = std::max(peaks.speed, std::abs(joints[j] - previous[j]) / dt);
+    if (!before.empty())
+      for (size_t j = 0; j < 3; ++j)
+        peaks.acceleration = std::max(
+            peaks.acceleration, std::abs(joints[j] - 2 * previous[j] + before[j]) / (dt * dt));
+    before = previous;
+    previous = joints;
+  }
+  return peaks;
+}
+
 // A slicer's jitter of 0.02 mm chords at 100 mm/s on the delta, where its limits over each
 // chord's box allow that speed: a corner after an edge too short for a window of its own has
 // its window taken on straight past the edge's end (39 mm here), where the delta's limits fall
@@ -293,21 +318,10 @@ TEST(UniformTimeLaw, ADeltaCornerAfterAShortEdgeIsWeighedUnderItsOwnLimits) {
   Trajectory plan;
   ASSERT_NO_THROW(plan = UniformPlanner{UniformSettings{}}.plan_in_context(
                       polyline_job(jitter, 100.0), limits, context));
-  // the carriages within their speed limit (1 ms samples)
-  const JointLimit carriage = delta.joint_limits().front();
-  const double dt = 0.001;
-  double peak_v = 0.0;
-  JointVector previous;
-  for (double t = 0.0; t <= plan.duration_s(); t += dt) {
-    JointVector joints;
-    ASSERT_TRUE(delta.inverse(Pose(plan.at(t).position_mm), joints));
-    if (!previous.empty())
-      for (size_t j = 0; j < 3; ++j)
-        peak_v = std::max(peak_v, std::abs(joints[j] - previous[j]) / dt);
-    previous = joints;
-  }
-  EXPECT_GT(peak_v, 0.0);
-  EXPECT_LE(peak_v, carriage.v_max);
+  // the carriages within their speed limit
+  const CarriagePeaks peaks = carriage_peaks(delta, plan);
+  EXPECT_GT(peaks.speed, 0.0);
+  EXPECT_LE(peaks.speed, delta.joint_limits().front().v_max);
 }
 
 TEST(UniformTimeLaw, DeltaCarriagesWithinTheirLimits) {
@@ -325,25 +339,10 @@ TEST(UniformTimeLaw, DeltaCarriagesWithinTheirLimits) {
   JointLimit carriage = delta.joint_limits().front();
   // the planner holds the TCP limits the machine maps over each move's box; the carriages stay
   // within theirs (jerk: the delta has no carriage jerk limit)
-  std::vector<JointVector> q;
-  const double dt = 0.001;
-  double peak_v = 0.0, peak_a = 0.0;
-  JointVector previous, before;
-  for (double t = 0.0; t <= plan.duration_s(); t += dt) {
-    JointVector joints;
-    ASSERT_TRUE(delta.inverse(Pose(plan.at(t).position_mm), joints));
-    if (!previous.empty())
-      for (size_t j = 0; j < 3; ++j)
-        peak_v = std::max(peak_v, std::abs(joints[j] - previous[j]) / dt);
-    if (!before.empty())
-      for (size_t j = 0; j < 3; ++j)
-        peak_a = std::max(peak_a, std::abs(joints[j] - 2 * previous[j] + before[j]) / (dt * dt));
-    before = previous;
-    previous = joints;
-  }
-  EXPECT_LE(peak_v, carriage.v_max);
-  EXPECT_LE(peak_a, carriage.a_max);
-  EXPECT_GT(peak_v, 0.0);
+  const CarriagePeaks peaks = carriage_peaks(delta, plan);
+  EXPECT_LE(peaks.speed, carriage.v_max);
+  EXPECT_LE(peaks.acceleration, carriage.a_max);
+  EXPECT_GT(peaks.speed, 0.0);
 }
 
 // Plans an extrusion polyline at `speed` with curved ramps and without (speeds changing on the
