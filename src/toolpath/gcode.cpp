@@ -490,9 +490,22 @@ constexpr const char* kNestedComment =
     "a comment inside a comment: '(' ... '(' ... ')' (comments do not nest; the first ')' ends "
     "both)";
 
-// Why a G code the reader refuses would move the path in a way it cannot follow; nullptr for
-// the codes it reads or may ignore
-const char* unsupported_g_code_reason(int tenths) {
+// A G code the reader refuses: why it would move the path in a way the reader cannot follow
+// (nullptr for the codes it reads or may ignore), and whether it is modal motion (splines,
+// threading, canned cycles, a modal macro call), whose following lines of axis words repeat
+// it (`G81 X20 Y20 Z-5 R2`, then `X30`): those are no G0..G3 of the mode before, and the code
+// is refused once, at its line.
+struct RefusedGCode {
+  const char* reason = nullptr;
+  bool modal_motion = false;
+};
+constexpr const char* kChangesThePath =
+    " is not supported (splines, canned cycles, threading and inverse-time or per-revolution "
+    "feed change the path)";
+constexpr const char* kRunsAMacro =
+    " is not supported: a macro call runs moves this file does not hold (export the program "
+    "expanded)";
+RefusedGCode refused_g_code(int tenths) {
   switch (tenths) {
     case 50:   // G5 cubic spline
     case 51:   // G5.1 quadratic spline
@@ -510,31 +523,36 @@ const char* unsupported_g_code_reason(int tenths) {
     case 870:
     case 880:
     case 890:
+      return {kChangesThePath, true};
     case 930:  // G93 inverse-time feed
     case 950:  // G95 feed per revolution
-      return " is not supported (splines, canned cycles, threading and inverse-time or "
-             "per-revolution feed change the path)";
+      return {kChangesThePath, false};
     case 720:  // G72, G74, G75, G77, G78, G79: Fanuc's turning and tapping cycles, Haas's G74
     case 740:  // tapping cycle, whose repeat lines are more cycles
     case 750:
     case 770:
     case 780:
     case 790:
-      return " is not supported: a canned cycle (tapping, or a lathe's turning cycle) cuts "
-             "moves this file does not hold, and its following lines repeat it";
+      return {
+          " is not supported: a canned cycle (tapping, or a lathe's turning cycle) cuts "
+          "moves this file does not hold, and its following lines repeat it",
+          true};
     case 700:  // G70, G71: inch and mm in Sinumerik, Heidenhain ISO and Fanuc's system B, but
     case 710:  // finishing and roughing cycles in Fanuc's lathe system A
-      return " is not supported: it means inch or mm in Sinumerik and Fanuc's system B but a "
-             "lathe's turning cycle in Fanuc's system A; write G20 (inch) or G21 (mm)";
+      return {
+          " is not supported: it means inch or mm in Sinumerik and Fanuc's system B but a "
+          "lathe's turning cycle in Fanuc's system A; write G20 (inch) or G21 (mm)"};
     case 410:  // G41, G41.1, G42, G42.1: cutter radius compensation
     case 411:
     case 420:
     case 421:
-      return " is not supported: cutter radius compensation offsets the path by a tool radius "
-             "the file does not give (export the toolpath without it, G40)";
+      return {
+          " is not supported: cutter radius compensation offsets the path by a tool radius "
+          "the file does not give (export the toolpath without it, G40)"};
     case 70:  // G7: LinuxCNC's lathe diameter mode
-      return " is not supported: a lathe's diameter mode reads every X that follows as a "
-             "diameter, twice the distance moved (write the program in radius mode, G8)";
+      return {
+          " is not supported: a lathe's diameter mode reads every X that follows as a "
+          "diameter, twice the distance moved (write the program in radius mode, G8)"};
     case 121:  // G12.1, G13.1: Fanuc's polar interpolation
     case 131:
     case 160:  // G16 polar coordinates
@@ -542,50 +560,17 @@ const char* unsupported_g_code_reason(int tenths) {
     case 510:  // G51 scaling
     case 511:  // G51.1 mirroring
     case 680:  // G68 rotation
-      return " is not supported: polar coordinates, local offsets, scaling, mirroring and "
-             "rotation change every point that follows (export the toolpath with them applied)";
-    case 650:  // G65 macro call, G66 and G66.1 modal macro calls (Fanuc)
-    case 660:
+      return {
+          " is not supported: polar coordinates, local offsets, scaling, mirroring and "
+          "rotation change every point that follows (export the toolpath with them "
+          "applied)"};
+    case 650:  // G65 macro call
+      return {kRunsAMacro, false};
+    case 660:  // G66 and G66.1 modal macro calls (Fanuc): at every move, at every line after
     case 661:
-      return " is not supported: a macro call runs moves this file does not hold (export the "
-             "program expanded)";
+      return {kRunsAMacro, true};
     default:
-      return nullptr;
-  }
-}
-
-// The refused G codes that are modal motion: splines, threading, canned cycles and a modal
-// macro call. The axis words of the lines after one repeat it (`G81 X20 Y20 Z-5 R2`, then
-// `X30`): they are no G0..G3 of the mode before, and the code is refused once, at its line.
-bool is_modal_motion(int tenths) {
-  switch (tenths) {
-    case 50:  // G5, G5.1, G5.2
-    case 51:
-    case 52:
-    case 330:  // G33, G33.1
-    case 331:
-    case 720:  // G72..G79, G81..G89: canned cycles (Fanuc's lathe cycles among them)
-    case 730:
-    case 740:
-    case 750:
-    case 760:
-    case 770:
-    case 780:
-    case 790:
-    case 810:
-    case 820:
-    case 830:
-    case 840:
-    case 850:
-    case 860:
-    case 870:
-    case 880:
-    case 890:
-    case 661:  // G66.1: a macro call at every line after it (G66: at every move)
-    case 660:
-      return true;
-    default:
-      return false;
+      return {};
   }
 }
 
@@ -953,9 +938,9 @@ void GcodeParser::execute(int line_number) {
         uses_axes = true;
       continue;
     }
-    if (const char* reason = unsupported_g_code_reason(code.tenths)) {
-      problem(line_number, g_code_name(code.tenths) + reason);
-      if (is_modal_motion(code.tenths)) motion_mode_ = kRefusedMotion;
+    if (const RefusedGCode refused = refused_g_code(code.tenths); refused.reason != nullptr) {
+      problem(line_number, g_code_name(code.tenths) + refused.reason);
+      if (refused.modal_motion) motion_mode_ = kRefusedMotion;
       return;
     }
     // G12 and G13 with a radius I: Mach3's circular pocket, a circle cut about the position
